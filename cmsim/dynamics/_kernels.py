@@ -1,0 +1,306 @@
+"""Numba kernels of the equations of motion and the fixed-step Runge-Kutta integrator.
+
+This module isolates the numba convention: ``@njit(cache=True)``, float64/int64 arrays and
+scalars only (grouped in one plain tuple ``P``), no Python objects, no random numbers. The
+model arrays are built and documented in :mod:`cmsim.dynamics.model`.
+
+Right-hand side contract: ``rhs_jit(t, y, dydt, row, P, diag, want_diag, W)`` with ``y = [q, v]``
+(shape ``(2n,)``), ``q`` the DOF deviations from the nominal rigid rotation (translations in m,
+rotations in rad, rotations of shaft 2 counted positive in its own sense of motion), ``v`` their
+rates; it writes row ``row`` of the 2-D array ``dydt`` with ``[v, M⁻¹(f_ext + g(t, q, v) − K q
+− C v)]`` where ``g`` holds the bearing and mesh forces. With ``want_diag`` it also writes the
+output forces into ``diag``. ``W`` = (g, cos_nom, sin_nom, jit_cos, jit_sin) are scratch arrays
+from :func:`make_work`.
+
+Hot-path code never slices arrays: in numba every view takes an atomic reference count, which
+cost more than the physics here.
+
+``P`` = (minv, kc, fext, omega, b_int, b_par, b_cos, b_sin, jitter, m_int, m_par, geo, tab_k,
+tab_e, teeth1, teeth2, kc_ptr, kc_idx) with ``kc`` the non-zeros of ``[K C]`` (n, 2n) in
+compressed-row form (``kc_ptr``, ``kc_idx``) and ``teeth1/2`` the cos and sin of multiples of
+the angular pitch, shape (Z, 2); index constants below.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from cmsim.bearings._kernels import ball_forces_jit, ball_forces_row_jit
+from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit, table_lookup_jit
+
+# b_int columns: DOF indices, number of balls, index of the first bearing sharing the same
+# nominal cage rotation (its cos/sin are computed once)
+BI_X, BI_Y, BI_T, BI_NB, BI_GROUP = 0, 1, 2, 3, 4
+BI_SIZE = 5
+# b_par columns: stiffness, exponent, clearance, cage angle per physical inner-ring angle,
+# physical sense of the shaft (+1 CCW, −1 CW), viscous damping to ground, initial cage phase
+BP_K, BP_P, BP_C, BP_CAGE, BP_SENSE, BP_DAMP, BP_PHASE = 0, 1, 2, 3, 4, 5, 6
+BP_SIZE = 7
+# m_int entries
+MI_G1, MI_G2, MI_SLOTS, MI_ON = 0, 1, 2, 3
+MI_SIZE = 4
+# m_par entries
+(MP_A0, MP_PSI10, MP_PSI20, MP_PB, MP_SLO, MP_OM1, MP_OM2, MP_MU, MP_V0, MP_CHYST, MP_KOSTER,
+ MP_DTHR, MP_TAB0, MP_TABD, MP_JDT, MP_DIAGB, MP_ZBEFORE, MP_ZAFTER) = range(18)
+MP_SIZE = 18
+
+
+@njit(cache=True)
+def _jitter_at(jitter, ib, iball, t, jdt):
+    ng = jitter.shape[2]
+    u = t / jdt
+    if u <= 0.0:
+        return jitter[ib, iball, 0]
+    if u >= ng - 1:
+        return jitter[ib, iball, ng - 1]
+    i = int(u)
+    f = u - i
+    return jitter[ib, iball, i] + f * (jitter[ib, iball, i + 1] - jitter[ib, iball, i])
+
+
+@njit(cache=True)
+def _bearing_forces(t, y, n, g, P, diag, want_diag, W):
+    omega = P[3]
+    b_int = P[4]
+    b_par = P[5]
+    b_cos = P[6]
+    b_sin = P[7]
+    jitter = P[8]
+    jdt = P[10][MP_JDT]
+    cos_nom = W[1]
+    sin_nom = W[2]
+    jit_cos = W[3]
+    jit_sin = W[4]
+    with_jitter = jitter.shape[2] > 1
+    for ib in range(b_int.shape[0]):
+        ix = b_int[ib, BI_X]
+        iy = b_int[ib, BI_Y]
+        it = b_int[ib, BI_T]
+        n_balls = b_int[ib, BI_NB]
+        rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
+        grp = b_int[ib, BI_GROUP]
+        if grp == ib:
+            nominal = rate * omega[it] * t + b_par[ib, BP_PHASE]
+            cos_nom[ib] = math.cos(nominal)
+            sin_nom[ib] = math.sin(nominal)
+        # cage angle = nominal + rate·q[it]; the deviation is small: rotate by it
+        dev = rate * y[it]
+        if abs(dev) < 1e-2:
+            d2 = dev * dev
+            cd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0)
+            sd = dev * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0))
+        else:
+            cd = math.cos(dev)
+            sd = math.sin(dev)
+        cc = cos_nom[grp] * cd - sin_nom[grp] * sd
+        sc = sin_nom[grp] * cd + cos_nom[grp] * sd
+        if with_jitter:
+            for i in range(n_balls):
+                j = _jitter_at(jitter, ib, i, t, jdt)
+                j2 = j * j
+                cj = 1.0 - 0.5 * j2 * (1.0 - j2 / 12.0)
+                sj = j * (1.0 - j2 / 6.0 * (1.0 - j2 / 20.0))
+                jit_cos[0, i] = b_cos[ib, i] * cj - b_sin[ib, i] * sj
+                jit_sin[0, i] = b_sin[ib, i] * cj + b_cos[ib, i] * sj
+            fx, fy = ball_forces_row_jit(y[ix], y[iy], cc, sc, jit_cos, jit_sin, 0, n_balls,
+                                         b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
+        else:
+            fx, fy = ball_forces_row_jit(y[ix], y[iy], cc, sc, b_cos, b_sin, ib, n_balls,
+                                         b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
+        g[ix] -= fx
+        g[iy] -= fy
+        if want_diag:
+            diag[2 * ib] = fx + b_par[ib, BP_DAMP] * y[n + ix]
+            diag[2 * ib + 1] = fy + b_par[ib, BP_DAMP] * y[n + iy]
+
+
+@njit(cache=True)
+def _mesh_forces(t, y, n, g, P, diag, want_diag):
+    m_int = P[9]
+    mp = P[10]
+    geo = P[11]
+    tab_k = P[12]
+    tab_e = P[13]
+    teeth1 = P[14]
+    teeth2 = P[15]
+    z1 = teeth1.shape[0]
+    z2 = teeth2.shape[0]
+    i1 = m_int[MI_G1]
+    i2 = m_int[MI_G2]
+    rb1 = geo[0]
+    rb2 = geo[1]
+    pb = mp[MP_PB]
+    c1x = y[i1]
+    c1y = y[i1 + 1]
+    c2x = y[i2]
+    c2y = mp[MP_A0] + y[i2 + 1]
+    phi_t1, length, cos_t1, sin_t1 = mesh_frame_jit(c1x, c1y, c2x, c2y, rb1, rb2)
+    # physical involute origins of the reference pair (tooth 0 on both gears)
+    psi1 = mp[MP_OM1] * t + y[i1 + 2] + mp[MP_PSI10]
+    psi2 = mp[MP_PSI20] - (mp[MP_OM2] * t + y[i2 + 2])
+    cp1 = math.cos(psi1)
+    sp1 = math.sin(psi1)
+    cp2 = math.cos(psi2)
+    sp2 = math.sin(psi2)
+    # interference: nominal rolling cancels exactly (rb1·Ω1 = rb2·Ω2)
+    delta_inv = (rb1 * (y[i1 + 2] + mp[MP_PSI10] - phi_t1)
+                 + rb2 * (mp[MP_PSI20] - y[i2 + 2] - (phi_t1 + math.pi))
+                 - length)
+    s_ref = rb1 * (psi1 - phi_t1)
+    m0 = int(math.floor((s_ref - mp[MP_SLO]) / pb))
+    w1 = mp[MP_OM1] + y[n + i1 + 2]
+    w2 = -(mp[MP_OM2] + y[n + i2 + 2])
+    lo = length - geo[3] - mp[MP_ZBEFORE]
+    hi = geo[2] + mp[MP_ZAFTER]
+    k1 = m0 % z1
+    k2 = m0 % z2
+    for j in range(m_int[MI_SLOTS]):
+        if j > 0:
+            # next slot: one tooth earlier on both gears
+            k1 = k1 - 1 if k1 > 0 else z1 - 1
+            k2 = k2 - 1 if k2 > 0 else z2 - 1
+        pair = m0 - j
+        s = s_ref - pair * pb
+        if s < lo or s > hi:
+            if want_diag:
+                diag[int(mp[MP_DIAGB]) + j] = 0.0
+            continue
+        # involute origins of this pair: gear-1 tooth `pair` pitches back, gear-2 tooth on
+        c1n = cp1 * teeth1[k1, 0] + sp1 * teeth1[k1, 1]
+        s1n = sp1 * teeth1[k1, 0] - cp1 * teeth1[k1, 1]
+        c2n = cp2 * teeth2[k2, 0] - sp2 * teeth2[k2, 1]
+        s2n = sp2 * teeth2[k2, 0] + cp2 * teeth2[k2, 1]
+        delta, nx, ny, px, py, s_eq, chi1, chi2 = pair_contact_jit(
+            s, delta_inv, c1n, s1n, c2n, s2n, c1x, c1y, c2x, c2y, cos_t1, sin_t1, length, geo)
+        # relative velocity of the contact points (gear 1 minus gear 2)
+        rx1 = px - c1x
+        ry1 = py - c1y
+        rx2 = px - c2x
+        ry2 = py - c2y
+        dvx = (y[n + i1] - w1 * ry1) - (y[n + i2] - w2 * ry2)
+        dvy = (y[n + i1 + 1] + w1 * rx1) - (y[n + i2 + 1] + w2 * rx2)
+        approach = dvx * nx + dvy * ny
+        overlap = delta - table_lookup_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_e)
+        if overlap > 0.0:
+            fn = table_lookup_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_k) * overlap \
+                + mp[MP_CHYST] * approach
+            if fn < 0.0:
+                fn = 0.0
+        elif approach > 0.0:
+            gap = max(-overlap, mp[MP_DTHR])
+            req = chi1 * chi2 / (chi1 + chi2) if chi1 > 0.0 and chi2 > 0.0 else 0.0
+            x = req / (2.0 * gap)
+            fn = mp[MP_KOSTER] * x * math.sqrt(x) * approach
+        else:
+            fn = 0.0
+        if want_diag:
+            diag[int(mp[MP_DIAGB]) + j] = fn
+        if fn == 0.0:
+            continue
+        # tangent t = (ny, −nx); sliding velocity of gear 1 relative to gear 2 along t
+        slide = dvx * ny - dvy * nx
+        ff = mp[MP_MU] * fn * slide / math.sqrt(slide * slide + mp[MP_V0] * mp[MP_V0])
+        # force on gear 2: fn·n + ff·t ; on gear 1: the opposite
+        f2x = fn * nx + ff * ny
+        f2y = fn * ny - ff * nx
+        g[i2] += f2x
+        g[i2 + 1] += f2y
+        g[i1] -= f2x
+        g[i1 + 1] -= f2y
+        # moments (counter-clockwise positive); shaft-2 rotation counts clockwise
+        g[i1 + 2] -= rx1 * f2y - ry1 * f2x
+        g[i2 + 2] -= rx2 * f2y - ry2 * f2x
+
+
+@njit(cache=True)
+def linear_accel_jit(y, g, minv, kc_ptr, kc_idx, kc_val, dydt, row):
+    """Row ``row`` of ``dydt`` = ``[v, M⁻¹(g − [K C]·y)]`` for ``y = [q, v]`` (eq. 1, linear part).
+
+    ``[K C]`` (n, 2n) is given in compressed-row form (``kc_ptr``, ``kc_idx``, ``kc_val``).
+    """
+    n = minv.shape[0]
+    for i in range(n):
+        acc = g[i]
+        for k in range(kc_ptr[i], kc_ptr[i + 1]):
+            acc -= kc_val[k] * y[kc_idx[k]]
+        dydt[row, i] = y[n + i]
+        dydt[row, n + i] = minv[i] * acc
+
+
+def make_work(P):
+    """Scratch arrays ``W`` for :func:`rhs_jit`."""
+    nb, max_balls = P[6].shape
+    return (np.empty(P[0].shape[0]), np.empty(nb), np.empty(nb), np.empty((1, max_balls)),
+            np.empty((1, max_balls)))
+
+
+@njit(cache=True)
+def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
+    """Equations of motion (module docstring); writes ``dydt[row]`` and optionally ``diag``."""
+    minv = P[0]
+    fext = P[2]
+    n = minv.shape[0]
+    g = W[0]
+    for i in range(n):
+        g[i] = fext[i]
+    _bearing_forces(t, y, n, g, P, diag, want_diag, W)
+    if P[9][MI_ON] != 0:
+        _mesh_forces(t, y, n, g, P, diag, want_diag)
+    linear_accel_jit(y, g, minv, P[16], P[17], P[1], dydt, row)
+
+
+@njit(cache=True)
+def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, out_y, out_diag,
+                  max_disp, trans_mask):
+    """Fixed-step explicit Runge-Kutta with output every ``substeps`` steps.
+
+    The scheme is data: ``rk_a`` (s, s) strictly lower triangular, ``rk_b`` (s,), ``rk_c`` (s,).
+    ``W`` is the scratch tuple of :func:`make_work`.
+    Sample ``m`` of ``out_y`` is the state at ``t0 + m·substeps·h``; ``out_diag[m]`` holds the
+    output forces at that instant (from the first stage of the following step).
+
+    Returns
+    -------
+    int
+        −1 on success, else the index of the first output sample that was non-finite or
+        exceeded ``max_disp`` on a translational DOF (``trans_mask``).
+    """
+    ns = rk_b.shape[0]
+    dim = y0.shape[0]
+    n = dim // 2
+    k = np.zeros((ns, dim))
+    y = y0.copy()
+    yi = np.empty(dim)
+    scratch = np.empty(out_diag.shape[1])
+    t = t0
+    for m in range(n_out):
+        for i in range(dim):
+            out_y[m, i] = y[i]
+        for i in range(n):
+            if not (math.isfinite(y[i]) and math.isfinite(y[n + i])) or \
+                    (trans_mask[i] and abs(y[i]) > max_disp):
+                return m
+        for sub in range(substeps):
+            for st in range(ns):
+                for i in range(dim):
+                    acc = y[i]
+                    for jj in range(st):
+                        acc += h * rk_a[st, jj] * k[jj, i]
+                    yi[i] = acc
+                first = st == 0 and sub == 0
+                rhs_jit(t + rk_c[st] * h, yi, k, st, P, scratch, first, W)
+                if first:
+                    for i in range(scratch.shape[0]):
+                        out_diag[m, i] = scratch[i]
+                    if m == n_out - 1:
+                        return -1
+            for i in range(dim):
+                acc = 0.0
+                for st in range(ns):
+                    acc += rk_b[st] * k[st, i]
+                y[i] += h * acc
+            t = t0 + (m * substeps + sub + 1) * h
+    return -1

@@ -1,0 +1,51 @@
+"""Fixed-step explicit Runge-Kutta schemes as data (one numba kernel runs them all).
+
+References
+----------
+.. [1] P. Bogacki, L. F. Shampine, "A 3(2) pair of Runge-Kutta formulas", Appl. Math. Lett.
+   2 (1989) 321-325 (MATLAB/Simulink ``ode3``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["ButcherTableau", "SCHEMES"]
+
+
+@dataclass(frozen=True)
+class ButcherTableau:
+    """Explicit Runge-Kutta coefficients.
+
+    Attributes
+    ----------
+    a : ndarray, shape (s, s)
+        Strictly lower-triangular stage matrix.
+    b : ndarray, shape (s,)
+        Weights.
+    c : ndarray, shape (s,)
+        Nodes.
+    order : int
+        Order of accuracy.
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    order: int
+
+
+SCHEMES = {
+    # Bogacki-Shampine 3rd order (Simulink ode3), without the FSAL error stage
+    "ode3": ButcherTableau(np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, 0.75, 0.0]]),
+                           np.array([2.0 / 9.0, 1.0 / 3.0, 4.0 / 9.0]),
+                           np.array([0.0, 0.5, 0.75]), 3),
+    # classical 4th-order Runge-Kutta, for convergence checks
+    "rk4": ButcherTableau(np.array([[0.0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1.0, 0]]),
+                          np.array([1.0, 2.0, 2.0, 1.0]) / 6.0, np.array([0.0, 0.5, 0.5, 1.0]), 4),
+    # Heun's 2nd-order method, for convergence checks
+    "heun": ButcherTableau(np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([0.5, 0.5]),
+                           np.array([0.0, 1.0]), 2),
+}

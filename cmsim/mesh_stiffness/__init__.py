@@ -1,0 +1,1 @@
+"""Mesh stiffness: tooth geometry, contact geometry kernels, stiffness tables."""
