@@ -1,0 +1,71 @@
+"""Input checks shared by the spectra modules.
+
+Every public function of :mod:`cmsim.spectra` validates its inputs here, at the boundary, and
+raises :class:`~cmsim.errors.ParameterError` naming the parameter and the allowed range.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cmsim.errors import ParameterError, check_range
+
+#: Windows accepted by the amplitude-spectrum functions.
+WINDOWS = ("flattop", "hann", "boxcar")
+
+#: Detrend options: ``"constant"`` removes the mean, ``"linear"`` a straight line,
+#: ``None`` nothing.
+DETRENDS = ("constant", "linear", None)
+
+#: Fewest samples accepted in a signal.
+MIN_SAMPLES = 8
+
+
+def signal_1d(x, name="x", min_samples=MIN_SAMPLES):
+    """Return ``x`` as a finite float64 1-D array of at least ``min_samples`` samples."""
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a 1-D array of numbers") from None
+    if arr.ndim != 1:
+        raise ParameterError(f"{name} must be 1-D, got shape {arr.shape}")
+    if arr.size < min_samples:
+        raise ParameterError(f"{name} needs at least {min_samples} samples, got {arr.size}")
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(f"{name} must contain only finite values (found NaN or inf)")
+    return arr
+
+
+def sampling_rate(fs, name="fs"):
+    """Return ``fs`` as a float > 0 (Hz)."""
+    return check_range(name, fs, 0.0, lo_open=True, unit="Hz")
+
+
+def choice(name, value, allowed):
+    """Return ``value`` if it is one of ``allowed``, else raise naming the options."""
+    if value not in allowed:
+        raise ParameterError(f"{name} must be one of {allowed!r}, got {value!r}")
+    return value
+
+
+def positive_int(name, value, lo=1, hi=None):
+    """Return ``value`` as an int in ``[lo, hi]``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ParameterError(f"{name} must be an integer >= {lo}, got {value!r}")
+    if value < lo or (hi is not None and value > hi):
+        rng = f"[{lo}, {hi}]" if hi is not None else f">= {lo}"
+        raise ParameterError(f"{name} must be an integer in {rng}, got {value}")
+    return int(value)
+
+
+def band(name, band_hz, fs):
+    """Return ``(lo, hi)`` with ``0 <= lo < hi <= fs/2`` (Hz)."""
+    try:
+        lo, hi = (float(v) for v in band_hz)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a pair (lo, hi) in Hz, got {band_hz!r}") from None
+    nyq = 0.5 * fs
+    if not (np.isfinite(lo) and np.isfinite(hi)) or not 0.0 <= lo < hi <= nyq:
+        raise ParameterError(f"{name} must satisfy 0 <= lo < hi <= fs/2 = {nyq:g} Hz, "
+                             f"got ({lo:g}, {hi:g})")
+    return lo, hi

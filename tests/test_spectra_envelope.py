@@ -1,0 +1,110 @@
+"""Envelope spectra, spectral kurtosis and the kurtogram.
+
+Test tier: closed form (the envelope of A(1 + μ cos 2πf_m t)·sin 2πf_c t is A(1 + μ cos 2πf_m t);
+SK = 0 for Gaussian noise and −1 for a steady tone; an impulse train exciting a resonance shows
+its repetition rate in the envelope spectrum of the resonance band).
+"""
+
+import numpy as np
+import pytest
+
+from cmsim.errors import ParameterError
+from cmsim.spectra import (bandpass, envelope, envelope_spectrum, kurtogram,
+                           spectral_kurtosis)
+
+FS = 20_000.0
+
+
+def _impulse_train(rep_hz=97.3, resonance_hz=3000.0, zeta=0.05, seconds=1.0, noise=0.3,
+                   seed=3):
+    """Decaying resonance hit at rep_hz, plus two gear tones and white noise."""
+    n = int(FS * seconds)
+    t = np.arange(n) / FS
+    wn = 2 * np.pi * resonance_hz
+    th = np.arange(int(0.02 * FS)) / FS
+    h = np.exp(-zeta * wn * th) * np.sin(wn * np.sqrt(1 - zeta ** 2) * th)
+    hits = np.zeros(n)
+    hits[np.round(np.arange(0.0, seconds, 1.0 / rep_hz) * FS).astype(int)] = 1.0
+    x = np.convolve(hits, h)[:n]
+    x /= np.abs(x).max()
+    gear = 0.5 * np.sin(2 * np.pi * 466.67 * t) + 0.3 * np.sin(2 * np.pi * 933.33 * t)
+    rng = np.random.default_rng(seed)
+    return x + gear + noise * rng.standard_normal(n)
+
+
+def test_kurtogram_finds_resonance_and_envelope_shows_repetition_rate():
+    rep = 97.3
+    x = _impulse_train(rep)
+    kg = kurtogram(x, FS)
+    lo, hi = kg.band_hz
+    assert lo < 3000.0 < hi
+    assert kg.kurtosis_max > 1.0
+    assert kg.bandwidth_hz > 2 * rep                      # wide enough to carry the modulation
+    s = envelope_spectrum(x, FS, kg.band_hz)
+    sel = s.freq_hz > 5.0
+    f_top = s.freq_hz[sel][np.argmax(s.amplitude[sel])]
+    assert abs(f_top - rep) <= s.resolution_hz
+    # without the band the envelope is dominated by the gear tones, not the repetition rate
+    s_all = envelope_spectrum(x, FS, None)
+    assert s_all.kind == "envelope"
+    f_all = s_all.freq_hz[sel][np.argmax(s_all.amplitude[sel])]
+    assert abs(f_all - rep) > 10 * s.resolution_hz
+
+
+def test_envelope_of_am_signal_reads_modulation_amplitude():
+    n = 40_000
+    t = np.arange(n) / FS
+    a, mu, fm, fc = 2.0, 0.3, 60.6, 3000.0
+    x = a * (1 + mu * np.cos(2 * np.pi * fm * t)) * np.sin(2 * np.pi * fc * t)
+    env = envelope(x, FS, (2500.0, 3500.0))
+    mid = slice(n // 10, -n // 10)                          # away from the Hilbert edge effects
+    assert np.allclose(env[mid], a * (1 + mu * np.cos(2 * np.pi * fm * t[mid])), atol=0.02)
+    s = envelope_spectrum(x, FS, (2500.0, 3500.0))
+    i = np.argmin(np.abs(s.freq_hz - fm))
+    assert s.amplitude[i - 2: i + 3].max() == pytest.approx(a * mu, rel=0.02)
+
+
+def test_bandpass_keeps_band_and_removes_outside():
+    t = np.arange(20_000) / FS
+    inside, outside = np.sin(2 * np.pi * 3000 * t), np.sin(2 * np.pi * 500 * t)
+    y = bandpass(inside + outside, FS, (2000.0, 4000.0))
+    mid = slice(2000, -2000)
+    assert np.std(y[mid] - inside[mid]) < 0.02
+    assert np.allclose(bandpass(inside, FS, (0.0, FS / 2)), inside)
+    low = bandpass(inside + outside, FS, (0.0, 1000.0))
+    assert np.std(low[mid] - outside[mid]) < 0.02
+
+
+def test_spectral_kurtosis_of_noise_and_tone():
+    rng = np.random.default_rng(5)
+    n = 100_000
+    x = rng.standard_normal(n)
+    f, sk = spectral_kurtosis(x, FS, 256)
+    assert np.isnan(sk[0]) and np.isnan(sk[-1])
+    assert abs(np.nanmean(sk)) < 0.05
+    t = np.arange(n) / FS
+    f, sk = spectral_kurtosis(np.sin(2 * np.pi * 2500.0 * t) + 0.01 * x, FS, 256)
+    assert sk[np.argmin(np.abs(f - 2500.0))] == pytest.approx(-1.0, abs=0.05)
+
+
+def test_kurtogram_respects_min_freq_and_custom_lengths():
+    x = _impulse_train()
+    kg = kurtogram(x, FS, nperseg=(32, 64, 128), min_freq_hz=4000.0)
+    assert kg.nperseg == (32, 64, 128)
+    assert kg.band_hz[0] >= 4000.0
+    assert kg.bandwidth_hz == pytest.approx(2 * FS / kg.best_nperseg)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: envelope_spectrum(np.ones(1000), 1000.0, (100.0, 600.0)), "band_hz"),
+    (lambda: envelope_spectrum(np.ones(1000), 1000.0, (300.0, 200.0)), "band_hz"),
+    (lambda: envelope_spectrum(np.ones(1000), 1000.0, 200.0), "band_hz"),
+    (lambda: bandpass(np.ones(1000), 1000.0, (10.0, 100.0), filter_order=0), "filter_order"),
+    (lambda: spectral_kurtosis(np.ones(100), 1000.0, 64), "nperseg"),
+    (lambda: kurtogram(np.ones(500), 1000.0), "x too short"),
+    (lambda: kurtogram(np.ones(5000), 1000.0, min_freq_hz=600.0), "min_freq_hz"),
+    (lambda: kurtogram(np.ones(5000), 1000.0, nperseg=(16, 4.5)), "nperseg"),
+])
+def test_bad_inputs_name_the_parameter(call, name):
+    with pytest.raises(ParameterError, match=name):
+        call()
