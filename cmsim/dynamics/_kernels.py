@@ -12,13 +12,15 @@ rates; it writes row ``row`` of the 2-D array ``dydt`` with ``[v, M⁻¹(f_ext +
 output forces into ``diag``. ``W`` = (g, cos_nom, sin_nom, jit_cos, jit_sin) are scratch arrays
 from :func:`make_work`.
 
-Hot-path code never slices arrays: in numba every view takes an atomic reference count, which
-cost more than the physics here.
+Hot-path code never slices arrays (in numba every view takes an atomic reference count) and
+small kernels are inlined at numba-IR level (a call with array arguments costs about 25 ns).
+The bearing forces are compiled with fastmath so the ball loop vectorises; the finiteness
+checks live in the integrator, which is compiled without it.
 
-``P`` = (minv, kc, fext, omega, b_int, b_par, b_cos, b_sin, jitter, m_int, m_par, geo, tab_k,
-tab_e, teeth1, teeth2, kc_ptr, kc_idx) with ``kc`` the non-zeros of ``[K C]`` (n, 2n) in
-compressed-row form (``kc_ptr``, ``kc_idx``) and ``teeth1/2`` the cos and sin of multiples of
-the angular pitch, shape (Z, 2); index constants below.
+``P`` = (minv, springs, fext, omega, b_int, b_par, b_cos, b_sin, jitter, m_int, m_par, geo, tab_k,
+tab_e, teeth1, teeth2, spring_ends) with the linear K and C as two-node spring-dampers
+(``springs`` (e, 2) = k, c; ``spring_ends`` (e, 2) = DOF indices, −1 = ground) and ``teeth1/2``
+the cos and sin of multiples of the angular pitch, shape (Z, 2); index constants below.
 """
 
 from __future__ import annotations
@@ -28,8 +30,8 @@ import math
 import numpy as np
 from numba import njit
 
-from cmsim.bearings._kernels import ball_forces_jit, ball_forces_row_jit
-from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit, table_lookup_jit
+from cmsim.bearings._kernels import ball_forces_cage_frame_jit
+from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit, table_lookup2_jit
 
 # b_int columns: DOF indices, number of balls, index of the first bearing sharing the same
 # nominal cage rotation (its cos/sin are computed once)
@@ -48,7 +50,7 @@ MI_SIZE = 4
 MP_SIZE = 18
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def _jitter_at(jitter, ib, iball, t, jdt):
     ng = jitter.shape[2]
     u = t / jdt
@@ -61,55 +63,65 @@ def _jitter_at(jitter, ib, iball, t, jdt):
     return jitter[ib, iball, i] + f * (jitter[ib, iball, i + 1] - jitter[ib, iball, i])
 
 
-@njit(cache=True)
-def _bearing_forces(t, y, n, g, P, diag, want_diag, W):
-    omega = P[3]
+@njit(cache=True, error_model="numpy")
+def _jittered_offsets(t, P, W):
+    """Fill ``W[3]``, ``W[4]`` (n_bearings, max_balls) with cos, sin of the jittered ball
+    offsets at time ``t`` (nominal spacing plus each ball's slip jitter)."""
     b_int = P[4]
-    b_par = P[5]
     b_cos = P[6]
     b_sin = P[7]
     jitter = P[8]
     jdt = P[10][MP_JDT]
-    cos_nom = W[1]
-    sin_nom = W[2]
     jit_cos = W[3]
     jit_sin = W[4]
-    with_jitter = jitter.shape[2] > 1
+    for ib in range(b_int.shape[0]):
+        for i in range(b_int[ib, BI_NB]):
+            j = _jitter_at(jitter, ib, i, t, jdt)
+            j2 = j * j
+            cj = 1.0 - j2 * (0.5 - j2 * (1.0 / 24.0))
+            sj = j * (1.0 - j2 * (1.0 / 6.0 - j2 * (1.0 / 120.0)))
+            jit_cos[ib, i] = b_cos[ib, i] * cj - b_sin[ib, i] * sj
+            jit_sin[ib, i] = b_sin[ib, i] * cj + b_cos[ib, i] * sj
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _bearing_forces(t, y, n, g, P, diag, want_diag, W, ball_cos, ball_sin):
+    """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage.
+
+    Written flat on purpose: with helper functions inlined, a jitter branch, or arrays taken
+    out of ``P`` inside the loop, numba stops vectorising the ball loop (2-3× slower).
+    The cage angle's nominal part (rate·Ω·t) is computed once per group of bearings turning
+    alike; the small dynamic deviation (rate·q_θ) is applied as a rotation (Taylor series).
+    Each bearing works in its cage frame: the inner-ring offset is turned by −θ_cage once
+    instead of turning every ball.
+    """
+    omega = P[3]
+    b_int = P[4]
+    b_par = P[5]
+    cos_nom = W[1]
+    sin_nom = W[2]
     for ib in range(b_int.shape[0]):
         ix = b_int[ib, BI_X]
         iy = b_int[ib, BI_Y]
         it = b_int[ib, BI_T]
-        n_balls = b_int[ib, BI_NB]
         rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
         grp = b_int[ib, BI_GROUP]
         if grp == ib:
             nominal = rate * omega[it] * t + b_par[ib, BP_PHASE]
             cos_nom[ib] = math.cos(nominal)
             sin_nom[ib] = math.sin(nominal)
-        # cage angle = nominal + rate·q[it]; the deviation is small: rotate by it
         dev = rate * y[it]
-        if abs(dev) < 1e-2:
-            d2 = dev * dev
-            cd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0)
-            sd = dev * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0))
-        else:
-            cd = math.cos(dev)
-            sd = math.sin(dev)
+        d2 = dev * dev
+        cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0)))
+        sd = dev * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0 - d2 * (1.0 / 5040.0))))
         cc = cos_nom[grp] * cd - sin_nom[grp] * sd
         sc = sin_nom[grp] * cd + cos_nom[grp] * sd
-        if with_jitter:
-            for i in range(n_balls):
-                j = _jitter_at(jitter, ib, i, t, jdt)
-                j2 = j * j
-                cj = 1.0 - 0.5 * j2 * (1.0 - j2 / 12.0)
-                sj = j * (1.0 - j2 / 6.0 * (1.0 - j2 / 20.0))
-                jit_cos[0, i] = b_cos[ib, i] * cj - b_sin[ib, i] * sj
-                jit_sin[0, i] = b_sin[ib, i] * cj + b_cos[ib, i] * sj
-            fx, fy = ball_forces_row_jit(y[ix], y[iy], cc, sc, jit_cos, jit_sin, 0, n_balls,
-                                         b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
-        else:
-            fx, fy = ball_forces_row_jit(y[ix], y[iy], cc, sc, b_cos, b_sin, ib, n_balls,
-                                         b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
+        xr = y[ix] * cc + y[iy] * sc
+        yr = y[iy] * cc - y[ix] * sc
+        fxr, fyr = ball_forces_cage_frame_jit(xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB],
+                                              b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
+        fx = fxr * cc - fyr * sc
+        fy = fyr * cc + fxr * sc
         g[ix] -= fx
         g[iy] -= fy
         if want_diag:
@@ -117,7 +129,7 @@ def _bearing_forces(t, y, n, g, P, diag, want_diag, W):
             diag[2 * ib + 1] = fy + b_par[ib, BP_DAMP] * y[n + iy]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _mesh_forces(t, y, n, g, P, diag, want_diag):
     m_int = P[9]
     mp = P[10]
@@ -141,22 +153,22 @@ def _mesh_forces(t, y, n, g, P, diag, want_diag):
     # physical involute origins of the reference pair (tooth 0 on both gears)
     psi1 = mp[MP_OM1] * t + y[i1 + 2] + mp[MP_PSI10]
     psi2 = mp[MP_PSI20] - (mp[MP_OM2] * t + y[i2 + 2])
-    cp1 = math.cos(psi1)
-    sp1 = math.sin(psi1)
-    cp2 = math.cos(psi2)
-    sp2 = math.sin(psi2)
+    trig_done = False
+    cp1 = sp1 = cp2 = sp2 = 0.0
     # interference: nominal rolling cancels exactly (rb1·Ω1 = rb2·Ω2)
     delta_inv = (rb1 * (y[i1 + 2] + mp[MP_PSI10] - phi_t1)
                  + rb2 * (mp[MP_PSI20] - y[i2 + 2] - (phi_t1 + math.pi))
                  - length)
     s_ref = rb1 * (psi1 - phi_t1)
-    m0 = int(math.floor((s_ref - mp[MP_SLO]) / pb))
+    m0f = math.floor((s_ref - mp[MP_SLO]) / pb)
+    m0 = int(m0f)
     w1 = mp[MP_OM1] + y[n + i1 + 2]
     w2 = -(mp[MP_OM2] + y[n + i2 + 2])
     lo = length - geo[3] - mp[MP_ZBEFORE]
     hi = geo[2] + mp[MP_ZAFTER]
-    k1 = m0 % z1
-    k2 = m0 % z2
+    # tooth numbers of the first slot's pair, m0 mod Z (float floor: integer % is slow)
+    k1 = int(m0f - z1 * math.floor(m0f / z1))
+    k2 = int(m0f - z2 * math.floor(m0f / z2))
     for j in range(m_int[MI_SLOTS]):
         if j > 0:
             # next slot: one tooth earlier on both gears
@@ -168,7 +180,14 @@ def _mesh_forces(t, y, n, g, P, diag, want_diag):
             if want_diag:
                 diag[int(mp[MP_DIAGB]) + j] = 0.0
             continue
-        # involute origins of this pair: gear-1 tooth `pair` pitches back, gear-2 tooth on
+        # involute origins of this pair: gear-1 tooth `pair` pitches back, gear-2 tooth on;
+        # only a corner (rounded-tip) contact needs them
+        if not trig_done and (s < length - geo[3] or s > geo[2]):
+            cp1 = math.cos(psi1)
+            sp1 = math.sin(psi1)
+            cp2 = math.cos(psi2)
+            sp2 = math.sin(psi2)
+            trig_done = True
         c1n = cp1 * teeth1[k1, 0] + sp1 * teeth1[k1, 1]
         s1n = sp1 * teeth1[k1, 0] - cp1 * teeth1[k1, 1]
         c2n = cp2 * teeth2[k2, 0] - sp2 * teeth2[k2, 1]
@@ -183,10 +202,10 @@ def _mesh_forces(t, y, n, g, P, diag, want_diag):
         dvx = (y[n + i1] - w1 * ry1) - (y[n + i2] - w2 * ry2)
         dvy = (y[n + i1 + 1] + w1 * rx1) - (y[n + i2 + 1] + w2 * rx2)
         approach = dvx * nx + dvy * ny
-        overlap = delta - table_lookup_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_e)
+        k_pair, e_pair = table_lookup2_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_k, tab_e)
+        overlap = delta - e_pair
         if overlap > 0.0:
-            fn = table_lookup_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_k) * overlap \
-                + mp[MP_CHYST] * approach
+            fn = k_pair * overlap + mp[MP_CHYST] * approach
             if fn < 0.0:
                 fn = 0.0
         elif approach > 0.0:
@@ -215,29 +234,36 @@ def _mesh_forces(t, y, n, g, P, diag, want_diag):
         g[i2 + 2] -= rx2 * f2y - ry2 * f2x
 
 
-@njit(cache=True)
-def linear_accel_jit(y, g, minv, kc_ptr, kc_idx, kc_val, dydt, row):
-    """Row ``row`` of ``dydt`` = ``[v, M⁻¹(g − [K C]·y)]`` for ``y = [q, v]`` (eq. 1, linear part).
+@njit(cache=True, inline="always", error_model="numpy")
+def linear_accel_jit(y, g, minv, springs, ends, dydt, row):
+    """Row ``row`` of ``dydt`` = ``[v, M⁻¹(g − K q − C v)]`` for ``y = [q, v]`` (eq. 1, linear).
 
-    ``[K C]`` (n, 2n) is given in compressed-row form (``kc_ptr``, ``kc_idx``, ``kc_val``).
+    K and C are sums of two-node spring-dampers (Annex A): ``ends[e] = (a, b)`` DOF indices
+    (``b = −1`` for a connection to ground), ``springs[e] = (k, c)``. ``g`` is overwritten.
     """
     n = minv.shape[0]
+    for e in range(ends.shape[0]):
+        a = ends[e, 0]
+        b = ends[e, 1]
+        if b >= 0:
+            f = springs[e, 0] * (y[a] - y[b]) + springs[e, 1] * (y[n + a] - y[n + b])
+            g[b] += f
+        else:
+            f = springs[e, 0] * y[a] + springs[e, 1] * y[n + a]
+        g[a] -= f
     for i in range(n):
-        acc = g[i]
-        for k in range(kc_ptr[i], kc_ptr[i + 1]):
-            acc -= kc_val[k] * y[kc_idx[k]]
         dydt[row, i] = y[n + i]
-        dydt[row, n + i] = minv[i] * acc
+        dydt[row, n + i] = minv[i] * g[i]
 
 
 def make_work(P):
     """Scratch arrays ``W`` for :func:`rhs_jit`."""
     nb, max_balls = P[6].shape
-    return (np.empty(P[0].shape[0]), np.empty(nb), np.empty(nb), np.empty((1, max_balls)),
-            np.empty((1, max_balls)))
+    return (np.empty(P[0].shape[0]), np.empty(nb), np.empty(nb), np.empty((nb, max_balls)),
+            np.empty((nb, max_balls)))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     """Equations of motion (module docstring); writes ``dydt[row]`` and optionally ``diag``."""
     minv = P[0]
@@ -246,27 +272,32 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     g = W[0]
     for i in range(n):
         g[i] = fext[i]
-    _bearing_forces(t, y, n, g, P, diag, want_diag, W)
+    if P[8].shape[2] > 1:
+        _jittered_offsets(t, P, W)
+        _bearing_forces(t, y, n, g, P, diag, want_diag, W, W[3], W[4])
+    else:
+        _bearing_forces(t, y, n, g, P, diag, want_diag, W, P[6], P[7])
     if P[9][MI_ON] != 0:
         _mesh_forces(t, y, n, g, P, diag, want_diag)
-    linear_accel_jit(y, g, minv, P[16], P[17], P[1], dydt, row)
+    linear_accel_jit(y, g, minv, P[1], P[16], dydt, row)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, out_y, out_diag,
-                  max_disp, trans_mask):
+                  max_disp, max_rot, trans_mask):
     """Fixed-step explicit Runge-Kutta with output every ``substeps`` steps.
 
     The scheme is data: ``rk_a`` (s, s) strictly lower triangular, ``rk_b`` (s,), ``rk_c`` (s,).
-    ``W`` is the scratch tuple of :func:`make_work`.
-    Sample ``m`` of ``out_y`` is the state at ``t0 + m·substeps·h``; ``out_diag[m]`` holds the
-    output forces at that instant (from the first stage of the following step).
+    ``W`` is the scratch tuple of :func:`make_work`. Sample ``m`` of ``out_y`` is the state at
+    ``t0 + m·substeps·h``; ``out_diag[m]`` holds the output forces at that instant (from the
+    first stage of the following step, so they cost nothing extra).
 
     Returns
     -------
     int
         −1 on success, else the index of the first output sample that was non-finite or
-        exceeded ``max_disp`` on a translational DOF (``trans_mask``).
+        exceeded ``max_disp`` on a translational DOF (``trans_mask``) or ``max_rot`` on a
+        rotational one.
     """
     ns = rk_b.shape[0]
     dim = y0.shape[0]
@@ -274,33 +305,34 @@ def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, out_y, out
     k = np.zeros((ns, dim))
     y = y0.copy()
     yi = np.empty(dim)
+    ha = h * rk_a
+    hb = h * rk_b
     scratch = np.empty(out_diag.shape[1])
-    t = t0
     for m in range(n_out):
         for i in range(dim):
             out_y[m, i] = y[i]
         for i in range(n):
-            if not (math.isfinite(y[i]) and math.isfinite(y[n + i])) or \
-                    (trans_mask[i] and abs(y[i]) > max_disp):
+            limit = max_disp if trans_mask[i] else max_rot
+            if not (math.isfinite(y[i]) and math.isfinite(y[n + i]) and abs(y[i]) <= limit):
                 return m
         for sub in range(substeps):
-            for st in range(ns):
+            t = t0 + (m * substeps + sub) * h
+            rhs_jit(t, y, k, 0, P, scratch, sub == 0, W)
+            if sub == 0:
+                for i in range(scratch.shape[0]):
+                    out_diag[m, i] = scratch[i]
+                if m == n_out - 1:
+                    return -1
+            for st in range(1, ns):
                 for i in range(dim):
                     acc = y[i]
                     for jj in range(st):
-                        acc += h * rk_a[st, jj] * k[jj, i]
+                        acc += ha[st, jj] * k[jj, i]
                     yi[i] = acc
-                first = st == 0 and sub == 0
-                rhs_jit(t + rk_c[st] * h, yi, k, st, P, scratch, first, W)
-                if first:
-                    for i in range(scratch.shape[0]):
-                        out_diag[m, i] = scratch[i]
-                    if m == n_out - 1:
-                        return -1
+                rhs_jit(t + rk_c[st] * h, yi, k, st, P, scratch, False, W)
             for i in range(dim):
                 acc = 0.0
                 for st in range(ns):
-                    acc += rk_b[st] * k[st, i]
-                y[i] += h * acc
-            t = t0 + (m * substeps + sub + 1) * h
+                    acc += hb[st] * k[st, i]
+                y[i] += acc
     return -1

@@ -16,7 +16,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse
 
 from cmsim.bearings.forces import ball_offsets
 from cmsim.bearings.hertz import bearing_contact_stiffness
@@ -181,35 +180,40 @@ def _node_masses(rig):
     return np.array(masses, dtype=float)
 
 
-def _add_spring(mat, i, j, k):
-    mat[i, i] += k
-    if j is not None:
-        mat[j, j] += k
-        mat[i, j] -= k
-        mat[j, i] -= k
-
-
-def _linear_matrices(rig):
-    n = rig.n_dof
-    kmat = np.zeros((n, n))
-    cmat = np.zeros((n, n))
+def _spring_elements(rig):
+    """Two-node spring-dampers of Annex A: list of (dof_a, dof_b or −1, k, c)."""
+    elements = []
     for i, shaft in enumerate(rig.shafts):
         b1, c, b2 = 9 * i, 9 * i + 3, 9 * i + 6
         for seg, (na, nb) in enumerate(((b1, c), (c, b2))):
             for d in (0, 1):
-                _add_spring(kmat, na + d, nb + d, shaft.flexural_stiffness_n_per_m[seg])
-                _add_spring(cmat, na + d, nb + d, shaft.flexural_damping_n_s_per_m[seg])
-            _add_spring(kmat, na + 2, nb + 2, shaft.torsional_stiffness_nm_per_rad[seg])
-            _add_spring(cmat, na + 2, nb + 2, shaft.torsional_damping_nm_s_per_rad[seg])
+                elements.append((na + d, nb + d, shaft.flexural_stiffness_n_per_m[seg],
+                                 shaft.flexural_damping_n_s_per_m[seg]))
+            elements.append((na + 2, nb + 2, shaft.torsional_stiffness_nm_per_rad[seg],
+                             shaft.torsional_damping_nm_s_per_rad[seg]))
         for node, brg in ((b1, shaft.bearing_1), (b2, shaft.bearing_2)):
             for d in (0, 1):
-                _add_spring(cmat, node + d, None, brg.damping_n_s_per_m)
+                elements.append((node + d, -1, 0.0, brg.damping_n_s_per_m))
     # imposed input rotation: the coupling is a spring to ground in deviation coordinates
-    _add_spring(kmat, 2, None, rig.input_coupling.stiffness_nm_per_rad)
-    _add_spring(cmat, 2, None, rig.input_coupling.damping_nm_s_per_rad)
+    elements.append((2, -1, rig.input_coupling.stiffness_nm_per_rad,
+                     rig.input_coupling.damping_nm_s_per_rad))
     if rig.gears is not None:
-        _add_spring(kmat, 9 + 6 + 2, n - 1, rig.output_coupling.stiffness_nm_per_rad)
-        _add_spring(cmat, 9 + 6 + 2, n - 1, rig.output_coupling.damping_nm_s_per_rad)
+        elements.append((9 + 6 + 2, rig.n_dof - 1, rig.output_coupling.stiffness_nm_per_rad,
+                         rig.output_coupling.damping_nm_s_per_rad))
+    return elements
+
+
+def _linear_matrices(elements, n):
+    """Assemble K and C (n, n) from spring elements."""
+    kmat = np.zeros((n, n))
+    cmat = np.zeros((n, n))
+    for a, b, k, c in elements:
+        for mat, value in ((kmat, k), (cmat, c)):
+            mat[a, a] += value
+            if b >= 0:
+                mat[b, b] += value
+                mat[a, b] -= value
+                mat[b, a] -= value
     return kmat, cmat
 
 
@@ -243,7 +247,8 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
     slip = SlipModel() if slip is None else slip
     n = rig.n_dof
     mass = _node_masses(rig)
-    kmat, cmat = _linear_matrices(rig)
+    elements = _spring_elements(rig)
+    kmat, cmat = _linear_matrices(elements, n)
     names = _dof_names(rig)
     omega = np.zeros(n)
     ratio = rig.gears.driving.n_teeth / rig.gears.driven.n_teeth if rig.gears else 0.0
@@ -336,10 +341,10 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         m_par[K.MP_TABD] = 1.0
         tab_k = np.zeros(2)
         tab_e = np.zeros(2)
-    kc = scipy.sparse.csr_matrix(np.hstack([kmat, cmat]))
-    packed = (1.0 / mass, kc.data.astype(float), force, omega, b_int, b_par, b_cos, b_sin,
-              jitter, m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2,
-              kc.indptr.astype(np.int64), kc.indices.astype(np.int64))
+    springs = np.array([(k, c) for _, _, k, c in elements])
+    spring_ends = np.array([(a, b) for a, b, _, _ in elements], dtype=np.int64)
+    packed = (1.0 / mass, springs, force, omega, b_int, b_par, b_cos, b_sin, jitter, m_int,
+              m_par, geo, tab_k, tab_e, teeth1, teeth2, spring_ends)
     return DynamicModel(rig, op, mesh_table, names, mass, kmat, cmat, force, omega, packed,
                         tuple(diag_names), slip)
 

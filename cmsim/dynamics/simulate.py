@@ -15,7 +15,11 @@ from cmsim.dynamics.quasistatic import quasi_static_state
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
 from cmsim.run import Run
 
-__all__ = ["simulate", "integrate"]
+__all__ = ["simulate", "integrate", "MAX_ROTATION_DEVIATION_RAD"]
+
+#: A dynamic twist beyond this (rad) means the run has diverged; it also bounds the Taylor
+#: rotation of the cage angle in the bearing kernel (error < 1e-10 below it).
+MAX_ROTATION_DEVIATION_RAD = 0.5
 
 
 def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3"):
@@ -51,17 +55,20 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3"):
     states = np.empty((n_out, y0.size))
     diag = np.empty((n_out, len(model.diag_names)))
     max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
+    max_rot = MAX_ROTATION_DEVIATION_RAD
     mask = model.translational_mask
     args = (tab.a, tab.b, tab.c, model.packed, K.make_work(model.packed))
     # compile (or load from cache) outside the timed region
-    K.integrate_jit(y0, t0, h, 1, 1, *args, states[:1], diag[:1], max_disp, mask)
+    K.integrate_jit(y0, t0, h, 1, 1, *args, states[:1], diag[:1], max_disp, max_rot, mask)
     start = time.perf_counter()
-    status = K.integrate_jit(y0, t0, h, n_out, substeps, *args, states, diag, max_disp, mask)
+    status = K.integrate_jit(y0, t0, h, n_out, substeps, *args, states, diag, max_disp,
+                             max_rot, mask)
     wall = time.perf_counter() - start
     if status >= 0:
         raise IntegrationDiverged(
             f"the integration diverged at t = {t0 + status * dt_out:.6g} s (a displacement "
-            f"exceeded {max_disp:g} m or became non-finite); use a smaller step "
+            f"exceeded {max_disp:g} m, a rotation deviation {max_rot:g} rad, or a value became "
+            f"non-finite); use a smaller step "
             f"(substeps > {substeps} or a higher fs_hz) or check the rig parameters")
     return states, diag, wall
 
@@ -78,7 +85,8 @@ def _compile_seconds():
         K.integrate_jit(y0, 0.0, 1e-5, 2, 1, SCHEMES["ode3"].a, SCHEMES["ode3"].b,
                         SCHEMES["ode3"].c, model.packed, K.make_work(model.packed),
                         np.empty((2, y0.size)),
-                        np.empty((2, len(model.diag_names))), 1.0, model.translational_mask)
+                        np.empty((2, len(model.diag_names))), 1.0, 1.0,
+                        model.translational_mask)
         _compile_seconds.value = time.perf_counter() - start
     return _compile_seconds.value
 
