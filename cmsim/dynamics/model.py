@@ -224,7 +224,8 @@ def _dof_names(rig):
     return tuple(names)
 
 
-def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=None):
+def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=None,
+                cage_phases_rad=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
 
     Parameters
@@ -239,6 +240,9 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         Span over which jitter is generated (only with ``slip``), s.
     seed : int, optional
         Seed of the jitter generator.
+    cage_phases_rad : sequence of float, optional
+        Initial cage angle θ0 of each bearing (eq. 7), one per bearing in
+        ``rig.bearing_names`` order; default all zero.
 
     Returns
     -------
@@ -272,6 +276,10 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
     b_cos = np.zeros((nb, max_balls))
     b_sin = np.zeros((nb, max_balls))
     node_of = {name: k for k, name in enumerate(rig.node_names)}
+    phases = np.zeros(nb) if cage_phases_rad is None else np.asarray(cage_phases_rad, float)
+    if phases.shape != (nb,) or not np.all(np.isfinite(phases)):
+        raise ParameterError(f"cage_phases_rad needs {nb} finite values (one per bearing "
+                             f"{rig.bearing_names}), got {cage_phases_rad!r}")
     for ib, (bname, brg) in enumerate(zip(rig.bearing_names, bearings)):
         node = node_of[bname]
         k_in, k_out = cage_ratios(brg)
@@ -280,7 +288,7 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         group = next(j for j in range(ib + 1)
                      if j == ib or (b_par[j, K.BP_CAGE] * b_par[j, K.BP_SENSE]
                                     * omega[b_int[j, K.BI_T]] == rate
-                                    and b_par[j, K.BP_PHASE] == 0.0))
+                                    and b_par[j, K.BP_PHASE] == phases[ib]))
         b_int[ib] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls, group)
         b_par[ib, K.BP_K] = bearing_contact_stiffness(brg)
         b_par[ib, K.BP_P] = brg.load_exponent
@@ -288,6 +296,7 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         b_par[ib, K.BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio
         b_par[ib, K.BP_SENSE] = sense
         b_par[ib, K.BP_DAMP] = brg.damping_n_s_per_m
+        b_par[ib, K.BP_PHASE] = phases[ib]
         co, so = ball_offsets(brg)
         b_cos[ib, :brg.n_balls] = co
         b_sin[ib, :brg.n_balls] = so

@@ -92,7 +92,7 @@ def _compile_seconds():
 
 
 def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
-             mesh_table=None, slip=None, seed=None, warmup_s=0.05):
+             mesh_table=None, slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random"):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -116,9 +116,13 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
     slip : SlipModel, optional
         Random ball-position jitter; uses ``seed``.
     seed : int, optional
-        Seed for the jitter; drawn at random and recorded when omitted.
+        Seed for the jitter and the cage phases; drawn at random and recorded when omitted.
     warmup_s : float
         Simulated time discarded before recording, s.
+    cage_phases_rad : "random", sequence of float or None
+        Initial cage angle of each bearing: drawn uniformly from ``seed`` (default — the
+        relative phase of independent cages is arbitrary, and equal phases can cancel the
+        ball-pass line in the DTE by symmetry), given explicitly, or ``None`` for all zero.
 
     Returns
     -------
@@ -132,9 +136,15 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
     if seed is None:
         seed = int(np.random.SeedSequence().entropy % (2 ** 31))
     slip = SlipModel() if slip is None else slip
+    rng = np.random.default_rng(seed)
+    if isinstance(cage_phases_rad, str):
+        if cage_phases_rad != "random":
+            raise ParameterError(f"cage_phases_rad must be 'random', None or one angle per "
+                                 f"bearing, got {cage_phases_rad!r}")
+        cage_phases_rad = rng.uniform(0.0, 2.0 * math.pi, len(rig.bearings))
     compile_s = _compile_seconds()
     model = build_model(rig, op, mesh_table, slip=slip, duration_s=warmup_s + duration_s,
-                        seed=seed)
+                        seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad)
     n = model.n_dof
     q0 = quasi_static_state(model, 0.0)
     y0 = np.concatenate([q0, np.zeros(n)])
@@ -156,6 +166,7 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
                             "radial_load_angle_rad": op.radial_load_angle_rad},
         "fs_hz": fs_hz, "substeps": int(substeps), "scheme": scheme, "warmup_s": warmup_s,
         "duration_s": n_rec / fs_hz, "seed": int(seed),
+        "cage_phases_rad": [float(x) for x in model.packed[5][:, K.BP_PHASE]],
         "slip": {"ball_rms_rad": slip.ball_rms_rad, "cage_rms_rad": slip.cage_rms_rad,
                  "correlation_s": slip.correlation_s},
         "mesh_table": None if model.mesh_table is None else {

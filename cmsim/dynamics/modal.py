@@ -1,0 +1,172 @@
+"""Linearised modal analysis about the quasi-static state (paper 001 Tables 5/6, ref. [34]).
+
+Each bearing is linearised at its quasi-static displacement and its tangent stiffness is
+averaged over one ball-pass (bearing) cycle; the mesh enters as k̄·g·gᵀ with k̄ the mean mesh
+stiffness over a mesh cycle and g = ∂δ/∂q the line-of-action coupling vector. Friction and the
+centre-distance dependence of the mesh geometry are left out of the linear model (as in the
+paper's linearised model). See papers/NOTES.md for the mixed-mode orientation issue.
+
+References
+----------
+.. [1] A. Fernandez-del-Rincon et al., MSSP 2016, Tables 5-6.
+.. [2] A. Fernandez-del-Rincon et al., "Load effects on the dynamics of spur gear
+   transmissions", ASME IDETC 2010, 369-378.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from cmsim.bearings._kernels import ball_tangent_stiffness_jit
+from cmsim.bearings.kinematics import ball_pass_cycles_per_rev
+from cmsim.dynamics import _kernels as K
+from cmsim.dynamics.model import build_model
+from cmsim.dynamics.quasistatic import quasi_static_orbit
+from cmsim.errors import ParameterError
+
+__all__ = ["ModalResult", "modal_analysis", "MODE_TYPES"]
+
+#: Mode types of the paper: rotational, translational, mixed.
+MODE_TYPES = ("R", "T", "R-T")
+
+#: Kinetic-energy share of the rotational DOFs above which a mode is "R" (and below
+#: 1 − this, "T").
+PURE_MODE_SHARE = 0.9
+
+
+@dataclass(frozen=True)
+class ModalResult:
+    """Natural frequencies and mode shapes of the linearised model.
+
+    Attributes
+    ----------
+    frequencies_hz : ndarray, shape (n,)
+        Natural frequencies, ascending, Hz.
+    shapes : ndarray, shape (n, n)
+        Mass-normalised mode shapes, one per column.
+    types : tuple of str
+        ``"R"``, ``"T"`` or ``"R-T"`` per mode (see :data:`PURE_MODE_SHARE`).
+    details : tuple of str
+        ``"R"``, ``"Tn"`` (translation mostly along the line of action), ``"Tt"`` (mostly
+        normal to it) or ``"R-T"``.
+    rotational_share : ndarray, shape (n,)
+        Kinetic-energy share of the rotational DOFs per mode.
+    dof_names : tuple of str
+    mean_mesh_stiffness_n_per_m : float
+        k̄ used for the mesh (0 without gears).
+    bearing_stiffness_n_per_m : ndarray, shape (n_bearings, 2, 2)
+        Cycle-averaged tangent stiffness of each bearing, N/m.
+    """
+
+    frequencies_hz: np.ndarray
+    shapes: np.ndarray
+    types: tuple
+    details: tuple
+    rotational_share: np.ndarray
+    dof_names: tuple
+    mean_mesh_stiffness_n_per_m: float
+    bearing_stiffness_n_per_m: np.ndarray
+
+    def to_records(self):
+        """One dict per mode (``mode``, ``frequency_hz``, ``type``, ``detail``)."""
+        return [{"mode": i + 1, "frequency_hz": float(f), "type": t, "detail": d}
+                for i, (f, t, d) in enumerate(zip(self.frequencies_hz, self.types, self.details))]
+
+
+def _bearing_cycle_times(model, n_positions):
+    """Instants spanning one ball-pass period of the first bearing, s."""
+    brg = model.rig.bearings[0]
+    cycles_per_rev = ball_pass_cycles_per_rev(brg)
+    period = 2.0 * math.pi / (model.op.omega_rad_s * cycles_per_rev)
+    return period * np.arange(n_positions) / n_positions
+
+
+def _averaged_bearing_stiffness(model, states, times):
+    """Tangent stiffness of each bearing averaged over the given states, (nb, 2, 2)."""
+    P = model.packed
+    b_int, b_par, b_cos, b_sin = P[4], P[5], P[6], P[7]
+    nb = b_int.shape[0]
+    out = np.zeros((nb, 2, 2))
+    for q, t in zip(states, times):
+        for ib in range(nb):
+            ix, iy, it, n_balls = (int(v) for v in b_int[ib, :4])
+            rate = b_par[ib, K.BP_CAGE] * b_par[ib, K.BP_SENSE]
+            cage = rate * (model.omega[it] * t + q[it]) + b_par[ib, K.BP_PHASE]
+            kxx, kxy, kyy = ball_tangent_stiffness_jit(
+                q[ix], q[iy], math.cos(cage), math.sin(cage), b_cos[ib, :n_balls],
+                b_sin[ib, :n_balls], b_par[ib, K.BP_K], b_par[ib, K.BP_P], b_par[ib, K.BP_C])
+            out[ib] += np.array([[kxx, kxy], [kxy, kyy]])
+    return out / len(states)
+
+
+def modal_analysis(rig, op, mesh_table=None, *, n_positions=24):
+    """Natural frequencies and mode types of ``rig`` at ``op``.
+
+    Parameters
+    ----------
+    rig : Rig
+    op : OperatingPoint
+        Speed (sets the bearing-cycle instants) and torque (sets the linearisation point).
+    mesh_table : MeshStiffnessTable, optional
+        Pair stiffness (default: potential-energy table).
+    n_positions : int
+        Quasi-static solutions per bearing cycle used for the average (>= 4).
+
+    Returns
+    -------
+    ModalResult
+    """
+    if not isinstance(n_positions, (int, np.integer)) or n_positions < 4:
+        raise ParameterError(f"n_positions must be an integer >= 4, got {n_positions!r}")
+    model = build_model(rig, op, mesh_table)
+    times = _bearing_cycle_times(model, n_positions)
+    states = quasi_static_orbit(model, times)
+    k_brg = _averaged_bearing_stiffness(model, states, times)
+    kmat = model.stiffness.copy()
+    for ib in range(k_brg.shape[0]):
+        ix = int(model.packed[4][ib, K.BI_X])
+        kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
+    k_mean = 0.0
+    if rig.gears is not None:
+        k_mean = model.mesh_table.mean_mesh_stiffness(rig.gears)
+        g = model.mesh_jacobian()
+        kmat += k_mean * np.outer(g, g)
+    kmat = 0.5 * (kmat + kmat.T)
+    eigvals, shapes = scipy.linalg.eigh(kmat, np.diag(model.mass))
+    freqs = np.sqrt(np.clip(eigvals, 0.0, None)) / (2.0 * math.pi)
+    types, details, shares = _classify(model, shapes)
+    return ModalResult(freqs, shapes, tuple(types), tuple(details), np.array(shares),
+                       model.dof_names, k_mean, k_brg)
+
+
+def _classify(model, shapes):
+    rot = np.array([d.startswith("theta") for d in model.dof_names])
+    energy = model.mass[:, None] * shapes ** 2
+    total = energy.sum(axis=0)
+    share_rot = energy[rot].sum(axis=0) / total
+    # translational energy along / normal to each shaft's line of action
+    loa, oloa = np.zeros(shapes.shape[1]), np.zeros(shapes.shape[1])
+    for name in model.rig.node_names:
+        e = model.loa_direction(0 if name.startswith("1") else 1)
+        ix = model.index(f"x_{name}")
+        m = model.mass[ix]
+        along = e[0] * shapes[ix] + e[1] * shapes[ix + 1]
+        normal = -e[1] * shapes[ix] + e[0] * shapes[ix + 1]
+        loa += m * along ** 2
+        oloa += m * normal ** 2
+    types, details = [], []
+    for j in range(shapes.shape[1]):
+        if share_rot[j] >= PURE_MODE_SHARE:
+            types.append("R")
+            details.append("R")
+        elif share_rot[j] <= 1.0 - PURE_MODE_SHARE:
+            types.append("T")
+            details.append("Tn" if loa[j] >= oloa[j] else "Tt")
+        else:
+            types.append("R-T")
+            details.append("R-T")
+    return types, details, share_rot
