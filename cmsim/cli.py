@@ -58,7 +58,8 @@ def _cmd_simulate(args):
     rig = _load_rig(args)
     op = _operating_point(args)
     table = MeshStiffnessTable.load(args.mesh_table) if args.mesh_table else None
-    slip = SlipModel(ball_rms_rad=args.slip_rms_rad, cage_rms_rad=args.cage_slip_rms_rad)
+    slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
+                     correlation_s=args.slip_correlation_s)
     run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
                    mesh_table=table, slip=slip, seed=args.seed, warmup_s=args.warmup_s)
     if args.out:
@@ -109,10 +110,12 @@ def _add_simulate(sub):
     p.add_argument("--substeps", type=int, default=1, help="integration steps per sample")
     p.add_argument("--warmup-s", type=float, default=0.05, help="discarded start, s")
     p.add_argument("--mesh-table", metavar="FILE.npz", help="pair stiffness table to use")
-    p.add_argument("--slip-rms-rad", type=float, default=0.0,
-                   help="rms random angular jitter of each ball, rad")
-    p.add_argument("--cage-slip-rms-rad", type=float, default=0.0,
-                   help="rms random jitter common to a bearing's balls, rad")
+    p.add_argument("--cage-slip", type=float, default=0.0, metavar="FRACTION",
+                   help="rms random cage-speed fluctuation (0.01 = 1 %%); spreads ball-pass lines")
+    p.add_argument("--ball-jitter-rad", type=float, default=0.0,
+                   help="rms random angular deviation of each ball in its pocket, rad")
+    p.add_argument("--slip-correlation-s", type=float, default=5e-3,
+                   help="correlation time of the slip processes, s")
     p.add_argument("--seed", type=int, help="random seed (recorded in the run)")
     p.add_argument("--out", type=Path, metavar="RUN.npz", help="write the run here")
     _add_rig_options(p)

@@ -683,6 +683,25 @@ class Rig:
             mesh_contact=MeshContact(),
         )
 
+    @classmethod
+    def rotor_on_bearings(cls, bearing, rotor, *, name="rotor on two ball bearings",
+                          bearing_2=None, shaft_stiffness_n_per_m=(2.0e8, 2.0e8),
+                          shaft_damping_n_s_per_m=(30.0, 30.0),
+                          torsional_stiffness_nm_per_rad=(1.0e5, 1.0e5),
+                          input_coupling=None):
+        """A bearing test rig: one shaft ``1b1 - 1D1 - 1b2`` carrying a rotor, no gears.
+
+        Driven at constant speed through ``input_coupling``; load it with
+        :attr:`OperatingPoint.radial_load_n`. ``bearing_2`` defaults to ``bearing``.
+        """
+        shaft = ShaftLine(bearing_1=bearing, bearing_2=bearing if bearing_2 is None else bearing_2,
+                          flexural_stiffness_n_per_m=shaft_stiffness_n_per_m,
+                          flexural_damping_n_s_per_m=shaft_damping_n_s_per_m,
+                          torsional_stiffness_nm_per_rad=torsional_stiffness_nm_per_rad,
+                          torsional_damping_nm_s_per_rad=(0.0, 0.0), rotor=rotor)
+        return cls(name=name, shafts=(shaft,),
+                   input_coupling=Coupling() if input_coupling is None else input_coupling)
+
     # ------------------------------------------------------------------ TOML
     def to_dict(self):
         """Plain nested dict (SI values) with a format version."""

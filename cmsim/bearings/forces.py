@@ -18,7 +18,8 @@ from cmsim.bearings._kernels import (ball_forces_jit, ball_tangent_stiffness_jit
 from cmsim.bearings.hertz import bearing_contact_stiffness
 from cmsim.errors import check_range
 
-__all__ = ["ball_offsets", "bearing_force", "bearing_tangent_stiffness", "loaded_balls"]
+__all__ = ["ball_offsets", "bearing_force", "bearing_tangent_stiffness", "loaded_balls",
+           "bearing_strain_energy"]
 
 
 def ball_offsets(bearing):
@@ -70,3 +71,31 @@ def loaded_balls(bearing, x_m, y_m, cage_angle_rad=0.0):
     """Number of balls in contact."""
     x, y, cc, sc, co, so = _args(bearing, x_m, y_m, cage_angle_rad)
     return int(loaded_ball_count_jit(x, y, cc, sc, co, so, bearing.clearance_m))
+
+
+def bearing_strain_energy(bearing, x_m, y_m, cage_angle_rad):
+    """Elastic energy stored in the ball contacts, k/(p+1)·Σ H(δ_i) δ_i^(p+1), J.
+
+    Its gradient in (x, y) is the force of :func:`bearing_force`. Arrays broadcast.
+
+    Parameters
+    ----------
+    bearing : RollingBearing
+    x_m, y_m : float or ndarray
+        Inner-ring offset, m.
+    cage_angle_rad : float or ndarray
+        Cage angle, rad.
+
+    Returns
+    -------
+    float or ndarray
+        Energy, J.
+    """
+    x, y, cage = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float),
+                                     np.asarray(cage_angle_rad, float))
+    theta = cage[..., None] + 2.0 * math.pi * np.arange(bearing.n_balls) / bearing.n_balls
+    overlap = x[..., None] * np.cos(theta) + y[..., None] * np.sin(theta) - bearing.clearance_m
+    p = bearing.load_exponent
+    energy = bearing_contact_stiffness(bearing) / (p + 1.0) * np.sum(
+        np.clip(overlap, 0.0, None) ** (p + 1.0), axis=-1)
+    return energy if energy.ndim else float(energy)

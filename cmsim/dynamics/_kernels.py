@@ -9,8 +9,8 @@ Right-hand side contract: ``rhs_jit(t, y, dydt, row, P, diag, want_diag, W)`` wi
 rotations in rad, rotations of shaft 2 counted positive in its own sense of motion), ``v`` their
 rates; it writes row ``row`` of the 2-D array ``dydt`` with ``[v, M⁻¹(f_ext + g(t, q, v) − K q
 − C v)]`` where ``g`` holds the bearing and mesh forces. With ``want_diag`` it also writes the
-output forces into ``diag``. ``W`` = (g, cos_nom, sin_nom, jit_cos, jit_sin) are scratch arrays
-from :func:`make_work`.
+output forces into ``diag``. ``W`` = (g, cos_nom, sin_nom, slip_cos, slip_sin, cage_slip) are
+scratch arrays from :func:`make_work`.
 
 Hot-path code never slices arrays (in numba every view takes an atomic reference count) and
 small kernels are inlined at numba-IR level (a call with array arguments costs about 25 ns).
@@ -64,9 +64,9 @@ def _jitter_at(jitter, ib, iball, t, jdt):
 
 
 @njit(cache=True, error_model="numpy")
-def _jittered_offsets(t, P, W):
-    """Fill ``W[3]``, ``W[4]`` (n_bearings, max_balls) with cos, sin of the jittered ball
-    offsets at time ``t`` (nominal spacing plus each ball's slip jitter)."""
+def _slip_offsets(t, P, W):
+    """Fill ``W[3]``, ``W[4]`` (n_bearings, max_balls) with cos, sin of the ball offsets
+    with slip at time ``t``, and ``W[5]`` with each cage's slip angle."""
     b_int = P[4]
     b_cos = P[6]
     b_sin = P[7]
@@ -74,7 +74,10 @@ def _jittered_offsets(t, P, W):
     jdt = P[10][MP_JDT]
     jit_cos = W[3]
     jit_sin = W[4]
+    cage_slip = W[5]
+    row = b_cos.shape[1]
     for ib in range(b_int.shape[0]):
+        cage_slip[ib] = _jitter_at(jitter, ib, row, t, jdt)
         for i in range(b_int[ib, BI_NB]):
             j = _jitter_at(jitter, ib, i, t, jdt)
             j2 = j * j
@@ -86,7 +89,8 @@ def _jittered_offsets(t, P, W):
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def _bearing_forces(t, y, n, g, P, diag, want_diag, W, ball_cos, ball_sin):
-    """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage.
+    """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage
+    and cages shifted by the slip angles ``W[5]`` (zeros without slip).
 
     Written flat on purpose: with helper functions inlined, a jitter branch, or arrays taken
     out of ``P`` inside the loop, numba stops vectorising the ball loop (2-3× slower).
@@ -100,6 +104,7 @@ def _bearing_forces(t, y, n, g, P, diag, want_diag, W, ball_cos, ball_sin):
     b_par = P[5]
     cos_nom = W[1]
     sin_nom = W[2]
+    cage_slip = W[5]
     for ib in range(b_int.shape[0]):
         ix = b_int[ib, BI_X]
         iy = b_int[ib, BI_Y]
@@ -107,7 +112,7 @@ def _bearing_forces(t, y, n, g, P, diag, want_diag, W, ball_cos, ball_sin):
         rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
         grp = b_int[ib, BI_GROUP]
         if grp == ib:
-            nominal = rate * omega[it] * t + b_par[ib, BP_PHASE]
+            nominal = rate * omega[it] * t + b_par[ib, BP_PHASE] + cage_slip[ib]
             cos_nom[ib] = math.cos(nominal)
             sin_nom[ib] = math.sin(nominal)
         dev = rate * y[it]
@@ -260,7 +265,7 @@ def make_work(P):
     """Scratch arrays ``W`` for :func:`rhs_jit`."""
     nb, max_balls = P[6].shape
     return (np.empty(P[0].shape[0]), np.empty(nb), np.empty(nb), np.empty((nb, max_balls)),
-            np.empty((nb, max_balls)))
+            np.empty((nb, max_balls)), np.zeros(nb))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -273,7 +278,7 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     for i in range(n):
         g[i] = fext[i]
     if P[8].shape[2] > 1:
-        _jittered_offsets(t, P, W)
+        _slip_offsets(t, P, W)
         _bearing_forces(t, y, n, g, P, diag, want_diag, W, W[3], W[4])
     else:
         _bearing_forces(t, y, n, g, P, diag, want_diag, W, P[6], P[7])

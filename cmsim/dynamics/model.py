@@ -32,33 +32,40 @@ __all__ = ["DynamicModel", "SlipModel", "build_model"]
 
 @dataclass(frozen=True)
 class SlipModel:
-    """Random ball-position jitter imitating rolling slip (paper 001 §5, last assumption).
+    """Random rolling slip (paper 001 §5, last assumption, and §6.2.1).
+
+    Two independent effects, both Ornstein-Uhlenbeck processes with correlation time
+    ``correlation_s``, drawn from the run's seed:
+
+    * the cage speed fluctuates by a fraction ``cage_speed_rms`` of its nominal value, so the
+      cage angle wanders like a random walk and the ball-pass lines spread over a band;
+    * each ball leads or lags its nominal place in the cage by a small angle of standard
+      deviation ``ball_rms_rad`` (cage-pocket play).
 
     Attributes
     ----------
+    cage_speed_rms : float
+        Standard deviation of the relative cage-speed fluctuation (0.01 = 1 %).
     ball_rms_rad : float
-        Standard deviation of each ball's independent angular deviation, rad.
-    cage_rms_rad : float
-        Standard deviation of a deviation common to all balls of a bearing (cage speed
-        fluctuation), rad.
+        Standard deviation of each ball's angular deviation, rad (<= 0.05).
     correlation_s : float
-        Correlation time of both Ornstein-Uhlenbeck processes, s.
+        Correlation time of both processes, s.
     """
 
+    cage_speed_rms: float = 0.0
     ball_rms_rad: float = 0.0
-    cage_rms_rad: float = 0.0
     correlation_s: float = 5e-3
 
     def __post_init__(self):
         from cmsim.errors import check_range
+        check_range("cage_speed_rms", self.cage_speed_rms, 0.0, 0.2)
         check_range("ball_rms_rad", self.ball_rms_rad, 0.0, 0.05, unit="rad")
-        check_range("cage_rms_rad", self.cage_rms_rad, 0.0, 0.05, unit="rad")
         check_range("correlation_s", self.correlation_s, 1e-5, 10.0, unit="s")
 
     @property
     def active(self):
-        """True when any jitter is requested."""
-        return self.ball_rms_rad > 0.0 or self.cage_rms_rad > 0.0
+        """True when any slip is requested."""
+        return self.cage_speed_rms > 0.0 or self.ball_rms_rad > 0.0
 
 
 @dataclass(frozen=True)
@@ -285,8 +292,11 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         k_in, k_out = cage_ratios(brg)
         sense = 1.0 if bname.startswith("1") else -1.0
         rate = (k_in + k_out * brg.outer_ring_speed_ratio) * sense * omega[3 * node + 2]
+        # bearings turning alike share the nominal cage cos/sin (not with slip: each cage
+        # then wanders on its own)
         group = next(j for j in range(ib + 1)
-                     if j == ib or (b_par[j, K.BP_CAGE] * b_par[j, K.BP_SENSE]
+                     if j == ib or (not slip.active
+                                    and b_par[j, K.BP_CAGE] * b_par[j, K.BP_SENSE]
                                     * omega[b_int[j, K.BI_T]] == rate
                                     and b_par[j, K.BP_PHASE] == phases[ib]))
         b_int[ib] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls, group)
@@ -300,7 +310,8 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         co, so = ball_offsets(brg)
         b_cos[ib, :brg.n_balls] = co
         b_sin[ib, :brg.n_balls] = so
-    jitter, jdt = _jitter(bearings, max_balls, slip, duration_s, seed)
+    cage_rates = [abs(b_par[ib, K.BP_CAGE] * omega[b_int[ib, K.BI_T]]) for ib in range(nb)]
+    jitter, jdt = _jitter(bearings, max_balls, cage_rates, slip, duration_s, seed)
 
     # ---- mesh
     m_int = np.zeros(K.MI_SIZE, dtype=np.int64)
@@ -378,19 +389,24 @@ def _pe_table_cached(pair):
     return _PE_CACHE[pair]
 
 
-def _jitter(bearings, max_balls, slip, duration_s, seed):
-    """Jitter grid (nb, max_balls, n_grid) and its spacing; a dummy (…, 1) grid when off."""
+def _jitter(bearings, max_balls, cage_rates, slip, duration_s, seed):
+    """Slip grid (nb, max_balls + 1, n_grid) and its spacing; a dummy (…, 1) grid when off.
+
+    Rows 0..n_balls−1 hold each ball's deviation from its nominal cage pocket; row
+    ``max_balls`` holds the cage angle offset (a random walk: the integral of the cage-speed
+    fluctuation), rad.
+    """
     nb = len(bearings)
     if not slip.active:
-        return np.zeros((nb, max_balls, 1)), 1.0
+        return np.zeros((nb, max_balls + 1, 1)), 1.0
     from cmsim.bearings.kinematics import slip_jitter
     rng = np.random.default_rng(seed)
     dt = slip.correlation_s / 10.0
     n_grid = int(math.ceil(duration_s / dt)) + 2
-    out = np.zeros((nb, max_balls, n_grid))
+    out = np.zeros((nb, max_balls + 1, n_grid))
     for ib, brg in enumerate(bearings):
         out[ib, :brg.n_balls] = slip_jitter(brg.n_balls, n_grid, dt, slip.ball_rms_rad,
                                             slip.correlation_s, rng)
-        out[ib, :brg.n_balls] += slip_jitter(1, n_grid, dt, slip.cage_rms_rad,
-                                             slip.correlation_s, rng)
+        speed = slip_jitter(1, n_grid, dt, slip.cage_speed_rms, slip.correlation_s, rng)[0]
+        out[ib, max_balls] = np.concatenate([[0.0], np.cumsum(speed[:-1])]) * cage_rates[ib] * dt
     return out, dt

@@ -167,7 +167,7 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
         "fs_hz": fs_hz, "substeps": int(substeps), "scheme": scheme, "warmup_s": warmup_s,
         "duration_s": n_rec / fs_hz, "seed": int(seed),
         "cage_phases_rad": [float(x) for x in model.packed[5][:, K.BP_PHASE]],
-        "slip": {"ball_rms_rad": slip.ball_rms_rad, "cage_rms_rad": slip.cage_rms_rad,
+        "slip": {"cage_speed_rms": slip.cage_speed_rms, "ball_rms_rad": slip.ball_rms_rad,
                  "correlation_s": slip.correlation_s},
         "mesh_table": None if model.mesh_table is None else {
             "method": model.mesh_table.method, "torque_nm": model.mesh_table.torque_nm},
