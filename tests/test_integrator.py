@@ -31,7 +31,7 @@ def sdof_packed():
             np.zeros((0, 1)), np.zeros((0, 1)), np.zeros((0, 1, 1)),
             np.zeros(K.MI_SIZE, dtype=np.int64), np.zeros(K.MP_SIZE), np.zeros(14),
             np.zeros(2), np.zeros(2), np.zeros((1, 2)), np.zeros((1, 2)),
-            np.array([[0, -1]], dtype=np.int64))
+            np.array([[0, 0, 1]], dtype=np.int64))
 
 
 def sdof_exact(t):
@@ -49,8 +49,8 @@ def run_sdof(scheme, h, t_end=2e-3):
     n_out = int(round(t_end / h)) + 1
     out = np.empty((n_out, 2))
     status = K.integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, tab.a, tab.b, tab.c, P,
-                             K.make_work(P), out, np.empty((n_out, 0)), 1.0, 1.0,
-                             np.array([True]))
+                             K.make_work(P), K.make_integrator_buffers(tab.b, 2, 0), out,
+                             np.empty((n_out, 0)), 1.0, 1.0, np.array([True]))
     assert status == -1
     t = h * np.arange(n_out)
     return t, out[:, 0]

@@ -12,14 +12,17 @@ rates; it writes row ``row`` of the 2-D array ``dydt`` with ``[v, M⁻¹(f_ext +
 output forces into ``diag``. ``W`` = (g, cos_nom, sin_nom, slip_cos, slip_sin, cage_slip) are
 scratch arrays from :func:`make_work`.
 
-Hot-path code never slices arrays (in numba every view takes an atomic reference count) and
-small kernels are inlined at numba-IR level (a call with array arguments costs about 25 ns).
+Hot-path code never slices arrays and never takes arrays out of tuples inside loops (numba
+takes an atomic reference count for each), and the integrator and force kernels are compiled
+without numba's reference-counting runtime (``_nrt=False``, so they allocate nothing: the
+caller passes every buffer), which halved the cost of a step. Small kernels are inlined at
+numba-IR level (a call with array arguments costs about 25 ns).
 The bearing forces are compiled with fastmath so the ball loop vectorises; the finiteness
 checks live in the integrator, which is compiled without it.
 
 ``P`` = (minv, springs, fext, omega, b_int, b_par, b_cos, b_sin, jitter, m_int, m_par, geo, tab_k,
 tab_e, teeth1, teeth2, spring_ends) with the linear K and C as two-node spring-dampers
-(``springs`` (e, 2) = k, c; ``spring_ends`` (e, 2) = DOF indices, −1 = ground) and ``teeth1/2``
+(``springs`` (e, 2) = k, c; ``spring_ends`` (e, 3), see :func:`linear_accel_jit`) and ``teeth1/2``
 the cos and sin of multiples of the angular pitch, shape (Z, 2); index constants below.
 """
 
@@ -63,7 +66,7 @@ def _jitter_at(jitter, ib, iball, t, jdt):
     return jitter[ib, iball, i] + f * (jitter[ib, iball, i + 1] - jitter[ib, iball, i])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _slip_offsets(t, P, W):
     """Fill ``W[3]``, ``W[4]`` (n_bearings, max_balls) with cos, sin of the ball offsets
     with slip at time ``t``, and ``W[5]`` with each cage's slip angle."""
@@ -87,8 +90,9 @@ def _slip_offsets(t, P, W):
             jit_sin[ib, i] = b_sin[ib, i] * cj + b_cos[ib, i] * sj
 
 
-@njit(cache=True, fastmath=True, error_model="numpy")
-def _bearing_forces(t, y, n, g, P, diag, want_diag, W, ball_cos, ball_sin):
+@njit(cache=True, fastmath=True, error_model="numpy", _nrt=False)
+def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, cos_nom, sin_nom,
+                    cage_slip, diag, want_diag):
     """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage
     and cages shifted by the slip angles ``W[5]`` (zeros without slip).
 
@@ -97,14 +101,9 @@ def _bearing_forces(t, y, n, g, P, diag, want_diag, W, ball_cos, ball_sin):
     The cage angle's nominal part (rate·Ω·t) is computed once per group of bearings turning
     alike; the small dynamic deviation (rate·q_θ) is applied as a rotation (Taylor series).
     Each bearing works in its cage frame: the inner-ring offset is turned by −θ_cage once
-    instead of turning every ball.
+    instead of turning every ball. Arrays come as arguments, not in the tuple ``P``: a
+    non-inlined call copies its arguments, and ``P`` holds 17 arrays.
     """
-    omega = P[3]
-    b_int = P[4]
-    b_par = P[5]
-    cos_nom = W[1]
-    sin_nom = W[2]
-    cage_slip = W[5]
     for ib in range(b_int.shape[0]):
         ix = b_int[ib, BI_X]
         iy = b_int[ib, BI_Y]
@@ -134,15 +133,10 @@ def _bearing_forces(t, y, n, g, P, diag, want_diag, W, ball_cos, ball_sin):
             diag[2 * ib + 1] = fy + b_par[ib, BP_DAMP] * y[n + iy]
 
 
-@njit(cache=True, error_model="numpy")
-def _mesh_forces(t, y, n, g, P, diag, want_diag):
-    m_int = P[9]
-    mp = P[10]
-    geo = P[11]
-    tab_k = P[12]
-    tab_e = P[13]
-    teeth1 = P[14]
-    teeth2 = P[15]
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag, want_diag):
+    """Forces of the tooth pairs in the potential-contact zone (exact rigid-body geometry,
+    table stiffness, hysteretic or Koster squeeze damping, smoothed Coulomb friction)."""
     z1 = teeth1.shape[0]
     z2 = teeth2.shape[0]
     i1 = m_int[MI_G1]
@@ -243,19 +237,22 @@ def _mesh_forces(t, y, n, g, P, diag, want_diag):
 def linear_accel_jit(y, g, minv, springs, ends, dydt, row):
     """Row ``row`` of ``dydt`` = ``[v, M⁻¹(g − K q − C v)]`` for ``y = [q, v]`` (eq. 1, linear).
 
-    K and C are sums of two-node spring-dampers (Annex A): ``ends[e] = (a, b)`` DOF indices
-    (``b = −1`` for a connection to ground), ``springs[e] = (k, c)``. ``g`` is overwritten.
+    K and C are sums of spring-dampers (Annex A): ``ends[e] = (a, b)`` DOF indices,
+    ``springs[e] = (k, c)``; ground connections have ``b = a`` and are listed last with
+    their own count in ``ends[0, 2]`` (so both loops are branch-free). ``g`` is overwritten.
     """
     n = minv.shape[0]
-    for e in range(ends.shape[0]):
+    n_springs = ends.shape[0]
+    n_ground = ends[0, 2]
+    for e in range(n_springs - n_ground):
         a = ends[e, 0]
         b = ends[e, 1]
-        if b >= 0:
-            f = springs[e, 0] * (y[a] - y[b]) + springs[e, 1] * (y[n + a] - y[n + b])
-            g[b] += f
-        else:
-            f = springs[e, 0] * y[a] + springs[e, 1] * y[n + a]
+        f = springs[e, 0] * (y[a] - y[b]) + springs[e, 1] * (y[n + a] - y[n + b])
+        g[b] += f
         g[a] -= f
+    for e in range(n_springs - n_ground, n_springs):
+        a = ends[e, 0]
+        g[a] -= springs[e, 0] * y[a] + springs[e, 1] * y[n + a]
     for i in range(n):
         dydt[row, i] = y[n + i]
         dydt[row, n + i] = minv[i] * g[i]
@@ -279,21 +276,33 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
         g[i] = fext[i]
     if P[8].shape[2] > 1:
         _slip_offsets(t, P, W)
-        _bearing_forces(t, y, n, g, P, diag, want_diag, W, W[3], W[4])
+        ball_cos = W[3]
+        ball_sin = W[4]
     else:
-        _bearing_forces(t, y, n, g, P, diag, want_diag, W, P[6], P[7])
+        ball_cos = P[6]
+        ball_sin = P[7]
+    if P[4].shape[0] > 0:
+        _bearing_forces(t, y, n, g, P[3], P[4], P[5], ball_cos, ball_sin, W[1], W[2], W[5],
+                        diag, want_diag)
     if P[9][MI_ON] != 0:
-        _mesh_forces(t, y, n, g, P, diag, want_diag)
+        _mesh_forces(t, y, n, g, P[9], P[10], P[11], P[12], P[13], P[14], P[15], diag,
+                     want_diag)
     linear_accel_jit(y, g, minv, P[1], P[16], dydt, row)
 
 
-@njit(cache=True, error_model="numpy")
-def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, out_y, out_diag,
+def make_integrator_buffers(tableau_b, dim, n_diag):
+    """Buffers of :func:`integrate_jit`: stage slopes (s, dim), state, stage state, diag."""
+    return (np.zeros((tableau_b.shape[0], dim)), np.empty(dim), np.empty(dim), np.empty(n_diag))
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, B, out_y, out_diag,
                   max_disp, max_rot, trans_mask):
     """Fixed-step explicit Runge-Kutta with output every ``substeps`` steps.
 
     The scheme is data: ``rk_a`` (s, s) strictly lower triangular, ``rk_b`` (s,), ``rk_c`` (s,).
-    ``W`` is the scratch tuple of :func:`make_work`. Sample ``m`` of ``out_y`` is the state at
+    ``W`` is the scratch tuple of :func:`make_work`, ``B`` that of
+    :func:`make_integrator_buffers`. Sample ``m`` of ``out_y`` is the state at
     ``t0 + m·substeps·h``; ``out_diag[m]`` holds the output forces at that instant (from the
     first stage of the following step, so they cost nothing extra).
 
@@ -304,15 +313,15 @@ def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, out_y, out
         exceeded ``max_disp`` on a translational DOF (``trans_mask``) or ``max_rot`` on a
         rotational one.
     """
+    k = B[0]
+    y = B[1]
+    yi = B[2]
+    scratch = B[3]
     ns = rk_b.shape[0]
     dim = y0.shape[0]
     n = dim // 2
-    k = np.zeros((ns, dim))
-    y = y0.copy()
-    yi = np.empty(dim)
-    ha = h * rk_a
-    hb = h * rk_b
-    scratch = np.empty(out_diag.shape[1])
+    for i in range(dim):
+        y[i] = y0[i]
     for m in range(n_out):
         for i in range(dim):
             out_y[m, i] = y[i]
@@ -332,12 +341,12 @@ def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, out_y, out
                 for i in range(dim):
                     acc = y[i]
                     for jj in range(st):
-                        acc += ha[st, jj] * k[jj, i]
+                        acc += h * rk_a[st, jj] * k[jj, i]
                     yi[i] = acc
                 rhs_jit(t + rk_c[st] * h, yi, k, st, P, scratch, False, W)
             for i in range(dim):
                 acc = 0.0
                 for st in range(ns):
-                    acc += hb[st] * k[st, i]
-                y[i] += acc
+                    acc += rk_b[st] * k[st, i]
+                y[i] += h * acc
     return -1

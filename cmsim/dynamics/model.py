@@ -361,8 +361,11 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         m_par[K.MP_TABD] = 1.0
         tab_k = np.zeros(2)
         tab_e = np.zeros(2)
-    springs = np.array([(k, c) for _, _, k, c in elements])
-    spring_ends = np.array([(a, b) for a, b, _, _ in elements], dtype=np.int64)
+    # kernel layout: two-node springs first, then ground springs (b = a), count in [0, 2]
+    ordered = sorted(elements, key=lambda e: e[1] < 0)
+    springs = np.array([(k, c) for _, _, k, c in ordered])
+    spring_ends = np.array([(a, a if b < 0 else b, 0) for a, b, _, _ in ordered], dtype=np.int64)
+    spring_ends[0, 2] = sum(1 for e in ordered if e[1] < 0)
     packed = (1.0 / mass, springs, force, omega, b_int, b_par, b_cos, b_sin, jitter, m_int,
               m_par, geo, tab_k, tab_e, teeth1, teeth2, spring_ends)
     return DynamicModel(rig, op, mesh_table, names, mass, kmat, cmat, force, omega, packed,

@@ -57,7 +57,8 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3"):
     max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
     max_rot = MAX_ROTATION_DEVIATION_RAD
     mask = model.translational_mask
-    args = (tab.a, tab.b, tab.c, model.packed, K.make_work(model.packed))
+    args = (tab.a, tab.b, tab.c, model.packed, K.make_work(model.packed),
+            K.make_integrator_buffers(tab.b, y0.size, len(model.diag_names)))
     # compile (or load from cache) outside the timed region
     K.integrate_jit(y0, t0, h, 1, 1, *args, states[:1], diag[:1], max_disp, max_rot, mask)
     start = time.perf_counter()
@@ -82,8 +83,10 @@ def _compile_seconds():
         model = build_model(rig, cmsim.OperatingPoint(1000.0, 10.0),
                             MeshStiffnessTable.constant(rig.gears, 1e8))
         y0 = np.zeros(2 * model.n_dof)
-        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, SCHEMES["ode3"].a, SCHEMES["ode3"].b,
-                        SCHEMES["ode3"].c, model.packed, K.make_work(model.packed),
+        tab = SCHEMES["ode3"]
+        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, tab.a, tab.b, tab.c, model.packed,
+                        K.make_work(model.packed),
+                        K.make_integrator_buffers(tab.b, y0.size, len(model.diag_names)),
                         np.empty((2, y0.size)),
                         np.empty((2, len(model.diag_names))), 1.0, 1.0,
                         model.translational_mask)

@@ -1,0 +1,83 @@
+"""The ``cmsim`` command line, called as ``main([...])``.
+
+Tier (c) behaviour: JSON contracts of the issue (keys and consistency), exit codes and error
+messages naming the parameter.
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from cmsim.cli import main
+from cmsim.run import Run
+
+
+def run_json(capsys, argv):
+    status = main(argv + ["--json"])
+    out = capsys.readouterr().out
+    return status, json.loads(out)
+
+
+def test_simulate_json_and_npz(capsys, tmp_path):
+    out = tmp_path / "run.npz"
+    status, res = run_json(capsys, ["simulate", "--speed-rpm", "1000", "--torque-nm", "50",
+                                    "--duration-s", "0.1", "--seed", "5", "--out", str(out)])
+    assert status == 0
+    for key in ("gmf_hz", "bpf_hz", "shaft_hz", "dte_mean_rad", "dte_rms_rad", "sim_s", "wall_s",
+                "realtime_factor", "compile_s"):
+        assert key in res
+    assert res["gmf_hz"] == pytest.approx(466.667, abs=1e-3)
+    assert res["realtime_factor"] == pytest.approx(res["sim_s"] / res["wall_s"])
+    run = Run.load(out)
+    assert run.meta["seed"] == 5
+    for name in ("dte", "F_1b1_x", "F_2b2_oloa", "x_1G1", "y_2b1", "theta_2J2", "Fmesh_0"):
+        assert name in run.signals
+    assert np.mean(run["dte"]) == pytest.approx(res["dte_mean_rad"])
+
+
+def test_simulate_with_options(capsys, tmp_path):
+    rig = tmp_path / "rig.toml"
+    from cmsim.rig import Rig
+    Rig.paper_2016().save(rig)
+    status, res = run_json(capsys, ["simulate", "--speed-rpm", "1500", "--torque-nm", "20",
+                                    "--duration-s", "0.05", "--rig", str(rig), "--friction",
+                                    "0.03", "--clearance-m", "-1e-6", "--seed", "1"])
+    assert status == 0
+    assert res["gmf_hz"] == pytest.approx(28 * 25)
+
+
+def test_modes_json(capsys):
+    status, res = run_json(capsys, ["modes", "--torque-nm", "50"])
+    assert status == 0
+    f = res["frequencies_hz"]
+    assert len(f) == len(res["types"]) == 19
+    assert f == sorted(f)
+    assert f[15] == pytest.approx(14382, rel=0.03)
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["simulate", "--speed-rpm", "0"], "speed_rpm"),
+    (["simulate", "--speed-rpm", "1000", "--torque-nm", "nan"], "torque_nm"),
+    (["simulate", "--speed-rpm", "1000", "--clearance-m", "0.02"], "clearance_m"),
+    (["simulate", "--speed-rpm", "1000", "--rig", "/nonexistent.toml"], "does not exist"),
+    (["modes", "--torque-nm", "-5"], "torque_nm"),
+])
+def test_bad_input_exit_code_and_message(capsys, argv, word):
+    status = main(argv + ["--json"])
+    cap = capsys.readouterr()
+    assert status == 2
+    assert word in json.loads(cap.out)["error"]
+    assert word in cap.err
+
+
+def test_divergence_exit_code(capsys):
+    status = main(["simulate", "--speed-rpm", "1000", "--torque-nm", "100", "--fs-hz", "2000",
+                   "--warmup-s", "0", "--duration-s", "0.2"])
+    assert status == 3
+    assert "diverged" in capsys.readouterr().err
+
+
+def test_text_output(capsys):
+    assert main(["modes", "--torque-nm", "10"]) == 0
+    assert "natural frequencies" in capsys.readouterr().out
