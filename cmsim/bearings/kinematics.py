@@ -51,13 +51,14 @@ def ball_angles(bearing, theta_inner_rad, theta_outer_rad=0.0, offset_rad=0.0):
 def ball_pass_cycles_per_rev(bearing):
     """Ball passes over a fixed load direction per inner-ring revolution.
 
-    N_b·|K_in + K_out·ρ| with ρ = ``outer_ring_speed_ratio``; the paper's rig gives 3.6342.
+    N_b·|K_in + K_out·ρ| with ρ = ``outer_ring_speed_ratio``. The paper's rig gives 3.6339
+    with the bearing's free contact angle (9.94°); the paper prints 3.6342 (α ≈ 10.0°).
 
     Examples
     --------
     >>> from cmsim.rig import Rig
     >>> round(ball_pass_cycles_per_rev(Rig.paper_2016().bearings[0]), 4)
-    3.6342
+    3.6339
     """
     k_in, k_out = cage_ratios(bearing)
     return bearing.n_balls * abs(k_in + k_out * bearing.outer_ring_speed_ratio)
