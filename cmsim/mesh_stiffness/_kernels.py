@@ -47,10 +47,11 @@ def mesh_frame_jit(c1x, c1y, c2x, c2y, rb1, rb2):
     dx = c2x - c1x
     dy = c2y - c1y
     a = math.sqrt(dx * dx + dy * dy)
-    ca = (rb1 + rb2) / a
+    inv_a = 1.0 / a
+    ca = (rb1 + rb2) * inv_a
     sa = math.sqrt(1.0 - ca * ca)
-    cg = dx / a
-    sg = dy / a
+    cg = dx * inv_a
+    sg = dy * inv_a
     cos_t1 = cg * ca + sg * sa
     sin_t1 = sg * ca - cg * sa
     return math.atan2(sin_t1, cos_t1), a * sa, cos_t1, sin_t1
@@ -127,8 +128,9 @@ def pair_contact_jit(s, delta_inv, cp1, sp1, cp2, sp2, c1x, c1y, c2x, c2y, cos_t
     ar = cp * wx + sp * wy
     ai = sp * wx - cp * wy
     roll = rb * math.atan2(ar * lam + ai * rb, ar * rb - ai * lam)
-    cphi = (wx * rb + wy * lam) / w2
-    sphi = (wy * rb - wx * lam) / w2
+    inv_w2 = 1.0 / w2
+    cphi = (wx * rb + wy * lam) * inv_w2
+    sphi = (wy * rb - wx * lam) * inv_w2
     tx = -sphi
     ty = cphi
     delta = rho - (lam - roll)
