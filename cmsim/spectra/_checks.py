@@ -21,6 +21,13 @@ DETRENDS = ("constant", "linear", None)
 MIN_SAMPLES = 8
 
 
+def readonly(a):
+    """A float64 copy of ``a`` that cannot be written (results behave as values)."""
+    a = np.array(a, dtype=float)
+    a.flags.writeable = False
+    return a
+
+
 def signal_1d(x, name="x", min_samples=MIN_SAMPLES):
     """Return ``x`` as a finite float64 1-D array of at least ``min_samples`` samples."""
     try:

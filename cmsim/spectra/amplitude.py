@@ -26,19 +26,13 @@ import numpy as np
 import scipy.signal
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import (DETRENDS, WINDOWS, choice, positive_int, sampling_rate,
-                                   signal_1d)
+from cmsim.spectra._checks import (DETRENDS, WINDOWS, choice, positive_int, readonly,
+                                   sampling_rate, signal_1d)
 
 __all__ = ["Spectrum", "amplitude_spectrum", "welch_amplitude", "SPECTRUM_KINDS"]
 
 #: Values of :attr:`Spectrum.kind`.
 SPECTRUM_KINDS = ("amplitude", "welch", "envelope")
-
-
-def _readonly(a):
-    a = np.array(a, dtype=float)
-    a.flags.writeable = False
-    return a
 
 
 @dataclass(frozen=True, eq=False)
@@ -77,8 +71,8 @@ class Spectrum:
     n_averages: int = 1
 
     def __post_init__(self):
-        object.__setattr__(self, "freq_hz", _readonly(self.freq_hz))
-        object.__setattr__(self, "amplitude", _readonly(self.amplitude))
+        object.__setattr__(self, "freq_hz", readonly(self.freq_hz))
+        object.__setattr__(self, "amplitude", readonly(self.amplitude))
         if self.freq_hz.shape != self.amplitude.shape or self.freq_hz.ndim != 1:
             raise ParameterError("freq_hz and amplitude must be 1-D arrays of the same shape")
         choice("kind", self.kind, SPECTRUM_KINDS)

@@ -34,7 +34,8 @@ import scipy.interpolate
 import scipy.signal
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import WINDOWS, choice, positive_int, sampling_rate, signal_1d
+from cmsim.spectra._checks import (WINDOWS, choice, positive_int, readonly, sampling_rate,
+                                  signal_1d)
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["OrderSpectrum", "tacho_pulse_times", "shaft_angle", "angle_resample",
@@ -43,12 +44,6 @@ __all__ = ["OrderSpectrum", "tacho_pulse_times", "shaft_angle", "angle_resample"
 #: Largest angle-domain record, as a multiple of the time-domain length (guards against a
 #: default samples_per_rev blowing up at near-zero speed).
 MAX_UPSAMPLING = 32
-
-
-def _readonly(a):
-    a = np.array(a, dtype=float)
-    a.flags.writeable = False
-    return a
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,8 +76,8 @@ class OrderSpectrum:
     samples_per_rev: int
 
     def __post_init__(self):
-        object.__setattr__(self, "order", _readonly(self.order))
-        object.__setattr__(self, "amplitude", _readonly(self.amplitude))
+        object.__setattr__(self, "order", readonly(self.order))
+        object.__setattr__(self, "amplitude", readonly(self.amplitude))
 
     def __iter__(self):
         yield self.order

@@ -20,16 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.spectra._checks import positive_int
+from cmsim.spectra._checks import positive_int, readonly
 from cmsim.spectra.order import angle_resample
 
 __all__ = ["SynchronousAverage", "time_synchronous_average"]
-
-
-def _readonly(a):
-    a = np.array(a, dtype=float)
-    a.flags.writeable = False
-    return a
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,7 +52,7 @@ class SynchronousAverage:
 
     def __post_init__(self):
         for name in ("angle_rev", "average", "residual"):
-            object.__setattr__(self, name, _readonly(getattr(self, name)))
+            object.__setattr__(self, name, readonly(getattr(self, name)))
 
 
 def time_synchronous_average(x, fs, *, speed_rpm=None, speed_time_s=None, tacho=None,
