@@ -156,6 +156,187 @@ def _add_modes(sub):
     p.set_defaults(func=_cmd_modes, text=_text_modes)
 
 
+# ---------------------------------------------------------------------- spectrum
+def _save_figure(fig, path):
+    import io
+
+    from cmsim._io import atomic_write_bytes
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    atomic_write_bytes(path, buf.getvalue())
+
+
+def _cmd_spectrum(args):
+    from cmsim.run import Run
+    from cmsim.spectra.run_spectrum import run_spectrum
+
+    run = Run.load(args.run)
+    spec = run_spectrum(run, args.signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
+                        resolution_hz=args.resolution_hz, bearing=args.bearing,
+                        max_peaks=args.top, threshold_db=args.threshold_db)
+    out = {"run": str(args.run), "signal": spec.signal, "kind": spec.kind, "unit": spec.unit,
+           "resolution_hz": spec.resolution_hz, "bearing": spec.bearing,
+           "families": spec.families, "band_hz": list(spec.band_hz) if spec.band_hz else None,
+           "max_hz": spec.max_hz, "n_peaks": len(spec.peaks), "peaks": spec.peak_records(),
+           "plot": None, **spec.extra}
+    if args.plot:
+        from cmsim.spectra.plots import plot_spectrum
+        fam = spec.families
+        fig = plot_spectrum(spec.freq_hz, spec.amplitude, spec.peaks, fam,
+                            amplitude_unit=spec.unit, max_freq=spec.max_hz,
+                            max_harmonic=max(1, int(spec.max_hz // fam.get("GMF", spec.max_hz))),
+                            title=f"{spec.signal}: {spec.kind} spectrum "
+                                  f"({spec.resolution_hz:.3g} Hz resolution)")
+        _save_figure(fig, args.plot)
+        out["plot"] = str(args.plot)
+    return out
+
+
+def _text_spectrum(res):
+    lines = [f"{res['kind']} spectrum of {res['signal']} [{res['unit']}], resolution "
+             f"{res['resolution_hz']:.4g} Hz, families of bearing {res['bearing']}: "
+             + ", ".join(f"{k} {v:.3f} Hz" for k, v in res["families"].items())]
+    if res["band_hz"]:
+        lines.append(f"demodulation band {res['band_hz'][0]:.0f}-{res['band_hz'][1]:.0f} Hz")
+    lines.append(f"{'frequency_hz':>13}  {'amplitude':>11}  {'dB re carrier':>13}  label")
+    for p in res["peaks"]:
+        db = "" if p["db_re_carrier"] is None else f"{p['db_re_carrier']:.1f}"
+        lines.append(f"{p['frequency_hz']:13.2f}  {p['amplitude']:11.4g}  {db:>13}  "
+                     f"{p['label']}")
+    if res["plot"]:
+        lines.append(f"wrote {res['plot']}")
+    return "\n".join(lines)
+
+
+def _add_spectrum(sub):
+    p = sub.add_parser("spectrum", help="labelled spectrum of one signal of a run",
+                       description="Amplitude, envelope or order spectrum of a run signal, "
+                                   "with its largest peaks named k·GMF ± m·BPF ± n·fr from "
+                                   "the run's own rig and operating point.")
+    p.add_argument("run", type=Path, metavar="RUN.npz", help="run written by cmsim simulate")
+    p.add_argument("--signal", default="F_1b1_loa", help="signal name (default F_1b1_loa)")
+    p.add_argument("--kind", default="amplitude", choices=("amplitude", "envelope", "order"),
+                   help="spectrum kind")
+    p.add_argument("--band-hz", type=float, nargs=2, metavar=("LO", "HI"),
+                   help="demodulation band for --kind envelope, Hz (default: kurtogram's)")
+    p.add_argument("--max-hz", type=float, metavar="F", help="list peaks up to F Hz")
+    p.add_argument("--resolution-hz", type=float, metavar="R",
+                   help="required bin spacing, Hz (error if the record is too short)")
+    p.add_argument("--bearing", help="bearing for the BPF family (default: from the signal)")
+    p.add_argument("--top", type=int, default=20, help="number of largest peaks listed")
+    p.add_argument("--threshold-db", type=float, default=15.0,
+                   help="least peak height above the noise floor, dB")
+    p.add_argument("--plot", type=Path, metavar="OUT.png", help="write the spectrum figure")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.set_defaults(func=_cmd_spectrum, text=_text_spectrum)
+
+
+# ---------------------------------------------------------------------- sweep
+def _cmd_sweep(args):
+    from cmsim.datasets import SweepSpec, run_sweep
+    from cmsim.rig import Rig
+
+    rig = Rig.load(args.rig) if args.rig else Rig.paper_2016()
+    spec = SweepSpec(speeds_rpm=args.speed_rpm, torques_nm=args.torque_nm,
+                     duration_s=args.duration_s, frictions=args.friction or (None,),
+                     clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
+                     warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
+                     seed_policy=args.seed_policy)
+    progress = not args.json and sys.stderr.isatty()
+    try:
+        summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,
+                            progress=progress)
+    except KeyboardInterrupt:
+        msg = (f"interrupted; finished runs are kept in {args.out}/manifest.json, re-run the "
+               f"same command to resume")
+        print(f"cmsim: {msg}", file=sys.stderr)
+        if args.json:
+            print(json.dumps({"error": msg}))
+        raise SystemExit(130) from None
+    return summary.to_dict()
+
+
+def _text_sweep(res):
+    lines = [f"{res['n_runs']} runs in {res['dir']}: {res['completed']} simulated, "
+             f"{res['skipped']} already there ({res['adopted']} adopted), "
+             f"{len(res['failed'])} failed",
+             f"wall {res['wall_s']:.2f} s on {res['workers']} workers ({res['start_method']}); "
+             f"integration {res['integration_s']:.2f} s, compile {res['compile_s']:.2f} s, "
+             f"setup {res['setup_s']:.2f} s, spectra {res['spectra_s']:.2f} s, "
+             f"save {res['save_s']:.2f} s; utilisation {100 * res['utilisation']:.0f} %",
+             f"manifest {res['manifest']}"]
+    return "\n".join(lines)
+
+
+def _add_sweep(sub):
+    p = sub.add_parser("sweep", help="simulate a grid of operating points in parallel",
+                       description="Simulate speeds × torques (× frictions × clearances) on "
+                                   "worker processes; each run is saved to DIR/runs/ and "
+                                   "recorded in DIR/manifest.json as it finishes. Re-running "
+                                   "the same command resumes: finished runs are skipped.")
+    p.add_argument("--torque-nm", type=float, nargs="+", required=True,
+                   help="output torques, N m")
+    p.add_argument("--speed-rpm", type=float, nargs="+", required=True,
+                   help="input shaft speeds, rpm")
+    p.add_argument("--duration-s", type=float, default=1.0, help="recorded duration, s")
+    p.add_argument("--out", type=Path, required=True, metavar="DIR", help="sweep directory")
+    p.add_argument("--rig", metavar="FILE.toml",
+                   help="rig description (default: the paper's rig, Tables 1-3)")
+    p.add_argument("--friction", type=float, nargs="+", metavar="F",
+                   help="mesh friction coefficients (default: the rig's)")
+    p.add_argument("--clearance-m", type=float, nargs="+", metavar="C",
+                   help="bearing radial clearances, m (negative = preload; default: the "
+                        "rig's); with several values write negatives in decimal (-0.000001)")
+    p.add_argument("--fs-hz", type=float, default=75_000.0, help="output sample rate, Hz")
+    p.add_argument("--warmup-s", type=float, default=0.05, help="discarded start, s")
+    p.add_argument("--substeps", type=int, default=1, help="integration steps per sample")
+    p.add_argument("--seed", type=int, default=0,
+                   help="base seed; run i gets a seed derived from (seed, i)")
+    p.add_argument("--seed-policy", default="per_run", choices=("per_run", "shared"),
+                   help="per_run: independent seed per run; shared: every run uses --seed")
+    p.add_argument("--workers", type=int, default=None,
+                   help="worker processes (default: number of CPUs)")
+    p.add_argument("--force", action="store_true",
+                   help="replace a manifest written for a different spec")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.set_defaults(func=_cmd_sweep, text=_text_sweep)
+
+
+# ---------------------------------------------------------------------- report
+def _cmd_report(args):
+    from cmsim.report import DEFAULT_SIGNALS, build_report
+
+    res = build_report(args.dir, tuple(args.signal) if args.signal else DEFAULT_SIGNALS,
+                       top_n=args.top, max_freq_hz=args.max_hz,
+                       progress=not args.json and sys.stderr.isatty())
+    return res.to_dict()
+
+
+def _text_report(res):
+    lines = [f"wrote {res['html']} with {len(res['figures'])} figures "
+             f"({', '.join(res['figures'])})",
+             f"report {res['total_s']:.2f} s: load {res['load_s']:.2f} s, spectra "
+             f"{res['spectra_s']:.2f} s, plots {res['plot_s']:.2f} s, html {res['write_s']:.2f} s"]
+    if res["dominant_signal"]:
+        lines.append(f"dominant GMF harmonic of {res['dominant_signal']}: " + ", ".join(
+            f"{r['name']}: {r['dominant_gmf_harmonic']}" for r in res["runs"]))
+    return "\n".join(lines)
+
+
+def _add_report(sub):
+    p = sub.add_parser("report", help="HTML report (waterfalls, orbits, DTE) of a sweep",
+                       description="Write DIR/report.html and its PNG figures from the run "
+                                   "files of a sweep directory.")
+    p.add_argument("dir", type=Path, metavar="DIR", help="sweep directory (cmsim sweep --out)")
+    p.add_argument("--signal", nargs="+", metavar="NAME",
+                   help="signals drawn as waterfalls (default: dte_um F_1b1_loa F_1b1_oloa)")
+    p.add_argument("--top", type=int, default=8, help="labelled peaks listed per run")
+    p.add_argument("--max-hz", type=float, metavar="F",
+                   help="upper frequency of the waterfalls, Hz (default 6.5 GMF)")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.set_defaults(func=_cmd_report, text=_text_report)
+
+
 # ---------------------------------------------------------------------- main
 def build_parser():
     """The argparse parser of ``cmsim``."""
@@ -170,7 +351,7 @@ def build_parser():
     return parser
 
 
-_COMMANDS = [_add_simulate, _add_modes]
+_COMMANDS = [_add_simulate, _add_modes, _add_spectrum, _add_sweep, _add_report]
 
 
 def _jsonable(obj):

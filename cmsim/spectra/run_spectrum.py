@@ -1,0 +1,244 @@
+"""Labelled spectrum of one signal of a saved run (what ``cmsim spectrum`` prints).
+
+The base frequencies used to name the peaks (GMF, BPF, fr, BPFO, …) come from the run's own
+metadata — its rig and operating point — through
+:func:`~cmsim.spectra.frequencies.rig_frequencies`, with the bearing taken from the signal
+name (``F_2b1_loa`` → bearing ``2b1`` and the output shaft rate as ``fr``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cmsim.errors import ParameterError, check_range
+from cmsim.spectra._checks import band as check_band
+from cmsim.spectra._checks import choice, positive_int
+from cmsim.spectra.amplitude import amplitude_spectrum
+from cmsim.spectra.envelope import envelope_spectrum
+from cmsim.spectra.frequencies import peak_families, rig_frequencies
+from cmsim.spectra.kurtogram import kurtogram
+from cmsim.spectra.labels import PEAK_KINDS, label_peaks
+from cmsim.spectra.order import order_spectrum
+
+__all__ = ["RunSpectrum", "run_spectrum", "signal_unit", "signal_bearing", "run_families"]
+
+
+def signal_unit(name):
+    """Unit of a run signal from its name: ``"N"``, ``"µm"``, ``"m"`` or ``"rad"``.
+
+    Examples
+    --------
+    >>> signal_unit("F_1b1_loa"), signal_unit("dte_um"), signal_unit("x_1G1")
+    ('N', 'µm', 'm')
+    """
+    if name.startswith(("F_", "Fmesh")):
+        return "N"
+    if name.endswith("_um"):
+        return "µm"
+    if name.startswith(("x_", "y_")):
+        return "m"
+    if name.startswith("theta") or name == "dte":
+        return "rad"
+    return ""
+
+
+def signal_bearing(name, bearing_names):
+    """Bearing a signal belongs to (``F_2b1_loa`` → ``"2b1"``), else the first bearing."""
+    for part in name.split("_"):
+        if part in bearing_names:
+            return part
+    return bearing_names[0]
+
+
+def run_families(run, bearing=None):
+    """``(rig_frequencies dict, families dict)`` of a run from its metadata.
+
+    Parameters
+    ----------
+    run : cmsim.run.Run
+        A run written by :func:`cmsim.dynamics.simulate` (meta holds ``rig`` and
+        ``operating_point``).
+    bearing : str, optional
+        Bearing whose BPF/BPFO/… and shaft rate are used (default the first).
+
+    Returns
+    -------
+    freqs : dict
+        :func:`~cmsim.spectra.frequencies.rig_frequencies` output, Hz.
+    families : dict of str to float
+        :func:`~cmsim.spectra.frequencies.peak_families` output, Hz.
+    """
+    from cmsim.rig import OperatingPoint, Rig
+
+    meta = run.meta
+    if "rig" not in meta or "operating_point" not in meta:
+        raise ParameterError("the run's meta lacks 'rig' or 'operating_point' (not written by "
+                             "cmsim.dynamics.simulate?)")
+    rig = Rig.from_dict(meta["rig"])
+    op = OperatingPoint(**meta["operating_point"])
+    freqs = rig_frequencies(rig, op)
+    return freqs, peak_families(freqs, bearing)
+
+
+@dataclass(frozen=True, eq=False)
+class RunSpectrum:
+    """Spectrum of one run signal and its labelled peaks.
+
+    Attributes
+    ----------
+    signal : str
+        Signal name.
+    kind : str
+        ``"amplitude"``, ``"envelope"`` or ``"order"``.
+    freq_hz : numpy.ndarray, shape (n_bins,)
+        Bin frequencies, Hz (for ``kind="order"``: orders × nominal shaft rate).
+    amplitude : numpy.ndarray, shape (n_bins,)
+        Amplitude per bin, unit :attr:`unit`.
+    resolution_hz : float
+        Bin spacing, Hz.
+    unit : str
+        Unit of the signal.
+    families : dict of str to float
+        Base frequencies used for the labels, Hz.
+    bearing : str
+        Bearing whose frequencies were used.
+    peaks : pandas.DataFrame
+        :func:`~cmsim.spectra.labels.label_peaks` rows below ``max_hz``, largest first;
+        ``frequency_hz`` always in Hz (plus ``order`` for ``kind="order"``).
+    band_hz : tuple of float or None
+        Demodulation band of an envelope spectrum, Hz.
+    max_hz : float
+        Upper frequency of the listed peaks, Hz.
+    """
+
+    signal: str
+    kind: str
+    freq_hz: np.ndarray
+    amplitude: np.ndarray
+    resolution_hz: float
+    unit: str
+    families: dict
+    bearing: str
+    peaks: object
+    band_hz: tuple | None = None
+    max_hz: float = math.inf
+    extra: dict = field(default_factory=dict)
+
+    def peak_records(self):
+        """Peaks as a list of dicts (JSON-ready: ``frequency_hz``, ``amplitude``, ``label``,
+        ``family``, ``db_re_carrier``, ``k``, ``m``, ``n``, ``snr_db``)."""
+        cols = ["frequency_hz", "amplitude", "label", "family", "db_re_carrier", "k", "m", "n",
+                "snr_db"] + (["order"] if "order" in self.peaks else [])
+        out = []
+        for row in self.peaks[cols].itertuples(index=False):
+            rec = {}
+            for c, v in zip(cols, row):
+                if c in ("k", "m", "n"):
+                    rec[c] = int(v)
+                elif c in ("label", "family"):
+                    rec[c] = str(v)
+                else:
+                    v = float(v)
+                    rec[c] = v if math.isfinite(v) else None
+            out.append(rec)
+        return out
+
+
+def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
+                 resolution_hz=None, bearing=None, max_peaks=20, threshold_db=15.0,
+                 max_sideband=3):
+    """Spectrum of ``run[signal]`` with its peaks named k·GMF ± m·BPF ± n·fr.
+
+    Parameters
+    ----------
+    run : cmsim.run.Run
+        Simulated run (meta must hold ``rig`` and ``operating_point``).
+    signal : str
+        Signal name, one of ``run.names``.
+    kind : {"amplitude", "envelope", "order"}
+        Amplitude spectrum of the record, envelope spectrum (band ``band_hz``, default the
+        kurtogram's), or order spectrum at the nominal shaft speed.
+    band_hz : tuple of float, optional
+        Demodulation band (lo, hi) in Hz, 0 <= lo < hi <= fs/2; only for ``kind="envelope"``.
+    max_hz : float, optional
+        Peaks above this frequency are not listed, Hz (> 0); default fs/2.
+    resolution_hz : float, optional
+        Largest acceptable bin spacing, Hz (> 0); a shorter record raises
+        :class:`~cmsim.errors.ParameterError` saying the length it needs.
+    bearing : str, optional
+        Bearing for the BPF family; default the bearing named in ``signal`` or the first.
+    max_peaks : int
+        Number of largest peaks listed (1-10000).
+    threshold_db : float
+        Least height of a peak above the noise floor, dB.
+    max_sideband : int
+        Largest |m|, |n| of a label (0-20).
+
+    Returns
+    -------
+    RunSpectrum
+    """
+    if not isinstance(signal, str) or signal not in run.signals:
+        raise ParameterError(f"signal must be one of the run's signals {run.names}, "
+                             f"got {signal!r}")
+    choice("kind", kind, PEAK_KINDS)
+    max_peaks = positive_int("max_peaks", max_peaks, lo=1, hi=10000)
+    fs = run.fs_hz
+    if band_hz is not None and kind != "envelope":
+        raise ParameterError(f"band_hz applies to kind='envelope' only (kind={kind!r})")
+    f_max = 0.5 * fs if max_hz is None else check_range("max_hz", max_hz, 0.0, 0.5 * fs,
+                                                        lo_open=True, unit="Hz")
+    freqs, _ = run_families(run)
+    bearing_names = tuple(k for k, v in freqs.items() if isinstance(v, dict))
+    brg = signal_bearing(signal, bearing_names) if bearing is None else bearing
+    if brg not in bearing_names:
+        raise ParameterError(f"bearing must be one of {list(bearing_names)}, got {bearing!r}")
+    fam = peak_families(freqs, brg)
+    x = np.asarray(run[signal], dtype=float)
+    res = None if resolution_hz is None else check_range("resolution_hz", resolution_hz, 0.0,
+                                                         lo_open=True, unit="Hz")
+    detrend = "linear" if signal.startswith("theta") else "constant"
+    band_used, extra = None, {}
+    if kind == "amplitude":
+        spec = amplitude_spectrum(x, fs, detrend=detrend, resolution_hz=res)
+        f, a, df_hz = spec.freq_hz, spec.amplitude, spec.resolution_hz
+        lab_f, lab_fam, scale = f, fam, 1.0
+    elif kind == "envelope":
+        if band_hz is None:
+            kg = kurtogram(x, fs)
+            band_used = tuple(float(b) for b in kg.band_hz)
+            extra["kurtosis"] = float(kg.kurtosis_max)
+        else:
+            band_used = check_band("band_hz", band_hz, fs)
+        spec = envelope_spectrum(x, fs, band_used, resolution_hz=res)
+        f, a, df_hz = spec.freq_hz, spec.amplitude, spec.resolution_hz
+        lab_f, lab_fam, scale = f, fam, 1.0
+    else:
+        fr = fam["fr"]
+        osp = order_spectrum(x, fs, speed_rpm=60.0 * fr)
+        df_hz = osp.resolution_order * fr
+        if res is not None and df_hz > res * (1.0 + 1e-12):
+            need = math.ceil(fr / res)
+            raise ParameterError(
+                f"record too short for resolution_hz={res:g} Hz: an order spectrum at "
+                f"{fr:g} Hz shaft rate needs at least {need} whole revolutions "
+                f"({need / fr:g} s), got {osp.n_revolutions} ({len(x) / fs:g} s)")
+        lab_f, a = osp.order, osp.amplitude
+        f = lab_f * fr
+        lab_fam = {k: v / fr for k, v in fam.items()}
+        scale = fr
+        extra["n_revolutions"] = int(osp.n_revolutions)
+    peaks = label_peaks(lab_f, a, lab_fam, threshold_db=threshold_db, max_sideband=max_sideband)
+    if kind == "order":
+        peaks.insert(1, "order", peaks["frequency_hz"].to_numpy())
+        peaks["frequency_hz"] = peaks["order"] * scale
+    peaks = peaks[peaks["frequency_hz"] <= f_max]
+    peaks = peaks.sort_values("amplitude", ascending=False, kind="stable").head(max_peaks)
+    return RunSpectrum(signal=signal, kind=kind, freq_hz=np.asarray(f), amplitude=np.asarray(a),
+                       resolution_hz=float(df_hz), unit=signal_unit(signal), families=dict(fam),
+                       bearing=brg, peaks=peaks.reset_index(drop=True), band_hz=band_used,
+                       max_hz=float(f_max), extra=extra)
+

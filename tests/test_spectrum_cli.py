@@ -1,0 +1,107 @@
+"""``cmsim spectrum``: JSON contract, kinds, plot, and errors naming the parameter.
+
+Test tier: behaviour contracts on one short run (0.2 s of the paper rig at 1000 rpm).
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from cmsim.cli import main
+from cmsim.dynamics import simulate
+from cmsim.errors import ParameterError
+from cmsim.rig import OperatingPoint, Rig
+from cmsim.run import Run
+from cmsim.spectra.run_spectrum import run_spectrum, signal_bearing, signal_unit
+
+
+@pytest.fixture(scope="module")
+def run_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("spectrum") / "run.npz"
+    simulate(Rig.paper_2016(), OperatingPoint(1000.0, 10.0), 0.2, seed=3).save(path)
+    return path
+
+
+def cli_json(capsys, argv):
+    status = main(argv + ["--json"])
+    out = capsys.readouterr().out
+    assert len(out.strip().splitlines()) == 1             # exactly one JSON object
+    return status, json.loads(out)
+
+
+def test_json_contract(capsys, run_file):
+    status, res = cli_json(capsys, ["spectrum", str(run_file), "--signal", "F_1b1_loa",
+                                    "--max-hz", "3000", "--top", "6"])
+    assert status == 0
+    for key in ("signal", "kind", "resolution_hz", "families", "peaks", "unit", "bearing"):
+        assert key in res
+    assert (res["signal"], res["kind"], res["unit"], res["bearing"]) == \
+        ("F_1b1_loa", "amplitude", "N", "1b1")
+    assert res["resolution_hz"] == pytest.approx(5.0)
+    assert res["families"]["GMF"] == pytest.approx(466.667, abs=1e-3)
+    peaks = res["peaks"]
+    assert 1 <= len(peaks) <= 6
+    amps = [p["amplitude"] for p in peaks]
+    assert amps == sorted(amps, reverse=True)               # largest first
+    for p in peaks:
+        assert {"frequency_hz", "amplitude", "label", "family", "db_re_carrier"} <= set(p)
+        assert 0 < p["frequency_hz"] <= 3000
+    assert peaks[0]["label"] == "2GMF"
+    assert peaks[0]["frequency_hz"] == pytest.approx(2 * 466.667, abs=5.0)
+
+
+def test_text_output_and_plot(capsys, run_file, tmp_path):
+    png = tmp_path / "s.png"
+    assert main(["spectrum", str(run_file), "--max-hz", "2500", "--plot", str(png)]) == 0
+    text = capsys.readouterr().out
+    assert "frequency_hz" in text and "2GMF" in text and f"wrote {png}" in text
+    assert png.stat().st_size > 5_000
+
+
+def test_other_kinds_and_shaft_two(capsys, run_file):
+    status, res = cli_json(capsys, ["spectrum", str(run_file), "--kind", "order", "--top", "3"])
+    assert status == 0 and res["kind"] == "order"
+    top = res["peaks"][0]
+    assert top["order"] == pytest.approx(56.0, abs=0.2)     # 2 × 28 teeth
+    assert top["frequency_hz"] == pytest.approx(top["order"] * 1000 / 60)
+    status, res = cli_json(capsys, ["spectrum", str(run_file), "--kind", "envelope",
+                                    "--band-hz", "1000", "3000", "--top", "3"])
+    assert status == 0 and res["band_hz"] == [1000.0, 3000.0]
+    status, res = cli_json(capsys, ["spectrum", str(run_file), "--signal", "F_2b1_oloa"])
+    assert status == 0 and res["bearing"] == "2b1"
+    assert res["families"]["fr"] == pytest.approx(1000 / 60)   # 28:28 gears
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--signal", "F_9b9_loa"], ["signal must be one of", "F_1b1_loa", "dte_um"]),
+    (["--resolution-hz", "1"], ["record too short", "resolution_hz=1", "75000 samples"]),
+    (["--kind", "order", "--resolution-hz", "1"], ["record too short", "revolutions"]),
+    (["--band-hz", "100", "200"], ["band_hz", "envelope"]),
+    (["--kind", "envelope", "--band-hz", "100", "90000"], ["band_hz", "fs/2"]),
+    (["--max-hz", "-3"], ["max_hz"]),
+    (["--top", "0"], ["max_peaks"]),
+    (["--bearing", "3b1"], ["bearing must be one of"]),
+])
+def test_errors_name_the_parameter(capsys, run_file, extra, words):
+    status, res = cli_json(capsys, ["spectrum", str(run_file)] + extra)
+    assert status == 2
+    for w in words:
+        assert w in res["error"], (w, res["error"])
+
+
+def test_missing_file(capsys, tmp_path):
+    status, res = cli_json(capsys, ["spectrum", str(tmp_path / "none.npz")])
+    assert status == 2 and "does not exist" in res["error"]
+
+
+def test_library_helpers(run_file):
+    run = Run.load(run_file)
+    assert signal_unit("F_1b1_x") == "N" and signal_unit("dte_um") == "µm"
+    assert signal_unit("theta_2J2") == "rad" and signal_unit("y_2G1") == "m"
+    assert signal_bearing("x_2b2", ("1b1", "1b2", "2b1", "2b2")) == "2b2"
+    assert signal_bearing("dte", ("1b1", "2b1")) == "1b1"
+    s = run_spectrum(run, "theta_1G1", max_hz=1000.0)     # ramp removed by linear detrend
+    assert np.all(s.peaks["frequency_hz"] <= 1000.0)
+    with pytest.raises(ParameterError, match="kind"):
+        run_spectrum(run, "dte", kind="cepstrum")
