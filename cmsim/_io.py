@@ -1,4 +1,8 @@
-"""Atomic file writes: write to a temporary file beside the target, then rename."""
+"""Atomic file writes: write to a temporary file beside the target, then rename.
+
+The file gets the permissions an ordinary ``open(path, "w")`` would give (0o666 less the
+umask), not the owner-only mode of the temporary file.
+"""
 
 from __future__ import annotations
 
@@ -19,6 +23,7 @@ def _atomic(path, write):
         with os.fdopen(fd, "wb") as fh:
             write(fh)
             fh.flush()
+            os.fchmod(fh.fileno(), 0o666 & ~_umask())
             os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
@@ -28,6 +33,13 @@ def _atomic(path, write):
             pass
         raise
     return path
+
+
+def _umask():
+    """The process umask (read by setting and restoring it)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def atomic_write_bytes(path, data):
