@@ -53,16 +53,16 @@ def _add_rig_options(p, *, friction=True):
 # ---------------------------------------------------------------------- simulate
 def _cmd_simulate(args):
     from cmsim.dynamics import SlipModel, simulate
-    from cmsim.mesh_stiffness.table import MeshStiffnessTable
     from cmsim.spectra import rig_frequencies
 
     rig = _load_rig(args)
     op = _operating_point(args)
-    table = MeshStiffnessTable.load(args.mesh_table) if args.mesh_table else None
+    table, mesh_model = _mesh_choice(args, rig, op)
     slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                      correlation_s=args.slip_correlation_s)
     run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
-                   mesh_table=table, slip=slip, seed=args.seed, warmup_s=args.warmup_s)
+                   mesh_table=table, slip=slip, seed=args.seed, warmup_s=args.warmup_s,
+                   mesh_model=mesh_model)
     if args.out:
         run.save(args.out)
     freqs = rig_frequencies(rig, op)
@@ -75,7 +75,8 @@ def _cmd_simulate(args):
         "sim_s": run.meta["sim_s"], "wall_s": run.meta["wall_s"],
         "realtime_factor": run.meta["realtime_factor"], "compile_s": run.meta["compile_s"],
         "seed": run.meta["seed"], "n_samples": int(run.t.size), "fs_hz": run.fs_hz,
-        "out": str(args.out) if args.out else None,
+        "out": str(args.out) if args.out else None, "mesh": run.meta["mesh"],
+        "mesh_table": run.meta["mesh_table"],
     }
     if rig.gears is not None:
         dte = run["dte"]
@@ -85,6 +86,27 @@ def _cmd_simulate(args):
         out[f"F_{b}_loa_mean_n"] = float(run[f"F_{b}_loa"].mean())
         out[f"F_{b}_loa_rms_n"] = float(run[f"F_{b}_loa"].std())
     return out
+
+
+def _mesh_choice(args, rig, op):
+    """(mesh_table, mesh_model) from --mesh, --mesh-table and --table-torque-nm."""
+    if rig.gears is None:
+        if args.mesh == "hybrid" or args.mesh_table:
+            raise ParameterError("--mesh hybrid and --mesh-table need a rig with gears")
+        return None, None
+    if args.mesh == "hybrid":
+        if args.mesh_table:
+            raise ParameterError("--mesh hybrid solves the contact on-line; drop --mesh-table")
+        from cmsim.mesh_stiffness.hybrid import HybridMeshModel
+        return None, HybridMeshModel.from_pair(rig.gears)
+    if args.table_torque_nm is not None and not args.mesh_table:
+        raise ParameterError("--table-torque-nm selects a table of --mesh-table FILE")
+    if not args.mesh_table:
+        return None, None
+    from cmsim.mesh_stiffness.torque_tables import MeshTableSet
+    tables = MeshTableSet.load(args.mesh_table)
+    torque = op.torque_nm if args.table_torque_nm is None else args.table_torque_nm
+    return tables.at(torque), None
 
 
 def _text_simulate(res):
@@ -110,7 +132,16 @@ def _add_simulate(sub):
     p.add_argument("--fs-hz", type=float, default=75_000.0, help="output sample rate, Hz")
     p.add_argument("--substeps", type=int, default=1, help="integration steps per sample")
     p.add_argument("--warmup-s", type=float, default=0.05, help="discarded start, s")
-    p.add_argument("--mesh-table", metavar="FILE.npz", help="pair stiffness table to use")
+    p.add_argument("--mesh", choices=("table", "hybrid"), default="table",
+                   help="tooth contact forces from a stiffness table (default; the "
+                        "potential-energy table unless --mesh-table) or solved on-line from "
+                        "the FE influence coefficients (hybrid: paper model A, ~4x slower)")
+    p.add_argument("--mesh-table", metavar="FILE.npz",
+                   help="pair stiffness table(s) from cmsim mesh-table; the table at the "
+                        "run's torque is used (linear in torque between tables)")
+    p.add_argument("--table-torque-nm", type=float, metavar="T",
+                   help="use the --mesh-table table of torque T instead (paper model C: "
+                        "tables at the wrong torque)")
     p.add_argument("--cage-slip", type=float, default=0.0, metavar="FRACTION",
                    help="rms random cage-speed fluctuation (0.01 = 1 %%); spreads ball-pass lines")
     p.add_argument("--ball-jitter-rad", type=float, default=0.0,
@@ -286,7 +317,7 @@ def _add_sweep(sub):
                    help="mesh friction coefficients (default: the rig's)")
     p.add_argument("--clearance-m", type=float, nargs="+", metavar="C",
                    help="bearing radial clearances, m (negative = preload; default: the "
-                        "rig's); with several values write negatives in decimal (-0.000001)")
+                        "rig's)")
     p.add_argument("--fs-hz", type=float, default=75_000.0, help="output sample rate, Hz")
     p.add_argument("--warmup-s", type=float, default=0.05, help="discarded start, s")
     p.add_argument("--substeps", type=int, default=1, help="integration steps per sample")
@@ -351,7 +382,76 @@ def build_parser():
     return parser
 
 
-_COMMANDS = [_add_simulate, _add_modes, _add_spectrum, _add_sweep, _add_report]
+# ---------------------------------------------------------------------- mesh-table
+def _cmd_mesh_table(args):
+    import time
+
+    from cmsim.mesh_stiffness.torque_tables import torque_tables
+
+    rig = _load_rig(args)
+    if rig.gears is None:
+        raise ParameterError("cmsim mesh-table needs a rig with gears")
+    start = time.perf_counter()
+    mesh_model = None
+    cache = None
+    if args.method == "hybrid":
+        from cmsim.mesh_stiffness.hybrid import HybridMeshModel
+        mesh_model = HybridMeshModel.from_pair(rig.gears)
+        info = mesh_model.driving.meta
+        cache = {"status": info.get("cache"), "key": info.get("key"),
+                 "build_s": info.get("build_seconds"),
+                 "load_s": time.perf_counter() - start}
+
+    def progress(i, n, row):
+        if not args.json and sys.stderr.isatty():
+            print(f"  {i}/{n}: {row['torque_nm']:g} N m", file=sys.stderr)
+
+    tables = torque_tables(rig, args.torque_nm, args.method, mesh_model=mesh_model,
+                           speed_rpm=args.speed_rpm, n_steps=args.steps,
+                           centres=args.centres, progress=progress)
+    if args.out:
+        tables.save(args.out)
+    return {"method": args.method, "rig": rig.name, "centres": args.centres,
+            "tables": list(tables.summary), "influence_cache": cache,
+            "seconds": time.perf_counter() - start, "out": str(args.out) if args.out else None}
+
+
+def _text_mesh_table(res):
+    lines = [f"{res['method']} mesh stiffness of {res['rig']} ({res['seconds']:.1f} s)",
+             f"{'torque_nm':>10}  {'mean_k_N/m':>11}  {'p2p_k_N/m':>11}  {'contact_ratio':>13}"]
+    for row in res["tables"]:
+        lines.append(f"{row['torque_nm']:10g}  {row['mean_stiffness_n_per_m']:11.4g}  "
+                     f"{row['peak_to_peak_stiffness_n_per_m']:11.4g}  "
+                     f"{row['loaded_contact_ratio']:13.3f}")
+    if res["out"]:
+        lines.append(f"wrote {res['out']}")
+    return "\n".join(lines)
+
+
+def _add_mesh_table(sub):
+    p = sub.add_parser("mesh-table", help="torque-dependent pair stiffness tables",
+                       description="Pair stiffness vs position on the line of action for "
+                                   "each torque (paper 001 section 6.1): quasi-static orbits "
+                                   "over a bearing cycle, their centroids, then one mesh cycle "
+                                   "with the gear centres there.")
+    p.add_argument("--torque-nm", type=float, nargs="+", required=True,
+                   help="output torques, N m")
+    p.add_argument("--method", choices=("hybrid", "potential-energy"), default="hybrid",
+                   help="hybrid FE + Weber-Banaschek (default) or potential energy")
+    p.add_argument("--centres", choices=("centroid", "nominal"), default="centroid",
+                   help="gear centres of the mesh-cycle sweep (default: orbit centroids)")
+    p.add_argument("--speed-rpm", type=float, default=1000.0,
+                   help="speed of the quasi-static orbits, rpm")
+    p.add_argument("--steps", type=int, default=120,
+                   help="driving-gear angles per mesh cycle")
+    p.add_argument("--out", type=Path, metavar="TABLE.npz",
+                   help="write the tables (for cmsim simulate --mesh-table)")
+    _add_rig_options(p, friction=False)
+    p.set_defaults(func=_cmd_mesh_table, text=_text_mesh_table)
+
+
+_COMMANDS = [_add_simulate, _add_modes, _add_mesh_table, _add_spectrum, _add_sweep,
+             _add_report]
 
 
 def _jsonable(obj):
@@ -366,25 +466,21 @@ def _jsonable(obj):
     return obj
 
 
-_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$", re.IGNORECASE)
+_NEGATIVE_EXPONENT_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)e[-+]?\d+$", re.IGNORECASE)
 
 
-def _join_negative_values(argv):
-    """``--clearance-m -1e-6`` → ``--clearance-m=-1e-6`` (argparse takes "-1e-6" for an option)."""
-    out = []
-    for arg in argv:
-        if out and out[-1].startswith("--") and "=" not in out[-1] and _NEGATIVE_NUMBER.match(arg):
-            out[-1] = f"{out[-1]}={arg}"
-        else:
-            out.append(arg)
-    return out
+def _plain_negative_numbers(argv):
+    """``-1e-6`` → ``-0.000001``: argparse takes a negative number in exponent notation for an
+    option, but a plain decimal for a value, also in lists (``--clearance-m 0 -1e-6``)."""
+    return [np.format_float_positional(float(a), trim="-")
+            if _NEGATIVE_EXPONENT_NUMBER.match(a) else a for a in argv]
 
 
 def main(argv=None):
     """Entry point of the ``cmsim`` console script; returns the exit status."""
     parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = parser.parse_args(_join_negative_values(argv))
+    args = parser.parse_args(_plain_negative_numbers(argv))
     try:
         res = args.func(args)
     except (ParameterError, FileNotFoundError) as exc:

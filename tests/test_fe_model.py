@@ -29,15 +29,6 @@ from cmsim.rig import Rig
 E, NU, B = 210e9, 0.3, 6.35e-3
 
 
-@pytest.fixture(scope="module", autouse=True)
-def session_cache(tmp_path_factory):
-    """One FE cache directory for the whole test session (shared by the test modules)."""
-    mp = pytest.MonkeyPatch()
-    mp.setenv("CMSIM_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cmsim-cache"))
-    yield
-    mp.undo()
-
-
 @pytest.fixture(scope="module")
 def gear():
     return Rig.paper_2016().gears.driving

@@ -23,15 +23,6 @@ from cmsim.mesh_stiffness.hybrid import HybridMeshModel, work_size
 from cmsim.rig import Rig
 
 
-@pytest.fixture(scope="module", autouse=True)
-def session_cache(tmp_path_factory):
-    """One FE cache directory for the whole test session (shared by the test modules)."""
-    mp = pytest.MonkeyPatch()
-    mp.setenv("CMSIM_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cmsim-cache"))
-    yield
-    mp.undo()
-
-
 @pytest.fixture(scope="module")
 def model():
     return HybridMeshModel.from_pair(Rig.paper_2016().gears)

@@ -33,15 +33,6 @@ from cmsim.rig import Rig
 PAPER_MEAN = {10.0: 1.08e8, 50.0: 1.16e8, 100.0: 1.19e8}
 
 
-@pytest.fixture(scope="module", autouse=True)
-def session_cache(tmp_path_factory):
-    """One FE cache directory for the whole test session (shared by the test modules)."""
-    mp = pytest.MonkeyPatch()
-    mp.setenv("CMSIM_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cmsim-cache"))
-    yield
-    mp.undo()
-
-
 @pytest.fixture(scope="module")
 def pair():
     return Rig.paper_2016().gears

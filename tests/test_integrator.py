@@ -31,7 +31,7 @@ def sdof_packed():
             np.zeros((0, 1)), np.zeros((0, 1)), np.zeros((0, 1, 1)),
             np.zeros(K.MI_SIZE, dtype=np.int64), np.zeros(K.MP_SIZE), np.zeros(14),
             np.zeros(2), np.zeros(2), np.zeros((1, 2)), np.zeros((1, 2)),
-            np.array([[0, 0, 1]], dtype=np.int64))
+            np.array([[0, 0, 1]], dtype=np.int64)) + K.no_hybrid()
 
 
 def sdof_exact(t):

@@ -21,9 +21,12 @@ The bearing forces are compiled with fastmath so the ball loop vectorises; the f
 checks live in the integrator, which is compiled without it.
 
 ``P`` = (minv, springs, fext, omega, b_int, b_par, b_cos, b_sin, jitter, m_int, m_par, geo, tab_k,
-tab_e, teeth1, teeth2, spring_ends) with the linear K and C as two-node spring-dampers
+tab_e, teeth1, teeth2, spring_ends, hp, diag1, cpl1, diag2, cpl2) with the linear K and C as two-node spring-dampers
 (``springs`` (e, 2) = k, c; ``spring_ends`` (e, 3), see :func:`linear_accel_jit`) and ``teeth1/2``
-the cos and sin of multiples of the angular pitch, shape (Z, 2); index constants below.
+the cos and sin of multiples of the angular pitch, shape (Z, 2); the last five are the hybrid
+contact model's parameters and influence tables
+(:meth:`cmsim.mesh_stiffness.hybrid.HybridMeshModel.kernel_args`; placeholders in table
+mode); index constants below.
 """
 
 from __future__ import annotations
@@ -34,6 +37,8 @@ import numpy as np
 from numba import njit
 
 from cmsim.bearings._kernels import ball_forces_cage_frame_jit
+from cmsim.mesh_stiffness._hybrid_kernels import (HP_SIZE, WORK_PER_N, WORK_PER_N2,
+                                                  hybrid_forces_jit)
 from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit, table_lookup2_jit
 
 # b_int columns: DOF indices, number of balls, index of the first bearing sharing the same
@@ -44,9 +49,13 @@ BI_SIZE = 5
 # physical sense of the shaft (+1 CCW, −1 CW), viscous damping to ground, initial cage phase
 BP_K, BP_P, BP_C, BP_CAGE, BP_SENSE, BP_DAMP, BP_PHASE = 0, 1, 2, 3, 4, 5, 6
 BP_SIZE = 7
-# m_int entries
-MI_G1, MI_G2, MI_SLOTS, MI_ON = 0, 1, 2, 3
-MI_SIZE = 4
+# m_int entries: DOF index of each gear's x, number of slots, mesh on, elastic-force mode
+MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE = 0, 1, 2, 3, 4
+MI_SIZE = 5
+MODE_TABLE, MODE_HYBRID = 0, 1
+# columns of the per-slot scratch ``W[6]`` of the mesh kernel
+SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP = range(8)
+SG_SIZE = 8
 # m_par entries
 (MP_A0, MP_PSI10, MP_PSI20, MP_PB, MP_SLO, MP_OM1, MP_OM2, MP_MU, MP_V0, MP_CHYST, MP_KOSTER,
  MP_DTHR, MP_TAB0, MP_TABD, MP_JDT, MP_DIAGB, MP_ZBEFORE, MP_ZAFTER) = range(18)
@@ -134,13 +143,22 @@ def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, cos_nom
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag, want_diag):
-    """Forces of the tooth pairs in the potential-contact zone (exact rigid-body geometry,
-    table stiffness, hysteretic or Koster squeeze damping, smoothed Coulomb friction)."""
+def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag, want_diag,
+                 hp, hd1, hc1, hd2, hc2, S, hw, hdelta, hrho1, hrho2, hchi1, hchi2, hout,
+                 hstat):
+    """Forces of the tooth pairs in the potential-contact zone: exact rigid-body geometry,
+    elastic force from the table (``MI_MODE`` 0) or from the on-line hybrid contact solve
+    (1, paper 001 model A), hysteretic or Koster squeeze damping, smoothed Coulomb friction.
+
+    Pass 1 stores each slot's geometry in ``S`` (columns ``SG_*``); in hybrid mode the
+    interferences of all slots are then solved together (out-of-zone slots enter with a
+    large negative interference, so they stay unloaded); pass 2 applies the forces."""
     z1 = teeth1.shape[0]
     z2 = teeth2.shape[0]
     i1 = m_int[MI_G1]
     i2 = m_int[MI_G2]
+    n_slots = m_int[MI_SLOTS]
+    hybrid = m_int[MI_MODE] == MODE_HYBRID
     rb1 = geo[0]
     rb2 = geo[1]
     pb = mp[MP_PB]
@@ -168,7 +186,8 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
     # tooth numbers of the first slot's pair, m0 mod Z (float floor: integer % is slow)
     k1 = int(m0f - z1 * math.floor(m0f / z1))
     k2 = int(m0f - z2 * math.floor(m0f / z2))
-    for j in range(m_int[MI_SLOTS]):
+    # ---- pass 1: geometry, and the elastic force in table mode
+    for j in range(n_slots):
         if j > 0:
             # next slot: one tooth earlier on both gears
             k1 = k1 - 1 if k1 > 0 else z1 - 1
@@ -176,9 +195,15 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
         pair = m0 - j
         s = s_ref - pair * pb
         if s < lo or s > hi:
-            if want_diag:
-                diag[int(mp[MP_DIAGB]) + j] = 0.0
+            S[j, SG_ON] = 0.0
+            if hybrid:
+                hdelta[j] = -1.0
+                hrho1[j] = hp[0]
+                hrho2[j] = hp[4]
+                hchi1[j] = 1.0
+                hchi2[j] = 1.0
             continue
+        S[j, SG_ON] = 1.0
         # involute origins of this pair: gear-1 tooth `pair` pitches back, gear-2 tooth on;
         # only a corner (rounded-tip) contact needs them
         if not trig_done and (s < length - geo[3] or s > geo[2]):
@@ -193,6 +218,51 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
         s2n = sp2 * teeth2[k2, 0] + cp2 * teeth2[k2, 1]
         delta, nx, ny, px, py, s_eq, chi1, chi2 = pair_contact_jit(
             s, delta_inv, c1n, s1n, c2n, s2n, c1x, c1y, c2x, c2y, cos_t1, sin_t1, length, geo)
+        S[j, SG_NX] = nx
+        S[j, SG_NY] = ny
+        S[j, SG_PX] = px
+        S[j, SG_PY] = py
+        S[j, SG_REQ] = chi1 * chi2 / (chi1 + chi2) if chi1 > 0.0 and chi2 > 0.0 else 0.0
+        if hybrid:
+            hdelta[j] = delta
+            hrho1[j] = s_eq
+            hrho2[j] = length - s_eq
+            hchi1[j] = max(chi1, 1e-9)
+            hchi2[j] = max(chi2, 1e-9)
+        else:
+            k_pair, e_pair = table_lookup2_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_k, tab_e)
+            overlap = delta - e_pair
+            S[j, SG_ELASTIC] = k_pair * overlap if overlap > 0.0 else 0.0
+            S[j, SG_GAP] = -overlap
+    if hybrid:
+        it = hybrid_forces_jit(hdelta, hrho1, hrho2, hchi1, hchi2, hp, hd1, hc1, hd2, hc2, hw,
+                               hout)
+        hstat[0] += 1.0
+        if it < 0:
+            hstat[1] += 1.0
+        loaded = False
+        for j in range(n_slots):
+            if hout[j] > 0.0:
+                loaded = True
+        for j in range(n_slots):
+            S[j, SG_ELASTIC] = hout[j]
+            # gap of an unloaded pair under the other pairs' loads, Σ_k C_jk F_k − δ_j (the
+            # solver leaves the coupling matrix C in the first n² entries of its work)
+            gap = -hdelta[j]
+            if loaded and hout[j] == 0.0:
+                for k in range(n_slots):
+                    gap += hw[j * n_slots + k] * hout[k]
+            S[j, SG_GAP] = gap
+    # ---- pass 2: damping, friction, forces and moments
+    for j in range(n_slots):
+        if S[j, SG_ON] == 0.0:
+            if want_diag:
+                diag[int(mp[MP_DIAGB]) + j] = 0.0
+            continue
+        nx = S[j, SG_NX]
+        ny = S[j, SG_NY]
+        px = S[j, SG_PX]
+        py = S[j, SG_PY]
         # relative velocity of the contact points (gear 1 minus gear 2)
         rx1 = px - c1x
         ry1 = py - c1y
@@ -201,16 +271,14 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
         dvx = (y[n + i1] - w1 * ry1) - (y[n + i2] - w2 * ry2)
         dvy = (y[n + i1 + 1] + w1 * rx1) - (y[n + i2 + 1] + w2 * rx2)
         approach = dvx * nx + dvy * ny
-        k_pair, e_pair = table_lookup2_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_k, tab_e)
-        overlap = delta - e_pair
-        if overlap > 0.0:
-            fn = k_pair * overlap + mp[MP_CHYST] * approach
+        elastic = S[j, SG_ELASTIC]
+        if elastic > 0.0:
+            fn = elastic + mp[MP_CHYST] * approach
             if fn < 0.0:
                 fn = 0.0
         elif approach > 0.0:
-            gap = max(-overlap, mp[MP_DTHR])
-            req = chi1 * chi2 / (chi1 + chi2) if chi1 > 0.0 and chi2 > 0.0 else 0.0
-            x = req / (2.0 * gap)
+            gap = max(S[j, SG_GAP], mp[MP_DTHR])
+            x = S[j, SG_REQ] / (2.0 * gap)
             fn = mp[MP_KOSTER] * x * math.sqrt(x) * approach
         else:
             fn = 0.0
@@ -258,11 +326,25 @@ def linear_accel_jit(y, g, minv, springs, ends, dydt, row):
         dydt[row, n + i] = minv[i] * g[i]
 
 
+def no_hybrid():
+    """Placeholders of the five hybrid entries of ``P`` when the mesh uses a table."""
+    return (np.zeros(HP_SIZE), np.zeros(2), np.zeros((1, 2, 2)), np.zeros(2),
+            np.zeros((1, 2, 2)))
+
+
 def make_work(P):
-    """Scratch arrays ``W`` for :func:`rhs_jit`."""
+    """Scratch arrays ``W`` for :func:`rhs_jit`.
+
+    ``W`` = (g, cos_nom, sin_nom, slip_cos, slip_sin, cage_slip, slot geometry (slots,
+    SG_SIZE), hybrid solver work, hybrid δ, ρ1, ρ2, χ1, χ2, forces (slots,), hybrid counters
+    [solves, non-converged solves])."""
     nb, max_balls = P[6].shape
+    slots = max(int(P[9][MI_SLOTS]), 1)
     return (np.empty(P[0].shape[0]), np.empty(nb), np.empty(nb), np.empty((nb, max_balls)),
-            np.empty((nb, max_balls)), np.zeros(nb))
+            np.empty((nb, max_balls)), np.zeros(nb), np.zeros((slots, SG_SIZE)),
+            np.zeros(WORK_PER_N2 * slots * slots + WORK_PER_N * slots), np.zeros(slots),
+            np.zeros(slots), np.zeros(slots), np.ones(slots), np.ones(slots), np.zeros(slots),
+            np.zeros(2))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -286,7 +368,8 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
                         diag, want_diag)
     if P[9][MI_ON] != 0:
         _mesh_forces(t, y, n, g, P[9], P[10], P[11], P[12], P[13], P[14], P[15], diag,
-                     want_diag)
+                     want_diag, P[17], P[18], P[19], P[20], P[21], W[6], W[7], W[8], W[9],
+                     W[10], W[11], W[12], W[13], W[14])
     linear_accel_jit(y, g, minv, P[1], P[16], dydt, row)
 
 

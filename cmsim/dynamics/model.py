@@ -94,6 +94,9 @@ class DynamicModel:
         Kernel argument tuple ``P`` (see :mod:`cmsim.dynamics._kernels`).
     diag_names : tuple of str
         Names of the output forces the kernel writes (bearing housing forces, pair forces).
+    slip : SlipModel
+    mesh_model : HybridMeshModel or None
+        On-line hybrid contact model (model A), or ``None`` for the table.
     """
 
     rig: object
@@ -108,6 +111,7 @@ class DynamicModel:
     packed: tuple = field(repr=False)
     diag_names: tuple = ()
     slip: SlipModel = SlipModel()
+    mesh_model: object = None
 
     @property
     def n_dof(self):
@@ -232,7 +236,7 @@ def _dof_names(rig):
 
 
 def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=None,
-                cage_phases_rad=None):
+                cage_phases_rad=None, mesh_model=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
 
     Parameters
@@ -240,7 +244,9 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
     rig : Rig
     op : OperatingPoint
     mesh_table : MeshStiffnessTable, optional
-        Pair stiffness; default: the potential-energy table of the rig's gears.
+        Pair stiffness; default: the potential-energy table of the rig's gears, or with
+        ``mesh_model`` the hybrid table of one mesh cycle at the operating torque (then used
+        only for the mesh damping coefficient and the start guess).
     slip : SlipModel, optional
         Ball-position jitter (default none).
     duration_s : float
@@ -250,12 +256,24 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
     cage_phases_rad : sequence of float, optional
         Initial cage angle θ0 of each bearing (eq. 7), one per bearing in
         ``rig.bearing_names`` order; default all zero.
+    mesh_model : HybridMeshModel, optional
+        Solve the tooth contact forces on-line from the FE influence coefficients at every
+        right-hand-side evaluation (paper 001 §6.1, model A) instead of using the table.
 
     Returns
     -------
     DynamicModel
     """
     slip = SlipModel() if slip is None else slip
+    if mesh_model is not None:
+        from cmsim.mesh_stiffness.hybrid import HybridMeshModel
+        if not isinstance(mesh_model, HybridMeshModel):
+            raise ParameterError(f"mesh_model must be a HybridMeshModel, got "
+                                 f"{type(mesh_model).__name__}")
+        if rig.gears is None:
+            raise ParameterError("mesh_model given for a rig without gears")
+        if mesh_model.pair != rig.gears:
+            raise ParameterError("mesh_model was built for a different gear pair than the rig's")
     n = rig.n_dof
     mass = _node_masses(rig)
     elements = _spring_elements(rig)
@@ -322,13 +340,15 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
     if rig.gears is not None:
         pair = rig.gears
         if mesh_table is None:
-            mesh_table = default_mesh_table(pair)
+            mesh_table = (default_mesh_table(pair) if mesh_model is None
+                          else hybrid_mesh_table(mesh_model, op.torque_nm))
         geo = contact_geometry(pair)
         n_slots = potential_slots(pair)
         psi10, psi20 = reference_phases(pair)
         lo, _ = table_range_m(pair)
         before, after = corner_zone_m(pair)
-        m_int[:] = (3 * node_of["1G1"], 3 * node_of["2G1"], n_slots, 1)
+        mode = K.MODE_TABLE if mesh_model is None else K.MODE_HYBRID
+        m_int[:] = (3 * node_of["1G1"], 3 * node_of["2G1"], n_slots, 1, mode)
         mc, lub = rig.mesh_contact, rig.lubricant
         k_mean = mesh_table.mean_mesh_stiffness(pair)
         m_par[K.MP_A0] = pair.working_centre_distance_m
@@ -366,10 +386,14 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
     springs = np.array([(k, c) for _, _, k, c in ordered])
     spring_ends = np.array([(a, a if b < 0 else b, 0) for a, b, _, _ in ordered], dtype=np.int64)
     spring_ends[0, 2] = sum(1 for e in ordered if e[1] < 0)
+    if mesh_model is not None:
+        hybrid = tuple(np.ascontiguousarray(a, dtype=float) for a in mesh_model.kernel_args())
+    else:
+        hybrid = K.no_hybrid()
     packed = (1.0 / mass, springs, force, omega, b_int, b_par, b_cos, b_sin, jitter, m_int,
-              m_par, geo, tab_k, tab_e, teeth1, teeth2, spring_ends)
+              m_par, geo, tab_k, tab_e, teeth1, teeth2, spring_ends) + hybrid
     return DynamicModel(rig, op, mesh_table, names, mass, kmat, cmat, force, omega, packed,
-                        tuple(diag_names), slip)
+                        tuple(diag_names), slip, mesh_model)
 
 
 def _pitch_multiples(n_teeth):
@@ -384,6 +408,22 @@ def default_mesh_table(pair):
 
 
 _PE_CACHE = {}
+_HYBRID_CACHE = {}
+
+
+def hybrid_mesh_table(mesh_model, output_torque_nm):
+    """Hybrid table of one mesh cycle at the driving torque that ``output_torque_nm`` needs.
+
+    Memoised per (model, torque): model A uses it for the mesh damping coefficient (from its
+    mean stiffness) and the quasi-static start guess.
+    """
+    pair = mesh_model.pair
+    drive = max(output_torque_nm, 1e-3) * pair.driving.n_teeth / pair.driven.n_teeth
+    key = (id(mesh_model), drive)
+    if key not in _HYBRID_CACHE:
+        from cmsim.mesh_stiffness.quasi_static import mesh_cycle
+        _HYBRID_CACHE[key] = (mesh_model, mesh_cycle(mesh_model, drive, n_steps=24).table)
+    return _HYBRID_CACHE[key][1]
 
 
 def _pe_table_cached(pair):

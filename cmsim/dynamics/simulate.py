@@ -22,7 +22,7 @@ __all__ = ["simulate", "integrate", "MAX_ROTATION_DEVIATION_RAD"]
 MAX_ROTATION_DEVIATION_RAD = 0.5
 
 
-def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3"):
+def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=None):
     """Run the fixed-step kernel; returns ``(states, diag, wall_s)``.
 
     Parameters
@@ -40,6 +40,9 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3"):
         Integration steps per output sample.
     scheme : str
         Key of :data:`cmsim.dynamics.integrator.SCHEMES`.
+    stats : dict, optional
+        Receives ``hybrid_solves`` and ``hybrid_unconverged`` (on-line contact solves of
+        model A, and those that hit the iteration limit and used their last iterate).
 
     Returns
     -------
@@ -57,14 +60,19 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3"):
     max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
     max_rot = MAX_ROTATION_DEVIATION_RAD
     mask = model.translational_mask
-    args = (tab.a, tab.b, tab.c, model.packed, K.make_work(model.packed),
+    work = K.make_work(model.packed)
+    args = (tab.a, tab.b, tab.c, model.packed, work,
             K.make_integrator_buffers(tab.b, y0.size, len(model.diag_names)))
     # compile (or load from cache) outside the timed region
     K.integrate_jit(y0, t0, h, 1, 1, *args, states[:1], diag[:1], max_disp, max_rot, mask)
+    work[-1][:] = 0.0
     start = time.perf_counter()
     status = K.integrate_jit(y0, t0, h, n_out, substeps, *args, states, diag, max_disp,
                              max_rot, mask)
     wall = time.perf_counter() - start
+    if stats is not None:
+        stats["hybrid_solves"] = int(work[-1][0])
+        stats["hybrid_unconverged"] = int(work[-1][1])
     if status >= 0:
         raise IntegrationDiverged(
             f"the integration diverged at t = {t0 + status * dt_out:.6g} s (a displacement "
@@ -95,7 +103,8 @@ def _compile_seconds():
 
 
 def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
-             mesh_table=None, slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random"):
+             mesh_table=None, slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
+             mesh_model=None):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -126,6 +135,10 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
         Initial cage angle of each bearing: drawn uniformly from ``seed`` (default — the
         relative phase of independent cages is arbitrary, and equal phases can cancel the
         ball-pass line in the DTE by symmetry), given explicitly, or ``None`` for all zero.
+    mesh_model : HybridMeshModel, optional
+        Solve the tooth contact on-line from the FE influence coefficients (paper 001 §6.1,
+        model A; about 3-4 times slower than a table), e.g.
+        ``HybridMeshModel.from_pair(rig.gears)``.
 
     Returns
     -------
@@ -147,7 +160,8 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
         cage_phases_rad = rng.uniform(0.0, 2.0 * math.pi, len(rig.bearings))
     compile_s = _compile_seconds()
     model = build_model(rig, op, mesh_table, slip=slip, duration_s=warmup_s + duration_s,
-                        seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad)
+                        seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad,
+                        mesh_model=mesh_model)
     n = model.n_dof
     q0 = quasi_static_state(model, 0.0)
     y0 = np.concatenate([q0, np.zeros(n)])
@@ -157,7 +171,8 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
     if n_rec < 2:
         raise ParameterError(f"duration_s = {duration_s:g} s gives fewer than 2 samples at "
                              f"fs_hz = {fs_hz:g}")
-    states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, substeps, scheme)
+    stats = {}
+    states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, substeps, scheme, stats)
     states, diag = states[n_warm:], diag[n_warm:]
     t = (n_warm + np.arange(n_rec)) * dt
     signals = _signals(model, t, states, diag)
@@ -172,8 +187,13 @@ def simulate(rig, op, duration_s, *, fs_hz=75_000.0, substeps=1, scheme="ode3",
         "cage_phases_rad": [float(x) for x in model.packed[5][:, K.BP_PHASE]],
         "slip": {"cage_speed_rms": slip.cage_speed_rms, "ball_rms_rad": slip.ball_rms_rad,
                  "correlation_s": slip.correlation_s},
+        "mesh": None if rig.gears is None else ("hybrid" if mesh_model is not None
+                                                 else "table"),
         "mesh_table": None if model.mesh_table is None else {
             "method": model.mesh_table.method, "torque_nm": model.mesh_table.torque_nm},
+        **({"hybrid_solves": stats["hybrid_solves"],
+            "hybrid_unconverged": stats["hybrid_unconverged"]} if mesh_model is not None
+           else {}),
         "sim_s": (n_warm + n_rec) / fs_hz, "wall_s": wall, "compile_s": compile_s,
         "realtime_factor": (n_warm + n_rec) / fs_hz / wall if wall > 0 else math.inf,
         "dof_names": list(model.dof_names),

@@ -1,0 +1,1 @@
+"""Reproducible studies from the source papers (each module documents its paper section)."""
