@@ -175,8 +175,10 @@ def pair_contacts(pair, theta1_rad, theta2_rad, centre1_m=(0.0, 0.0), centre2_m=
     -------
     dict of ndarray, shape (n_slots,)
         ``position_m`` (s of each pair), ``delta_m`` (overlap), ``normal`` (n_slots, 2),
-        ``point_m`` (n_slots, 2), ``s_eq_m``, ``tooth`` (gear-1 tooth number of the pair,
-        counting back from tooth 0).
+        ``point_m`` (n_slots, 2), ``s_eq_m``, ``chi1_m``, ``chi2_m`` (radii of curvature of
+        the two surfaces at the contact), ``tooth`` (gear-1 tooth number of the pair,
+        counting back from tooth 0); and ``length_m`` (T1T2, float) and ``centre1_m``
+        (absolute centre of gear 1).
     """
     geo = contact_geometry(pair)
     rb1, rb2 = geo[0], geo[1]
@@ -193,7 +195,8 @@ def pair_contacts(pair, theta1_rad, theta2_rad, centre1_m=(0.0, 0.0), centre2_m=
     lo = table_range_m(pair)[0] if slot_start_m is None else float(slot_start_m)
     n_slots = potential_slots(pair) if n_slots is None else int(n_slots)
     m0 = math.floor((s_ref - lo) / pb)
-    out = {k: np.empty(n_slots) for k in ("position_m", "delta_m", "s_eq_m")}
+    out = {k: np.empty(n_slots) for k in ("position_m", "delta_m", "s_eq_m", "chi1_m",
+                                          "chi2_m")}
     out["normal"] = np.empty((n_slots, 2))
     out["point_m"] = np.empty((n_slots, 2))
     out["tooth"] = np.empty(n_slots, dtype=int)
@@ -208,5 +211,9 @@ def pair_contacts(pair, theta1_rad, theta2_rad, centre1_m=(0.0, 0.0), centre2_m=
         out["normal"][j] = res[1:3]
         out["point_m"][j] = res[3:5]
         out["s_eq_m"][j] = res[5]
+        out["chi1_m"][j] = res[6]
+        out["chi2_m"][j] = res[7]
         out["tooth"][j] = n
+    out["length_m"] = length
+    out["centre1_m"] = (c1x, c1y)
     return out

@@ -38,9 +38,7 @@ from scipy.optimize import brentq
 
 from cmsim.errors import ParameterError, check_range
 from cmsim.mesh_stiffness._hybrid_kernels import hybrid_forces_jit
-from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit
-from cmsim.mesh_stiffness.contact import (contact_geometry, potential_slots, reference_phases,
-                                          table_range_m)
+from cmsim.mesh_stiffness.contact import pair_contacts, potential_slots, table_range_m
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel, work_size
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
@@ -55,9 +53,8 @@ def slot_contacts(pair, theta1_rad, theta2_rad, centre1_m=(0.0, 0.0), centre2_m=
                   n_slots=None, slot_start_m=None):
     """Rigid contact geometry of the potential pairs, with the curvature radii.
 
-    The same slots and numbers as :func:`cmsim.mesh_stiffness.contact.pair_contacts` (it
-    calls the same kernel), plus the radii of curvature χ1, χ2 and the instantaneous
-    line-of-action length that the hybrid solve needs.
+    :func:`cmsim.mesh_stiffness.contact.pair_contacts`, whose output includes the radii of
+    curvature χ1, χ2 and the instantaneous line-of-action length that the hybrid solve needs.
 
     Parameters
     ----------
@@ -78,41 +75,8 @@ def slot_contacts(pair, theta1_rad, theta2_rad, centre1_m=(0.0, 0.0), centre2_m=
         ``position_m``, ``delta_m``, ``s_eq_m``, ``chi1_m``, ``chi2_m`` (n_slots,),
         ``normal``, ``point_m`` (n_slots, 2), ``length_m`` (float, T1T2).
     """
-    geo = contact_geometry(pair)
-    rb1, rb2 = geo[0], geo[1]
-    pb = pair.driving.base_pitch_m
-    psi10, psi20 = reference_phases(pair)
-    a0 = pair.working_centre_distance_m
-    c1x, c1y = float(centre1_m[0]), float(centre1_m[1])
-    c2x, c2y = float(centre2_m[0]), a0 + float(centre2_m[1])
-    phi_t1, length, cos_t1, sin_t1 = mesh_frame_jit(c1x, c1y, c2x, c2y, rb1, rb2)
-    psi1 = theta1_rad + psi10
-    psi2 = psi20 - theta2_rad
-    delta_inv = rb1 * (psi1 - phi_t1) + rb2 * (psi2 - phi_t1 - math.pi) - length
-    s_ref = rb1 * (psi1 - phi_t1)
-    lo = table_range_m(pair)[0] if slot_start_m is None else float(slot_start_m)
-    n_slots = potential_slots(pair) if n_slots is None else int(n_slots)
-    m0 = math.floor((s_ref - lo) / pb)
-    out = {k: np.empty(n_slots) for k in ("position_m", "delta_m", "s_eq_m", "chi1_m",
-                                          "chi2_m")}
-    out["normal"] = np.empty((n_slots, 2))
-    out["point_m"] = np.empty((n_slots, 2))
-    for j in range(n_slots):
-        n = m0 - j
-        s = s_ref - n * pb
-        p1, p2 = psi1 - n * pb / rb1, psi2 + n * pb / rb2
-        res = pair_contact_jit(s, delta_inv, math.cos(p1), math.sin(p1), math.cos(p2),
-                               math.sin(p2), c1x, c1y, c2x, c2y, cos_t1, sin_t1, length, geo)
-        out["position_m"][j] = s
-        out["delta_m"][j] = res[0]
-        out["normal"][j] = res[1:3]
-        out["point_m"][j] = res[3:5]
-        out["s_eq_m"][j] = res[5]
-        out["chi1_m"][j] = res[6]
-        out["chi2_m"][j] = res[7]
-    out["length_m"] = length
-    out["centre1_m"] = (c1x, c1y)
-    return out
+    return pair_contacts(pair, theta1_rad, theta2_rad, centre1_m, centre2_m, n_slots,
+                         slot_start_m)
 
 
 @dataclass(frozen=True)
