@@ -43,6 +43,21 @@ def signal_1d(x, name="x", min_samples=MIN_SAMPLES):
     return arr
 
 
+def spectrum_arrays(freq, amp, min_samples=2):
+    """Return ``(freq, amp)`` of an amplitude spectrum: same shape, ``freq`` strictly
+    increasing, ``amp >= 0``."""
+    freq = signal_1d(freq, name="freq", min_samples=min_samples)
+    amp = signal_1d(amp, name="amp", min_samples=min_samples)
+    if freq.shape != amp.shape:
+        raise ParameterError(f"freq and amp must have the same shape, got {freq.shape} "
+                             f"and {amp.shape}")
+    if np.any(np.diff(freq) <= 0.0):
+        raise ParameterError("freq must be strictly increasing")
+    if np.any(amp < 0.0):
+        raise ParameterError("amp must be >= 0 (an amplitude spectrum)")
+    return freq, amp
+
+
 def sampling_rate(fs, name="fs"):
     """Return ``fs`` as a float > 0 (Hz)."""
     return check_range(name, fs, 0.0, lo_open=True, unit="Hz")

@@ -57,7 +57,8 @@ import scipy.ndimage
 import scipy.signal
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import WINDOWS, band, choice, positive_int, sampling_rate, signal_1d
+from cmsim.spectra._checks import (WINDOWS, band, choice, positive_int, sampling_rate,
+                                   signal_1d, spectrum_arrays)
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
 from cmsim.spectra.frequencies import FAMILY_KEYS, peak_families
@@ -108,19 +109,6 @@ TEMPLATES = (
 
 
 # ---------------------------------------------------------------------- peak finding
-def _spectrum_arrays(freq, amp):
-    freq = signal_1d(freq, name="freq", min_samples=4)
-    amp = signal_1d(amp, name="amp", min_samples=4)
-    if freq.shape != amp.shape:
-        raise ParameterError(f"freq and amp must have the same shape, got {freq.shape} "
-                             f"and {amp.shape}")
-    if np.any(np.diff(freq) <= 0.0):
-        raise ParameterError("freq must be strictly increasing")
-    if np.any(amp < 0.0):
-        raise ParameterError("amp must be >= 0 (an amplitude spectrum)")
-    return freq, amp
-
-
 def find_peaks(freq, amp, *, threshold_db=15.0, floor_bins=None, dynamic_range_db=80.0,
                min_freq=0.0, max_peaks=None):
     """Significant peaks of an amplitude spectrum above a running-median noise floor.
@@ -149,7 +137,7 @@ def find_peaks(freq, amp, *, threshold_db=15.0, floor_bins=None, dynamic_range_d
         ``amplitude``, ``floor`` (noise floor amplitude at the peak), ``snr_db`` (height above
         the floor, dB) and ``bin`` (index into ``freq``).
     """
-    freq, amp = _spectrum_arrays(freq, amp)
+    freq, amp = spectrum_arrays(freq, amp, min_samples=4)
     thr = check_range("threshold_db", threshold_db, 0.0, lo_open=True, unit="dB")
     dr = check_range("dynamic_range_db", dynamic_range_db, 0.0, lo_open=True, unit="dB")
     fmin = check_range("min_freq", min_freq, 0.0)
@@ -264,7 +252,7 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
         ``k``, ``m``, ``n`` (ints; 0 when unlabelled), ``expected_hz`` and ``error_hz`` (NaN
         when unlabelled). ``df.attrs`` holds ``families`` and ``tolerance_hz``.
     """
-    freq, amp = _spectrum_arrays(freq, amp)
+    freq, amp = spectrum_arrays(freq, amp, min_samples=4)
     fam = _check_families(families)
     df_bin = float(freq[1] - freq[0])
     tol = df_bin if tolerance_hz is None else check_range("tolerance_hz", tolerance_hz, 0.0,

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import choice, positive_int, signal_1d
+from cmsim.spectra._checks import choice, positive_int, signal_1d, spectrum_arrays
 
 __all__ = ["harmonic_amplitudes", "dominant_harmonic", "plot_family_waterfall",
            "plot_harmonic_trend", "FAMILY_MARKERS"]
@@ -33,15 +33,6 @@ FAMILY_MARKERS = {"GMF": ("v", "tab:blue", "k·GMF"),
                   "GMF±BPF": (".", "tab:red", "k·GMF ± m·BPF"),
                   "BPF": ("^", "tab:orange", "m·BPF"),
                   "other": ("x", "0.45", "other labelled / unlabelled")}
-
-
-def _spectrum(freq, amp):
-    freq = signal_1d(freq, name="freq", min_samples=2)
-    amp = signal_1d(amp, name="amp", min_samples=2)
-    if freq.shape != amp.shape:
-        raise ParameterError(f"freq and amp must have the same shape, got {freq.shape} and "
-                             f"{amp.shape}")
-    return freq, amp
 
 
 def harmonic_amplitudes(freq, amp, base_hz, n_harmonics=10, tolerance_hz=None):
@@ -74,7 +65,7 @@ def harmonic_amplitudes(freq, amp, base_hz, n_harmonics=10, tolerance_hz=None):
     >>> harmonic_amplitudes(f, a, 100.0, 4).tolist()
     [1.0, 0.0, 3.0, 0.0]
     """
-    freq, amp = _spectrum(freq, amp)
+    freq, amp = spectrum_arrays(freq, amp)
     base = check_range("base_hz", base_hz, 0.0, lo_open=True, unit="Hz")
     n = positive_int("n_harmonics", n_harmonics, lo=1, hi=1000)
     df = float(freq[1] - freq[0])
