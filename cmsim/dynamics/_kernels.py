@@ -9,8 +9,8 @@ Right-hand side contract: ``rhs_jit(t, y, dydt, row, P, diag, want_diag, W)`` wi
 rotations in rad, rotations of shaft 2 counted positive in its own sense of motion), ``v`` their
 rates; it writes row ``row`` of the 2-D array ``dydt`` with ``[v, M⁻¹(f_ext + g(t, q, v) − K q
 − C v)]`` where ``g`` holds the bearing and mesh forces. With ``want_diag`` it also writes the
-output forces into ``diag``. ``W`` = (g, cos_nom, sin_nom, slip_cos, slip_sin, cage_slip) are
-scratch arrays from :func:`make_work`.
+output forces into ``diag``. ``W`` holds the scratch arrays of :func:`make_work` (force
+vector, cage and slip trigonometry, per-slot mesh geometry, the hybrid solver's buffers).
 
 Hot-path code never slices arrays and never takes arrays out of tuples inside loops (numba
 takes an atomic reference count for each), and the integrator and force kernels are compiled

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -133,10 +133,9 @@ class MeshTableSet:
         with np.load(path) as z:
             info = json.loads(str(z["meta"]))
             if info.get("kind") != "mesh-table-set":
-                t = MeshStiffnessTable(z["position_m"], z["stiffness_n_per_m"],
-                                       z["separation_m"], info["base_radius_m"],
-                                       info["method"], info["torque_nm"] or 0.0, info["meta"])
-                return cls((t,), meta={"source_file": str(path)})
+                t = MeshStiffnessTable.load(path)
+                return cls((replace(t, torque_nm=t.torque_nm or 0.0),),
+                           meta={"source_file": str(path)})
             tables = tuple(MeshStiffnessTable(z["position_m"], k, e, info["base_radius_m"],
                                               info["method"], float(q), m)
                            for q, k, e, m in zip(z["torques_nm"], z["stiffness_n_per_m"],
@@ -200,9 +199,7 @@ def torque_tables(rig, torques_nm, method="hybrid", *, mesh_model=None, speed_rp
         base = default_mesh_table(pair)
         _, k_mesh, count = base.mesh_stiffness(pair)
         for q in torques:
-            tables.append(MeshStiffnessTable(base.position_m, base.stiffness_n_per_m,
-                                             base.separation_m, base.base_radius_m,
-                                             base.method, torque_nm=q, meta=base.meta))
+            tables.append(replace(base, torque_nm=q))
             summary.append({"torque_nm": q, "mean_stiffness_n_per_m": float(np.mean(k_mesh)),
                             "peak_to_peak_stiffness_n_per_m": float(np.ptp(k_mesh)),
                             "loaded_contact_ratio": float(np.mean(count))})
@@ -223,10 +220,7 @@ def torque_tables(rig, torques_nm, method="hybrid", *, mesh_model=None, speed_rp
             c1, c2, spread = _orbit_centroids(rig, q, speed_rpm, mesh_model, n_orbit)
         cycle = mesh_cycle(mesh_model, q * ratio, c1, c2, n_steps=n_steps, n_points=n_points)
         k_mesh = cycle.mesh_stiffness_n_per_m
-        table = cycle.table
-        tables.append(MeshStiffnessTable(table.position_m, table.stiffness_n_per_m,
-                                         table.separation_m, table.base_radius_m, table.method,
-                                         torque_nm=q, meta=table.meta))
+        tables.append(replace(cycle.table, torque_nm=q))     # labelled by output torque
         summary.append({
             "torque_nm": q, "driving_torque_nm": q * ratio,
             "mean_stiffness_n_per_m": float(np.mean(k_mesh)),

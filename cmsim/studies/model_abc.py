@@ -123,6 +123,7 @@ def model_abc_study(rig=None, *, speed_rpm=1000.0, torque_nm=100.0, low_torque_n
     from cmsim.mesh_stiffness.hybrid import HybridMeshModel
     from cmsim.mesh_stiffness.torque_tables import torque_tables
     from cmsim.rig import OperatingPoint, Rig
+    from cmsim.spectra.frequencies import rig_frequencies
 
     rig = Rig.paper_2016() if rig is None else rig
     if rig.gears is None:
@@ -135,7 +136,7 @@ def model_abc_study(rig=None, *, speed_rpm=1000.0, torque_nm=100.0, low_torque_n
     tables = torque_tables(rig, [low, torque], mesh_model=mesh_model, speed_rpm=speed_rpm)
     tables_s = time.perf_counter() - t0
     op = OperatingPoint(speed_rpm, torque)
-    gmf = op.speed_rpm / 60.0 * rig.gears.driving.n_teeth
+    gmf = rig_frequencies(rig, op)["gmf_hz"]
     common = dict(fs_hz=fs_hz, seed=seed, cage_phases_rad=None)
     runs = {"A": simulate(rig, op, duration_s, mesh_model=mesh_model, **common),
             "B": simulate(rig, op, duration_s, mesh_table=tables.at(torque), **common),
