@@ -53,7 +53,7 @@ def _add_rig_options(p, *, friction=True):
 # ---------------------------------------------------------------------- simulate
 def _cmd_simulate(args):
     from cmsim.dynamics import SlipModel, simulate
-    from cmsim.spectra import rig_frequencies
+    from cmsim.frequencies import rig_frequencies
 
     rig = _load_rig(args)
     op = _operating_point(args)
@@ -61,8 +61,8 @@ def _cmd_simulate(args):
     slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                      correlation_s=args.slip_correlation_s)
     run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
-                   mesh_table=table, slip=slip, seed=args.seed, warmup_s=args.warmup_s,
-                   mesh_model=mesh_model)
+                   mesh=mesh_model if mesh_model is not None else table, slip=slip,
+                   seed=args.seed, warmup_s=args.warmup_s)
     if args.out:
         run.save(args.out)
     freqs = rig_frequencies(rig, op)

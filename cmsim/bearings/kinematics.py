@@ -16,12 +16,38 @@ import math
 
 import numpy as np
 
-__all__ = ["cage_ratios", "cage_angle", "ball_angles", "ball_pass_cycles_per_rev",
+__all__ = ["cage_speed_ratios", "cage_ratios", "cage_angle", "ball_angles", "ball_pass_cycles_per_rev",
            "slip_jitter"]
 
 
+def cage_speed_ratios(ball_diameter_m, pitch_diameter_m, contact_angle_rad=0.0):
+    """(K_in, K_out) = ((1 − γ)/2, (1 + γ)/2), γ = (d/D)·cos α: the one cage formula.
+
+    The cage turns at f_c = K_in·f_in + K_out·f_out (rolling without slip); every cage,
+    defect and ball-pass rate in cmsim (:mod:`cmsim.frequencies`, the model's ball angles)
+    derives from these two ratios.
+
+    Parameters
+    ----------
+    ball_diameter_m : float
+        Ball diameter d, m.
+    pitch_diameter_m : float
+        Pitch diameter D, m.
+    contact_angle_rad : float
+        Contact angle α, rad.
+
+    Examples
+    --------
+    >>> k_in, k_out = cage_speed_ratios(7.94e-3, 39.04e-3)      # CWRU 6205
+    >>> round(k_in, 6), round(k_out, 6)
+    (0.398309, 0.601691)
+    """
+    gamma = ball_diameter_m / pitch_diameter_m * math.cos(contact_angle_rad)
+    return 0.5 * (1.0 - gamma), 0.5 * (1.0 + gamma)
+
+
 def cage_ratios(bearing):
-    """(K_in, K_out) with θ_cage = K_in·θ_in + K_out·θ_out.
+    """(K_in, K_out) with θ_cage = K_in·θ_in + K_out·θ_out (:func:`cage_speed_ratios`).
 
     Examples
     --------
@@ -30,9 +56,8 @@ def cage_ratios(bearing):
     >>> round(k_in + k_out, 12)
     1.0
     """
-    gamma = bearing.ball_diameter_m / bearing.pitch_diameter_m * math.cos(
-        bearing.effective_contact_angle_rad)
-    return 0.5 * (1.0 - gamma), 0.5 * (1.0 + gamma)
+    return cage_speed_ratios(bearing.ball_diameter_m, bearing.pitch_diameter_m,
+                             bearing.effective_contact_angle_rad)
 
 
 def cage_angle(bearing, theta_inner_rad, theta_outer_rad=0.0):

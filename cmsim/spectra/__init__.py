@@ -10,7 +10,7 @@ module              content
 ``kurtogram``       :func:`spectral_kurtosis`, :func:`kurtogram` (STFT-based)
 ``order``           :func:`angle_resample`, :func:`order_spectrum`, :func:`tacho_pulse_times`
 ``tsa``             :func:`time_synchronous_average`
-``frequencies``     :func:`bearing_frequencies`, :func:`rig_frequencies`, :func:`peak_families`
+``frequencies``     re-export of :mod:`cmsim.frequencies` (:class:`RigFrequencies`, ...)
 ``labels``          :func:`find_peaks`, :func:`label_peaks`, :func:`labelled_peaks`
 ``plots``           :func:`plot_spectrum`, :func:`plot_waterfall`, :func:`plot_orbit`,
                     :func:`plot_kurtogram` (matplotlib imported lazily, Agg canvas)
@@ -23,8 +23,8 @@ module              content
 
 from cmsim.spectra.amplitude import Spectrum, amplitude_spectrum, welch_amplitude
 from cmsim.spectra.envelope import bandpass, envelope, envelope_spectrum
-from cmsim.spectra.frequencies import (BearingFrequencies, bearing_frequencies, peak_families,
-                                       rig_frequencies)
+from cmsim.spectra.frequencies import (BearingFrequencies, RigFrequencies, bearing_frequencies,
+                                       peak_families, rig_frequencies)
 from cmsim.spectra.kurtogram import Kurtogram, kurtogram, spectral_kurtosis
 from cmsim.spectra.labels import FamilyTemplate, find_peaks, label_peaks, labelled_peaks
 from cmsim.spectra.order import (OrderSpectrum, angle_resample, order_spectrum, shaft_angle,
@@ -39,7 +39,8 @@ from cmsim.spectra.waterfall import (dominant_harmonic, harmonic_amplitudes,
 __all__ = [
     "Spectrum", "amplitude_spectrum", "welch_amplitude",
     "bandpass", "envelope", "envelope_spectrum",
-    "BearingFrequencies", "bearing_frequencies", "rig_frequencies", "peak_families",
+    "BearingFrequencies", "RigFrequencies", "bearing_frequencies", "rig_frequencies",
+    "peak_families",
     "Kurtogram", "kurtogram", "spectral_kurtosis",
     "FamilyTemplate", "find_peaks", "label_peaks", "labelled_peaks",
     "OrderSpectrum", "angle_resample", "order_spectrum", "shaft_angle", "tacho_pulse_times",

@@ -57,11 +57,11 @@ import scipy.ndimage
 import scipy.signal
 
 from cmsim.errors import ParameterError, check_range
+from cmsim.frequencies import FAMILY_KEYS, RigFrequencies, peak_families
 from cmsim.spectra._checks import (WINDOWS, band, choice, positive_int, sampling_rate,
                                    signal_1d, spectrum_arrays)
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
-from cmsim.spectra.frequencies import FAMILY_KEYS, peak_families
 from cmsim.spectra.kurtogram import kurtogram
 from cmsim.spectra.order import order_spectrum
 
@@ -232,7 +232,7 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     families : dict of str to float
         Base frequencies by name, keys from :data:`FAMILY_KEYS`, e.g.
         ``{"GMF": 466.67, "BPF": 60.57, "fr": 16.67}`` or
-        :func:`~cmsim.spectra.frequencies.peak_families` output.
+        :meth:`~cmsim.frequencies.RigFrequencies.families` output.
     tolerance_hz : float, optional
         Largest |peak − candidate| for a match, same unit as ``freq``; default one bin.
     max_harmonic : int, optional
@@ -316,9 +316,9 @@ def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=No
         Signal, any unit.
     fs : float
         Sampling rate, Hz.
-    freqs : dict
-        :func:`~cmsim.spectra.frequencies.rig_frequencies` output, or a families dict
-        (keys from :data:`FAMILY_KEYS`, Hz).
+    freqs : cmsim.frequencies.RigFrequencies or dict
+        Characteristic frequencies (:func:`~cmsim.frequencies.rig_frequencies`), or a
+        families dict (keys from :data:`FAMILY_KEYS`, Hz).
     kind : {"amplitude", "envelope", "order"}
         ``"amplitude"``: :func:`~cmsim.spectra.amplitude.amplitude_spectrum`;
         ``"envelope"``: :func:`~cmsim.spectra.envelope.envelope_spectrum` in ``band_hz``
@@ -329,7 +329,7 @@ def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=No
     speed_rpm : float or array_like, optional
         Shaft speed for ``kind="order"``; default constant 60·fr.
     bearing : str, optional
-        Bearing whose frequencies are used when ``freqs`` comes from ``rig_frequencies``.
+        Bearing whose frequencies are used when ``freqs`` is a ``RigFrequencies``.
     window : {"flattop", "hann", "boxcar"}
         Spectrum window.
     tolerance_hz : float, optional
@@ -350,9 +350,13 @@ def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=No
     choice("kind", kind, PEAK_KINDS)
     choice("window", window, WINDOWS)
     fs = sampling_rate(fs)
-    if not isinstance(freqs, dict):
-        raise ParameterError(f"freqs must be a dict, got {type(freqs).__name__}")
-    fam = peak_families(freqs, bearing) if "shaft_hz" in freqs else _check_families(freqs)
+    if isinstance(freqs, RigFrequencies):
+        fam = freqs.families(bearing)
+    elif isinstance(freqs, dict):
+        fam = peak_families(freqs, bearing) if "shaft_hz" in freqs else _check_families(freqs)
+    else:
+        raise ParameterError(f"freqs must be a RigFrequencies or a families dict, got "
+                             f"{type(freqs).__name__}")
     if kind == "amplitude":
         f, a = amplitude_spectrum(x, fs, window=window)
     elif kind == "envelope":

@@ -2,7 +2,7 @@
 
 The base frequencies used to name the peaks (GMF, BPF, fr, BPFO, …) come from the run's own
 metadata — its rig and operating point — through
-:func:`~cmsim.spectra.frequencies.rig_frequencies`, with the bearing taken from the signal
+:func:`~cmsim.frequencies.rig_frequencies`, with the bearing taken from the signal
 name (``F_2b1_loa`` → bearing ``2b1`` and the output shaft rate as ``fr``).
 """
 
@@ -14,11 +14,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
+from cmsim.frequencies import rig_frequencies
 from cmsim.spectra._checks import band as check_band
 from cmsim.spectra._checks import choice, positive_int
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
-from cmsim.spectra.frequencies import peak_families, rig_frequencies
 from cmsim.spectra.kurtogram import kurtogram
 from cmsim.spectra.labels import PEAK_KINDS, label_peaks
 from cmsim.spectra.order import order_spectrum
@@ -54,7 +54,7 @@ def signal_bearing(name, bearing_names):
 
 
 def run_families(run, bearing=None):
-    """``(rig_frequencies dict, families dict)`` of a run from its metadata.
+    """``(RigFrequencies, families dict)`` of a run from its metadata.
 
     Parameters
     ----------
@@ -66,10 +66,10 @@ def run_families(run, bearing=None):
 
     Returns
     -------
-    freqs : dict
-        :func:`~cmsim.spectra.frequencies.rig_frequencies` output, Hz.
+    freqs : cmsim.frequencies.RigFrequencies
+        Characteristic frequencies of the run's rig, Hz.
     families : dict of str to float
-        :func:`~cmsim.spectra.frequencies.peak_families` output, Hz.
+        :meth:`~cmsim.frequencies.RigFrequencies.families` of ``bearing``, Hz.
     """
     from cmsim.rig import OperatingPoint, Rig
 
@@ -80,7 +80,7 @@ def run_families(run, bearing=None):
     rig = Rig.from_dict(meta["rig"])
     op = OperatingPoint(**meta["operating_point"])
     freqs = rig_frequencies(rig, op)
-    return freqs, peak_families(freqs, bearing)
+    return freqs, freqs.families(bearing)
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,11 +192,11 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
     f_max = 0.5 * fs if max_hz is None else check_range("max_hz", max_hz, 0.0, 0.5 * fs,
                                                         lo_open=True, unit="Hz")
     freqs, _ = run_families(run)
-    bearing_names = tuple(k for k, v in freqs.items() if isinstance(v, dict))
+    bearing_names = freqs.bearing_names
     brg = signal_bearing(signal, bearing_names) if bearing is None else bearing
     if brg not in bearing_names:
         raise ParameterError(f"bearing must be one of {list(bearing_names)}, got {bearing!r}")
-    fam = peak_families(freqs, brg)
+    fam = freqs.families(brg)
     x = np.asarray(run[signal], dtype=float)
     res = None if resolution_hz is None else check_range("resolution_hz", resolution_hz, 0.0,
                                                          lo_open=True, unit="Hz")

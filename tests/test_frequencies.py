@@ -1,4 +1,5 @@
-"""Characteristic frequencies: bearing kinematics with one or both rings rotating, GMF.
+"""Characteristic frequencies (cmsim.frequencies): bearing kinematics with one or both rings
+rotating, GMF, the typed RigFrequencies record.
 
 Test tier: closed form (textbook bearing formulas, hand-computed for the CWRU 6205 bearing;
 the paper rig's 3.6342 bearing cycles per gear turn, Fernandez-del-Rincon et al. 2016 §5).
@@ -11,7 +12,9 @@ import pytest
 
 from cmsim.errors import ParameterError
 from cmsim.rig import OperatingPoint, Rig
-from cmsim.spectra import bearing_frequencies, peak_families, rig_frequencies
+from cmsim.bearings.kinematics import cage_ratios
+from cmsim.frequencies import (BearingFrequencies, RigFrequencies, bearing_frequencies,
+                              peak_families, rig_frequencies)
 
 # CWRU drive-end bearing SKF 6205-2RS JEM: 9 balls, d = 7.94 mm, D = 39.04 mm, α = 0
 N_BALLS, D_BALL, D_PITCH = 9, 7.94e-3, 39.04e-3
@@ -65,13 +68,15 @@ def test_both_rings_rotating_invariants(outer_hz):
 def test_paper_rig_gmf_and_bearing_cycles_per_gear_turn():
     rig = Rig.paper_2016()
     f = rig_frequencies(rig, OperatingPoint(speed_rpm=1000.0))
-    assert f["shaft_hz"] == pytest.approx(1000 / 60)
-    assert f["gmf_hz"] == pytest.approx(466.67, abs=0.005)
-    assert f["output_shaft_hz"] == pytest.approx(1000 / 60)       # 28/28 teeth
-    assert set(rig.bearing_names) <= set(f)
+    assert isinstance(f, RigFrequencies)
+    assert f.fr1_hz == pytest.approx(1000 / 60)
+    assert f.gmf_hz == pytest.approx(466.67, abs=0.005)
+    assert f.fr2_hz == pytest.approx(1000 / 60)       # 28/28 teeth
+    assert f.bearing_names == rig.bearing_names
     for name in rig.bearing_names:
-        assert f[name]["bpf_hz"] / f[name]["shaft_hz"] == pytest.approx(3.6342, abs=5e-4)
-        assert f[name]["bpf_hz"] == pytest.approx(f[name]["bpfo_hz"], rel=1e-12)
+        b = f.bearing(name)
+        assert b.bpf_hz / b.shaft_hz == pytest.approx(3.6342, abs=5e-4)
+        assert b.bpf_hz == pytest.approx(b.bpfo_hz, rel=1e-12)
 
 
 def test_rig_frequencies_follow_gear_ratio_and_outer_ring_speed():
@@ -81,19 +86,55 @@ def test_rig_frequencies_follow_gear_ratio_and_outer_ring_speed():
     sh2 = rig.shafts[1]
     sh2 = replace(sh2, bearing_1=replace(sh2.bearing_1, outer_ring_speed_ratio=-1.0))
     rig2 = replace(rig, gears=replace(rig.gears, driven=wheel), shafts=(rig.shafts[0], sh2))
-    f = rig_frequencies(rig2, OperatingPoint(speed_rpm=1200.0))
-    assert f["output_shaft_hz"] == pytest.approx(20.0 * 28 / 42)
-    assert f["gmf_hz"] == pytest.approx(28 * 20.0)
-    assert f["2b2"]["shaft_hz"] == pytest.approx(20.0 * 28 / 42)
+    f = RigFrequencies.of(rig2, OperatingPoint(speed_rpm=1200.0))
+    assert f.fr2_hz == pytest.approx(20.0 * 28 / 42)
+    assert f.gmf_hz == pytest.approx(28 * 20.0)
+    assert f.bearing("2b2").shaft_hz == pytest.approx(20.0 * 28 / 42)
     b = rig2.shafts[1].bearing_1
-    ref = bearing_frequencies(f["2b1"]["shaft_hz"], b.n_balls, b.ball_diameter_m,
+    ref = bearing_frequencies(f.bearing("2b1").shaft_hz, b.n_balls, b.ball_diameter_m,
                               b.pitch_diameter_m, b.effective_contact_angle_rad,
-                              outer_ring_hz=-f["2b1"]["shaft_hz"])
-    assert f["2b1"]["bpfi_hz"] == pytest.approx(ref.bpfi_hz, rel=1e-12)
-    assert f["2b1"]["bpfo_hz"] > f["2b2"]["bpfo_hz"]              # counter-rotating outer ring
-    fam = peak_families(f, "2b1")
-    assert fam["fr"] == pytest.approx(f["2b1"]["shaft_hz"])
+                              outer_ring_hz=-f.bearing("2b1").shaft_hz)
+    assert f.bearing("2b1").bpfi_hz == pytest.approx(ref.bpfi_hz, rel=1e-12)
+    assert f.bearing("2b1").bpfo_hz > f.bearing("2b2").bpfo_hz    # counter-rotating outer ring
+    fam = f.families("2b1")
+    assert fam["fr"] == pytest.approx(f.bearing("2b1").shaft_hz)
     assert set(fam) == {"GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF"}
+    assert peak_families(f, "2b1") == fam
+
+
+def test_cage_rate_is_the_kinematics_cage_formula():
+    """FTF/f_shaft equals K_in of bearings.kinematics (the one cage formula) for a fixed
+    outer ring, and the model's ball pass equals N·K_in·f_shaft."""
+    rig = Rig.paper_2016()
+    f = rig_frequencies(rig, OperatingPoint(speed_rpm=900.0))
+    for name, brg in zip(rig.bearing_names, rig.bearings):
+        k_in, _ = cage_ratios(brg)
+        b = f.bearing(name)
+        assert b.ftf_hz == pytest.approx(k_in * b.shaft_hz, rel=1e-12)
+        assert b.bpf_hz == pytest.approx(brg.n_balls * k_in * b.shaft_hz, rel=1e-12)
+
+
+def test_dict_round_trip_and_mapping_access():
+    f = rig_frequencies(Rig.paper_2016(), OperatingPoint(speed_rpm=1000.0))
+    d = f.to_dict()
+    assert set(d) == {"shaft_hz", "output_shaft_hz", "gmf_hz", "1b1", "1b2", "2b1", "2b2"}
+    assert RigFrequencies.from_dict(d) == f
+    assert f["1b1"]["bpf_hz"] == pytest.approx(f.bearing("1b1").bpf_hz, rel=1e-15)
+    assert f["gmf_hz"] == pytest.approx(f.gmf_hz, rel=1e-15)
+    with pytest.raises(ParameterError, match="bearing must be one of"):
+        f.bearing("9b9")
+
+
+def test_measured_record_frequencies_without_gears():
+    """A measured record: one named bearing, no gears, no GMF family."""
+    brg = bearing_frequencies(1797 / 60, N_BALLS, D_BALL, D_PITCH)
+    f = RigFrequencies(fr1_hz=1797 / 60, bearings={"DE": brg})
+    assert not f.has_gears and f.gmf_hz is None
+    fam = f.families("DE")
+    assert "GMF" not in fam
+    assert fam["BPFO"] == pytest.approx(brg.bpfo_hz, rel=1e-15)
+    with pytest.raises(ParameterError, match="BearingFrequencies"):
+        RigFrequencies(fr1_hz=10.0, bearings={"DE": {"bpfo_hz": 1.0}})
 
 
 def test_peak_families_drop_zero_frequencies():
@@ -122,5 +163,6 @@ def test_bad_bearing_inputs_name_the_parameter(kwargs, name):
 
 def test_values_are_plain_floats():
     f = rig_frequencies(Rig.paper_2016(), OperatingPoint(speed_rpm=600.0))
-    assert all(isinstance(v, float) for v in f["1b1"].values())
-    assert np.isfinite(f["gmf_hz"])
+    assert isinstance(f.bearing("1b1"), BearingFrequencies)
+    assert all(isinstance(v, float) for v in f.bearing("1b1").to_dict().values())
+    assert np.isfinite(f.gmf_hz)
