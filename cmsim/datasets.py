@@ -38,6 +38,7 @@ import math
 import multiprocessing
 import os
 import sys
+import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -46,8 +47,15 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_text
+from cmsim.dynamics.simulate import _compile_seconds, simulate
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
 from cmsim.rig import OperatingPoint, Rig
+from cmsim.run import Run
+from cmsim.spectra.amplitude import amplitude_spectrum
+from cmsim.spectra.frequencies import peak_families
+from cmsim.spectra.labels import label_peaks
+from cmsim.spectra.run_spectrum import run_families, signal_bearing
+from cmsim.spectra.waterfall import harmonic_amplitudes
 
 __all__ = ["SweepSpec", "SweepCase", "SweepSummary", "run_sweep", "read_manifest",
            "run_features", "SEED_POLICIES", "START_METHODS", "MANIFEST_NAME", "RUNS_DIR",
@@ -339,12 +347,6 @@ def run_features(run, signals=FEATURE_SIGNALS, n_harmonics=6, top_n=5):
         ``gmf_harmonics`` (amplitudes of 1..n_harmonics × GMF, signal unit) and
         ``top_peaks`` (list of {frequency_hz, amplitude, label, db_re_carrier}).
     """
-    from cmsim.spectra.amplitude import amplitude_spectrum
-    from cmsim.spectra.frequencies import peak_families
-    from cmsim.spectra.labels import label_peaks
-    from cmsim.spectra.run_spectrum import run_families, signal_bearing
-    from cmsim.spectra.waterfall import harmonic_amplitudes
-
     freqs, _ = run_families(run)
     bearings = tuple(k for k, v in freqs.items() if isinstance(v, dict))
     out = {}
@@ -376,9 +378,6 @@ _PROCESS_RUNS = {"n": 0, "warm": False}
 
 def _run_case(spec, case, path):
     """Simulate one case, save it atomically, return a small JSON-ready record."""
-    from cmsim.dynamics import simulate
-    from cmsim.run import Run
-
     start = time.perf_counter()
     first = _PROCESS_RUNS["n"] == 0 and not _PROCESS_RUNS["warm"]
     _PROCESS_RUNS["n"] += 1
@@ -418,23 +417,15 @@ def _watch_parent(parent_pid, period_s=0.5):
 
 def _worker_init(parent_pid):
     """Pool initializer: watch the parent from a daemon thread."""
-    import threading
-
     threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True,
                      name="cmsim-parent-watch").start()
 
 
 def _warm_kernels(spec):
-    """Import the spectra stack and load/compile the kernels in this process, before forking
-    workers (which inherit both). Returns ``{"compile": s, "startup": s}``: kernel
-    compile/load time, and the rest (imports, a 3-sample run)."""
+    """Load/compile the kernels in this process, before forking workers (which inherit
+    them). Returns ``{"compile": s, "startup": s}``: kernel compile/load time, and the rest
+    (a 3-sample run)."""
     start = time.perf_counter()
-    import cmsim.spectra.run_spectrum  # noqa: F401  (pandas, scipy.signal, ndimage)
-    import cmsim.spectra.waterfall  # noqa: F401
-    from cmsim.dynamics import simulate
-
-    from cmsim.dynamics.simulate import _compile_seconds
-
     case = spec.cases()[0]
     try:                     # also builds a model, so every kernel in the path is loaded
         simulate(spec.case_rig(case), spec.case_operating_point(case), 3.0 / spec.fs_hz,
@@ -518,8 +509,6 @@ def _file_matches(spec, case, path, entry=None):
 
 
 def _adopt(spec, case, path):
-    from cmsim.run import Run
-
     start = time.perf_counter()
     run = Run.load(path)
     features = run_features(run)

@@ -38,7 +38,18 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_bytes, atomic_write_text
+from cmsim.datasets import RUNS_DIR, read_manifest
 from cmsim.errors import ParameterError, check_range
+from cmsim.plots import plot_orbit_family, plot_trace_family
+from cmsim.rig import OperatingPoint, Rig
+from cmsim.run import Run
+from cmsim.spectra._checks import positive_int
+from cmsim.spectra.amplitude import amplitude_spectrum
+from cmsim.spectra.frequencies import peak_families, rig_frequencies
+from cmsim.spectra.labels import label_peaks
+from cmsim.spectra.run_spectrum import signal_bearing, signal_unit
+from cmsim.spectra.waterfall import (harmonic_amplitudes, plot_family_waterfall,
+                                     plot_harmonic_trend)
 
 __all__ = ["ReportResult", "build_report", "sweep_run_files", "DEFAULT_SIGNALS", "SWEEP_AXES"]
 
@@ -96,8 +107,6 @@ class ReportResult:
 
 def sweep_run_files(sweep_dir):
     """Run files of a sweep: the manifest's finished runs in index order, else ``runs/*.npz``."""
-    from cmsim.datasets import RUNS_DIR, read_manifest
-
     d = Path(sweep_dir)
     if not d.is_dir():
         raise ParameterError(f"sweep directory {d} does not exist (or is not a directory)")
@@ -116,14 +125,6 @@ def sweep_run_files(sweep_dir):
 # ---------------------------------------------------------------------- per-run digest
 def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
     """Everything the report needs from one run (the run itself is then dropped)."""
-    from cmsim.rig import OperatingPoint, Rig
-    from cmsim.run import Run
-    from cmsim.spectra.amplitude import amplitude_spectrum
-    from cmsim.spectra.frequencies import peak_families, rig_frequencies
-    from cmsim.spectra.labels import label_peaks
-    from cmsim.spectra.run_spectrum import signal_bearing, signal_unit
-    from cmsim.spectra.waterfall import harmonic_amplitudes
-
     t0 = time.perf_counter()
     run = Run.load(path)
     t1 = time.perf_counter()
@@ -226,8 +227,6 @@ def _common_axis(members, signal, in_orders):
 
 
 def _waterfall(members, signal, axis, in_orders, f_show, dyn_db, title):
-    from cmsim.spectra.waterfall import plot_family_waterfall
-
     freq, amps = _common_axis(members, signal, in_orders)
     m0 = members[0]
     fam = dict(m0["families"][signal])
@@ -338,8 +337,6 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
     """
     from tqdm import tqdm
 
-    from cmsim.spectra._checks import positive_int
-
     start = time.perf_counter()
     out_dir = Path(sweep_dir)
     files = sweep_run_files(out_dir)
@@ -398,8 +395,6 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
 def _group_section(gi, fixed, members, axis, in_orders, signals, dom_signal, f_show, dyn,
                    n_mesh_cycles, sfx, emit):
     """Figures of one group and their HTML (captions)."""
-    from cmsim.spectra.sweep_plots import plot_orbit_family, plot_trace_family
-    from cmsim.spectra.waterfall import plot_harmonic_trend
 
     values = [m[axis] for m in members]
     vlabel = SWEEP_AXES[axis]

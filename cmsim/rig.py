@@ -28,7 +28,9 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+import tomli_w
 
+from cmsim._io import atomic_write_text
 from cmsim.errors import ParameterError, check_range
 
 __all__ = [
@@ -725,9 +727,6 @@ class Rig:
 
     def save(self, path):
         """Write the rig as TOML (atomically)."""
-        import tomli_w
-
-        from cmsim._io import atomic_write_text
         text = ("# cmsim rig description — auto-generated, SI units (m, kg, N, s, rad).\n"
                 "# Keys ending in _deg or _mm are accepted on reading and converted.\n"
                 + tomli_w.dumps(_drop_none(self.to_dict())))

@@ -1,4 +1,4 @@
-"""Quasi-static loaded mesh and hybrid stiffness tables of the paper pair (quasi_static).
+"""Quasi-static loaded mesh and hybrid stiffness tables of the paper pair (mesh_cycle).
 
 Tiers:
 
@@ -25,7 +25,7 @@ from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness.contact import active_path_m, pair_contacts, table_range_m
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.potential_energy import iso6336_stiffness
-from cmsim.mesh_stiffness.quasi_static import mesh_cycle, quasi_static_mesh, slot_contacts
+from cmsim.mesh_stiffness.mesh_cycle import mesh_cycle, quasi_static_mesh, slot_contacts
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.rig import Rig
 

@@ -23,7 +23,7 @@ from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_state
 from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
-from cmsim.mesh_stiffness.quasi_static import slot_contacts
+from cmsim.mesh_stiffness.mesh_cycle import slot_contacts
 from cmsim.mesh_stiffness.torque_tables import MeshTableSet, torque_tables
 from cmsim.rig import OperatingPoint, Rig, Rotor
 from cmsim.studies.model_abc import gmf_harmonics, model_abc_study

@@ -421,7 +421,7 @@ def hybrid_mesh_table(mesh_model, output_torque_nm):
     drive = max(output_torque_nm, 1e-3) * pair.driving.n_teeth / pair.driven.n_teeth
     key = (id(mesh_model), drive)
     if key not in _HYBRID_CACHE:
-        from cmsim.mesh_stiffness.quasi_static import mesh_cycle
+        from cmsim.mesh_stiffness.mesh_cycle import mesh_cycle
         _HYBRID_CACHE[key] = (mesh_model, mesh_cycle(mesh_model, drive, n_steps=24).table)
     return _HYBRID_CACHE[key][1]
 

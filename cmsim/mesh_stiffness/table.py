@@ -24,6 +24,8 @@ import numpy as np
 
 from cmsim._io import atomic_savez
 from cmsim.errors import ParameterError
+from cmsim.mesh_stiffness.contact import active_path_m, table_range_m
+from cmsim.mesh_stiffness.potential_energy import pair_stiffness_potential_energy
 
 __all__ = ["MeshStiffnessTable", "MESH_METHODS"]
 
@@ -114,7 +116,6 @@ class MeshStiffnessTable:
             Sum of the pair stiffnesses in contact, N/m.
         pairs_in_contact : ndarray of int, shape (n_points,)
         """
-        from cmsim.mesh_stiffness.contact import active_path_m
         s0, s1 = active_path_m(pair)
         pb = pair.driving.base_pitch_m
         s = s0 + pb * np.arange(n_points) / n_points
@@ -135,7 +136,6 @@ class MeshStiffnessTable:
     @classmethod
     def constant(cls, pair, stiffness_n_per_m, n_points=64):
         """Load-independent table with the same stiffness everywhere (closed-form tests)."""
-        from cmsim.mesh_stiffness.contact import table_range_m
         lo, hi = table_range_m(pair)
         s = np.linspace(lo, hi, n_points)
         return cls(s, np.full(n_points, float(stiffness_n_per_m)), np.zeros(n_points),
@@ -148,8 +148,6 @@ class MeshStiffnessTable:
         The stiffness over the involute path is extended as a constant (its end values)
         into the tip-rounding (corner contact) zones on both sides.
         """
-        from cmsim.mesh_stiffness.contact import active_path_m, table_range_m
-        from cmsim.mesh_stiffness.potential_energy import pair_stiffness_potential_energy
         lo, hi = table_range_m(pair)
         s = np.linspace(lo, hi, n_points)
         s0, s1 = active_path_m(pair)

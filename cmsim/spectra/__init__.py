@@ -17,7 +17,6 @@ module              content
 ``run_spectrum``    :func:`run_spectrum` (labelled spectrum of a run signal), :class:`RunSpectrum`
 ``waterfall``       :func:`harmonic_amplitudes`, :func:`dominant_harmonic`,
                     :func:`plot_family_waterfall`, :func:`plot_harmonic_trend`
-``sweep_plots``     :func:`plot_orbit_family`, :func:`plot_trace_family`
 ==================  ==============================================================
 """
 
@@ -31,7 +30,6 @@ from cmsim.spectra.order import (OrderSpectrum, angle_resample, order_spectrum, 
                                  tacho_pulse_times)
 from cmsim.spectra.plots import plot_kurtogram, plot_orbit, plot_spectrum, plot_waterfall
 from cmsim.spectra.run_spectrum import RunSpectrum, run_spectrum
-from cmsim.spectra.sweep_plots import plot_orbit_family, plot_trace_family
 from cmsim.spectra.tsa import SynchronousAverage, time_synchronous_average
 from cmsim.spectra.waterfall import (dominant_harmonic, harmonic_amplitudes,
                                      plot_family_waterfall, plot_harmonic_trend)
@@ -46,6 +44,6 @@ __all__ = [
     "OrderSpectrum", "angle_resample", "order_spectrum", "shaft_angle", "tacho_pulse_times",
     "plot_kurtogram", "plot_orbit", "plot_spectrum", "plot_waterfall",
     "SynchronousAverage", "time_synchronous_average",
-    "RunSpectrum", "run_spectrum", "plot_orbit_family", "plot_trace_family",
+    "RunSpectrum", "run_spectrum",
     "dominant_harmonic", "harmonic_amplitudes", "plot_family_waterfall", "plot_harmonic_trend",
 ]

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
+from cmsim.rig import OperatingPoint, Rig
 from cmsim.frequencies import rig_frequencies
 from cmsim.spectra._checks import band as check_band
 from cmsim.spectra._checks import choice, positive_int
@@ -71,8 +72,6 @@ def run_families(run, bearing=None):
     families : dict of str to float
         :meth:`~cmsim.frequencies.RigFrequencies.families` of ``bearing``, Hz.
     """
-    from cmsim.rig import OperatingPoint, Rig
-
     meta = run.meta
     if "rig" not in meta or "operating_point" not in meta:
         raise ParameterError("the run's meta lacks 'rig' or 'operating_point' (not written by "
@@ -241,4 +240,3 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
                        resolution_hz=float(df_hz), unit=signal_unit(signal), families=dict(fam),
                        bearing=brg, peaks=peaks.reset_index(drop=True), band_hz=band_used,
                        max_hz=float(f_max), extra=extra)
-

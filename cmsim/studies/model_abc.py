@@ -28,7 +28,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cmsim.dynamics.simulate import simulate
 from cmsim.errors import ParameterError, check_range
+from cmsim.mesh_stiffness.hybrid import HybridMeshModel
+from cmsim.mesh_stiffness.torque_tables import torque_tables
+from cmsim.rig import OperatingPoint, Rig
+from cmsim.spectra.amplitude import amplitude_spectrum
+from cmsim.spectra.frequencies import rig_frequencies
+from cmsim.spectra.waterfall import harmonic_amplitudes
 
 __all__ = ["ModelComparison", "model_abc_study", "gmf_harmonics"]
 
@@ -44,8 +51,6 @@ def gmf_harmonics(signal, fs_hz, gmf_hz, n_harmonics=6):
     ndarray, shape (n_harmonics,)
         Amplitudes in the unit of ``signal``.
     """
-    from cmsim.spectra.amplitude import amplitude_spectrum
-    from cmsim.spectra.waterfall import harmonic_amplitudes
     spec = amplitude_spectrum(np.asarray(signal, dtype=float), fs_hz)
     out = harmonic_amplitudes(spec.freq_hz, spec.amplitude, gmf_hz, n_harmonics)
     if not np.all(np.isfinite(out)):
@@ -119,12 +124,6 @@ def model_abc_study(rig=None, *, speed_rpm=1000.0, torque_nm=100.0, low_torque_n
     -------
     ModelComparison
     """
-    from cmsim.dynamics.simulate import simulate
-    from cmsim.mesh_stiffness.hybrid import HybridMeshModel
-    from cmsim.mesh_stiffness.torque_tables import torque_tables
-    from cmsim.rig import OperatingPoint, Rig
-    from cmsim.spectra.frequencies import rig_frequencies
-
     rig = Rig.paper_2016() if rig is None else rig
     if rig.gears is None:
         raise ParameterError("the model A/B/C study needs a rig with gears")
