@@ -176,7 +176,7 @@ def torque_tables(rig, torques_nm, method="hybrid", *, mesh_model=None, speed_rp
     -------
     MeshTableSet
     """
-    from cmsim.mesh_stiffness.mesh_cycle import mesh_cycle
+    from cmsim.mesh_stiffness.quasi_static import mesh_cycle
 
     if rig.gears is None:
         raise ParameterError("torque_tables needs a rig with gears")
@@ -264,3 +264,4 @@ def _orbit_centroids(rig, torque_nm, speed_rpm, mesh_model, n_orbit):
         radius = max(radius, float(np.max(np.hypot(*(pts - c).T))) * 1e6)
         out.append((float(c[0]), float(c[1])))
     return out[0], out[1], radius
+
