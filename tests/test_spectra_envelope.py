@@ -2,7 +2,8 @@
 
 Test tier: closed form (the envelope of A(1 + μ cos 2πf_m t)·sin 2πf_c t is A(1 + μ cos 2πf_m t);
 SK = 0 for Gaussian noise and −1 for a steady tone; an impulse train exciting a resonance shows
-its repetition rate in the envelope spectrum of the resonance band).
+its repetition rate in the envelope spectrum of the resonance band; a band narrower than
+3 × the fault rate is not selected however large its SK).
 """
 
 import numpy as np
@@ -11,6 +12,7 @@ import pytest
 from cmsim.errors import ParameterError
 from cmsim.spectra import (bandpass, envelope, envelope_spectrum, kurtogram,
                            spectral_kurtosis)
+from cmsim.spectra.kurtogram import DEFAULT_MIN_BANDWIDTH_HZ
 
 FS = 20_000.0
 
@@ -95,6 +97,46 @@ def test_kurtogram_respects_min_freq_and_custom_lengths():
     assert kg.bandwidth_hz == pytest.approx(2 * FS / kg.best_nperseg)
 
 
+def _fault_plus_narrow_disturbance(rep_hz=97.3, seconds=4.0):
+    """Impulses at rep_hz on a 3 kHz resonance plus a 6 kHz tone switched on in 12 random
+    bursts of 75 ms: a strong narrow-band disturbance, very impulsive at fine resolution."""
+    x = _impulse_train(rep_hz, seconds=seconds)
+    n = x.size
+    t = np.arange(n) / FS
+    gate = np.zeros(n)
+    for start in np.random.default_rng(7).choice(n - 2000, 12, replace=False):
+        gate[start: start + 1500] = 1.0
+    return x + 0.5 * gate * np.sin(2 * np.pi * 6000.0 * t)
+
+
+def test_kurtogram_min_bandwidth_from_fault_rate_keeps_the_bearing_band():
+    rep = 97.3
+    x = _fault_plus_narrow_disturbance(rep)
+    kg = kurtogram(x, FS, max_fault_hz=rep)
+    assert kg.bandwidth_hz >= 3.0 * rep
+    assert kg.band_hz[0] < 3000.0 < kg.band_hz[1]
+    s = envelope_spectrum(x, FS, kg.band_hz)
+    sel = s.freq_hz > 5.0
+    assert abs(s.freq_hz[sel][np.argmax(s.amplitude[sel])] - rep) <= s.resolution_hz
+    # the default (no fault rate given) also keeps bands >= DEFAULT_MIN_BANDWIDTH_HZ
+    assert kurtogram(x, FS).bandwidth_hz >= DEFAULT_MIN_BANDWIDTH_HZ
+
+
+def test_kurtogram_min_bandwidth_removes_the_narrow_levels():
+    """Without the constraint the 39 Hz band on the disturbance wins (its SK is the largest);
+    with it, those levels are not considered (their SK is still returned for plotting)."""
+    rep = 97.3
+    x = _fault_plus_narrow_disturbance(rep)
+    free = kurtogram(x, FS, min_bandwidth_hz=0.0)
+    assert free.bandwidth_hz < 3.0 * rep
+    assert abs(free.centre_hz - 6000.0) <= free.bandwidth_hz
+    kept = kurtogram(x, FS, max_fault_hz=rep)
+    assert kept.nperseg == free.nperseg
+    assert kept.kurtosis_max < free.kurtosis_max
+    assert kept.best_nperseg < free.best_nperseg
+    assert kurtogram(x, FS, min_bandwidth_hz=3.0 * rep).band_hz == kept.band_hz
+
+
 @pytest.mark.parametrize("call, name", [
     (lambda: envelope_spectrum(np.ones(1000), 1000.0, (100.0, 600.0)), "band_hz"),
     (lambda: envelope_spectrum(np.ones(1000), 1000.0, (300.0, 200.0)), "band_hz"),
@@ -104,6 +146,9 @@ def test_kurtogram_respects_min_freq_and_custom_lengths():
     (lambda: kurtogram(np.ones(500), 1000.0), "x too short"),
     (lambda: kurtogram(np.ones(5000), 1000.0, min_freq_hz=600.0), "min_freq_hz"),
     (lambda: kurtogram(np.ones(5000), 1000.0, nperseg=(16, 4.5)), "nperseg"),
+    (lambda: kurtogram(np.ones(5000), 1000.0, min_bandwidth_hz=-1.0), "min_bandwidth_hz"),
+    (lambda: kurtogram(np.ones(5000), 1000.0, max_fault_hz=0.0), "max_fault_hz"),
+    (lambda: kurtogram(np.ones(5000), 1000.0, min_bandwidth_hz=400.0), "min_bandwidth_hz"),
 ])
 def test_bad_inputs_name_the_parameter(call, name):
     with pytest.raises(ParameterError, match=name):

@@ -14,6 +14,15 @@ intermediate 1.5·2^k (so that consecutive bandwidths differ by factors 1.5 and 
 2·fs/N_w — the −6 dB width of the Hann window's response. The cell with the largest SK whose
 band lies inside (0, fs/2) is returned as the demodulation band.
 
+Minimum bandwidth. A band narrower than the fault rate it must carry cannot hold the
+modulation: the envelope of a band of width B shows modulation frequencies up to about B/2,
+and the fault line plus its first sidebands (f_c ± f_fault) need B ≥ 2·f_fault. Long windows
+(N_w = 4096 at 32 kHz: 16 Hz) would otherwise win on a strong narrow-band disturbance, whose
+SK can exceed that of the bearing impacts. Levels with 2·fs/N_w below ``min_bandwidth_hz`` are
+therefore not considered; by default ``min_bandwidth_hz`` = :data:`FAULT_BANDWIDTH_FACTOR` ×
+``max_fault_hz`` (3 × the highest characteristic frequency of interest, e.g. BPFI) when that
+is given, else :data:`DEFAULT_MIN_BANDWIDTH_HZ`.
+
 References
 ----------
 .. [1] J. Antoni, R. B. Randall, "The spectral kurtosis: application to the vibratory
@@ -32,13 +41,21 @@ import scipy.signal
 from cmsim.errors import ParameterError, check_range
 from cmsim.spectra._checks import positive_int, sampling_rate, signal_1d
 
-__all__ = ["Kurtogram", "spectral_kurtosis", "kurtogram"]
+__all__ = ["Kurtogram", "spectral_kurtosis", "kurtogram", "FAULT_BANDWIDTH_FACTOR",
+           "DEFAULT_MIN_BANDWIDTH_HZ"]
 
 #: Fewest STFT segments accepted for one SK estimate.
 MIN_SEGMENTS = 16
 
 #: Bandwidth of one STFT cell in bins of fs/N_w (−6 dB width of the Hann window).
 HANN_BANDWIDTH_BINS = 2.0
+
+#: Default least band, in multiples of the highest fault frequency of interest.
+FAULT_BANDWIDTH_FACTOR = 3.0
+
+#: Default least band without a fault frequency, Hz (3 × 162 Hz, the BPFI of a 6205 bearing
+#: at 1800 rpm; below it a band cannot carry a typical rolling-bearing modulation).
+DEFAULT_MIN_BANDWIDTH_HZ = 500.0
 
 
 def _stft_moments(x, fs, nperseg, overlap):
@@ -53,8 +70,13 @@ def _stft_moments(x, fs, nperseg, overlap):
             f"record too short for nperseg={nperseg}: {max(p1 - p0, 0)} full STFT segments, "
             f"need >= {MIN_SEGMENTS} (at least about {nperseg * (1 + MIN_SEGMENTS * (1 - overlap)):.0f} "
             f"samples, got {x.size})")
-    p2 = np.abs(sft.stft(x - x.mean(), p0=p0, p1=p1)) ** 2
-    return sft.f, p2.mean(axis=1), (p2 ** 2).mean(axis=1), p1 - p0
+    # the same segments as sft.stft(x, p0=p0, p1=p1) (segment p starts at p·hop − m_num_mid),
+    # transformed in one vectorised rfft instead of one FFT call per segment
+    start = p0 * hop - sft.m_num_mid
+    frames = np.lib.stride_tricks.sliding_window_view(x - x.mean(), nperseg)
+    frames = frames[start: start + (p1 - p0 - 1) * hop + 1: hop]
+    p2 = np.abs(np.fft.rfft(frames * sft.win, axis=1)) ** 2
+    return sft.f, p2.mean(axis=0), (p2 ** 2).mean(axis=0), p1 - p0
 
 
 def spectral_kurtosis(x, fs, nperseg=256, *, overlap=0.75):
@@ -158,7 +180,8 @@ def _default_lengths(n):
     return tuple(sorted(out))
 
 
-def kurtogram(x, fs, nperseg=None, *, overlap=0.75, min_freq_hz=0.0):
+def kurtogram(x, fs, nperseg=None, *, overlap=0.75, min_freq_hz=0.0, min_bandwidth_hz=None,
+              max_fault_hz=None):
     """STFT-based kurtogram and the band of largest spectral kurtosis.
 
     Parameters
@@ -174,6 +197,14 @@ def kurtogram(x, fs, nperseg=None, *, overlap=0.75, min_freq_hz=0.0):
     min_freq_hz : float
         Bands whose lower edge is below this frequency are ignored, Hz (e.g. to skip the
         shaft-rate region); the upper edge must stay below fs/2.
+    min_bandwidth_hz : float, optional
+        Least bandwidth 2·fs/N_w of a candidate band, Hz (>= 0); levels finer than this are
+        not considered (their SK is still computed and returned for plotting). Default
+        ``FAULT_BANDWIDTH_FACTOR * max_fault_hz`` when ``max_fault_hz`` is given, else
+        :data:`DEFAULT_MIN_BANDWIDTH_HZ`. Pass 0 to consider every level.
+    max_fault_hz : float, optional
+        Highest characteristic (fault) frequency the band must pass, Hz (> 0), e.g.
+        ``max(bpfo, bpfi, 2·bsf)`` of the bearing; sets the default ``min_bandwidth_hz``.
 
     Returns
     -------
@@ -187,6 +218,13 @@ def kurtogram(x, fs, nperseg=None, *, overlap=0.75, min_freq_hz=0.0):
     fs = sampling_rate(fs)
     ov = check_range("overlap", overlap, 0.0, 0.9)
     f_min = check_range("min_freq_hz", min_freq_hz, 0.0, 0.5 * fs, hi_open=True, unit="Hz")
+    if min_bandwidth_hz is not None:
+        bw_min = check_range("min_bandwidth_hz", min_bandwidth_hz, 0.0, 0.5 * fs, unit="Hz")
+    elif max_fault_hz is not None:
+        bw_min = FAULT_BANDWIDTH_FACTOR * check_range("max_fault_hz", max_fault_hz, 0.0,
+                                                      0.5 * fs, lo_open=True, unit="Hz")
+    else:
+        bw_min = min(DEFAULT_MIN_BANDWIDTH_HZ, 0.25 * fs)
     if nperseg is None:
         lengths = _default_lengths(x.size)
     else:
@@ -202,7 +240,7 @@ def kurtogram(x, fs, nperseg=None, *, overlap=0.75, min_freq_hz=0.0):
     for nw in lengths:
         f, sk = spectral_kurtosis(x, fs, nw, overlap=ov)
         bw = HANN_BANDWIDTH_BINS * fs / nw
-        ok = np.isfinite(sk) & (f - 0.5 * bw >= f_min) & (f - 0.5 * bw >= 0.0) \
+        ok = (bw >= bw_min) & np.isfinite(sk) & (f - 0.5 * bw >= f_min) & (f - 0.5 * bw >= 0.0) \
             & (f + 0.5 * bw <= 0.5 * fs)
         if np.any(ok):
             i = int(np.argmax(np.where(ok, sk, -np.inf)))
@@ -211,8 +249,9 @@ def kurtogram(x, fs, nperseg=None, *, overlap=0.75, min_freq_hz=0.0):
         freqs.append(f)
         kurts.append(sk)
     if best[3] == 0:
-        raise ParameterError(f"no kurtogram band fits between min_freq_hz={f_min:g} Hz and "
-                             f"fs/2={0.5 * fs:g} Hz for nperseg={lengths}")
+        raise ParameterError(f"no kurtogram band of width >= min_bandwidth_hz={bw_min:g} Hz "
+                             f"fits between min_freq_hz={f_min:g} Hz and fs/2={0.5 * fs:g} Hz "
+                             f"for nperseg={lengths}")
     return Kurtogram(fs=fs, nperseg=lengths, freq_hz=tuple(freqs), kurtosis=tuple(kurts),
                      centre_hz=best[1], bandwidth_hz=best[2], kurtosis_max=best[0],
                      best_nperseg=best[3])
