@@ -71,20 +71,9 @@ def _cmd_simulate(args):
         "shaft_hz": freqs["shaft_hz"],
         "gmf_hz": freqs.get("gmf_hz"),
         "bpf_hz": freqs[first]["bpf_hz"],
-        "dte_mean_rad": None, "dte_rms_rad": None, "dte_mean_um": None, "dte_rms_um": None,
-        "sim_s": run.meta["sim_s"], "wall_s": run.meta["wall_s"],
-        "realtime_factor": run.meta["realtime_factor"], "compile_s": run.meta["compile_s"],
-        "seed": run.meta["seed"], "n_samples": int(run.t.size), "fs_hz": run.fs_hz,
-        "out": str(args.out) if args.out else None, "mesh": run.meta["mesh"],
-        "mesh_table": run.meta["mesh_table"],
+        **run.summary(),
+        "out": str(args.out) if args.out else None,
     }
-    if rig.gears is not None:
-        dte = run["dte"]
-        out.update(dte_mean_rad=float(dte.mean()), dte_rms_rad=float(dte.std()),
-                   dte_mean_um=float(run["dte_um"].mean()), dte_rms_um=float(run["dte_um"].std()))
-    for b in rig.bearing_names:
-        out[f"F_{b}_loa_mean_n"] = float(run[f"F_{b}_loa"].mean())
-        out[f"F_{b}_loa_rms_n"] = float(run[f"F_{b}_loa"].std())
     return out
 
 
