@@ -102,11 +102,31 @@ class MeshStiffnessTable:
         """e(s) by linear interpolation, held constant outside the grid, m."""
         return np.interp(position_m, self.position_m, self.separation_m)
 
-    def mesh_stiffness(self, pair, n_points=400):
-        """Total mesh stiffness over one mesh cycle at nominal geometry.
+    def contact_range_m(self, pair):
+        """Positions on the line of action where a pair of this table carries load, m.
 
-        Sums k over the pairs whose position lies on the involute path
+        The loaded range of the quasi-static mesh cycle that built the table
+        (``meta["loaded_range_m"]``: hybrid tables, which extend beyond the nominal involute
+        path as the teeth deflect under load), else the nominal involute path
         [s_start, s_end] (:func:`cmsim.mesh_stiffness.contact.active_path_m`).
+
+        Returns
+        -------
+        (float, float)
+        """
+        loaded = self.meta.get("loaded_range_m")
+        if loaded is not None:
+            return float(loaded[0]), float(loaded[1])
+        s0, s1 = active_path_m(pair)
+        return float(s0), float(s1)
+
+    def mesh_stiffness(self, pair, n_points=400):
+        """Total mesh stiffness over one mesh cycle.
+
+        Sums k over the pairs whose position lies in :meth:`contact_range_m` (for hybrid
+        tables the range loaded at the table's torque, so the mean equals the loaded mesh
+        stiffness of the mesh cycle that built the table; for load-independent tables the
+        nominal involute path).
 
         Returns
         -------
@@ -116,7 +136,7 @@ class MeshStiffnessTable:
             Sum of the pair stiffnesses in contact, N/m.
         pairs_in_contact : ndarray of int, shape (n_points,)
         """
-        s0, s1 = active_path_m(pair)
+        s0, s1 = self.contact_range_m(pair)
         pb = pair.driving.base_pitch_m
         s = s0 + pb * np.arange(n_points) / n_points
         total = np.zeros(n_points)
