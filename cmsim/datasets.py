@@ -389,10 +389,9 @@ def _run_case(spec, case, path):
         return {"name": case.name, "status": "failed", "error": str(exc), "pid": os.getpid(),
                 "timing_s": {"total": time.perf_counter() - start}}
     sim_end = time.perf_counter()
-    meta = dict(run.meta)
-    meta["sweep_case"] = {**case.to_dict(), "base_seed": spec.seed,
-                          "seed_policy": spec.seed_policy}
-    run = Run(run.t, run.signals, meta)
+    run = run.with_meta(sweep_case={**case.to_dict(), "base_seed": spec.seed,
+                                    "seed_policy": spec.seed_policy})
+    meta = run.meta
     features = run_features(run)
     spectra_end = time.perf_counter()
     run.save(path)

@@ -41,7 +41,6 @@ from cmsim._io import atomic_write_bytes, atomic_write_text
 from cmsim.datasets import RUNS_DIR, read_manifest
 from cmsim.errors import ParameterError, check_range
 from cmsim.plots import plot_orbit_family, plot_trace_family
-from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 from cmsim.spectra._checks import positive_int
 from cmsim.spectra.amplitude import amplitude_spectrum
@@ -131,9 +130,7 @@ def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
     missing = [s for s in signals if s not in run.signals]
     if missing:
         raise ParameterError(f"signal(s) {missing} not in {path.name}; available: {run.names}")
-    meta = run.meta
-    rig = Rig.from_dict(meta["rig"])
-    op = OperatingPoint(**meta["operating_point"])
+    meta, rig, op = run.meta, run.rig, run.operating_point
     freqs = rig_frequencies(rig, op)
     bearings = rig.bearing_names
     fs = run.fs_hz

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.rig import OperatingPoint, Rig
+from cmsim.run import signal_info
 from cmsim.frequencies import rig_frequencies
 from cmsim.spectra._checks import band as check_band
 from cmsim.spectra._checks import choice, positive_int
@@ -28,22 +28,17 @@ __all__ = ["RunSpectrum", "run_spectrum", "signal_unit", "signal_bearing", "run_
 
 
 def signal_unit(name):
-    """Unit of a run signal from its name: ``"N"``, ``"µm"``, ``"m"`` or ``"rad"``.
+    """Unit of a run signal (:func:`cmsim.run.signal_info`), ``""`` for a name not in the schema.
 
     Examples
     --------
     >>> signal_unit("F_1b1_loa"), signal_unit("dte_um"), signal_unit("x_1G1")
     ('N', 'µm', 'm')
     """
-    if name.startswith(("F_", "Fmesh")):
-        return "N"
-    if name.endswith("_um"):
-        return "µm"
-    if name.startswith(("x_", "y_")):
-        return "m"
-    if name.startswith("theta") or name == "dte":
-        return "rad"
-    return ""
+    try:
+        return signal_info(name).unit
+    except ParameterError:
+        return ""
 
 
 def signal_bearing(name, bearing_names):
@@ -72,12 +67,10 @@ def run_families(run, bearing=None):
     families : dict of str to float
         :meth:`~cmsim.frequencies.RigFrequencies.families` of ``bearing``, Hz.
     """
-    meta = run.meta
-    if "rig" not in meta or "operating_point" not in meta:
+    rig, op = run.rig, run.operating_point
+    if rig is None or op is None:
         raise ParameterError("the run's meta lacks 'rig' or 'operating_point' (not written by "
                              "cmsim.dynamics.simulate?)")
-    rig = Rig.from_dict(meta["rig"])
-    op = OperatingPoint(**meta["operating_point"])
     freqs = rig_frequencies(rig, op)
     return freqs, freqs.families(bearing)
 
