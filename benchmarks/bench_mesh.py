@@ -22,7 +22,7 @@ import cmsim
 from cmsim.dynamics.simulate import simulate
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.influence import influence_table
-from cmsim.mesh_stiffness.torque_tables import torque_tables
+from cmsim.dynamics.torque_tables import torque_tables
 
 REPEATS = 3
 
@@ -55,12 +55,12 @@ def main():
     op = cmsim.OperatingPoint(1000.0, 100.0)
     b_table = tables.at(100.0)
     kw = dict(seed=0, cage_phases_rad=None, warmup_s=0.01)
-    simulate(rig, op, 0.01, mesh_model=model, **kw)        # compile outside the timing
+    simulate(rig, op, 0.01, mesh=model, **kw)        # compile outside the timing
     rtf_a, rtf_b = 0.0, 0.0
     for _ in range(REPEATS):
-        rtf_a = max(rtf_a, simulate(rig, op, 0.3, mesh_model=model, **kw)
+        rtf_a = max(rtf_a, simulate(rig, op, 0.3, mesh=model, **kw)
                     .meta["realtime_factor"])
-        rtf_b = max(rtf_b, simulate(rig, op, 0.3, mesh_table=b_table, **kw)
+        rtf_b = max(rtf_b, simulate(rig, op, 0.3, mesh=b_table, **kw)
                     .meta["realtime_factor"])
     ratio = rtf_b / rtf_a
     print(f"3. realtime factor at 75 kHz: model A {rtf_a:.2f}, model B {rtf_b:.2f}; "

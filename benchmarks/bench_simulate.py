@@ -81,14 +81,14 @@ def numpy_rhs_factory(model):
     """The same equations as the kernel, written with NumPy (what a user would write)."""
     P = model.packed
     n = model.n_dof
-    minv, fext, omega = P[0], P[2], P[3]
+    minv, fext, omega = P.minv, P.fext, P.omega
     kmat, cmat = model.stiffness, model.damping
-    b_int, b_par, b_cos, b_sin = P[4], P[5], P[6], P[7]
-    m_int, mp, geo, tab_k, tab_e = P[9], P[10], P[11], P[12], P[13]
+    b_int, b_par, b_cos, b_sin = P.b_int, P.b_par, P.b_cos, P.b_sin
+    m_int, mp, geo, tab_k, tab_e = P.m_int, P.m_par, P.geo, P.tab_k, P.tab_e
     i1, i2, n_slots = int(m_int[0]), int(m_int[1]), int(m_int[2])
     rb1, rb2 = geo[0], geo[1]
     offsets = np.arctan2(b_sin, b_cos)
-    z1, z2 = P[14].shape[0], P[15].shape[0]
+    z1, z2 = P.teeth1.shape[0], P.teeth2.shape[0]
     s_tab = mp[K.MP_TAB0] + mp[K.MP_TABD] * np.arange(tab_k.size)
 
     def rhs(t, y):
@@ -128,7 +128,8 @@ def numpy_rhs_factory(model):
             approach = dvx * nx + dvy * ny
             overlap = delta - np.interp(s_eq, s_tab, tab_e)
             if overlap > 0:
-                fn = max(np.interp(s_eq, s_tab, tab_k) * overlap + mp[K.MP_CHYST] * approach, 0.0)
+                k_pair = np.interp(s_eq, s_tab, tab_k)
+                fn = max(k_pair * (overlap + mp[K.MP_BETA] * approach), 0.0)
             elif approach > 0:
                 gap = max(-overlap, mp[K.MP_DTHR])
                 req = chi1 * chi2 / (chi1 + chi2) if chi1 > 0 and chi2 > 0 else 0.0
@@ -151,6 +152,7 @@ def main():
     rig = cmsim.Rig.paper_2016()
     op = cmsim.OperatingPoint(1000.0, 100.0)
     model = build_model(rig, op, cage_phases_rad=[0.3, 1.1, 2.0, 4.4])
+    print(f"mesh: {model.mesh_table.method} table at {model.mesh_table.torque_nm} N m")
     n = model.n_dof
     y0 = np.concatenate([quasi_static_state(model, 0.0), np.zeros(n)])
     h = 1.0 / FS
@@ -165,16 +167,14 @@ def main():
 
     # 2a. bare dense linear ode3
     out = np.empty((n_steps, 2 * n))
-    args = (model.packed[0], model.stiffness, model.damping, model.force, out)
+    args = (model.packed.minv, model.stiffness, model.damping, model.force, out)
     dense_linear_ode3(y0, h, 10, *args)
     dense = best_of(lambda: dense_linear_ode3(y0, h, n_steps, *args)) / n_steps
     print(f"per-step cost / bare dense-linear numba ode3: {ours_per_step / dense:.2f} "
           f"(baseline {dense * 1e9:.0f} ns per step)   [target <= 3]")
     # 2b. our own integrator on the linear part only (no bearings, no mesh)
-    P = list(model.packed)
-    P[4] = np.zeros((0, K.BI_SIZE), dtype=np.int64)
-    P[9] = np.zeros(K.MI_SIZE, dtype=np.int64)
-    P = tuple(P)
+    P = model.packed._replace(b_int=np.zeros((0, K.BI_SIZE), dtype=np.int64),
+                              m_int=np.zeros(K.MI_SIZE, dtype=np.int64))
     tab = SCHEMES["ode3"]
     diag = np.empty((n_steps, len(model.diag_names)))
 

@@ -26,12 +26,12 @@ M, KS, C, F0, X0 = 2.0, 8.0e6, 40.0, 300.0, 1e-4
 
 def sdof_packed():
     """Kernel arrays of m x'' + c x' + k x = F0 (layout documented in dynamics._kernels)."""
-    return (np.array([1.0 / M]), np.array([[KS, C]]), np.array([F0]), np.zeros(1),
+    return K.KernelParams(np.array([1.0 / M]), np.array([[KS, C]]), np.array([F0]), np.zeros(1),
             np.zeros((0, K.BI_SIZE), dtype=np.int64), np.zeros((0, K.BP_SIZE)),
             np.zeros((0, 1)), np.zeros((0, 1)), np.zeros((0, 1, 1)),
             np.zeros(K.MI_SIZE, dtype=np.int64), np.zeros(K.MP_SIZE), np.zeros(14),
             np.zeros(2), np.zeros(2), np.zeros((1, 2)), np.zeros((1, 2)),
-            np.array([[0, 0, 1]], dtype=np.int64)) + K.no_hybrid()
+            np.array([[0, 0, 1]], dtype=np.int64), *K.no_hybrid())
 
 
 def sdof_exact(t):
@@ -94,9 +94,10 @@ def _energy(model, states, t):
     load = -q @ model.force
     balls = 0.0
     for ib, brg in enumerate(model.rig.bearings):
-        ix, iy, it = (int(v) for v in model.packed[4][ib, :3])
-        rate = model.packed[5][ib, K.BP_CAGE] * model.packed[5][ib, K.BP_SENSE]
-        cage = rate * (model.omega[it] * t + q[:, it]) + model.packed[5][ib, K.BP_PHASE]
+        ix, iy, it = (int(v) for v in model.packed.b_int[ib, :3])
+        b_par = model.packed.b_par
+        cage = (b_par[ib, K.BP_CAGE] * b_par[ib, K.BP_SENSE] * (model.omega[it] * t + q[:, it])
+                + b_par[ib, K.BP_PHASE])
         balls = balls + bearing_strain_energy(brg, q[:, ix], q[:, iy], cage)
     return kinetic + springs + load + balls
 

@@ -21,10 +21,11 @@ import pytest
 
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_state
+from cmsim.dynamics.torque_tables import torque_tables
 from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.mesh_cycle import slot_contacts
-from cmsim.mesh_stiffness.torque_tables import MeshTableSet, torque_tables
+from cmsim.mesh_stiffness.table_set import MeshTableSet
 from cmsim.rig import OperatingPoint, Rig, Rotor
 from cmsim.studies.model_abc import gmf_harmonics, model_abc_study
 
@@ -55,7 +56,7 @@ def test_online_forces_equal_independent_hybrid_solve(rig, mesh_model, t):
     # no mesh damping: a corner contact has a normal approach velocity even in the nominal
     # motion, and the hysteretic term would add to the elastic force compared here
     undamped = replace(rig, mesh_contact=replace(rig.mesh_contact, damping_ratio=0.0))
-    model = build_model(undamped, op, mesh_model=mesh_model)
+    model = build_model(undamped, op, mesh_model)
     q = quasi_static_state(model, t)
     # nominal rotation at rest relative to it: velocities of the nominal motion only
     _, diag = model.rhs(t, np.concatenate([q, np.zeros(model.n_dof)]), want_diag=True)
@@ -80,13 +81,12 @@ def test_mesh_model_must_match_the_rig(rig, mesh_model):
     rotor_rig = Rig.rotor_on_bearings(rig.shafts[0].bearing_1,
                                       Rotor(mass_kg=4.0, inertia_kg_m2=0.01))
     with pytest.raises(ParameterError, match="without gears"):
-        build_model(rotor_rig, OperatingPoint(1000.0, 0.0, radial_load_n=100.0),
-                    mesh_model=mesh_model)
+        build_model(rotor_rig, OperatingPoint(1000.0, 0.0, radial_load_n=100.0), mesh_model)
     wider = replace(rig, gears=replace(rig.gears, centre_distance_m=0.0891))
     with pytest.raises(ParameterError, match="different gear pair"):
-        build_model(wider, OperatingPoint(1000.0, 10.0), mesh_model=mesh_model)
+        build_model(wider, OperatingPoint(1000.0, 10.0), mesh_model)
     with pytest.raises(ParameterError, match="HybridMeshModel"):
-        build_model(rig, OperatingPoint(1000.0, 10.0), mesh_model="hybrid")
+        build_model(rig, OperatingPoint(1000.0, 10.0), "no-such-mesh")
 
 
 def test_torque_tables_follow_the_paper(tables):

@@ -1,37 +1,38 @@
 """Numba kernels of the equations of motion and the fixed-step Runge-Kutta integrator.
 
 This module isolates the numba convention: ``@njit(cache=True)``, float64/int64 arrays and
-scalars only (grouped in one plain tuple ``P``), no Python objects, no random numbers. The
-model arrays are built and documented in :mod:`cmsim.dynamics.model`.
+scalars only, grouped in two named tuples owned by this module — :class:`KernelParams` ``P``
+(the model, read only) and :class:`Work` ``W`` (scratch) —, no Python objects, no random
+numbers. :mod:`cmsim.dynamics.model` fills ``P`` (its fields are documented on the class).
 
 Right-hand side contract: ``rhs_jit(t, y, dydt, row, P, diag, want_diag, W)`` with ``y = [q, v]``
 (shape ``(2n,)``), ``q`` the DOF deviations from the nominal rigid rotation (translations in m,
 rotations in rad, rotations of shaft 2 counted positive in its own sense of motion), ``v`` their
 rates; it writes row ``row`` of the 2-D array ``dydt`` with ``[v, M⁻¹(f_ext + g(t, q, v) − K q
 − C v)]`` where ``g`` holds the bearing and mesh forces. With ``want_diag`` it also writes the
-output forces into ``diag``. ``W`` holds the scratch arrays of :func:`make_work` (force
-vector, cage and slip trigonometry, per-slot mesh geometry, the hybrid solver's buffers).
+output forces into ``diag``.
 
 Hot-path code never slices arrays and never takes arrays out of tuples inside loops (numba
 takes an atomic reference count for each), and the integrator and force kernels are compiled
 without numba's reference-counting runtime (``_nrt=False``, so they allocate nothing: the
-caller passes every buffer), which halved the cost of a step. Small kernels are inlined at
-numba-IR level (a call with array arguments costs about 25 ns).
+caller passes every buffer). Small kernels are inlined at numba-IR level (a call with array
+arguments costs about 25 ns).
 The bearing forces are compiled with fastmath so the ball loop vectorises; the finiteness
 checks live in the integrator, which is compiled without it.
 
-``P`` = (minv, springs, fext, omega, b_int, b_par, b_cos, b_sin, jitter, m_int, m_par, geo, tab_k,
-tab_e, teeth1, teeth2, spring_ends, hp, diag1, cpl1, diag2, cpl2) with the linear K and C as two-node spring-dampers
-(``springs`` (e, 2) = k, c; ``spring_ends`` (e, 3), see :func:`linear_accel_jit`) and ``teeth1/2``
-the cos and sin of multiples of the angular pitch, shape (Z, 2); the last five are the hybrid
-contact model's parameters and influence tables
-(:meth:`cmsim.mesh_stiffness.hybrid.HybridMeshModel.kernel_args`; placeholders in table
-mode); index constants below.
+Trigonometry by rotation. The cage angles and the two gears' involute origin angles advance
+by small increments from one call to the next. Each keeps an *anchor* in ``W`` (an angle and
+its exact cosine and sine); a call rotates the anchor by the small difference with a Taylor
+series (error below 1e-15 for |difference| <= :data:`ANCHOR_RAD`) and re-anchors with exact
+``cos``/``sin`` only when the difference grows past it — about once per hundred steps instead
+of twelve transcendental calls per step. The line of action's angle is likewise a short
+``atan`` series about its nominal value. Results agree with direct trigonometry to rounding.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -39,12 +40,11 @@ from numba import njit
 from cmsim.bearings._kernels import ball_forces_cage_frame_jit
 from cmsim.mesh_stiffness._hybrid_kernels import (HP_SIZE, WORK_PER_N, WORK_PER_N2,
                                                   hybrid_forces_jit)
-from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit, table_lookup2_jit
+from cmsim.mesh_stiffness._kernels import pair_contact_jit, table_lookup2_jit
 
-# b_int columns: DOF indices, number of balls, index of the first bearing sharing the same
-# nominal cage rotation (its cos/sin are computed once)
-BI_X, BI_Y, BI_T, BI_NB, BI_GROUP = 0, 1, 2, 3, 4
-BI_SIZE = 5
+# b_int columns: DOF indices, number of balls
+BI_X, BI_Y, BI_T, BI_NB = 0, 1, 2, 3
+BI_SIZE = 4
 # b_par columns: stiffness, exponent, clearance, cage angle per physical inner-ring angle,
 # physical sense of the shaft (+1 CCW, −1 CW), viscous damping to ground, initial cage phase
 BP_K, BP_P, BP_C, BP_CAGE, BP_SENSE, BP_DAMP, BP_PHASE = 0, 1, 2, 3, 4, 5, 6
@@ -53,13 +53,114 @@ BP_SIZE = 7
 MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE = 0, 1, 2, 3, 4
 MI_SIZE = 5
 MODE_TABLE, MODE_HYBRID = 0, 1
-# columns of the per-slot scratch ``W[6]`` of the mesh kernel
-SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP = range(8)
-SG_SIZE = 8
-# m_par entries
-(MP_A0, MP_PSI10, MP_PSI20, MP_PB, MP_SLO, MP_OM1, MP_OM2, MP_MU, MP_V0, MP_CHYST, MP_KOSTER,
- MP_DTHR, MP_TAB0, MP_TABD, MP_JDT, MP_DIAGB, MP_ZBEFORE, MP_ZAFTER) = range(18)
-MP_SIZE = 18
+# columns of the per-slot scratch ``W.slots`` of the mesh kernel
+SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP, SG_KPAIR = range(9)
+SG_SIZE = 9
+# m_par entries. MP_BETA: stiffness-proportional mesh damping coefficient β (s): a loaded
+# pair of stiffness k_j gets the viscous coefficient β·k_j, so the mesh as a whole has
+# 2ξ√(k̄·M_eq) on average whatever the number of pairs in contact. MP_COST1, MP_SINT1: cos
+# and sin of the nominal line-of-action angle.
+(MP_A0, MP_PSI10, MP_PSI20, MP_PB, MP_SLO, MP_OM1, MP_OM2, MP_MU, MP_V0, MP_BETA, MP_KOSTER,
+ MP_DTHR, MP_TAB0, MP_TABD, MP_JDT, MP_DIAGB, MP_ZBEFORE, MP_ZAFTER, MP_PHIT0, MP_COST0,
+ MP_SINT0) = range(21)
+MP_SIZE = 21
+# columns of an angle anchor (``W.cage``, ``W.psi``): angle, its cos and sin, valid flag
+AN_ANGLE, AN_COS, AN_SIN, AN_VALID = 0, 1, 2, 3
+AN_SIZE = 4
+#: Largest angle (rad) a rotation anchor is carried by its Taylor series before re-anchoring.
+ANCHOR_RAD = 0.05
+
+
+class KernelParams(NamedTuple):
+    """Model arrays ``P`` of the kernels (all float64 unless stated; SI units).
+
+    Attributes
+    ----------
+    minv : (n,) inverse of the diagonal mass matrix.
+    springs : (e, 2) stiffness and damping of each two-node spring-damper (Annex A).
+    fext : (n,) constant external load (output torque, radial load).
+    omega : (n,) nominal rotation speed of each DOF, rad/s (0 for translations).
+    b_int : int64 (nb, BI_SIZE) bearing DOF indices and ball counts.
+    b_par : (nb, BP_SIZE) bearing parameters (``BP_*`` columns).
+    b_cos, b_sin : (nb, max_balls) cos and sin of each ball's offset in its cage.
+    jitter : (nb, max_balls + 1, n_grid) slip grid (a dummy (nb, ·, 1) when slip is off).
+    m_int : int64 (MI_SIZE,) mesh integers (``MI_*``).
+    m_par : (MP_SIZE,) mesh parameters (``MP_*``).
+    geo : (GEO_SIZE,) tooth geometry vector of :mod:`cmsim.mesh_stiffness._kernels`.
+    tab_k, tab_e : (m,) pair stiffness (N/m) and unloaded separation (m) on a uniform grid.
+    teeth1, teeth2 : (Z, 2) cos and sin of multiples of each gear's angular pitch.
+    spring_ends : int64 (e, 3) DOF indices (a, b) of each spring; ``[0, 2]`` = ground count.
+    hp, hd1, hc1, hd2, hc2 : hybrid contact parameters and influence tables
+        (:meth:`cmsim.mesh_stiffness.hybrid.HybridMeshModel.kernel_args`; placeholders in
+        table mode).
+    """
+
+    minv: np.ndarray
+    springs: np.ndarray
+    fext: np.ndarray
+    omega: np.ndarray
+    b_int: np.ndarray
+    b_par: np.ndarray
+    b_cos: np.ndarray
+    b_sin: np.ndarray
+    jitter: np.ndarray
+    m_int: np.ndarray
+    m_par: np.ndarray
+    geo: np.ndarray
+    tab_k: np.ndarray
+    tab_e: np.ndarray
+    teeth1: np.ndarray
+    teeth2: np.ndarray
+    spring_ends: np.ndarray
+    hp: np.ndarray
+    hd1: np.ndarray
+    hc1: np.ndarray
+    hd2: np.ndarray
+    hc2: np.ndarray
+
+
+class Work(NamedTuple):
+    """Scratch arrays ``W`` of :func:`rhs_jit` (see :func:`make_work`)."""
+
+    g: np.ndarray          # (n,) force vector
+    cage: np.ndarray       # (nb, AN_SIZE) cage-angle anchors
+    slip_cos: np.ndarray   # (nb, max_balls) ball offsets with slip
+    slip_sin: np.ndarray
+    cage_slip: np.ndarray  # (nb,) cage slip angle
+    slots: np.ndarray      # (slots, SG_SIZE) per-slot mesh geometry
+    hwork: np.ndarray      # hybrid solver work
+    hdelta: np.ndarray     # (slots,) hybrid δ, ρ1, ρ2, χ1, χ2, forces
+    hrho1: np.ndarray
+    hrho2: np.ndarray
+    hchi1: np.ndarray
+    hchi2: np.ndarray
+    hout: np.ndarray
+    hstat: np.ndarray      # (2,) hybrid counters [solves, non-converged solves]
+    psi: np.ndarray        # (2, AN_SIZE) anchors of the gears' involute origin angles
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _rotate_small(c0, s0, d):
+    """cos and sin of (a + d) from those of a, for |d| <= ANCHOR_RAD (Taylor, < 1e-15)."""
+    d2 = d * d
+    cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0 - d2 * (1.0 / 40320.0))))
+    sd = d * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0 - d2 * (1.0 / 5040.0))))
+    return c0 * cd - s0 * sd, s0 * cd + c0 * sd
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _anchored_cos_sin(anchor, row, angle):
+    """cos and sin of ``angle`` by rotating the anchor in ``anchor[row]`` (module docstring)."""
+    d = angle - anchor[row, AN_ANGLE]
+    if anchor[row, AN_VALID] == 0.0 or d > ANCHOR_RAD or d < -ANCHOR_RAD:
+        c = math.cos(angle)
+        s = math.sin(angle)
+        anchor[row, AN_ANGLE] = angle
+        anchor[row, AN_COS] = c
+        anchor[row, AN_SIN] = s
+        anchor[row, AN_VALID] = 1.0
+        return c, s
+    return _rotate_small(anchor[row, AN_COS], anchor[row, AN_SIN], d)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -76,17 +177,9 @@ def _jitter_at(jitter, ib, iball, t, jdt):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _slip_offsets(t, P, W):
-    """Fill ``W[3]``, ``W[4]`` (n_bearings, max_balls) with cos, sin of the ball offsets
-    with slip at time ``t``, and ``W[5]`` with each cage's slip angle."""
-    b_int = P[4]
-    b_cos = P[6]
-    b_sin = P[7]
-    jitter = P[8]
-    jdt = P[10][MP_JDT]
-    jit_cos = W[3]
-    jit_sin = W[4]
-    cage_slip = W[5]
+def _slip_offsets(t, b_int, b_cos, b_sin, jitter, jdt, jit_cos, jit_sin, cage_slip):
+    """Fill ``jit_cos``, ``jit_sin`` (n_bearings, max_balls) with cos, sin of the ball offsets
+    with slip at time ``t``, and ``cage_slip`` with each cage's slip angle."""
     row = b_cos.shape[1]
     for ib in range(b_int.shape[0]):
         cage_slip[ib] = _jitter_at(jitter, ib, row, t, jdt)
@@ -100,35 +193,26 @@ def _slip_offsets(t, P, W):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", _nrt=False)
-def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, cos_nom, sin_nom,
-                    cage_slip, diag, want_diag):
+def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor, cage_slip,
+                    diag, want_diag):
     """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage
-    and cages shifted by the slip angles ``W[5]`` (zeros without slip).
+    and cages shifted by the slip angles ``cage_slip`` (zeros without slip).
 
     Written flat on purpose: with helper functions inlined, a jitter branch, or arrays taken
     out of ``P`` inside the loop, numba stops vectorising the ball loop (2-3× slower).
-    The cage angle's nominal part (rate·Ω·t) is computed once per group of bearings turning
-    alike; the small dynamic deviation (rate·q_θ) is applied as a rotation (Taylor series).
-    Each bearing works in its cage frame: the inner-ring offset is turned by −θ_cage once
-    instead of turning every ball. Arrays come as arguments, not in the tuple ``P``: a
-    non-inlined call copies its arguments, and ``P`` holds 17 arrays.
+    The cage angle (nominal rate·Ω·t, phase, slip and the dynamic deviation rate·q_θ) is
+    turned into cos and sin by rotating the bearing's anchor (module docstring). Each bearing
+    works in its cage frame: the inner-ring offset is turned by −θ_cage once instead of
+    turning every ball. Arrays come as arguments, not in the tuple ``P``: a non-inlined call
+    copies its arguments.
     """
     for ib in range(b_int.shape[0]):
         ix = b_int[ib, BI_X]
         iy = b_int[ib, BI_Y]
         it = b_int[ib, BI_T]
         rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
-        grp = b_int[ib, BI_GROUP]
-        if grp == ib:
-            nominal = rate * omega[it] * t + b_par[ib, BP_PHASE] + cage_slip[ib]
-            cos_nom[ib] = math.cos(nominal)
-            sin_nom[ib] = math.sin(nominal)
-        dev = rate * y[it]
-        d2 = dev * dev
-        cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0)))
-        sd = dev * (1.0 - d2 * (1.0 / 6.0 - d2 * (1.0 / 120.0 - d2 * (1.0 / 5040.0))))
-        cc = cos_nom[grp] * cd - sin_nom[grp] * sd
-        sc = sin_nom[grp] * cd + cos_nom[grp] * sd
+        angle = rate * (omega[it] * t + y[it]) + b_par[ib, BP_PHASE] + cage_slip[ib]
+        cc, sc = _anchored_cos_sin(anchor, ib, angle)
         xr = y[ix] * cc + y[iy] * sc
         yr = y[iy] * cc - y[ix] * sc
         fxr, fyr = ball_forces_cage_frame_jit(xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB],
@@ -142,13 +226,40 @@ def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, cos_nom
             diag[2 * ib + 1] = fy + b_par[ib, BP_DAMP] * y[n + iy]
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, inline="always", error_model="numpy")
+def _mesh_frame(c1x, c1y, c2x, c2y, rb1, rb2, mp):
+    """Line of action for the gear centres C1, C2 (as
+    :func:`cmsim.mesh_stiffness._kernels.mesh_frame_jit`, with its angle from an ``atan``
+    series about the nominal angle instead of ``atan2``)."""
+    dx = c2x - c1x
+    dy = c2y - c1y
+    a = math.sqrt(dx * dx + dy * dy)
+    inv_a = 1.0 / a
+    ca = (rb1 + rb2) * inv_a
+    sa = math.sqrt(1.0 - ca * ca)
+    cg = dx * inv_a
+    sg = dy * inv_a
+    cos_t1 = cg * ca + sg * sa
+    sin_t1 = sg * ca - cg * sa
+    cross = mp[MP_COST0] * sin_t1 - mp[MP_SINT0] * cos_t1
+    dot = mp[MP_COST0] * cos_t1 + mp[MP_SINT0] * sin_t1
+    u = cross / dot
+    if dot > 0.0 and u < 1e-2 and u > -1e-2:
+        u2 = u * u
+        phi = mp[MP_PHIT0] + u * (1.0 - u2 * (1.0 / 3.0 - u2 * (1.0 / 5.0 - u2 * (1.0 / 7.0))))
+    else:
+        phi = math.atan2(sin_t1, cos_t1)
+    return phi, a * sa, cos_t1, sin_t1
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag, want_diag,
                  hp, hd1, hc1, hd2, hc2, S, hw, hdelta, hrho1, hrho2, hchi1, hchi2, hout,
-                 hstat):
+                 hstat, psi_anchor):
     """Forces of the tooth pairs in the potential-contact zone: exact rigid-body geometry,
     elastic force from the table (``MI_MODE`` 0) or from the on-line hybrid contact solve
-    (1, paper 001 model A), hysteretic or Koster squeeze damping, smoothed Coulomb friction.
+    (1, paper 001 model A), stiffness-proportional hysteretic damping (``MP_BETA``) or Koster
+    squeeze damping, smoothed Coulomb friction.
 
     Pass 1 stores each slot's geometry in ``S`` (columns ``SG_*``); in hybrid mode the
     interferences of all slots are then solved together (out-of-zone slots enter with a
@@ -166,7 +277,7 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
     c1y = y[i1 + 1]
     c2x = y[i2]
     c2y = mp[MP_A0] + y[i2 + 1]
-    phi_t1, length, cos_t1, sin_t1 = mesh_frame_jit(c1x, c1y, c2x, c2y, rb1, rb2)
+    phi_t1, length, cos_t1, sin_t1 = _mesh_frame(c1x, c1y, c2x, c2y, rb1, rb2, mp)
     # physical involute origins of the reference pair (tooth 0 on both gears)
     psi1 = mp[MP_OM1] * t + y[i1 + 2] + mp[MP_PSI10]
     psi2 = mp[MP_PSI20] - (mp[MP_OM2] * t + y[i2 + 2])
@@ -207,10 +318,8 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
         # involute origins of this pair: gear-1 tooth `pair` pitches back, gear-2 tooth on;
         # only a corner (rounded-tip) contact needs them
         if not trig_done and (s < length - geo[3] or s > geo[2]):
-            cp1 = math.cos(psi1)
-            sp1 = math.sin(psi1)
-            cp2 = math.cos(psi2)
-            sp2 = math.sin(psi2)
+            cp1, sp1 = _anchored_cos_sin(psi_anchor, 0, psi1)
+            cp2, sp2 = _anchored_cos_sin(psi_anchor, 1, psi2)
             trig_done = True
         c1n = cp1 * teeth1[k1, 0] + sp1 * teeth1[k1, 1]
         s1n = sp1 * teeth1[k1, 0] - cp1 * teeth1[k1, 1]
@@ -234,6 +343,7 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
             overlap = delta - e_pair
             S[j, SG_ELASTIC] = k_pair * overlap if overlap > 0.0 else 0.0
             S[j, SG_GAP] = -overlap
+            S[j, SG_KPAIR] = k_pair
     if hybrid:
         it = hybrid_forces_jit(hdelta, hrho1, hrho2, hchi1, hchi2, hp, hd1, hc1, hd2, hc2, hw,
                                hout)
@@ -246,6 +356,8 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
                 loaded = True
         for j in range(n_slots):
             S[j, SG_ELASTIC] = hout[j]
+            # secant stiffness of a loaded pair, F/δ, for its share of the mesh damping
+            S[j, SG_KPAIR] = hout[j] / hdelta[j] if hout[j] > 0.0 and hdelta[j] > 0.0 else 0.0
             # gap of an unloaded pair under the other pairs' loads, Σ_k C_jk F_k − δ_j (the
             # solver leaves the coupling matrix C in the first n² entries of its work)
             gap = -hdelta[j]
@@ -273,7 +385,7 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
         approach = dvx * nx + dvy * ny
         elastic = S[j, SG_ELASTIC]
         if elastic > 0.0:
-            fn = elastic + mp[MP_CHYST] * approach
+            fn = elastic + mp[MP_BETA] * S[j, SG_KPAIR] * approach
             if fn < 0.0:
                 fn = 0.0
         elif approach > 0.0:
@@ -327,55 +439,65 @@ def linear_accel_jit(y, g, minv, springs, ends, dydt, row):
 
 
 def no_hybrid():
-    """Placeholders of the five hybrid entries of ``P`` when the mesh uses a table."""
+    """Placeholders ``(hp, hd1, hc1, hd2, hc2)`` of the hybrid fields when the mesh uses a
+    table."""
     return (np.zeros(HP_SIZE), np.zeros(2), np.zeros((1, 2, 2)), np.zeros(2),
             np.zeros((1, 2, 2)))
 
 
 def make_work(P):
-    """Scratch arrays ``W`` for :func:`rhs_jit`.
-
-    ``W`` = (g, cos_nom, sin_nom, slip_cos, slip_sin, cage_slip, slot geometry (slots,
-    SG_SIZE), hybrid solver work, hybrid δ, ρ1, ρ2, χ1, χ2, forces (slots,), hybrid counters
-    [solves, non-converged solves])."""
-    nb, max_balls = P[6].shape
-    slots = max(int(P[9][MI_SLOTS]), 1)
-    return (np.empty(P[0].shape[0]), np.empty(nb), np.empty(nb), np.empty((nb, max_balls)),
-            np.empty((nb, max_balls)), np.zeros(nb), np.zeros((slots, SG_SIZE)),
-            np.zeros(WORK_PER_N2 * slots * slots + WORK_PER_N * slots), np.zeros(slots),
-            np.zeros(slots), np.zeros(slots), np.ones(slots), np.ones(slots), np.zeros(slots),
-            np.zeros(2))
+    """Fresh scratch arrays :class:`Work` for :func:`rhs_jit` with model ``P``."""
+    nb, max_balls = P.b_cos.shape
+    slots = max(int(P.m_int[MI_SLOTS]), 1)
+    return Work(np.empty(P.minv.shape[0]), np.zeros((nb, AN_SIZE)),
+                np.empty((nb, max_balls)), np.empty((nb, max_balls)), np.zeros(nb),
+                np.zeros((slots, SG_SIZE)),
+                np.zeros(WORK_PER_N2 * slots * slots + WORK_PER_N * slots), np.zeros(slots),
+                np.zeros(slots), np.zeros(slots), np.ones(slots), np.ones(slots),
+                np.zeros(slots), np.zeros(2), np.zeros((2, AN_SIZE)))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     """Equations of motion (module docstring); writes ``dydt[row]`` and optionally ``diag``."""
-    minv = P[0]
-    fext = P[2]
+    minv = P.minv
+    fext = P.fext
     n = minv.shape[0]
-    g = W[0]
+    g = W.g
     for i in range(n):
         g[i] = fext[i]
-    if P[8].shape[2] > 1:
-        _slip_offsets(t, P, W)
-        ball_cos = W[3]
-        ball_sin = W[4]
+    if P.jitter.shape[2] > 1:
+        _slip_offsets(t, P.b_int, P.b_cos, P.b_sin, P.jitter, P.m_par[MP_JDT], W.slip_cos,
+                      W.slip_sin, W.cage_slip)
+        ball_cos = W.slip_cos
+        ball_sin = W.slip_sin
     else:
-        ball_cos = P[6]
-        ball_sin = P[7]
-    if P[4].shape[0] > 0:
-        _bearing_forces(t, y, n, g, P[3], P[4], P[5], ball_cos, ball_sin, W[1], W[2], W[5],
-                        diag, want_diag)
-    if P[9][MI_ON] != 0:
-        _mesh_forces(t, y, n, g, P[9], P[10], P[11], P[12], P[13], P[14], P[15], diag,
-                     want_diag, P[17], P[18], P[19], P[20], P[21], W[6], W[7], W[8], W[9],
-                     W[10], W[11], W[12], W[13], W[14])
-    linear_accel_jit(y, g, minv, P[1], P[16], dydt, row)
+        ball_cos = P.b_cos
+        ball_sin = P.b_sin
+    if P.b_int.shape[0] > 0:
+        _bearing_forces(t, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
+                        W.cage_slip, diag, want_diag)
+    if P.m_int[MI_ON] != 0:
+        _mesh_forces(t, y, n, g, P.m_int, P.m_par, P.geo, P.tab_k, P.tab_e, P.teeth1,
+                     P.teeth2, diag, want_diag, P.hp, P.hd1, P.hc1, P.hd2, P.hc2, W.slots,
+                     W.hwork, W.hdelta, W.hrho1, W.hrho2, W.hchi1, W.hchi2, W.hout, W.hstat,
+                     W.psi)
+    linear_accel_jit(y, g, minv, P.springs, P.spring_ends, dydt, row)
+
+
+class IntegratorBuffers(NamedTuple):
+    """Buffers ``B`` of :func:`integrate_jit`."""
+
+    k: np.ndarray        # (s, dim) stage slopes
+    y: np.ndarray        # (dim,) state
+    yi: np.ndarray       # (dim,) stage state
+    scratch: np.ndarray  # (n_diag,) output forces of the current step
 
 
 def make_integrator_buffers(tableau_b, dim, n_diag):
-    """Buffers of :func:`integrate_jit`: stage slopes (s, dim), state, stage state, diag."""
-    return (np.zeros((tableau_b.shape[0], dim)), np.empty(dim), np.empty(dim), np.empty(n_diag))
+    """Buffers of :func:`integrate_jit` for a scheme of ``len(tableau_b)`` stages."""
+    return IntegratorBuffers(np.zeros((tableau_b.shape[0], dim)), np.empty(dim),
+                             np.empty(dim), np.empty(n_diag))
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -384,7 +506,7 @@ def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, B, out_y, 
     """Fixed-step explicit Runge-Kutta with output every ``substeps`` steps.
 
     The scheme is data: ``rk_a`` (s, s) strictly lower triangular, ``rk_b`` (s,), ``rk_c`` (s,).
-    ``W`` is the scratch tuple of :func:`make_work`, ``B`` that of
+    ``W`` is the :class:`Work` of :func:`make_work`, ``B`` the :class:`IntegratorBuffers` of
     :func:`make_integrator_buffers`. Sample ``m`` of ``out_y`` is the state at
     ``t0 + m·substeps·h``; ``out_diag[m]`` holds the output forces at that instant (from the
     first stage of the following step, so they cost nothing extra).
@@ -396,10 +518,10 @@ def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, B, out_y, 
         exceeded ``max_disp`` on a translational DOF (``trans_mask``) or ``max_rot`` on a
         rotational one.
     """
-    k = B[0]
-    y = B[1]
-    yi = B[2]
-    scratch = B[3]
+    k = B.k
+    y = B.y
+    yi = B.yi
+    scratch = B.scratch
     ns = rk_b.shape[0]
     dim = y0.shape[0]
     n = dim // 2

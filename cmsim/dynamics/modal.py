@@ -88,7 +88,7 @@ def _bearing_cycle_times(model, n_positions):
 def _averaged_bearing_stiffness(model, states, times):
     """Tangent stiffness of each bearing averaged over the given states, (nb, 2, 2)."""
     P = model.packed
-    b_int, b_par, b_cos, b_sin = P[4], P[5], P[6], P[7]
+    b_int, b_par, b_cos, b_sin = P.b_int, P.b_par, P.b_cos, P.b_sin
     nb = b_int.shape[0]
     out = np.zeros((nb, 2, 2))
     for q, t in zip(states, times):
@@ -103,7 +103,7 @@ def _averaged_bearing_stiffness(model, states, times):
     return out / len(states)
 
 
-def modal_analysis(rig, op, mesh_table=None, *, n_positions=24):
+def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     """Natural frequencies and mode types of ``rig`` at ``op``.
 
     Parameters
@@ -111,8 +111,9 @@ def modal_analysis(rig, op, mesh_table=None, *, n_positions=24):
     rig : Rig
     op : OperatingPoint
         Speed (sets the bearing-cycle instants) and torque (sets the linearisation point).
-    mesh_table : MeshStiffnessTable, optional
-        Pair stiffness (default: potential-energy table).
+    mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
+        Tooth contact model, as in :func:`cmsim.dynamics.simulate` (default: the rig's
+        hybrid tables at the torque); the mesh enters as its mean stiffness k̄ at the torque.
     n_positions : int
         Quasi-static solutions per bearing cycle used for the average (>= 4).
 
@@ -122,13 +123,13 @@ def modal_analysis(rig, op, mesh_table=None, *, n_positions=24):
     """
     if not isinstance(n_positions, (int, np.integer)) or n_positions < 4:
         raise ParameterError(f"n_positions must be an integer >= 4, got {n_positions!r}")
-    model = build_model(rig, op, mesh_table)
+    model = build_model(rig, op, mesh)
     times = _bearing_cycle_times(model, n_positions)
     states = quasi_static_orbit(model, times)
     k_brg = _averaged_bearing_stiffness(model, states, times)
     kmat = model.stiffness.copy()
     for ib in range(k_brg.shape[0]):
-        ix = int(model.packed[4][ib, K.BI_X])
+        ix = int(model.packed.b_int[ib, K.BI_X])
         kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
     k_mean = 0.0
     if rig.gears is not None:

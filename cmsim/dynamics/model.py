@@ -1,5 +1,14 @@
 """Equations of motion of a rig at an operating point (paper 001, eq. 1 and Annex A).
 
+The model is built in three parts by lifetime, so that a dataset or a calibration that runs
+one rig many times rebuilds only what changes:
+
+* :class:`RigModel` — per rig: masses, shaft and coupling springs, bearing and tooth
+  geometry (:func:`rig_model`, memoised per rig);
+* :class:`DynamicModel` — per operating point: speeds, loads, the mesh stiffness at the
+  torque (:func:`build_model`);
+* per run: cage phases and slip, by :meth:`DynamicModel.for_run` (cheap).
+
 The DOFs are ordered as in eq. 1: ``x, y, θ`` of each node (``1b1, 1G1, 1b2, 2b1, 2G1, 2b2``)
 then ``θ_2J2``. Rotations are deviations from the nominal rigid rotation Ω·t (shaft 1 at the
 imposed speed, shaft 2 at Ω·Z1/Z2, counted positive in its own sense of motion), so the input
@@ -17,17 +26,21 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from dataclasses import replace
+from functools import lru_cache
+
 from cmsim.bearings.forces import ball_offsets
 from cmsim.bearings.hertz import bearing_contact_stiffness
-from cmsim.bearings.kinematics import cage_ratios
+from cmsim.bearings.kinematics import cage_ratios, slip_jitter
 from cmsim.dynamics import _kernels as K
-from cmsim.errors import ParameterError
+from cmsim.dynamics.mesh_choice import resolve_mesh
+from cmsim.errors import ParameterError, check_range
 from cmsim.mesh_stiffness._kernels import GEO_SIZE
 from cmsim.mesh_stiffness.contact import (contact_geometry, corner_zone_m, potential_slots,
                                           reference_phases, table_range_m)
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
-__all__ = ["DynamicModel", "SlipModel", "build_model"]
+__all__ = ["DynamicModel", "RigModel", "SlipModel", "build_model", "rig_model"]
 
 
 @dataclass(frozen=True)
@@ -57,7 +70,6 @@ class SlipModel:
     correlation_s: float = 5e-3
 
     def __post_init__(self):
-        from cmsim.errors import check_range
         check_range("cage_speed_rms", self.cage_speed_rms, 0.0, 0.2)
         check_range("ball_rms_rad", self.ball_rms_rad, 0.0, 0.05, unit="rad")
         check_range("correlation_s", self.correlation_s, 1e-5, 10.0, unit="s")
@@ -69,49 +81,45 @@ class SlipModel:
 
 
 @dataclass(frozen=True)
-class DynamicModel:
-    """Arrays of eq. 1 for one rig and operating point, ready for the numba kernels.
+class RigModel:
+    """The parts of eq. 1 that depend on the rig alone (built once per rig).
 
     Attributes
     ----------
     rig : Rig
-    op : OperatingPoint
-    mesh_table : MeshStiffnessTable or None
-        Pair stiffness table (gear rigs).
     dof_names : tuple of str
         ``x_1b1, y_1b1, theta_1b1, ...``.
     mass : ndarray, shape (n,)
         Diagonal of M (kg or kg·m²).
-    stiffness : ndarray, shape (n, n)
-        Linear K of the shafts and couplings (N/m, N·m/rad).
-    damping : ndarray, shape (n, n)
-        Linear C of shafts, couplings and bearings.
-    force : ndarray, shape (n,)
-        Constant external load (output torque, radial load).
-    omega : ndarray, shape (n,)
-        Nominal rotation speed of each DOF, rad/s (0 for translations).
-    packed : tuple
-        Kernel argument tuple ``P`` (see :mod:`cmsim.dynamics._kernels`).
-    diag_names : tuple of str
-        Names of the output forces the kernel writes (bearing housing forces, pair forces).
-    slip : SlipModel
-    mesh_model : HybridMeshModel or None
-        On-line hybrid contact model (model A), or ``None`` for the table.
+    stiffness, damping : ndarray, shape (n, n)
+        Linear K and C of the shafts, couplings and bearing dampers.
+    springs : ndarray, shape (e, 2)
+        Spring-damper (k, c) of each element in kernel order.
+    spring_ends : ndarray of int64, shape (e, 3)
+        DOF indices of each element (:func:`cmsim.dynamics._kernels.linear_accel_jit`).
+    b_int : ndarray of int64, shape (nb, BI_SIZE)
+        Bearing DOF indices and ball counts.
+    b_par : ndarray, shape (nb, BP_SIZE)
+        Bearing parameters; the phase column is set per run.
+    b_cos, b_sin : ndarray, shape (nb, max_balls)
+        cos and sin of the ball offsets in each cage.
+    mesh : dict
+        Tooth geometry of the kernels (``geo``, ``teeth1``, ``teeth2``, slots, phases, zone
+        limits); empty without gears.
     """
 
     rig: object
-    op: object
-    mesh_table: MeshStiffnessTable | None
     dof_names: tuple
-    mass: np.ndarray
-    stiffness: np.ndarray
-    damping: np.ndarray
-    force: np.ndarray
-    omega: np.ndarray
-    packed: tuple = field(repr=False)
-    diag_names: tuple = ()
-    slip: SlipModel = SlipModel()
-    mesh_model: object = None
+    mass: np.ndarray = field(repr=False)
+    stiffness: np.ndarray = field(repr=False)
+    damping: np.ndarray = field(repr=False)
+    springs: np.ndarray = field(repr=False)
+    spring_ends: np.ndarray = field(repr=False)
+    b_int: np.ndarray = field(repr=False)
+    b_par: np.ndarray = field(repr=False)
+    b_cos: np.ndarray = field(repr=False)
+    b_sin: np.ndarray = field(repr=False)
+    mesh: dict = field(repr=False, default_factory=dict)
 
     @property
     def n_dof(self):
@@ -125,10 +133,173 @@ class DynamicModel:
         except ValueError:
             raise KeyError(f"no DOF {name!r}; DOFs are {self.dof_names}") from None
 
+
+@lru_cache(maxsize=16)
+def rig_model(rig):
+    """The :class:`RigModel` of ``rig`` (memoised: rigs are frozen values)."""
+    n = rig.n_dof
+    mass = _node_masses(rig)
+    elements = _spring_elements(rig)
+    kmat, cmat = _linear_matrices(elements, n)
+    names = _dof_names(rig)
+    # kernel layout: two-node springs first, then ground springs (b = a), count in [0, 2]
+    ordered = sorted(elements, key=lambda e: e[1] < 0)
+    springs = np.array([(k, c) for _, _, k, c in ordered])
+    spring_ends = np.array([(a, a if b < 0 else b, 0) for a, b, _, _ in ordered], dtype=np.int64)
+    spring_ends[0, 2] = sum(1 for e in ordered if e[1] < 0)
+    bearings = rig.bearings
+    nb = len(bearings)
+    max_balls = max(b.n_balls for b in bearings)
+    b_int = np.zeros((nb, K.BI_SIZE), dtype=np.int64)
+    b_par = np.zeros((nb, K.BP_SIZE))
+    b_cos = np.zeros((nb, max_balls))
+    b_sin = np.zeros((nb, max_balls))
+    node_of = {name: k for k, name in enumerate(rig.node_names)}
+    for ib, (bname, brg) in enumerate(zip(rig.bearing_names, bearings)):
+        node = node_of[bname]
+        k_in, k_out = cage_ratios(brg)
+        b_int[ib] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls)
+        b_par[ib, K.BP_K] = bearing_contact_stiffness(brg)
+        b_par[ib, K.BP_P] = brg.load_exponent
+        b_par[ib, K.BP_C] = brg.clearance_m
+        b_par[ib, K.BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio
+        b_par[ib, K.BP_SENSE] = 1.0 if bname.startswith("1") else -1.0
+        b_par[ib, K.BP_DAMP] = brg.damping_n_s_per_m
+        co, so = ball_offsets(brg)
+        b_cos[ib, :brg.n_balls] = co
+        b_sin[ib, :brg.n_balls] = so
+    mesh = {}
+    if rig.gears is not None:
+        pair = rig.gears
+        lo, _ = table_range_m(pair)
+        before, after = corner_zone_m(pair)
+        psi10, psi20 = reference_phases(pair)
+        alpha = pair.working_pressure_angle_rad
+        lub = rig.lubricant
+        mesh = {"geo": contact_geometry(pair), "n_slots": potential_slots(pair),
+                "psi10": psi10, "psi20": psi20, "slo": lo, "before": before, "after": after,
+                "teeth1": _pitch_multiples(pair.driving.n_teeth),
+                "teeth2": _pitch_multiples(pair.driven.n_teeth),
+                "g1": 3 * node_of["1G1"], "g2": 3 * node_of["2G1"],
+                # nominal line of action: tangent point T1 at polar angle π/2 − α_w
+                "phi_t0": 0.5 * math.pi - alpha,
+                "koster": 12 * math.pi * lub.dynamic_viscosity_pa_s * min(
+                    pair.driving.face_width_m, pair.driven.face_width_m)}
+    for arr in (mass, kmat, cmat, springs, spring_ends, b_int, b_par, b_cos, b_sin):
+        arr.setflags(write=False)
+    return RigModel(rig, names, mass, kmat, cmat, springs, spring_ends, b_int, b_par, b_cos,
+                    b_sin, mesh)
+
+
+@dataclass(frozen=True)
+class DynamicModel:
+    """Arrays of eq. 1 for one rig, operating point and run, ready for the numba kernels.
+
+    Attributes
+    ----------
+    rig_model : RigModel
+        The per-rig part.
+    op : OperatingPoint
+    mesh_table : MeshStiffnessTable or None
+        Pair stiffness table (gear rigs; with the on-line model it sets only the mean
+        stiffness for the damping and the start guess).
+    force : ndarray, shape (n,)
+        Constant external load (output torque, radial load).
+    omega : ndarray, shape (n,)
+        Nominal rotation speed of each DOF, rad/s (0 for translations).
+    packed : KernelParams
+        Named kernel arrays ``P`` (:class:`cmsim.dynamics._kernels.KernelParams`).
+    diag_names : tuple of str
+        Names of the output forces the kernel writes (bearing housing forces, pair forces).
+    slip : SlipModel
+    mesh_model : HybridMeshModel or None
+        On-line hybrid contact model (model A), or ``None`` for the table.
+    cage_phases_rad : ndarray, shape (n_bearings,)
+        Initial cage angle of each bearing, rad.
+    """
+
+    rig_model: RigModel
+    op: object
+    mesh_table: MeshStiffnessTable | None
+    force: np.ndarray
+    omega: np.ndarray
+    packed: K.KernelParams = field(repr=False)
+    diag_names: tuple = ()
+    slip: SlipModel = SlipModel()
+    mesh_model: object = None
+    cage_phases_rad: np.ndarray = field(default=None, repr=False)
+
+    @property
+    def rig(self):
+        """The rig."""
+        return self.rig_model.rig
+
+    @property
+    def dof_names(self):
+        """``x_1b1, y_1b1, theta_1b1, ...``."""
+        return self.rig_model.dof_names
+
+    @property
+    def mass(self):
+        """Diagonal of M, shape (n,)."""
+        return self.rig_model.mass
+
+    @property
+    def stiffness(self):
+        """Linear K, shape (n, n)."""
+        return self.rig_model.stiffness
+
+    @property
+    def damping(self):
+        """Linear C, shape (n, n)."""
+        return self.rig_model.damping
+
+    @property
+    def n_dof(self):
+        """Number of DOFs."""
+        return self.mass.size
+
+    def index(self, name):
+        """Position of DOF ``name`` (e.g. ``"theta_1G1"``)."""
+        return self.rig_model.index(name)
+
     @property
     def translational_mask(self):
         """Boolean mask of the x/y DOFs, shape (n,)."""
         return np.array([not d.startswith("theta") for d in self.dof_names])
+
+    def for_run(self, *, cage_phases_rad=None, slip=None, duration_s=1.0, seed=None):
+        """The same model with another run's cage phases and slip (nothing else rebuilt).
+
+        Parameters
+        ----------
+        cage_phases_rad : sequence of float, optional
+            Initial cage angle θ0 of each bearing (eq. 7), one per bearing in
+            ``rig.bearing_names`` order; default all zero.
+        slip : SlipModel, optional
+            Random rolling slip (default none).
+        duration_s : float
+            Span over which the slip is generated (only with ``slip``), s.
+        seed : int, optional
+            Seed of the slip generator.
+        """
+        rig = self.rig
+        nb = len(rig.bearings)
+        slip = SlipModel() if slip is None else slip
+        phases = np.zeros(nb) if cage_phases_rad is None else np.asarray(cage_phases_rad, float)
+        if phases.shape != (nb,) or not np.all(np.isfinite(phases)):
+            raise ParameterError(f"cage_phases_rad needs {nb} finite values (one per bearing "
+                                 f"{rig.bearing_names}), got {cage_phases_rad!r}")
+        b_par = self.rig_model.b_par.copy()
+        b_par[:, K.BP_PHASE] = phases
+        cage_rates = [abs(b_par[ib, K.BP_CAGE] * self.omega[self.rig_model.b_int[ib, K.BI_T]])
+                      for ib in range(nb)]
+        jitter, jdt = _jitter(rig.bearings, self.rig_model.b_cos.shape[1], cage_rates, slip,
+                              duration_s, seed)
+        m_par = self.packed.m_par.copy()
+        m_par[K.MP_JDT] = jdt
+        packed = self.packed._replace(b_par=b_par, jitter=jitter, m_par=m_par)
+        return replace(self, packed=packed, slip=slip, cage_phases_rad=phases)
 
     def rhs(self, t, y, want_diag=False):
         """Evaluate the kernel right-hand side; returns ``dydt`` (and ``diag``)."""
@@ -235,54 +406,40 @@ def _dof_names(rig):
     return tuple(names)
 
 
-def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=None,
-                cage_phases_rad=None, mesh_model=None):
+def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
+                cage_phases_rad=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
 
     Parameters
     ----------
     rig : Rig
     op : OperatingPoint
-    mesh_table : MeshStiffnessTable, optional
-        Pair stiffness; default: the potential-energy table of the rig's gears, or with
-        ``mesh_model`` the hybrid table of one mesh cycle at the operating torque (then used
-        only for the mesh damping coefficient and the start guess).
-    slip : SlipModel, optional
-        Ball-position jitter (default none).
-    duration_s : float
-        Span over which jitter is generated (only with ``slip``), s.
-    seed : int, optional
-        Seed of the jitter generator.
-    cage_phases_rad : sequence of float, optional
-        Initial cage angle θ0 of each bearing (eq. 7), one per bearing in
-        ``rig.bearing_names`` order; default all zero.
-    mesh_model : HybridMeshModel, optional
-        Solve the tooth contact forces on-line from the FE influence coefficients at every
-        right-hand-side evaluation (paper 001 §6.1, model A) instead of using the table.
+    mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
+        Tooth contact model (:func:`cmsim.dynamics.mesh_choice.resolve_mesh`): ``None`` =
+        the rig's hybrid FE + Weber–Banaschek tables at the operating torque (paper 001
+        §6.1, model B); ``"potential-energy"``; ``"hybrid"`` = on-line contact solve
+        (model A); or an explicit table, table set or hybrid model.
+    slip, duration_s, seed, cage_phases_rad
+        Per-run values, as in :meth:`DynamicModel.for_run`.
 
     Returns
     -------
     DynamicModel
+
+    Notes
+    -----
+    Mesh damping is stiffness-proportional per pair: a loaded pair of stiffness k_j (the
+    table's, or the secant F/δ of the on-line solve) gets β·k_j with
+    β = 2ξ√(M_eq/k̄), so the mesh has 2ξ√(k̄·M_eq) on average (k̄: mean mesh stiffness at the
+    torque) and does not double in double contact.
     """
-    slip = SlipModel() if slip is None else slip
-    if mesh_model is not None:
-        from cmsim.mesh_stiffness.hybrid import HybridMeshModel
-        if not isinstance(mesh_model, HybridMeshModel):
-            raise ParameterError(f"mesh_model must be a HybridMeshModel, got "
-                                 f"{type(mesh_model).__name__}")
-        if rig.gears is None:
-            raise ParameterError("mesh_model given for a rig without gears")
-        if mesh_model.pair != rig.gears:
-            raise ParameterError("mesh_model was built for a different gear pair than the rig's")
-    n = rig.n_dof
-    mass = _node_masses(rig)
-    elements = _spring_elements(rig)
-    kmat, cmat = _linear_matrices(elements, n)
-    names = _dof_names(rig)
+    rm = rig_model(rig)
+    n = rm.n_dof
+    mesh_table, mesh_model = resolve_mesh(rig, mesh, op.torque_nm)
     omega = np.zeros(n)
     ratio = rig.gears.driving.n_teeth / rig.gears.driven.n_teeth if rig.gears else 0.0
     speeds = (op.omega_rad_s, op.omega_rad_s * ratio)
-    for i, name in enumerate(names):
+    for i, name in enumerate(rm.dof_names):
         if name.startswith("theta"):
             omega[i] = speeds[0] if name[-3] == "1" else speeds[1]
     force = np.zeros(n)
@@ -292,144 +449,65 @@ def build_model(rig, op, mesh_table=None, *, slip=None, duration_s=1.0, seed=Non
         force[3] += op.radial_load_n * math.cos(op.radial_load_angle_rad)
         force[4] += op.radial_load_n * math.sin(op.radial_load_angle_rad)
 
-    # ---- bearings
-    bearings = rig.bearings
-    nb = len(bearings)
-    max_balls = max(b.n_balls for b in bearings)
-    b_int = np.zeros((nb, K.BI_SIZE), dtype=np.int64)
-    b_par = np.zeros((nb, K.BP_SIZE))
-    b_cos = np.zeros((nb, max_balls))
-    b_sin = np.zeros((nb, max_balls))
-    node_of = {name: k for k, name in enumerate(rig.node_names)}
-    phases = np.zeros(nb) if cage_phases_rad is None else np.asarray(cage_phases_rad, float)
-    if phases.shape != (nb,) or not np.all(np.isfinite(phases)):
-        raise ParameterError(f"cage_phases_rad needs {nb} finite values (one per bearing "
-                             f"{rig.bearing_names}), got {cage_phases_rad!r}")
-    for ib, (bname, brg) in enumerate(zip(rig.bearing_names, bearings)):
-        node = node_of[bname]
-        k_in, k_out = cage_ratios(brg)
-        sense = 1.0 if bname.startswith("1") else -1.0
-        rate = (k_in + k_out * brg.outer_ring_speed_ratio) * sense * omega[3 * node + 2]
-        # bearings turning alike share the nominal cage cos/sin (not with slip: each cage
-        # then wanders on its own)
-        group = next(j for j in range(ib + 1)
-                     if j == ib or (not slip.active
-                                    and b_par[j, K.BP_CAGE] * b_par[j, K.BP_SENSE]
-                                    * omega[b_int[j, K.BI_T]] == rate
-                                    and b_par[j, K.BP_PHASE] == phases[ib]))
-        b_int[ib] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls, group)
-        b_par[ib, K.BP_K] = bearing_contact_stiffness(brg)
-        b_par[ib, K.BP_P] = brg.load_exponent
-        b_par[ib, K.BP_C] = brg.clearance_m
-        b_par[ib, K.BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio
-        b_par[ib, K.BP_SENSE] = sense
-        b_par[ib, K.BP_DAMP] = brg.damping_n_s_per_m
-        b_par[ib, K.BP_PHASE] = phases[ib]
-        co, so = ball_offsets(brg)
-        b_cos[ib, :brg.n_balls] = co
-        b_sin[ib, :brg.n_balls] = so
-    cage_rates = [abs(b_par[ib, K.BP_CAGE] * omega[b_int[ib, K.BI_T]]) for ib in range(nb)]
-    jitter, jdt = _jitter(bearings, max_balls, cage_rates, slip, duration_s, seed)
-
-    # ---- mesh
+    nb = len(rig.bearings)
     m_int = np.zeros(K.MI_SIZE, dtype=np.int64)
     m_par = np.zeros(K.MP_SIZE)
-    m_par[K.MP_JDT] = jdt
+    m_par[K.MP_JDT] = 1.0
     m_par[K.MP_DIAGB] = 2 * nb
     diag_names = [f"F_{b}_{d}" for b in rig.bearing_names for d in ("x", "y")]
     if rig.gears is not None:
-        pair = rig.gears
-        if mesh_table is None:
-            mesh_table = (default_mesh_table(pair) if mesh_model is None
-                          else hybrid_mesh_table(mesh_model, op.torque_nm))
-        geo = contact_geometry(pair)
-        n_slots = potential_slots(pair)
-        psi10, psi20 = reference_phases(pair)
-        lo, _ = table_range_m(pair)
-        before, after = corner_zone_m(pair)
+        pair, geom = rig.gears, rm.mesh
         mode = K.MODE_TABLE if mesh_model is None else K.MODE_HYBRID
-        m_int[:] = (3 * node_of["1G1"], 3 * node_of["2G1"], n_slots, 1, mode)
-        mc, lub = rig.mesh_contact, rig.lubricant
+        m_int[:] = (geom["g1"], geom["g2"], geom["n_slots"], 1, mode)
+        mc = rig.mesh_contact
         k_mean = mesh_table.mean_mesh_stiffness(pair)
         m_par[K.MP_A0] = pair.working_centre_distance_m
-        m_par[K.MP_PSI10] = psi10
-        m_par[K.MP_PSI20] = psi20
+        m_par[K.MP_PSI10] = geom["psi10"]
+        m_par[K.MP_PSI20] = geom["psi20"]
         m_par[K.MP_PB] = pair.driving.base_pitch_m
-        m_par[K.MP_SLO] = lo
+        m_par[K.MP_SLO] = geom["slo"]
         m_par[K.MP_OM1] = speeds[0]
         m_par[K.MP_OM2] = speeds[1]
         m_par[K.MP_MU] = mc.friction_coefficient
         m_par[K.MP_V0] = mc.friction_smoothing_m_s
-        m_par[K.MP_CHYST] = 2 * mc.damping_ratio * math.sqrt(k_mean * pair.mesh_stiffness_mass_kg)
-        m_par[K.MP_KOSTER] = 12 * math.pi * lub.dynamic_viscosity_pa_s * min(
-            pair.driving.face_width_m, pair.driven.face_width_m)
+        m_par[K.MP_BETA] = 2 * mc.damping_ratio * math.sqrt(pair.mesh_stiffness_mass_kg / k_mean)
+        m_par[K.MP_KOSTER] = geom["koster"]
         m_par[K.MP_DTHR] = mc.squeeze_gap_threshold_m
         m_par[K.MP_TAB0] = mesh_table.position_m[0]
         m_par[K.MP_TABD] = mesh_table.spacing_m
-        m_par[K.MP_ZBEFORE] = before
-        m_par[K.MP_ZAFTER] = after
+        m_par[K.MP_ZBEFORE] = geom["before"]
+        m_par[K.MP_ZAFTER] = geom["after"]
+        m_par[K.MP_PHIT0] = geom["phi_t0"]
+        m_par[K.MP_COST0] = math.cos(geom["phi_t0"])
+        m_par[K.MP_SINT0] = math.sin(geom["phi_t0"])
         tab_k = np.ascontiguousarray(mesh_table.stiffness_n_per_m)
         tab_e = np.ascontiguousarray(mesh_table.separation_m)
-        diag_names += [f"Fmesh_{j}" for j in range(n_slots)]
-        teeth1 = _pitch_multiples(pair.driving.n_teeth)
-        teeth2 = _pitch_multiples(pair.driven.n_teeth)
+        diag_names += [f"Fmesh_{j}" for j in range(geom["n_slots"])]
+        geo, teeth1, teeth2 = geom["geo"], geom["teeth1"], geom["teeth2"]
     else:
-        if mesh_table is not None:
-            raise ParameterError("mesh_table given for a rig without gears")
         geo = np.zeros(GEO_SIZE)
         teeth1 = teeth2 = np.zeros((1, 2))
         m_par[K.MP_TABD] = 1.0
         tab_k = np.zeros(2)
         tab_e = np.zeros(2)
-    # kernel layout: two-node springs first, then ground springs (b = a), count in [0, 2]
-    ordered = sorted(elements, key=lambda e: e[1] < 0)
-    springs = np.array([(k, c) for _, _, k, c in ordered])
-    spring_ends = np.array([(a, a if b < 0 else b, 0) for a, b, _, _ in ordered], dtype=np.int64)
-    spring_ends[0, 2] = sum(1 for e in ordered if e[1] < 0)
     if mesh_model is not None:
         hybrid = tuple(np.ascontiguousarray(a, dtype=float) for a in mesh_model.kernel_args())
     else:
         hybrid = K.no_hybrid()
-    packed = (1.0 / mass, springs, force, omega, b_int, b_par, b_cos, b_sin, jitter, m_int,
-              m_par, geo, tab_k, tab_e, teeth1, teeth2, spring_ends) + hybrid
-    return DynamicModel(rig, op, mesh_table, names, mass, kmat, cmat, force, omega, packed,
-                        tuple(diag_names), slip, mesh_model)
+    packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, rm.b_int, rm.b_par,
+                            rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
+                            m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
+                            *hybrid)
+    model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
+                         SlipModel(), mesh_model, np.zeros(nb))
+    return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
+                         seed=seed)
 
 
 def _pitch_multiples(n_teeth):
     """cos and sin of k·2π/Z for k = 0..Z−1, shape (Z, 2)."""
     a = 2.0 * math.pi * np.arange(n_teeth) / n_teeth
     return np.ascontiguousarray(np.column_stack([np.cos(a), np.sin(a)]))
-
-
-def default_mesh_table(pair):
-    """Potential-energy table of ``pair`` (cached per gear pair)."""
-    return _pe_table_cached(pair)
-
-
-_PE_CACHE = {}
-_HYBRID_CACHE = {}
-
-
-def hybrid_mesh_table(mesh_model, output_torque_nm):
-    """Hybrid table of one mesh cycle at the driving torque that ``output_torque_nm`` needs.
-
-    Memoised per (model, torque): model A uses it for the mesh damping coefficient (from its
-    mean stiffness) and the quasi-static start guess.
-    """
-    pair = mesh_model.pair
-    drive = max(output_torque_nm, 1e-3) * pair.driving.n_teeth / pair.driven.n_teeth
-    key = (id(mesh_model), drive)
-    if key not in _HYBRID_CACHE:
-        from cmsim.mesh_stiffness.mesh_cycle import mesh_cycle
-        _HYBRID_CACHE[key] = (mesh_model, mesh_cycle(mesh_model, drive, n_steps=24).table)
-    return _HYBRID_CACHE[key][1]
-
-
-def _pe_table_cached(pair):
-    if pair not in _PE_CACHE:
-        _PE_CACHE[pair] = MeshStiffnessTable.potential_energy(pair)
-    return _PE_CACHE[pair]
 
 
 def _jitter(bearings, max_balls, cage_rates, slip, duration_s, seed):
@@ -442,7 +520,6 @@ def _jitter(bearings, max_balls, cage_rates, slip, duration_s, seed):
     nb = len(bearings)
     if not slip.active:
         return np.zeros((nb, max_balls + 1, 1)), 1.0
-    from cmsim.bearings.kinematics import slip_jitter
     rng = np.random.default_rng(seed)
     dt = slip.correlation_s / 10.0
     n_grid = int(math.ceil(duration_s / dt)) + 2

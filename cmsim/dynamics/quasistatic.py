@@ -44,7 +44,7 @@ def _linear_guess(model, f_ref):
         k_re = bearing_contact_stiffness(brg)
         deflection = (load / k_re) ** (1.0 / brg.load_exponent)
         k_lin = 1.5 * load / deflection
-        ix = int(model.packed[4][ib, 0])
+        ix = int(model.packed.b_int[ib, 0])
         kmat[ix, ix] += k_lin
         kmat[ix + 1, ix + 1] += k_lin
         offsets[ix:ix + 2] = max(brg.clearance_m, 0.0)
@@ -54,7 +54,7 @@ def _linear_guess(model, f_ref):
     q = np.linalg.solve(kmat, model.force)
     # push each bearing across its clearance in the direction it moves
     for ib in range(nb):
-        ix = int(model.packed[4][ib, 0])
+        ix = int(model.packed.b_int[ib, 0])
         r = math.hypot(q[ix], q[ix + 1])
         if r > 0:
             q[ix:ix + 2] += offsets[ix:ix + 2] * q[ix:ix + 2] / r
