@@ -34,7 +34,6 @@ Processes
 from __future__ import annotations
 
 import json
-import math
 import multiprocessing
 import os
 import sys
@@ -49,13 +48,10 @@ import numpy as np
 from cmsim._io import atomic_write_text
 from cmsim.dynamics.simulate import _compile_seconds, simulate
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
+from cmsim.features import N_GMF_HARMONICS
+from cmsim.features import run_features as signal_features
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
-from cmsim.spectra.amplitude import amplitude_spectrum
-from cmsim.spectra.frequencies import peak_families
-from cmsim.spectra.labels import label_peaks
-from cmsim.spectra.run_spectrum import run_families, signal_bearing
-from cmsim.spectra.waterfall import harmonic_amplitudes
 
 __all__ = ["SweepSpec", "SweepCase", "SweepSummary", "run_sweep", "read_manifest",
            "run_features", "SEED_POLICIES", "START_METHODS", "MANIFEST_NAME", "RUNS_DIR",
@@ -326,8 +322,8 @@ class SweepSummary:
 
 
 # ---------------------------------------------------------------------- features
-def run_features(run, signals=FEATURE_SIGNALS, n_harmonics=6, top_n=5):
-    """Spectral summary of a run for the manifest: GMF harmonics and the largest peaks.
+def run_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS, top_n=5):
+    """Features of a run for the manifest (:mod:`cmsim.features`), per signal.
 
     Parameters
     ----------
@@ -336,40 +332,21 @@ def run_features(run, signals=FEATURE_SIGNALS, n_harmonics=6, top_n=5):
     signals : sequence of str
         Signals to summarise (those absent from the run are left out).
     n_harmonics : int
-        GMF harmonics measured.
+        GMF harmonics measured (default 6, :data:`cmsim.features.N_GMF_HARMONICS`).
     top_n : int
         Largest labelled peaks kept per signal.
 
     Returns
     -------
     dict
-        Per signal: ``dominant_gmf_harmonic`` (int or None for bearing rigs),
-        ``gmf_harmonics`` (amplitudes of 1..n_harmonics × GMF, signal unit) and
-        ``top_peaks`` (list of {frequency_hz, amplitude, label, db_re_carrier}).
+        Per signal, :meth:`cmsim.features.FeatureRow.to_summary`: ``dominant_gmf_harmonic``
+        (int or None for bearing rigs), ``gmf_harmonics`` (amplitudes of 1..n_harmonics ×
+        GMF, signal unit), ``top_peaks`` (list of {frequency_hz, amplitude, label,
+        db_re_carrier}) and ``features`` (the flat feature columns, NaN as None).
     """
-    freqs, _ = run_families(run)
-    bearings = tuple(k for k, v in freqs.items() if isinstance(v, dict))
-    out = {}
-    for name in signals:
-        if name not in run.signals:
-            continue
-        fam = peak_families(freqs, signal_bearing(name, bearings))
-        f, a = amplitude_spectrum(run[name], run.fs_hz)
-        peaks = label_peaks(f, a, fam).sort_values("amplitude", ascending=False).head(top_n)
-        entry = {"top_peaks": [
-            {"frequency_hz": float(r.frequency_hz), "amplitude": float(r.amplitude),
-             "label": str(r.label),
-             "db_re_carrier": float(r.db_re_carrier) if math.isfinite(r.db_re_carrier) else None}
-            for r in peaks.itertuples()]}
-        if "GMF" in fam:
-            h = harmonic_amplitudes(f, a, fam["GMF"], n_harmonics)
-            entry["gmf_harmonics"] = [float(v) if math.isfinite(v) else None for v in h]
-            entry["dominant_gmf_harmonic"] = int(np.nanargmax(h)) + 1
-        else:
-            entry["gmf_harmonics"] = None
-            entry["dominant_gmf_harmonic"] = None
-        out[name] = entry
-    return out
+    return {name: signal_features(run, name, n_gmf_harmonics=n_harmonics,
+                                  top_n=top_n).to_summary()
+            for name in signals if name in run.signals}
 
 
 # ---------------------------------------------------------------------- worker

@@ -40,15 +40,15 @@ import numpy as np
 from cmsim._io import atomic_write_bytes, atomic_write_text
 from cmsim.datasets import RUNS_DIR, read_manifest
 from cmsim.errors import ParameterError, check_range
+from cmsim.features import N_GMF_HARMONICS, gmf_levels
+from cmsim.frequencies import rig_frequencies
 from cmsim.plots import plot_orbit_family, plot_trace_family
 from cmsim.run import Run
 from cmsim.spectra._checks import positive_int
 from cmsim.spectra.amplitude import amplitude_spectrum
-from cmsim.spectra.frequencies import peak_families, rig_frequencies
 from cmsim.spectra.labels import label_peaks
 from cmsim.spectra.run_spectrum import signal_bearing, signal_unit
-from cmsim.spectra.waterfall import (harmonic_amplitudes, plot_family_waterfall,
-                                     plot_harmonic_trend)
+from cmsim.spectra.waterfall import plot_family_waterfall, plot_harmonic_trend
 
 __all__ = ["ReportResult", "build_report", "sweep_run_files", "DEFAULT_SIGNALS", "SWEEP_AXES"]
 
@@ -138,12 +138,12 @@ def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
          "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
          "friction": rig.mesh_contact.friction_coefficient if rig.has_gears else None,
          "clearance_m": rig.bearings[0].clearance_m, "seed": meta.get("seed"),
-         "fs_hz": fs, "duration_s": run.t.size / fs, "shaft_hz": freqs["shaft_hz"],
-         "gmf_hz": freqs.get("gmf_hz"), "integration_s": float(meta.get("wall_s", 0.0)),
+         "fs_hz": fs, "duration_s": run.t.size / fs, "shaft_hz": freqs.fr1_hz,
+         "gmf_hz": freqs.gmf_hz, "integration_s": float(meta.get("wall_s", 0.0)),
          "spectra": {}, "peaks": {}, "harmonics": {}, "units": {}, "families": {}}
     d["clearance_um"] = d["clearance_m"] * 1e6
     if max_freq_hz is None:
-        f_show = 6.5 * freqs["gmf_hz"] if rig.has_gears else 10.5 * freqs[bearings[0]]["bpf_hz"]
+        f_show = 6.5 * freqs.gmf_hz if rig.has_gears else 10.5 * freqs.bearing(bearings[0]).bpf_hz
     else:
         f_show = check_range("max_freq_hz", max_freq_hz, 0.0, 0.5 * fs, lo_open=True,
                              unit="Hz")
@@ -153,7 +153,7 @@ def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
     d["dominant_signal"] = ("F_1b1_loa" if "F_1b1_loa" in run.signals else signals[0]) \
         if rig.has_gears else None
     for s in signals + extra:
-        fam = peak_families(freqs, signal_bearing(s, bearings))
+        fam = freqs.families(signal_bearing(s, bearings))
         f, a = amplitude_spectrum(run[s], fs)
         peaks = label_peaks(f, a, fam)
         keep = f <= 1.02 * f_show
@@ -162,21 +162,21 @@ def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
         d["units"][s] = signal_unit(s)
         d["families"][s] = fam
         if "GMF" in fam:
-            d["harmonics"][s] = harmonic_amplitudes(f, a, fam["GMF"], 10)
+            d["harmonics"][s] = gmf_levels((f, a), fam["GMF"])       # 1..6 × GMF
     # DTE: a few mesh cycles, and one turn of the input shaft, both from the end of the record
     if rig.has_gears and "dte_um" in run.signals:
         dte = run["dte_um"]
-        n_short = min(dte.size, max(2, int(round(n_mesh_cycles / freqs["gmf_hz"] * fs))))
-        n_turn = min(dte.size, max(2, int(round(fs / freqs["shaft_hz"]))))
+        n_short = min(dte.size, max(2, int(round(n_mesh_cycles / freqs.gmf_hz * fs))))
+        n_turn = min(dte.size, max(2, int(round(fs / freqs.fr1_hz))))
         d["dte_short"] = (np.arange(n_short) / fs, dte[-n_short:].copy())
         seg = dte[-n_turn:]
         d["dte_turn"] = (np.arange(n_turn) / fs, seg - seg.mean())
     # orbits of the first bearing of each shaft over its last ball-pass cycle
     d["orbits"] = {}
     for b in [n for n in bearings if n.endswith("b1")]:
-        n_cyc = min(run.t.size, max(2, int(round(fs / freqs[b]["bpf_hz"]))))
+        n_cyc = min(run.t.size, max(2, int(round(fs / freqs.bearing(b).bpf_hz))))
         d["orbits"][b] = (run[f"x_{b}"][-n_cyc:].copy(), run[f"y_{b}"][-n_cyc:].copy())
-        d.setdefault("bpf_hz", {})[b] = freqs[b]["bpf_hz"]
+        d.setdefault("bpf_hz", {})[b] = freqs.bearing(b).bpf_hz
     t2 = time.perf_counter()
     d["load_s"], d["spectra_s"] = t1 - t0, t2 - t1
     d["top_n"] = top_n
@@ -246,10 +246,11 @@ def _waterfall(members, signal, axis, in_orders, f_show, dyn_db, title):
 
 
 def _n_harm(m):
-    """GMF harmonics considered for the dominant one: those below the run's span (<= 10)."""
+    """GMF harmonics considered for the dominant one: those below the run's span, at most
+    the :data:`~cmsim.features.N_GMF_HARMONICS` (6) read by the feature extractor."""
     if not m["gmf_hz"]:
-        return 10
-    return max(1, min(10, int(m["f_show"] // m["gmf_hz"])))
+        return N_GMF_HARMONICS
+    return max(1, min(N_GMF_HARMONICS, int(m["f_show"] // m["gmf_hz"])))
 
 
 def _dominant(m, signal):

@@ -31,20 +31,20 @@ import numpy as np
 from cmsim.dynamics.simulate import simulate
 from cmsim.errors import ParameterError, check_range
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
+from cmsim.features import N_GMF_HARMONICS, gmf_levels
+from cmsim.frequencies import rig_frequencies
 from cmsim.mesh_stiffness.torque_tables import torque_tables
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.spectra.amplitude import amplitude_spectrum
-from cmsim.spectra.frequencies import rig_frequencies
-from cmsim.spectra.waterfall import harmonic_amplitudes
 
 __all__ = ["ModelComparison", "model_abc_study", "gmf_harmonics"]
 
 
-def gmf_harmonics(signal, fs_hz, gmf_hz, n_harmonics=6):
-    """Amplitudes of the first ``n_harmonics`` multiples of ``gmf_hz`` in ``signal``.
+def gmf_harmonics(signal, fs_hz, gmf_hz, n_harmonics=N_GMF_HARMONICS):
+    """Amplitudes of the first ``n_harmonics`` (default 6) multiples of ``gmf_hz`` in ``signal``.
 
-    Flat-top amplitude spectrum of the whole record, read by
-    :func:`cmsim.spectra.waterfall.harmonic_amplitudes`.
+    Flat-top amplitude spectrum of the whole record, read by the feature extractor's
+    :func:`cmsim.features.gmf_levels`; raises when a harmonic lies above fs/2.
 
     Returns
     -------
@@ -52,7 +52,7 @@ def gmf_harmonics(signal, fs_hz, gmf_hz, n_harmonics=6):
         Amplitudes in the unit of ``signal``.
     """
     spec = amplitude_spectrum(np.asarray(signal, dtype=float), fs_hz)
-    out = harmonic_amplitudes(spec.freq_hz, spec.amplitude, gmf_hz, n_harmonics)
+    out = gmf_levels(spec, gmf_hz, n_harmonics)
     if not np.all(np.isfinite(out)):
         raise ParameterError(f"{n_harmonics} harmonics of {gmf_hz:g} Hz exceed the Nyquist "
                              f"frequency {fs_hz / 2:g} Hz")
@@ -98,7 +98,8 @@ class ModelComparison:
 
 
 def model_abc_study(rig=None, *, speed_rpm=1000.0, torque_nm=100.0, low_torque_nm=10.0,
-                    duration_s=0.5, fs_hz=75_000.0, seed=0, n_harmonics=6, mesh_model=None):
+                    duration_s=0.5, fs_hz=75_000.0, seed=0, n_harmonics=N_GMF_HARMONICS,
+                    mesh_model=None):
     """Run models A, B and C of paper 001 §6.1 at one operating point.
 
     Parameters
@@ -135,7 +136,7 @@ def model_abc_study(rig=None, *, speed_rpm=1000.0, torque_nm=100.0, low_torque_n
     tables = torque_tables(rig, [low, torque], mesh_model=mesh_model, speed_rpm=speed_rpm)
     tables_s = time.perf_counter() - t0
     op = OperatingPoint(speed_rpm, torque)
-    gmf = rig_frequencies(rig, op)["gmf_hz"]
+    gmf = rig_frequencies(rig, op).gmf_hz
     common = dict(fs_hz=fs_hz, seed=seed, cage_phases_rad=None)
     runs = {"A": simulate(rig, op, duration_s, mesh_model=mesh_model, **common),
             "B": simulate(rig, op, duration_s, mesh_table=tables.at(torque), **common),
