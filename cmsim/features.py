@@ -163,6 +163,29 @@ class FeatureRow:
             out[f"peak{i}_db_re_carrier"] = p.db_re_carrier
         return out
 
+    def to_summary(self):
+        """JSON-ready summary (NaN → ``None``), the per-signal record of a sweep manifest.
+
+        Returns
+        -------
+        dict
+            ``gmf_harmonics`` (list of the GMF harmonic amplitudes, or ``None`` without
+            gears), ``dominant_gmf_harmonic`` (int or ``None``), ``top_peaks`` (list of
+            {frequency_hz, amplitude, label, db_re_carrier}, the padding left out) and
+            ``features`` (:meth:`to_dict`).
+        """
+        def js(v):
+            return None if isinstance(v, float) and not math.isfinite(v) else v
+
+        has_gmf = any(math.isfinite(a) for a in self.gmf_amp)
+        return {
+            "top_peaks": [{"frequency_hz": p.frequency_hz, "amplitude": p.amplitude,
+                           "label": p.label, "db_re_carrier": js(p.db_re_carrier)}
+                          for p in self.peaks if math.isfinite(p.frequency_hz)],
+            "gmf_harmonics": [js(float(a)) for a in self.gmf_amp] if has_gmf else None,
+            "dominant_gmf_harmonic": self.dominant_gmf_harmonic,
+            "features": {k: js(v) for k, v in self.to_dict().items()}}
+
     @property
     def dominant_gmf_harmonic(self):
         """k of the largest GMF harmonic (1-based), or ``None`` without a finite one."""
