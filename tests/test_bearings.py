@@ -141,6 +141,34 @@ def test_ball_pass_cycles_per_gear_turn(b209):
     assert ball_pass_cycles_per_rev(b209) == pytest.approx(3.6342, abs=5e-4)
 
 
+def test_contact_angle_follows_the_operating_clearance(b209):
+    """The kinematic contact angle is acos(1 − c/2A) of the operating clearance c (the paper's
+    c = P_d gives its 9.94° and 3.6342 cycles); under preload the balls sit at the groove
+    bottoms (α = 0: 9/2·(1 − d/D) = 3.6207 cycles), and the model's cage turns at that rate."""
+    from dataclasses import replace
+
+    from cmsim.dynamics.model import rig_model
+    from cmsim.dynamics import _kernels as K
+    assert b209.operating_contact_angle_rad == pytest.approx(b209.free_contact_angle_rad,
+                                                             rel=1e-9)
+    preloaded = replace(b209, clearance_m=-1e-6)
+    assert preloaded.effective_contact_angle_rad == 0.0
+    half_gamma = 0.5 * b209.ball_diameter_m / b209.pitch_diameter_m
+    assert ball_pass_cycles_per_rev(preloaded) == pytest.approx(
+        b209.n_balls * (0.5 - half_gamma), rel=1e-12)
+    assert ball_pass_cycles_per_rev(preloaded) == pytest.approx(3.6207, abs=5e-4)
+    # a larger clearance gives a larger angle: A = r_i + r_o − d, cos α = 1 − c/(2A)
+    loose = replace(b209, clearance_m=0.03e-3)
+    a = b209.inner_groove_radius_m + b209.outer_groove_radius_m - b209.ball_diameter_m
+    assert math.cos(loose.effective_contact_angle_rad) == pytest.approx(1 - 0.03e-3 / (2 * a))
+    # an explicit angle wins
+    assert replace(preloaded, contact_angle_rad=0.2).effective_contact_angle_rad == 0.2
+    rig = Rig.paper_2016()
+    for r, brg in ((rig, b209), (rig.with_clearance(-1e-6), preloaded)):
+        k_in, _ = cage_ratios(brg)
+        assert rig_model(r).b_par[0, K.BP_CAGE] == pytest.approx(k_in, rel=1e-12)
+
+
 @pytest.mark.parametrize("ratio", [0.5, -0.5, 1.0])
 def test_cage_speed_with_both_rings_rotating(b209, ratio):
     """Paper 002 Table 1: n_c = n_i K1 + n_o K2 (same sense) and n_i K1 − |n_o| K2 (counter),
