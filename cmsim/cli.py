@@ -57,7 +57,7 @@ def _cmd_simulate(args):
 
     rig = _load_rig(args)
     op = _operating_point(args)
-    table, mesh_model = _mesh_choice(args, rig, op)
+    table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
     slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                      correlation_s=args.slip_correlation_s)
     run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
@@ -67,35 +67,49 @@ def _cmd_simulate(args):
         run.save(args.out)
     freqs = rig_frequencies(rig, op)
     first = rig.bearing_names[0]
-    out = {
-        "shaft_hz": freqs["shaft_hz"],
-        "gmf_hz": freqs.get("gmf_hz"),
-        "bpf_hz": freqs[first]["bpf_hz"],
-        **run.summary(),
-        "out": str(args.out) if args.out else None,
-    }
+    out = {"shaft_hz": freqs.fr1_hz, "gmf_hz": freqs.gmf_hz,
+           "bpf_hz": freqs.bearing(first).bpf_hz, **run.summary(),
+           "out": str(args.out) if args.out else None}
     return out
 
 
-def _mesh_choice(args, rig, op):
-    """(mesh_table, mesh_model) from --mesh, --mesh-table and --table-torque-nm."""
-    if rig.gears is None:
-        if args.mesh == "hybrid" or args.mesh_table:
-            raise ParameterError("--mesh hybrid and --mesh-table need a rig with gears")
-        return None, None
-    if args.mesh == "hybrid":
-        if args.mesh_table:
-            raise ParameterError("--mesh hybrid solves the contact on-line; drop --mesh-table")
-        from cmsim.mesh_stiffness.hybrid import HybridMeshModel
-        return None, HybridMeshModel.from_pair(rig.gears)
+def _add_mesh_options(p):
+    """--mesh, --mesh-table and --table-torque-nm (simulate, modes, sweep)."""
+    p.add_argument("--mesh", choices=("hybrid-tables", "potential-energy", "hybrid"),
+                   default="hybrid-tables",
+                   help="tooth contact: hybrid FE + Weber-Banaschek tables at the run's torque "
+                        "(default; paper model B, shipped for the paper's rig, built and "
+                        "cached on first use for other rigs), the load-independent "
+                        "potential-energy table, or the contact solved on-line from the FE "
+                        "influence coefficients (hybrid: paper model A, ~4x slower)")
+    p.add_argument("--mesh-table", metavar="FILE.npz",
+                   help="pair stiffness table(s) from cmsim mesh-table instead; the table at "
+                        "the run's torque is used (linear in torque between tables)")
+    p.add_argument("--table-torque-nm", type=float, metavar="T",
+                   help="use the --mesh-table table of torque T instead (paper model C: "
+                        "tables at the wrong torque)")
+
+
+def _mesh_argument(args):
+    """The ``mesh`` value the options name: a string, or the MeshTableSet / table of a file."""
     if args.table_torque_nm is not None and not args.mesh_table:
         raise ParameterError("--table-torque-nm selects a table of --mesh-table FILE")
     if not args.mesh_table:
-        return None, None
-    from cmsim.mesh_stiffness.torque_tables import MeshTableSet
+        return args.mesh
+    if args.mesh != "hybrid-tables":
+        raise ParameterError(f"--mesh {args.mesh} and --mesh-table exclude each other")
+    from cmsim.mesh_stiffness.table_set import MeshTableSet
     tables = MeshTableSet.load(args.mesh_table)
-    torque = op.torque_nm if args.table_torque_nm is None else args.table_torque_nm
-    return tables.at(torque), None
+    return tables if args.table_torque_nm is None else tables.at(args.table_torque_nm)
+
+
+def _resolve_mesh_options(args, rig, torque_nm):
+    """(mesh_table, mesh_model) of the mesh options at ``torque_nm`` (resolve_mesh)."""
+    from cmsim.dynamics.mesh_choice import resolve_mesh
+    mesh = _mesh_argument(args)
+    if rig.gears is None and args.mesh_table:
+        raise ParameterError("--mesh-table needs a rig with gears")
+    return resolve_mesh(rig, mesh, torque_nm, progress=False if args.json else None)
 
 
 def _text_simulate(res):
@@ -121,16 +135,7 @@ def _add_simulate(sub):
     p.add_argument("--fs-hz", type=float, default=75_000.0, help="output sample rate, Hz")
     p.add_argument("--substeps", type=int, default=1, help="integration steps per sample")
     p.add_argument("--warmup-s", type=float, default=0.05, help="discarded start, s")
-    p.add_argument("--mesh", choices=("table", "hybrid"), default="table",
-                   help="tooth contact forces from a stiffness table (default; the "
-                        "potential-energy table unless --mesh-table) or solved on-line from "
-                        "the FE influence coefficients (hybrid: paper model A, ~4x slower)")
-    p.add_argument("--mesh-table", metavar="FILE.npz",
-                   help="pair stiffness table(s) from cmsim mesh-table; the table at the "
-                        "run's torque is used (linear in torque between tables)")
-    p.add_argument("--table-torque-nm", type=float, metavar="T",
-                   help="use the --mesh-table table of torque T instead (paper model C: "
-                        "tables at the wrong torque)")
+    _add_mesh_options(p)
     p.add_argument("--cage-slip", type=float, default=0.0, metavar="FRACTION",
                    help="rms random cage-speed fluctuation (0.01 = 1 %%); spreads ball-pass lines")
     p.add_argument("--ball-jitter-rad", type=float, default=0.0,
@@ -147,7 +152,10 @@ def _add_simulate(sub):
 def _cmd_modes(args):
     from cmsim.dynamics.modal import modal_analysis
     rig = _load_rig(args)
-    res = modal_analysis(rig, _operating_point(args), n_positions=args.positions)
+    op = _operating_point(args)
+    table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
+    res = modal_analysis(rig, op, mesh_model if mesh_model is not None else table,
+                         n_positions=args.positions)
     return {"torque_nm": args.torque_nm, "speed_rpm": args.speed_rpm,
             "frequencies_hz": [float(f) for f in res.frequencies_hz],
             "types": list(res.types), "details": list(res.details),
@@ -172,6 +180,7 @@ def _add_modes(sub):
                    help="speed, rpm (sets the bearing-cycle instants)")
     p.add_argument("--positions", type=int, default=24,
                    help="quasi-static positions averaged over a bearing cycle")
+    _add_mesh_options(p)
     _add_rig_options(p, friction=False)
     p.set_defaults(func=_cmd_modes, text=_text_modes)
 
@@ -257,11 +266,21 @@ def _cmd_sweep(args):
     from cmsim.rig import Rig
 
     rig = Rig.load(args.rig) if args.rig else Rig.paper_2016()
+    mesh = _mesh_argument(args)
+    extra = {}
+    if mesh != "hybrid-tables":
+        if "mesh" not in SweepSpec.__dataclass_fields__:
+            raise ParameterError("cmsim sweep supports only --mesh hybrid-tables for now")
+        extra["mesh"] = mesh
+    elif rig.gears is not None:
+        # build (or load) the rig's tables once, before the workers start
+        from cmsim.dynamics.mesh_choice import hybrid_table_set
+        hybrid_table_set(rig, progress=False if args.json else None)
     spec = SweepSpec(speeds_rpm=args.speed_rpm, torques_nm=args.torque_nm,
                      duration_s=args.duration_s, frictions=args.friction or (None,),
                      clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
                      warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
-                     seed_policy=args.seed_policy)
+                     seed_policy=args.seed_policy, **extra)
     progress = not args.json and sys.stderr.isatty()
     try:
         summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,
@@ -318,6 +337,7 @@ def _add_sweep(sub):
                    help="worker processes (default: number of CPUs)")
     p.add_argument("--force", action="store_true",
                    help="replace a manifest written for a different spec")
+    _add_mesh_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=_cmd_sweep, text=_text_sweep)
 
@@ -375,7 +395,7 @@ def build_parser():
 def _cmd_mesh_table(args):
     import time
 
-    from cmsim.mesh_stiffness.torque_tables import torque_tables
+    from cmsim.dynamics.torque_tables import torque_tables
 
     rig = _load_rig(args)
     if rig.gears is None:

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.run import signal_info
 from cmsim.frequencies import rig_frequencies
+from cmsim.run import signal_info
 from cmsim.spectra._checks import band as check_band
 from cmsim.spectra._checks import choice, positive_int
 from cmsim.spectra.amplitude import amplitude_spectrum
@@ -233,3 +233,4 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
                        resolution_hz=float(df_hz), unit=signal_unit(signal), families=dict(fam),
                        bearing=brg, peaks=peaks.reset_index(drop=True), band_hz=band_used,
                        max_hz=float(f_max), extra=extra)
+

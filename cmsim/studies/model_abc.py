@@ -5,7 +5,7 @@ The rig runs at one operating point (the paper: 1000 rpm, 100 N·m) three times:
 * **A** solves the tooth contact on-line from the FE influence coefficients at every
   right-hand-side evaluation (:class:`~cmsim.mesh_stiffness.hybrid.HybridMeshModel`);
 * **B** uses pair stiffness tables computed (by the same hybrid model, quasi-statically,
-  :func:`~cmsim.mesh_stiffness.torque_tables.torque_tables`) at the run's torque;
+  :func:`~cmsim.dynamics.torque_tables.torque_tables`) at the run's torque;
 * **C** uses tables computed at a low torque (the paper: 10 N·m), i.e. at the wrong load.
 
 Each run is summarised by its dynamic transmission error (mean, standard deviation,
@@ -29,11 +29,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim.dynamics.simulate import simulate
+from cmsim.dynamics.torque_tables import torque_tables
 from cmsim.errors import ParameterError, check_range
-from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.features import N_GMF_HARMONICS, gmf_levels
 from cmsim.frequencies import rig_frequencies
-from cmsim.mesh_stiffness.torque_tables import torque_tables
+from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.spectra.amplitude import amplitude_spectrum
 
@@ -138,9 +138,9 @@ def model_abc_study(rig=None, *, speed_rpm=1000.0, torque_nm=100.0, low_torque_n
     op = OperatingPoint(speed_rpm, torque)
     gmf = rig_frequencies(rig, op).gmf_hz
     common = dict(fs_hz=fs_hz, seed=seed, cage_phases_rad=None)
-    runs = {"A": simulate(rig, op, duration_s, mesh_model=mesh_model, **common),
-            "B": simulate(rig, op, duration_s, mesh_table=tables.at(torque), **common),
-            "C": simulate(rig, op, duration_s, mesh_table=tables.at(low), **common)}
+    runs = {"A": simulate(rig, op, duration_s, mesh=mesh_model, **common),
+            "B": simulate(rig, op, duration_s, mesh=tables.at(torque), **common),
+            "C": simulate(rig, op, duration_s, mesh=tables.at(low), **common)}
     metrics = {}
     for name, run in runs.items():
         dte = run["dte_um"]
