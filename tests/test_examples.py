@@ -13,8 +13,9 @@ machines moves the DTE standard deviation by less than 1e-10 relative, while hal
 integration step moves it by 2.4e-4 (potential-energy table) to 3.0e-4 (on-line hybrid).
 
 ``examples/model_abc.py`` at its default settings (1 s per model) takes about 4 s of CPU
-(15 s wall on the loaded 2-core machine) plus the FE influence tables when the session has
-not built them yet (about 10 s); it runs as shipped, so it is not reduced.
+for the runs, 12-13 s of CPU in pytest including the FE influence tables when the session has
+not built them yet (17-43 s wall on the loaded 2-core machine); it runs as shipped, not
+reduced, and is marked slow.
 """
 
 from __future__ import annotations
