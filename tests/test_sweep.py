@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from cmsim.cli import main
-from cmsim.datasets import (MANIFEST_NAME, RUNS_DIR, SweepSpec, read_manifest, run_sweep)
+from cmsim.datasets import (MANIFEST_NAME, RUNS_DIR, DirectoryLock, SweepSpec, read_manifest,
+                            run_sweep)
 from cmsim.errors import ParameterError
 from cmsim.rig import Rig
 from cmsim.run import Run
@@ -105,7 +106,7 @@ def test_sweep_writes_runs_and_manifest(tiny_sweep):
         path = out / entry["file"]
         assert entry["status"] == "done" and entry["bytes"] == path.stat().st_size
         assert entry["seed"] == case.seed
-        assert entry["operating_point"]["torque_nm"] == case.torque_nm
+        assert entry["operating_point"]["torque_nm"] == case.params["torque_nm"]
         t = entry["timing_s"]
         assert t["integration"] > 0 and t["total"] >= t["integration"] + t["spectra"]
         assert entry["features"]["F_1b1_loa"]["dominant_gmf_harmonic"] in range(1, 7)
@@ -113,7 +114,7 @@ def test_sweep_writes_runs_and_manifest(tiny_sweep):
         run = Run.load(path)
         assert run.meta["seed"] == case.seed
         assert run.meta["sweep_case"]["name"] == case.name
-        assert run.meta["operating_point"]["torque_nm"] == case.torque_nm
+        assert run.meta["operating_point"]["torque_nm"] == case.params["torque_nm"]
         assert run.t.size == int(round(0.05 * 75_000))
     assert os.getpid() not in pids                     # simulated in worker processes
     assert not list((out / RUNS_DIR).glob(".*"))       # no temp files, no lock left
@@ -205,11 +206,12 @@ def test_spec_mismatch_is_an_error_unless_forced(tiny_sweep, tmp_path):
 
 def test_directory_in_use_by_a_live_process(tiny_sweep, tmp_path):
     out = _copy(tiny_sweep[0], tmp_path)
-    (out / ".sweep.lock").write_text(str(os.getppid()))
-    with pytest.raises(ParameterError, match="in use by another sweep"):
-        run_sweep(SweepSpec(**TINY), out, workers=1)
-    (out / ".sweep.lock").write_text("999999999")      # stale lock: taken over
+    with DirectoryLock(out):                           # another holder of the OS lock
+        with pytest.raises(ParameterError, match=rf"another sweep \(pid {os.getpid()}\)"):
+            run_sweep(SweepSpec(**TINY), out, workers=1)
+    (out / ".sweep.lock").write_text("999999999")      # a file without an OS lock: taken
     assert run_sweep(SweepSpec(**TINY), out, workers=1).skipped == 2
+    assert not (out / ".sweep.lock").exists()
 
 
 @pytest.mark.parametrize("workers", [0, 1.5, True])
