@@ -9,7 +9,7 @@ writing a loop::
     spec = SweepSpec([Variation("speed_rpm", [1000, 1500]),
                       Variation("torque_nm", [10, 50, 100]),
                       Variation("clearance_m", [15e-6, -1e-6]),
-                      Variation("lubricant.viscosity_pa_s", [0.004, 0.04])],
+                      Variation("lubricant.dynamic_viscosity_pa_s", [0.004, 0.04])],
                      fixed={"radial_load_n": 0.0}, duration_s=0.5, seed=3)
     len(spec.cases())                                     # 2 * 3 * 2 * 2 = 24
 

@@ -12,7 +12,7 @@ named rig transformations (:data:`RIG_TRANSFORMS`)
     bearing; negative = preload), ``friction`` → :meth:`Rig.with_friction
     <cmsim.rig.Rig.with_friction>` (mesh friction coefficient).
 any rig field, by its dotted path
-    ``lubricant.viscosity_pa_s``, ``mesh_contact.damping_ratio``,
+    ``lubricant.dynamic_viscosity_pa_s``, ``mesh_contact.damping_ratio``,
     ``shafts.0.bearing_1.clearance_m`` (a number indexes a tuple), ``output_inertia_kg_m2``.
     The rig is rebuilt with :func:`dataclasses.replace` along the path, so each component
     checks the new value as it would on construction.
@@ -25,6 +25,7 @@ case name then leaves the setting out).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,7 +66,8 @@ class RigTransform:
 RIG_TRANSFORMS = {
     "clearance_m": RigTransform(apply=Rig.with_clearance,
                                 token=lambda v: f"c{v * 1e6:g}um",
-                                check=lambda label, v: check_range(label, v, unit="m")),
+                                check=lambda label, v: check_range(label, v, -1e-3, 1e-3,
+                                                                   unit="m")),
     "friction": RigTransform(apply=Rig.with_friction, token=lambda v: f"f{v:g}",
                              check=lambda label, v: check_range(label, v, 0.0, 1.0),
                              needs_gears=True),
@@ -82,7 +84,7 @@ def allowed_settings(rig=None):
     fields = [f.name for f in dataclasses.fields(Rig)]
     return (f"operating-point fields {list(OPERATING_POINT_FIELDS)}, rig transformations "
             f"{sorted(RIG_TRANSFORMS)}, or a dotted rig field path (e.g. "
-            f"'lubricant.viscosity_pa_s', 'shafts.0.bearing_1.clearance_m'; rig fields "
+            f"'lubricant.dynamic_viscosity_pa_s', 'shafts.0.bearing_1.clearance_m'; rig fields "
             f"{fields})")
 
 
@@ -163,7 +165,7 @@ def apply_rig_setting(rig, name, value):
 
 def value_token(name, value):
     """Part of a case name for ``name = value`` ("" for None), e.g. ``"T10Nm"``, ``"f0.03"``,
-    ``"lubricant-viscosity_pa_s0.004"``."""
+    ``"lubricant-dynamic_viscosity_pa_s0.004"``."""
     if value is None:
         return ""
     if name in _OP_TOKENS:
@@ -182,7 +184,13 @@ def _check_value(label, name, value):
         return RIG_TRANSFORMS[name].check(label, value)
     if isinstance(value, (int, np.integer)) and name not in OPERATING_POINT_FIELDS:
         return int(value)                  # an integer rig field (a number of balls)
-    return check_range(label, value)
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{label} must be a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise ParameterError(f"{label} must be a finite number, got {value!r}")
+    return v
 
 
 @dataclass(frozen=True)
