@@ -161,6 +161,17 @@ def test_bad_operating_point():
 
 
 def test_divergence_is_reported():
-    """A step far beyond the stability limit (2 kHz sampling, 16 kHz modes) blows up."""
+    """A step far beyond the stability limit (2 kHz step forced, 16 kHz modes) blows up."""
     with pytest.raises(IntegrationDiverged, match="diverged"):
-        simulate(RIG, _op(100), 0.2, fs_hz=2000.0, warmup_s=0.0, seed=1)
+        simulate(RIG, _op(100), 0.2, fs_hz=2000.0, substeps=1, warmup_s=0.0, seed=1)
+
+
+def test_low_output_rate_integrates_at_the_model_step():
+    """At a 2 kHz output rate the step is chosen from the highest mode (15.9 kHz: 38 steps
+    per sample, 76 kHz), so the run is stable, and the record is the anti-aliased one."""
+    run = simulate(RIG, _op(100), 0.2, fs_hz=2000.0, warmup_s=0.0, seed=1)
+    assert run.meta["substeps"] == 38
+    assert run.meta["highest_mode_hz"] == pytest.approx(15935.0, rel=2e-3)
+    assert run.meta["integration_fs_hz"] == pytest.approx(76000.0)
+    assert run.meta["anti_alias"]["attenuation_db"] >= 60.0
+    assert run.t.size == 400 and np.all(np.isfinite(run["dte_um"]))

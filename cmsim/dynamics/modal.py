@@ -103,6 +103,27 @@ def _averaged_bearing_stiffness(model, states, times):
     return out / len(states)
 
 
+def highest_frequency_hz(model, q, t=0.0):
+    """Highest natural frequency of ``model`` linearised at state ``q`` (time ``t``), Hz.
+
+    Bearings enter with their tangent stiffness at ``q`` and the mesh with the peak of its
+    total stiffness over a mesh cycle (double contact), so the figure bounds the stiffest
+    mode the integrator meets; it sets the automatic integration step of
+    :func:`cmsim.dynamics.simulate`. One 19×19 eigenvalue problem: cheap.
+    """
+    k_brg = _averaged_bearing_stiffness(model, [np.asarray(q, float)], [t])
+    kmat = model.stiffness.copy()
+    for ib in range(k_brg.shape[0]):
+        ix = int(model.packed.b_int[ib, K.BI_X])
+        kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
+    if model.rig.gears is not None:
+        k_peak = float(np.max(model.mesh_table.mesh_stiffness(model.rig.gears)[1]))
+        g = model.mesh_jacobian()
+        kmat += k_peak * np.outer(g, g)
+    eig = scipy.linalg.eigvalsh(0.5 * (kmat + kmat.T), np.diag(model.mass))
+    return float(math.sqrt(max(eig[-1], 0.0)) / (2.0 * math.pi))
+
+
 def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     """Natural frequencies and mode types of ``rig`` at ``op``.
 
