@@ -196,7 +196,7 @@ def test_foreign_or_corrupt_file_is_recomputed(tiny_sweep, tmp_path):
 def test_spec_mismatch_is_an_error_unless_forced(tiny_sweep, tmp_path):
     out = _copy(tiny_sweep[0], tmp_path)
     other = SweepSpec(**{**TINY, "torques_nm": [10.0, 100.0, 50.0]})
-    with pytest.raises(ParameterError, match=r"different sweep spec.*torques_nm.*force"):
+    with pytest.raises(ParameterError, match=r"different sweep spec.*variations: torque_nm.*force"):
         run_sweep(other, out, workers=1)
     s = run_sweep(other, out, workers=1, force=True)
     # cases 0 and 1 keep their names, seeds and parameters: their files are adopted

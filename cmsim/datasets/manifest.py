@@ -25,7 +25,7 @@ from cmsim.errors import ParameterError
 from cmsim.features import N_GMF_HARMONICS, run_features
 
 __all__ = ["MANIFEST_NAME", "RUNS_DIR", "FEATURE_SIGNALS", "read_manifest", "write_manifest",
-           "new_manifest", "spec_difference", "case_entry", "run_file", "file_matches",
+           "new_manifest", "case_entry", "run_file", "file_matches",
            "manifest_features"]
 
 #: File name of the manifest inside a sweep directory.
@@ -85,11 +85,6 @@ def write_manifest(out_dir, manifest):
     """Stamp ``manifest["updated"]`` and write it atomically to ``out_dir``."""
     manifest["updated"] = _now()
     atomic_write_text(Path(out_dir) / MANIFEST_NAME, json.dumps(manifest, indent=1) + "\n")
-
-
-def spec_difference(old, new):
-    """Top-level keys in which two spec dicts differ."""
-    return [k for k in sorted(set(old) | set(new)) if old.get(k) != new.get(k)]
 
 
 def manifest_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS, top_n=5):

@@ -39,8 +39,8 @@ import numpy as np
 from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (MANIFEST_NAME, RUNS_DIR, case_entry, file_matches,
                                      manifest_features, new_manifest, normalised,
-                                     read_manifest, run_file, spec_difference, write_manifest)
-from cmsim.datasets.spec import SweepSpec, mesh_key
+                                     read_manifest, run_file, write_manifest)
+from cmsim.datasets.spec import SweepSpec, mesh_key, spec_difference
 from cmsim.dynamics.simulate import _compile_seconds, simulate
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.run import Run
@@ -269,7 +269,7 @@ def _open_manifest(spec, out, force):
     spec_dict = normalised(spec.to_dict())
     manifest = read_manifest(out)
     if manifest is not None and manifest.get("spec") != spec_dict:
-        diff = spec_difference(manifest.get("spec", {}), spec_dict)
+        diff = spec_difference(manifest.get("spec", {}), spec)
         if not force:
             raise ParameterError(
                 f"{out / MANIFEST_NAME} was written for a different sweep spec (differs in "
