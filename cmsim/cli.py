@@ -272,12 +272,7 @@ def _cmd_sweep(args):
 
     rig = Rig.load(args.rig) if args.rig else Rig.paper_2016()
     mesh = _mesh_argument(args)
-    extra = {}
-    if mesh != "hybrid-tables":
-        if "mesh" not in SweepSpec.__dataclass_fields__:
-            raise ParameterError("cmsim sweep supports only --mesh hybrid-tables for now")
-        extra["mesh"] = mesh
-    elif rig.gears is not None:
+    if mesh == "hybrid-tables" and rig.gears is not None:
         # build (or load) the rig's tables once, before the workers start
         from cmsim.dynamics.mesh_choice import hybrid_table_set
         hybrid_table_set(rig, progress=False if args.json else None)
@@ -285,7 +280,7 @@ def _cmd_sweep(args):
                      duration_s=args.duration_s, frictions=args.friction or (None,),
                      clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
                      warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
-                     seed_policy=args.seed_policy, **extra)
+                     seed_policy=args.seed_policy, mesh=mesh)
     progress = not args.json and sys.stderr.isatty()
     try:
         summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,

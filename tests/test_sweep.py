@@ -264,3 +264,16 @@ def test_diverged_runs_are_recorded_and_reported(tmp_path, capsys):
     (entry,) = read_manifest(out)["runs"].values()
     assert entry["status"] == "failed" and "fs_hz" in entry["error"]
     assert not list((out / RUNS_DIR).glob("*.npz"))
+
+
+def test_cli_sweep_passes_the_mesh_choice(tmp_path, capsys):
+    out = tmp_path / "pe"
+    argv = ["sweep", "--torque-nm", "10", "--speed-rpm", "1000", "--duration-s", "0.05",
+            "--mesh", "potential-energy", "--out", str(out), "--workers", "1", "--json"]
+    assert main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["completed"] == 1
+    assert read_manifest(out)["spec"]["mesh"] == "potential-energy"
+    (path,) = (out / RUNS_DIR).glob("*.npz")
+    assert Run.load(path).meta["mesh_table"]["method"] == "potential-energy"
+    status = main(argv[:7] + ["--out", str(out), "--json"])     # default mesh: another spec
+    assert status == 2 and "mesh" in json.loads(capsys.readouterr().out)["error"]
