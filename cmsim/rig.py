@@ -374,20 +374,23 @@ class RollingBearing:
 
     @property
     def operating_contact_angle_rad(self):
-        """Contact angle of the mounted bearing, acos(1 − c/(2A)) for c > 0, else 0, rad.
+        """Contact angle of the mounted bearing, acos(1 − P/(2A)), rad.
 
-        The balls take up the operating clearance c (``clearance_m``, which paper 001 uses
-        as the diametral clearance, see papers/NOTES.md) by an axial shift of the rings,
-        which sets the contact angle as the free angle does for the unmounted clearance; for
-        the paper's bearing (c = P_d = 0.015 mm) both are 10.0° and the ball pass is 3.6342
-        cycles per revolution. Under preload (c <= 0) there is no play left to take up: the
-        balls sit at the groove bottoms, α = 0, and the ball pass follows (3.6207 for the
-        paper's bearing).
+        P = min(c, P_d) is the play the balls take up by an axial shift of the rings: the
+        operating clearance c (``clearance_m``, which paper 001 uses as the diametral
+        clearance, see papers/NOTES.md), at most the unmounted diametral clearance P_d of
+        the raceways (mounting only reduces it). For the paper's bearing c = P_d = 0.015 mm:
+        the free angle, 9.94°, and 3.6342 ball passes per revolution. Under preload
+        (c <= 0) no play is left: the balls sit at the groove bottoms, α = 0, and the ball
+        pass follows (3.6207 for the paper's bearing). Catalogue bearings built from the
+        pitch diameter have P_d = 0 and so α = 0, the angle of the published defect
+        frequencies.
         """
         a = self.inner_groove_radius_m + self.outer_groove_radius_m - self.ball_diameter_m
-        if self.clearance_m <= 0 or a <= 0:
+        play = min(self.clearance_m, self.diametral_clearance_m)
+        if play <= 0 or a <= 0:
             return 0.0
-        return math.acos(max(-1.0, 1.0 - self.clearance_m / (2 * a)))
+        return math.acos(max(-1.0, 1.0 - play / (2 * a)))
 
     @property
     def effective_contact_angle_rad(self):

@@ -157,10 +157,15 @@ def test_contact_angle_follows_the_operating_clearance(b209):
     assert ball_pass_cycles_per_rev(preloaded) == pytest.approx(
         b209.n_balls * (0.5 - half_gamma), rel=1e-12)
     assert ball_pass_cycles_per_rev(preloaded) == pytest.approx(3.6207, abs=5e-4)
-    # a larger clearance gives a larger angle: A = r_i + r_o − d, cos α = 1 − c/(2A)
-    loose = replace(b209, clearance_m=0.03e-3)
+    # a mounted clearance below the raceways' P_d gives a smaller angle, cos α = 1 − c/(2A)
+    # with A = r_i + r_o − d; a larger one cannot exceed the free angle
+    tighter = replace(b209, clearance_m=0.0075e-3)
     a = b209.inner_groove_radius_m + b209.outer_groove_radius_m - b209.ball_diameter_m
-    assert math.cos(loose.effective_contact_angle_rad) == pytest.approx(1 - 0.03e-3 / (2 * a))
+    assert math.cos(tighter.effective_contact_angle_rad) == pytest.approx(
+        1 - 0.0075e-3 / (2 * a), rel=1e-12)
+    assert 0 < tighter.effective_contact_angle_rad < b209.free_contact_angle_rad
+    loose = replace(b209, clearance_m=0.03e-3)
+    assert loose.effective_contact_angle_rad == pytest.approx(b209.free_contact_angle_rad)
     # an explicit angle wins
     assert replace(preloaded, contact_angle_rad=0.2).effective_contact_angle_rad == 0.2
     rig = Rig.paper_2016()
