@@ -1,18 +1,75 @@
-"""Exceptions raised by cmsim, and the one helper that checks a parameter's range."""
+"""Exceptions raised by cmsim, and the one helper that checks a parameter's range.
+
+A :class:`ParameterError` carries the name of the parameter it is about (``.param``, the
+Python name, e.g. ``"max_peaks"``) and its allowed range as text (``.allowed``), so a front end
+can say the same thing in its own words: the command line replaces ``.param`` with the option
+the user typed (``--top``), see :mod:`cmsim.cli`.
+"""
 
 from __future__ import annotations
 
 import math
+import numbers
+import re
 
-__all__ = ["ParameterError", "IntegrationDiverged", "check_range"]
+__all__ = ["ParameterError", "IntegrationDiverged", "check_range", "format_range",
+           "format_value"]
+
+_LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
 
 
 class ParameterError(ValueError):
-    """A parameter is outside its allowed range; the message names it and the range."""
+    """A parameter is outside its allowed range; the message names it and the range.
+
+    Parameters
+    ----------
+    message : str
+        One line naming the parameter, its allowed range and the value given.
+    param : str, optional
+        Name of the parameter (Python name); by default the message's first word when the
+        message reads ``"<name> must ..."`` (or ``needs``, ``=``, ``is``, ``has``).
+    allowed : str, optional
+        The allowed range as text, e.g. ``"> 0 kg"`` or ``"[1, 1000]"``.
+    """
+
+    def __init__(self, message, *, param=None, allowed=None):
+        super().__init__(message)
+        if param is None:
+            m = _LEADING_NAME.match(str(message))
+            param = m.group(1) if m else None
+        self.param = param
+        self.allowed = allowed
 
 
 class IntegrationDiverged(RuntimeError):
     """The time integration produced non-finite or runaway values."""
+
+
+def format_value(value):
+    """A value as a user reads it: ``nan``, ``1e+20``, ``'abc'`` (never ``np.float64(nan)``)."""
+    if isinstance(value, bool):
+        return repr(value)
+    if isinstance(value, numbers.Real):
+        return f"{float(value):g}"
+    return repr(value)
+
+
+def format_range(lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False, unit="",
+                 integer=False):
+    """Readable allowed range: ``"in (0, 0.1] m"``, ``"> 0 kg"``, ``"<= 5"``, ``"finite"``.
+
+    An infinite bound is never printed (infinity is always rejected).
+    """
+    kind = "an integer" if integer else "a number"
+    if math.isinf(lo) and math.isinf(hi):
+        text = f"{'an integer' if integer else 'a finite number'}"
+    elif math.isinf(hi):
+        text = f"{kind} {'>' if lo_open else '>='} {lo:g}"
+    elif math.isinf(lo):
+        text = f"{kind} {'<' if hi_open else '<='} {hi:g}"
+    else:
+        text = f"{kind} in {'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+    return text + (f" {unit}" if unit else "")
 
 
 def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False,
@@ -22,9 +79,9 @@ def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_ope
     Parameters
     ----------
     name : str
-        Parameter name as the user typed it (e.g. ``"speed_rpm"``).
+        Parameter name (e.g. ``"speed_rpm"``); recorded as the error's ``param``.
     value : float
-        Value to check; NaN is always rejected.
+        Value to check; NaN, infinities and booleans are always rejected.
     lo, hi : float
         Allowed range.
     lo_open, hi_open : bool
@@ -36,16 +93,23 @@ def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_ope
     --------
     >>> check_range("torque_nm", 10.0, 0.0, lo_open=True)
     10.0
+    >>> try:
+    ...     check_range("mass_kg", float("inf"), 0.0, lo_open=True, unit="kg")
+    ... except ParameterError as exc:
+    ...     print(exc)
+    mass_kg must be a number > 0 kg, got inf
     """
+    allowed = format_range(lo, hi, lo_open=lo_open, hi_open=hi_open, unit=unit)
+    if isinstance(value, bool):
+        raise ParameterError(f"{name} must be {allowed}, got {value!r}", param=name,
+                             allowed=allowed)
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number, got {value!r}") from None
-    left = "(" if lo_open else "["
-    right = ")" if hi_open else "]"
-    rng = f"{left}{lo:g}, {hi:g}{right}" + (f" {unit}" if unit else "")
-    if not math.isfinite(v):
-        raise ParameterError(f"{name} must be finite and in {rng}, got {value!r}")
-    if v < lo or v > hi or (lo_open and v == lo) or (hi_open and v == hi):
-        raise ParameterError(f"{name} must be in {rng}, got {v:g}")
+        raise ParameterError(f"{name} must be {allowed}, got {format_value(value)}",
+                             param=name, allowed=allowed) from None
+    if (not math.isfinite(v) or v < lo or v > hi or (lo_open and v == lo)
+            or (hi_open and v == hi)):
+        raise ParameterError(f"{name} must be {allowed}, got {format_value(v)}", param=name,
+                             allowed=allowed)
     return v
