@@ -9,6 +9,7 @@ linearisation point of the modal analysis.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from scipy.optimize import root
@@ -16,7 +17,10 @@ from scipy.optimize import root
 from cmsim.bearings.hertz import bearing_contact_stiffness
 from cmsim.errors import IntegrationDiverged
 
-__all__ = ["quasi_static_state", "quasi_static_orbit"]
+__all__ = ["quasi_static_state", "quasi_static_orbit", "initial_state"]
+
+#: Relative loads of the continuation that reaches a light load from a firmly loaded state.
+CONTINUATION_FACTORS = (64.0, 16.0, 4.0, 2.0, 1.0)
 
 
 def _scales(model):
@@ -109,3 +113,43 @@ def quasi_static_orbit(model, times_s):
         q = quasi_static_state(model, t, q_guess=q)
         out[i] = q
     return out
+
+
+def _with_load_scaled(model, factor):
+    """The same model with its external loads multiplied by ``factor``."""
+    force = model.force * factor
+    return replace(model, force=force, packed=model.packed._replace(fext=force),
+                   op=replace(model.op, torque_nm=model.op.torque_nm * factor,
+                              radial_load_n=model.op.radial_load_n * factor))
+
+
+def initial_state(model, t=0.0):
+    """Start of a dynamic run: ``(q, method)`` with ``method`` saying how ``q`` was found.
+
+    * ``"nominal geometry"`` — the rig carries no load (no torque, no radial load): the
+      nominal geometry is an equilibrium (every contact just touching or open), and the
+      unloaded gears have no unique one (gear 2 may turn freely within the backlash), so the
+      dynamics starts there and the contact model handles separation;
+    * ``"quasi-static"`` — :func:`quasi_static_state` from the linear guess;
+    * ``"continuation"`` — at light loads the Hertzian contacts barely close (their
+      stiffness vanishes at first touch, so Newton's method may stall): the equilibrium is
+      followed down from :data:`CONTINUATION_FACTORS` times the load, each step accepted
+      within a force residual of 1 % of the reference load (the warm-up of a dynamic run
+      absorbs far larger start errors);
+    * ``"nominal geometry (no equilibrium found)"`` — the last resort; the warm-up then
+      carries the start transient.
+    """
+    op = model.op
+    if op.torque_nm == 0.0 and op.radial_load_n == 0.0:
+        return np.zeros(model.n_dof), "nominal geometry"
+    try:
+        return quasi_static_state(model, t), "quasi-static"
+    except IntegrationDiverged:
+        pass
+    q = None
+    try:
+        for factor in CONTINUATION_FACTORS:
+            q = quasi_static_state(_with_load_scaled(model, factor), t, q_guess=q, tol=1e-5)
+        return q, "continuation"
+    except IntegrationDiverged:
+        return np.zeros(model.n_dof), "nominal geometry (no equilibrium found)"

@@ -13,7 +13,7 @@ from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
 from cmsim.dynamics.model import SlipModel, build_model
-from cmsim.dynamics.quasistatic import quasi_static_state
+from cmsim.dynamics.quasistatic import initial_state
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
@@ -249,7 +249,7 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
     model = build_model(rig, op, mesh, slip=slip, duration_s=warmup_s + duration_s,
                         seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad)
     n = model.n_dof
-    q0 = quasi_static_state(model, 0.0)
+    q0, start_method = initial_state(model, 0.0)
     y0 = np.concatenate([q0, np.zeros(n)])
     dt = 1.0 / fs_hz
     n_rec = int(round(duration_s * fs_hz))
@@ -298,7 +298,7 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         "sim_s": (n_warm + n_rec) / fs_hz, "wall_s": wall, "compile_s": compile_s,
         "realtime_factor": (n_warm + n_rec) / fs_hz / wall if wall > 0 else math.inf,
         "dof_names": list(model.dof_names),
-        "initial_state": q0.tolist(),
+        "initial_state": q0.tolist(), "initial_state_method": start_method,
     }
     return Run(t, signals, meta)
 
