@@ -42,6 +42,22 @@ RIG_FORMAT_VERSION = 1
 
 _DEG = math.pi / 180.0
 
+# Plausibility bounds: far beyond any gearbox or bearing test rig (the paper's rig: 28 teeth,
+# 6.24e8 N/m shafts, 4e5 N m/rad couplings, k_RE ~ 1e10 N/m^1.5, 0.8 kg gears), so a value
+# outside them is a typing or unit error; the integrator would need an absurdly small step.
+MAX_TEETH = 1000
+MAX_MASS_KG = 1.0e5
+MAX_INERTIA_KG_M2 = 1.0e4
+MAX_DAMPING_N_S_PER_M = 1.0e8
+MAX_CONTACT_STIFFNESS = 1.0e14
+MAX_TRANSLATIONAL_STIFFNESS = 1.0e12
+MAX_TORSIONAL_STIFFNESS = 1.0e10
+MAX_TORSIONAL_DAMPING = 1.0e6
+_SHAFT_MAX = {"flexural_stiffness_n_per_m": MAX_TRANSLATIONAL_STIFFNESS,
+              "flexural_damping_n_s_per_m": MAX_DAMPING_N_S_PER_M,
+              "torsional_stiffness_nm_per_rad": MAX_TORSIONAL_STIFFNESS,
+              "torsional_damping_nm_s_per_rad": MAX_TORSIONAL_DAMPING}
+
 
 def _involute(alpha):
     return math.tan(alpha) - alpha
@@ -111,10 +127,10 @@ class SpurGear:
     poisson_ratio: float = 0.3
 
     def __post_init__(self):
-        if not isinstance(self.n_teeth, (int, np.integer)) or isinstance(self.n_teeth, bool):
-            raise ParameterError(f"n_teeth must be an integer >= 6, got {self.n_teeth!r}")
-        if self.n_teeth < 6:
-            raise ParameterError(f"n_teeth must be an integer >= 6, got {self.n_teeth}")
+        if (not isinstance(self.n_teeth, (int, np.integer)) or isinstance(self.n_teeth, bool)
+                or not 6 <= self.n_teeth <= MAX_TEETH):
+            raise ParameterError(f"n_teeth must be an integer in [6, {MAX_TEETH}], got "
+                                 f"{self.n_teeth!r}", allowed=f"an integer in [6, {MAX_TEETH}]")
         check_range("module_m", self.module_m, 0.0, 0.1, lo_open=True, unit="m")
         check_range("face_width_m", self.face_width_m, 0.0, 2.0, lo_open=True, unit="m")
         check_range("pressure_angle_rad", self.pressure_angle_rad, 10 * _DEG, 35 * _DEG,
@@ -124,8 +140,9 @@ class SpurGear:
         check_range("rack_dedendum_coef", self.rack_dedendum_coef, 0.5, 2.0)
         check_range("rack_tip_radius_coef", self.rack_tip_radius_coef, 0.0, 0.5)
         check_range("tip_radius_coef", self.tip_radius_coef, 0.0, 0.3)
-        check_range("mass_kg", self.mass_kg, 0.0, lo_open=True, unit="kg")
-        check_range("inertia_kg_m2", self.inertia_kg_m2, 0.0, lo_open=True, unit="kg m^2")
+        check_range("mass_kg", self.mass_kg, 0.0, MAX_MASS_KG, lo_open=True, unit="kg")
+        check_range("inertia_kg_m2", self.inertia_kg_m2, 0.0, MAX_INERTIA_KG_M2, lo_open=True,
+                    unit="kg m^2")
         check_range("youngs_modulus_pa", self.youngs_modulus_pa, 1e9, 1e13, unit="Pa")
         check_range("poisson_ratio", self.poisson_ratio, 0.0, 0.5, hi_open=True)
         check_range("bore_radius_m", self.bore_radius_m, 0.0, self.root_radius_m, lo_open=True,
@@ -332,13 +349,16 @@ class RollingBearing:
                     unit="m (|c| below 5 % of the ball diameter)")
         if self.contact_angle_rad is not None:
             check_range("contact_angle_rad", self.contact_angle_rad, 0.0, 45 * _DEG, unit="rad")
-        check_range("mass_kg", self.mass_kg, 0.0, lo_open=True, unit="kg")
-        check_range("inertia_kg_m2", self.inertia_kg_m2, 0.0, lo_open=True, unit="kg m^2")
-        check_range("damping_n_s_per_m", self.damping_n_s_per_m, 0.0, unit="N s/m")
+        check_range("mass_kg", self.mass_kg, 0.0, MAX_MASS_KG, lo_open=True, unit="kg")
+        check_range("inertia_kg_m2", self.inertia_kg_m2, 0.0, MAX_INERTIA_KG_M2, lo_open=True,
+                    unit="kg m^2")
+        check_range("damping_n_s_per_m", self.damping_n_s_per_m, 0.0, MAX_DAMPING_N_S_PER_M,
+                    unit="N s/m")
         check_range("load_exponent", self.load_exponent, 1.0, 2.0)
         check_range("outer_ring_speed_ratio", self.outer_ring_speed_ratio, -10.0, 10.0)
         if self.stiffness_n_per_m_p is not None:
-            check_range("stiffness_n_per_m_p", self.stiffness_n_per_m_p, 0.0, lo_open=True)
+            check_range("stiffness_n_per_m_p", self.stiffness_n_per_m_p, 0.0,
+                        MAX_CONTACT_STIFFNESS, lo_open=True, unit="N/m^p")
 
     @classmethod
     def from_pitch(cls, n_balls, ball_diameter_m, pitch_diameter_m, *, groove_conformity=0.52,
@@ -417,8 +437,9 @@ class Rotor:
     inertia_kg_m2: float
 
     def __post_init__(self):
-        check_range("mass_kg", self.mass_kg, 0.0, lo_open=True, unit="kg")
-        check_range("inertia_kg_m2", self.inertia_kg_m2, 0.0, lo_open=True, unit="kg m^2")
+        check_range("mass_kg", self.mass_kg, 0.0, MAX_MASS_KG, lo_open=True, unit="kg")
+        check_range("inertia_kg_m2", self.inertia_kg_m2, 0.0, MAX_INERTIA_KG_M2, lo_open=True,
+                    unit="kg m^2")
 
 
 @dataclass(frozen=True)
@@ -452,12 +473,21 @@ class ShaftLine:
     def __post_init__(self):
         for name in ("flexural_stiffness_n_per_m", "flexural_damping_n_s_per_m",
                      "torsional_stiffness_nm_per_rad", "torsional_damping_nm_s_per_rad"):
-            v = tuple(float(x) for x in getattr(self, name))
+            raw = getattr(self, name)
+            try:
+                if isinstance(raw, (str, bytes)) or any(isinstance(x, bool) for x in raw):
+                    raise TypeError
+                v = tuple(float(x) for x in raw)
+            except (TypeError, ValueError):
+                raise ParameterError(f"{name} needs two numbers (segment b1-centre, "
+                                     f"centre-b2), got {raw!r}", param=name) from None
             if len(v) != 2:
-                raise ParameterError(f"{name} needs two values (segment b1-centre, centre-b2)")
+                raise ParameterError(f"{name} needs two values (segment b1-centre, centre-b2), "
+                                     f"got {len(v)}", param=name)
             lo_open = "stiffness" in name
+            hi = _SHAFT_MAX[name]
             for x in v:
-                check_range(name, x, 0.0, lo_open=lo_open)
+                check_range(name, x, 0.0, hi, lo_open=lo_open)
             object.__setattr__(self, name, v)
 
     @property
@@ -482,8 +512,10 @@ class Coupling:
     damping_nm_s_per_rad: float = 3.5761
 
     def __post_init__(self):
-        check_range("stiffness_nm_per_rad", self.stiffness_nm_per_rad, 0.0, lo_open=True)
-        check_range("damping_nm_s_per_rad", self.damping_nm_s_per_rad, 0.0)
+        check_range("stiffness_nm_per_rad", self.stiffness_nm_per_rad, 0.0,
+                    MAX_TORSIONAL_STIFFNESS, lo_open=True, unit="N m/rad")
+        check_range("damping_nm_s_per_rad", self.damping_nm_s_per_rad, 0.0,
+                    MAX_TORSIONAL_DAMPING, unit="N m s/rad")
 
 
 @dataclass(frozen=True)
@@ -614,7 +646,8 @@ class Rig:
                 raise ParameterError("a gear rig needs exactly 2 shafts (driving, driven)")
             if self.output_coupling is None or self.output_inertia_kg_m2 is None:
                 raise ParameterError("a gear rig needs output_coupling and output_inertia_kg_m2")
-            check_range("output_inertia_kg_m2", self.output_inertia_kg_m2, 0.0, lo_open=True)
+            check_range("output_inertia_kg_m2", self.output_inertia_kg_m2, 0.0,
+                        MAX_INERTIA_KG_M2, lo_open=True, unit="kg m^2")
             for i, s in enumerate(self.shafts):
                 if s.rotor is not None:
                     raise ParameterError(f"shaft {i + 1} of a gear rig carries the gear; "
@@ -759,14 +792,29 @@ class Rig:
     def load(cls, path):
         """Read a rig written by :meth:`save` (or by hand in the same layout)."""
         path = Path(path)
+
+        def refuse(detail):
+            err = ParameterError(f"rig file {path}: {detail}", param="rig")
+            err.detail = detail
+            return err
+
         try:
             with path.open("rb") as fh:
                 data = tomllib.load(fh)
         except FileNotFoundError:
-            raise ParameterError(f"rig file {path} does not exist") from None
+            raise refuse("does not exist") from None
+        except IsADirectoryError:
+            raise refuse("is a directory, not a TOML file") from None
+        except OSError as exc:
+            raise refuse(f"cannot be read ({exc.strerror or exc})") from None
+        except UnicodeDecodeError:
+            raise refuse("is not a text (TOML) file") from None
         except tomllib.TOMLDecodeError as exc:
-            raise ParameterError(f"rig file {path} is not valid TOML: {exc}") from None
-        return cls.from_dict(data)
+            raise refuse(f"is not valid TOML: {exc}") from None
+        try:
+            return cls.from_dict(data)
+        except ParameterError as exc:
+            raise refuse(str(exc)) from None
 
 
 # ---------------------------------------------------------------------- (de)serialisation
@@ -803,18 +851,47 @@ _NESTED = {
 }
 
 
+def _key(where, name):
+    """``rig.shafts[0].bearing_1`` + ``n_balls`` → ``shafts[0].bearing_1.n_balls``."""
+    path = f"{where}.{name}"
+    return path[len("rig."):] if path.startswith("rig.") else path
+
+
+def _check_numbers(cls, target, value, where, key):
+    """Refuse booleans, strings and nested lists where a field holds numbers."""
+    ftype = {f.name: str(f.type) for f in dataclasses.fields(cls)}[target]
+    if not ("float" in ftype or "int" in ftype):
+        return
+    items = value if isinstance(value, list) else [value]
+    for x in items:
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            what = "numbers" if isinstance(value, list) else "a number"
+            raise ParameterError(f"{_key(where, key)} must be {what}, got {value!r}",
+                                 param=_key(where, key), allowed=what)
+
+
 def _from_plain(cls, data, where):
     if not isinstance(data, dict):
         raise ParameterError(f"{where} must be a table, got {type(data).__name__}")
     names = {f.name for f in dataclasses.fields(cls)}
     kwargs = {}
+    given = {}
     for key, value in data.items():
         target = key
         for alias, (si, factor) in _UNIT_ALIASES.items():
             if key.endswith(alias) and key[: -len(alias)] + si in names:
-                target, value = key[: -len(alias)] + si, _scale(value, factor)
+                target = key[: -len(alias)] + si
+                _check_numbers(cls, target, value, where, key)
+                value = _scale(value, factor)
         if target not in names:
             raise ParameterError(f"unknown key {where}.{key}; allowed: {sorted(names)}")
+        if target in given:
+            raise ParameterError(f"{_key(where, given[target])} and {_key(where, key)} are both "
+                                 f"given (the same setting in two units); keep one",
+                                 param=_key(where, key))
+        given[target] = key
+        if value is not None and (cls.__name__, target) not in _NESTED:
+            _check_numbers(cls, target, value, where, key)
         sub = _NESTED.get((cls.__name__, target))
         if sub is not None and value is not None:
             sub_cls = globals()[sub]
@@ -826,9 +903,29 @@ def _from_plain(cls, data, where):
         elif isinstance(value, list):
             value = tuple(value)
         kwargs[target] = value
+    missing = [f.name for f in dataclasses.fields(cls)
+               if f.name not in kwargs and f.default is dataclasses.MISSING
+               and f.default_factory is dataclasses.MISSING]
+    if missing:
+        raise ParameterError(f"missing key {_key(where, missing[0])!r}"
+                             + (f" (and {', '.join(missing[1:])})" if missing[1:] else ""),
+                             param=_key(where, missing[0]))
     try:
         return cls(**kwargs)
-    except TypeError as exc:
+    except ParameterError as exc:
+        if getattr(exc, "located", False):
+            raise
+        # name the component: "shafts[0].bearing_1.n_balls must be ...", not "n_balls ..."
+        msg, param = str(exc), exc.param
+        if param and msg.startswith(param) and where != "rig":
+            param = _key(where, param)
+            msg = param + msg[len(exc.param):]
+        elif where != "rig":
+            msg = f"{where[len('rig.'):] if where.startswith('rig.') else where}: {msg}"
+        err = ParameterError(msg, param=param, allowed=exc.allowed)
+        err.located = True
+        raise err from None
+    except (TypeError, ValueError) as exc:
         raise ParameterError(f"{where}: {exc}") from None
 
 
