@@ -42,16 +42,25 @@ from cmsim.mesh_stiffness._hybrid_kernels import (HP_SIZE, WORK_PER_N, WORK_PER_
                                                   hybrid_forces_jit)
 from cmsim.mesh_stiffness._kernels import pair_contact_jit, table_lookup2_jit
 
-# b_int columns: DOF indices, number of balls
-BI_X, BI_Y, BI_T, BI_NB = 0, 1, 2, 3
-BI_SIZE = 4
+# b_int columns: DOF indices, number of balls, first row and count of the bearing's defects
+# in ``b_def``, 1 when the bearing has defects or off-size balls (its balls then take the
+# exact per-ball loop)
+BI_X, BI_Y, BI_T, BI_NB, BI_DEF0, BI_NDEF, BI_FAULTY = 0, 1, 2, 3, 4, 5, 6
+BI_SIZE = 7
 # b_par columns: stiffness, exponent, clearance, cage angle per physical inner-ring angle,
-# physical sense of the shaft (+1 CCW, −1 CW), viscous damping to ground, initial cage phase
-BP_K, BP_P, BP_C, BP_CAGE, BP_SENSE, BP_DAMP, BP_PHASE = 0, 1, 2, 3, 4, 5, 6
-BP_SIZE = 7
-# m_int entries: DOF index of each gear's x, number of slots, mesh on, elastic-force mode
-MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE = 0, 1, 2, 3, 4
-MI_SIZE = 5
+# physical sense of the shaft (+1 CCW, −1 CW), viscous damping to ground, initial cage phase,
+# ball spin angle per inner-ring angle relative to the cage ((D − d cos α)/d)
+BP_K, BP_P, BP_C, BP_CAGE, BP_SENSE, BP_DAMP, BP_PHASE, BP_SPIN = 0, 1, 2, 3, 4, 5, 6, 7
+BP_SIZE = 8
+# b_def columns (the FaultArrays.bearing_defects layout of cmsim.faults): bearing, kind,
+# centre angle, half-width, depth, entry ramp, exit ramp, ball index
+DF_BRG, DF_KIND, DF_CENTRE, DF_HALF, DF_DEPTH, DF_ENTRY, DF_EXIT, DF_BALL = range(8)
+DF_SIZE = 8
+DEF_OUTER, DEF_INNER, DEF_BALL = 1, 2, 3
+# m_int entries: DOF index of each gear's x, number of slots, mesh on, elastic-force mode,
+# per-tooth tables on, eccentricity on, speed/torque profile on, DOF of the output torque
+MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE, MI_TEETH, MI_ECC, MI_PROFILE, MI_TDOF = range(9)
+MI_SIZE = 9
 MODE_TABLE, MODE_HYBRID = 0, 1
 # columns of the per-slot scratch ``W.slots`` of the mesh kernel
 SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP, SG_KPAIR = range(9)
@@ -62,8 +71,12 @@ SG_SIZE = 9
 # and sin of the nominal line-of-action angle.
 (MP_A0, MP_PSI10, MP_PSI20, MP_PB, MP_SLO, MP_OM1, MP_OM2, MP_MU, MP_V0, MP_BETA, MP_KOSTER,
  MP_DTHR, MP_TAB0, MP_TABD, MP_JDT, MP_DIAGB, MP_ZBEFORE, MP_ZAFTER, MP_PHIT0, MP_COST0,
- MP_SINT0) = range(21)
-MP_SIZE = 21
+ MP_SINT0, MP_PT0, MP_PDT, MP_OMREF) = range(24)
+MP_SIZE = 24
+# columns of the profile table ``prof``: input-shaft angle Θ (rad), speed Ω (rad/s),
+# acceleration (rad/s²), output torque (N·m), on the uniform grid MP_PT0 + i·MP_PDT
+PR_THETA, PR_OMEGA, PR_ALPHA, PR_TORQUE = 0, 1, 2, 3
+PR_SIZE = 4
 # columns of an angle anchor (``W.cage``, ``W.psi``): angle, its cos and sin, valid flag
 AN_ANGLE, AN_COS, AN_SIN, AN_VALID = 0, 1, 2, 3
 AN_SIZE = 4
@@ -93,6 +106,16 @@ class KernelParams(NamedTuple):
     hp, hd1, hc1, hd2, hc2 : hybrid contact parameters and influence tables
         (:meth:`cmsim.mesh_stiffness.hybrid.HybridMeshModel.kernel_args`; placeholders in
         table mode).
+    b_def : (m, DF_SIZE) race and ball defects (``DF_*`` columns; (0, DF_SIZE) if none).
+    b_ang : (nb, max_balls) nominal angle of each ball in its cage, rad.
+    b_off : (nb, max_balls) extra overlap of each ball (off-size balls), m.
+    tk1, tk2 : (Z, m) per-tooth factor on the pair stiffness on the mesh table's grid
+        ((1, 1) when ``MI_TEETH`` is off); te1, te2 : the same for extra separation, m.
+    ecc : (2, 2) eccentricity (amplitude m, phase rad − the gear's reference phase) of each
+        gear's geometric centre.
+    prof : (n_t, PR_SIZE) input speed and output torque profile (``PR_*``; (1, PR_SIZE)
+        when ``MI_PROFILE`` is off). Nominal rotations are ``omega[i]·τ(t)`` with the
+        equivalent time τ = Θ(t)/Ω_ref (τ = t at constant speed).
     """
 
     minv: np.ndarray
@@ -117,6 +140,26 @@ class KernelParams(NamedTuple):
     hc1: np.ndarray
     hd2: np.ndarray
     hc2: np.ndarray
+    b_def: np.ndarray
+    b_ang: np.ndarray
+    b_off: np.ndarray
+    tk1: np.ndarray
+    tk2: np.ndarray
+    te1: np.ndarray
+    te2: np.ndarray
+    ecc: np.ndarray
+    prof: np.ndarray
+
+
+def no_faults(nb, max_balls):
+    """Neutral fault fields ``(b_def, b_off, tk1, tk2, te1, te2, ecc)`` of :class:`KernelParams`."""
+    return (np.zeros((0, DF_SIZE)), np.zeros((nb, max_balls)), np.ones((1, 1)),
+            np.ones((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 2)))
+
+
+def no_profile():
+    """Neutral ``prof`` field of :class:`KernelParams` (constant speed and torque)."""
+    return np.zeros((1, PR_SIZE))
 
 
 class Work(NamedTuple):
@@ -192,11 +235,70 @@ def _slip_offsets(t, b_int, b_cos, b_sin, jitter, jdt, jit_cos, jit_sin, cage_sl
             jit_sin[ib, i] = b_sin[ib, i] * cj + b_cos[ib, i] * sj
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _wrap(a):
+    """``a`` wrapped to [−π, π)."""
+    return a - 2.0 * math.pi * math.floor((a + math.pi) * (0.5 / math.pi))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _defect_profile(u, half, entry, exit_):
+    """Trapezoid depth profile (0..1) at ``u`` (the ball's position across the defect,
+    increasing with time): ramps of widths ``entry`` and ``exit_`` inside [−half, half]."""
+    if u <= -half or u >= half:
+        return 0.0
+    a = (u + half) / entry if entry > 0.0 else 1.0
+    b = (half - u) / exit_ if exit_ > 0.0 else 1.0
+    return min(1.0, a, b)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b_off, b_def,
+                      d0, nd, cage_angle, shaft_angle, spin_angle, dirn_cage, dirn_inner,
+                      dirn_spin):
+    """Eq. 9 ball by ball with defects and off-size balls (cage frame, as
+    :func:`cmsim.bearings._kernels.ball_forces_cage_frame_jit`).
+
+    Ball i's overlap is x_r cos φ_i + y_r sin φ_i − c + Δd_i − Σ depth·profile: an outer-race
+    defect is fixed in the housing (the ball's housing angle is θ_cage + φ_i), an inner-race
+    one turns with the shaft, a ball defect turns with the ball's spin and meets the outer
+    race at spin phase 0 and the inner race at π (Sawalhi & Randall 2008, MSSP 22).
+    """
+    fx = 0.0
+    fy = 0.0
+    for i in range(n_balls):
+        co = ball_cos[ib, i]
+        so = ball_sin[ib, i]
+        d = xr * co + yr * so - c + b_off[ib, i]
+        theta = cage_angle + b_ang[ib, i]
+        for r in range(d0, d0 + nd):
+            kind = int(b_def[r, DF_KIND])
+            if kind == DEF_OUTER:
+                u = dirn_cage * _wrap(theta - b_def[r, DF_CENTRE])
+            elif kind == DEF_INNER:
+                u = dirn_inner * _wrap(theta - shaft_angle - b_def[r, DF_CENTRE])
+            else:
+                if int(b_def[r, DF_BALL]) != i:
+                    continue
+                # both races: the spin phase modulo π
+                v = spin_angle - b_def[r, DF_CENTRE]
+                u = dirn_spin * (v - math.pi * math.floor(v / math.pi + 0.5))
+            d -= b_def[r, DF_DEPTH] * _defect_profile(u, b_def[r, DF_HALF], b_def[r, DF_ENTRY],
+                                                      b_def[r, DF_EXIT])
+        if d > 0.0:
+            f = d ** p
+            fx += f * co
+            fy += f * so
+    return k * fx, k * fy
+
+
 @njit(cache=True, fastmath=True, error_model="numpy", _nrt=False)
 def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor, cage_slip,
-                    diag, want_diag):
+                    diag, want_diag, b_ang, b_off, b_def):
     """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage
-    and cages shifted by the slip angles ``cage_slip`` (zeros without slip).
+    and cages shifted by the slip angles ``cage_slip`` (zeros without slip); ``t`` is the
+    equivalent time τ of the nominal rotation (``KernelParams``). Bearings with defects or
+    off-size balls (``BI_FAULTY``) take :func:`_faulty_ball_loop`.
 
     Written flat on purpose: with helper functions inlined, a jitter branch, or arrays taken
     out of ``P`` inside the loop, numba stops vectorising the ball loop (2-3× slower).
@@ -211,12 +313,26 @@ def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
         iy = b_int[ib, BI_Y]
         it = b_int[ib, BI_T]
         rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
-        angle = rate * (omega[it] * t + y[it]) + b_par[ib, BP_PHASE] + cage_slip[ib]
+        turned = omega[it] * t + y[it]
+        angle = rate * turned + b_par[ib, BP_PHASE] + cage_slip[ib]
         cc, sc = _anchored_cos_sin(anchor, ib, angle)
         xr = y[ix] * cc + y[iy] * sc
         yr = y[iy] * cc - y[ix] * sc
-        fxr, fyr = ball_forces_cage_frame_jit(xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB],
-                                              b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
+        if b_int[ib, BI_FAULTY] == 0:
+            fxr, fyr = ball_forces_cage_frame_jit(xr, yr, ball_cos, ball_sin, ib,
+                                                  b_int[ib, BI_NB], b_par[ib, BP_K],
+                                                  b_par[ib, BP_P], b_par[ib, BP_C])
+        else:
+            sense = b_par[ib, BP_SENSE]
+            shaft = sense * turned
+            forward = 1.0 if omega[it] >= 0.0 else -1.0
+            fxr, fyr = _faulty_ball_loop(
+                xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
+                b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_off, b_def, b_int[ib, BI_DEF0],
+                b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
+                forward * (1.0 if rate >= 0.0 else -1.0),
+                forward * (1.0 if rate - sense >= 0.0 else -1.0),
+                forward * (1.0 if sense - rate >= 0.0 else -1.0))
         fx = fxr * cc - fyr * sc
         fy = fyr * cc + fxr * sc
         g[ix] -= fx
@@ -339,7 +455,10 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
             hchi1[j] = max(chi1, 1e-9)
             hchi2[j] = max(chi2, 1e-9)
         else:
-            k_pair, e_pair = table_lookup2_jit(s_eq, mp[MP_TAB0], mp[MP_TABD], tab_k, tab_e)
+            # tables are functions of the pair's position s on the line of action (a corner
+            # contact's s_eq falls inside the involute path, where the stiffer involute values
+            # sit: read there, B doubled the corner forces, issue 9 model A/B/C)
+            k_pair, e_pair = table_lookup2_jit(s, mp[MP_TAB0], mp[MP_TABD], tab_k, tab_e)
             overlap = delta - e_pair
             S[j, SG_ELASTIC] = k_pair * overlap if overlap > 0.0 else 0.0
             S[j, SG_GAP] = -overlap

@@ -87,7 +87,8 @@ def pair_contact_jit(s, delta_inv, cp1, sp1, cp2, sp2, c1x, c1y, c2x, c2y, cos_t
         Contact point, m.
     s_eq : float
         Equivalent position on the line of action (the roll length of gear 1's contact
-        point), used to read the stiffness table, m.
+        point): the roll length ρ1 of the hybrid contact solve, m. Stiffness tables are read
+        at ``s``, not here: a corner contact's s_eq lies inside the involute path.
     chi1, chi2 : float
         Radii of curvature of the two surfaces at the contact, m.
 

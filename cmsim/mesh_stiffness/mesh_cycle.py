@@ -20,7 +20,10 @@ grid of positions s over the potential-contact zone
 (:func:`~cmsim.mesh_stiffness.contact.table_range_m`). Where a pair carries no load at this
 torque (early approach and late recess corners), the table holds the stiffness of the nearest
 loaded position (constant extrapolation), the same convention as the potential-energy table;
-the dynamics then only uses it if the dynamic interference becomes positive there.
+the dynamics then only uses it if the dynamic interference becomes positive there. The
+abscissa is the pair's position s (``position_m``), also for corner contacts, whose secant
+stiffness is about half the involute one; the dynamics reads the table at s too (not at the
+contact's s_eq, which for a corner contact lies inside the involute path).
 
 References
 ----------

@@ -16,6 +16,28 @@ overestimating the DTE fluctuation and the 4th/5th harmonics (Figs. 5-6).
 Runs share the seed and start with the cages at zero phase, so the three differ only in the
 mesh force model.
 
+Findings (issue 9; 1000 rpm, 100 N·m, 0.4 s, seed 1; harmonics 1-6 of F_1b1_loa in N)::
+
+    A  12.48  61.41  47.52  22.21  135.24  10.70   DTE std 4.559 µm, p2p 16.85 µm
+    B  12.47  62.09  47.39  21.89  136.84  10.33   B/A 1.00 1.01 1.00 0.99 1.01 0.97, std 1.004
+    C  13.86  70.60  50.55  20.99  126.50   7.64   C/A 1.11 1.15 1.06 0.94 0.94 0.71, std 1.129
+
+Before the fix B read 11.8 64.7 80.9 3.7 110.3 13.4 (3rd +70 %, 4th −83 %). Cause: the
+dynamics read the table at the contact's s_eq (gear 1's roll length at the contact point)
+while the table is a function of the pair's position s on the line of action. For involute
+contacts the two are equal; for a corner (rounded-tip) contact before or after the involute
+path, s_eq lies inside the path, so B gave the entering and leaving pairs the involute
+stiffness (0.55-0.59e8 N/m) instead of their own secant (0.29e8 near the path ends): on A's
+own trajectory, B's force law gave 1.37x A's corner forces and total-mesh-force harmonics
+1/3/4 of 77/110/58 N against A's 24/47/6 N. Read at s, B's force law on A's trajectory is
+within 0.3 % of A per pair on the involute path and 2-10 % in the corners, and its
+mesh-force harmonics 1-5 within 4 %. The other candidates are small: load dependence of the
+secant stiffness and pair coupling (involute bins within 0.3 %), contact outside the loaded
+range of the table (0.02 % of A's force), table grid (n_points 1025, n_steps 480: ≤ 2 %),
+nominal centres instead of orbit centroids (≤ 3 %). Model C still overestimates the DTE
+fluctuation (+13 %) and the 2nd harmonic (+15 %), but no longer the 4th/5th (−6 %, the paper:
+above); the 4th-harmonic excess of C before the fix came from the same lookup.
+
 References
 ----------
 .. [1] A. Fernandez-del-Rincon et al., MSSP 2016 (paper 001), §6.1, Figs. 5-6.
