@@ -23,7 +23,8 @@ __all__ = ["main", "build_parser"]
 
 def _load_rig(args):
     from cmsim.rig import Rig
-    rig = Rig.load(args.rig) if args.rig else Rig.paper_2016()
+    rig = _load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig \
+        else Rig.paper_2016()
     if getattr(args, "clearance_m", None) is not None:
         rig = rig.with_clearance(args.clearance_m)
     if getattr(args, "friction", None) is not None:
@@ -33,10 +34,13 @@ def _load_rig(args):
     return rig
 
 
-def _operating_point(args):
+def _operating_point(args, rig=None):
     from cmsim.rig import OperatingPoint
-    return OperatingPoint(speed_rpm=args.speed_rpm, torque_nm=args.torque_nm,
-                          radial_load_n=getattr(args, "radial_load_n", 0.0))
+    op = OperatingPoint(speed_rpm=args.speed_rpm, torque_nm=args.torque_nm,
+                        radial_load_n=getattr(args, "radial_load_n", 0.0))
+    if rig is not None:
+        _plausibility(args, rig, op)
+    return op
 
 
 def _add_rig_options(p, *, friction=True):
@@ -56,7 +60,7 @@ def _cmd_simulate(args):
     from cmsim.frequencies import rig_frequencies
 
     rig = _load_rig(args)
-    op = _operating_point(args)
+    op = _operating_point(args, rig)
     table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
     slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                      correlation_s=args.slip_correlation_s)
@@ -90,23 +94,41 @@ def _add_mesh_options(p):
                         "tables at the wrong torque)")
 
 
-def _mesh_argument(args):
-    """The ``mesh`` value the options name: a string, or the MeshTableSet / table of a file."""
+def _mesh_argument(args, torques_nm=()):
+    """The ``mesh`` value the options name: a string, or the MeshTableSet / table of a file.
+
+    A --mesh-table set of several torques is read between its tables only: a torque outside
+    its range (--table-torque-nm, or --torque-nm without it) is refused, not clamped.
+    """
     if args.table_torque_nm is not None and not args.mesh_table:
-        raise ParameterError("--table-torque-nm selects a table of --mesh-table FILE")
+        raise CLIError("--table-torque-nm selects a table of --mesh-table FILE; give "
+                       "--mesh-table too", option="--table-torque-nm")
     if not args.mesh_table:
         return args.mesh
     if args.mesh != "hybrid-tables":
-        raise ParameterError(f"--mesh {args.mesh} and --mesh-table exclude each other")
+        raise CLIError(f"--mesh {args.mesh} and --mesh-table exclude each other",
+                       option="--mesh")
     from cmsim.mesh_stiffness.table_set import MeshTableSet
-    tables = MeshTableSet.load(args.mesh_table)
+    tables = _load_file("--mesh-table", args.mesh_table, MeshTableSet.load,
+                        "a mesh stiffness table file (cmsim mesh-table --out)")
+    known = [float(t.torque_nm) for t in tables.tables]
+    if len(known) > 1:
+        lo, hi = min(known), max(known)
+        asked = ([("--table-torque-nm", args.table_torque_nm)]
+                 if args.table_torque_nm is not None
+                 else [("--torque-nm", q) for q in torques_nm])
+        for option, q in asked:
+            if not lo - 1e-9 * hi <= q <= hi + 1e-9 * hi:
+                raise CLIError(f"{option} {q:g} is outside the torques of --mesh-table "
+                               f"{args.mesh_table}: allowed [{lo:g}, {hi:g}] N m (tables "
+                               f"at {', '.join(f'{x:g}' for x in known)})", option=option)
     return tables if args.table_torque_nm is None else tables.at(args.table_torque_nm)
 
 
 def _resolve_mesh_options(args, rig, torque_nm):
     """(mesh_table, mesh_model) of the mesh options at ``torque_nm`` (resolve_mesh)."""
     from cmsim.dynamics.mesh_choice import resolve_mesh
-    mesh = _mesh_argument(args)
+    mesh = _mesh_argument(args, [torque_nm])
     if rig.gears is None and args.mesh_table:
         raise ParameterError("--mesh-table needs a rig with gears")
     return resolve_mesh(rig, mesh, torque_nm, progress=False if args.json else None)
@@ -157,7 +179,7 @@ def _add_simulate(sub):
 def _cmd_modes(args):
     from cmsim.dynamics.modal import modal_analysis
     rig = _load_rig(args)
-    op = _operating_point(args)
+    op = _operating_point(args, rig)
     table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
     res = modal_analysis(rig, op, mesh_model if mesh_model is not None else table,
                          n_positions=args.positions)
@@ -204,7 +226,12 @@ def _cmd_spectrum(args):
     from cmsim.run import Run
     from cmsim.spectra.run_spectrum import run_spectrum
 
-    run = Run.load(args.run)
+    def load(path):
+        run = Run.load(path)
+        run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
+        return run
+
+    run = _load_file("RUN.npz", args.run, load, "a cmsim run file (cmsim simulate --out)")
     spec = run_spectrum(run, args.signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
                         resolution_hz=args.resolution_hz, bearing=args.bearing,
                         max_peaks=args.top, threshold_db=args.threshold_db)
@@ -270,13 +297,26 @@ def _cmd_sweep(args):
     from cmsim.datasets import SweepSpec, run_sweep
     from cmsim.rig import Rig
 
-    rig = Rig.load(args.rig) if args.rig else Rig.paper_2016()
-    mesh = _mesh_argument(args)
+    rig = _load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig \
+        else Rig.paper_2016()
+    torques = args.torque_nm if args.torque_nm is not None else (
+        [0.0] if rig.gears is not None else None)
+    if args.torque_nm is not None and rig.gears is None:
+        raise CLIError("--torque-nm needs a rig with gears (this rig has none; use "
+                       "--radial-load-n)", option="--torque-nm")
+    if args.radial_load_n is not None and rig.gears is not None:
+        raise CLIError("--radial-load-n loads the rotor of a bearing rig; a gear rig is "
+                       "loaded by --torque-nm", option="--radial-load-n")
+    from cmsim.rig import OperatingPoint
+    _plausibility(args, rig, OperatingPoint(args.speed_rpm[0], max(torques or [0.0]),
+                                            args.radial_load_n or 0.0))
+    mesh = _mesh_argument(args, torques or ())
     if mesh == "hybrid-tables" and rig.gears is not None:
         # build (or load) the rig's tables once, before the workers start
         from cmsim.dynamics.mesh_choice import hybrid_table_set
         hybrid_table_set(rig, progress=False if args.json else None)
-    spec = SweepSpec(speeds_rpm=args.speed_rpm, torques_nm=args.torque_nm,
+    spec = SweepSpec(speeds_rpm=args.speed_rpm, torques_nm=torques,
+                     radial_load_n=args.radial_load_n,
                      duration_s=args.duration_s, frictions=args.friction or (None,),
                      clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
                      warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
@@ -313,8 +353,11 @@ def _add_sweep(sub):
                                    "worker processes; each run is saved to DIR/runs/ and "
                                    "recorded in DIR/manifest.json as it finishes. Re-running "
                                    "the same command resumes: finished runs are skipped.")
-    p.add_argument("--torque-nm", type=float, nargs="+", required=True,
-                   help="output torques, N m")
+    p.add_argument("--torque-nm", type=float, nargs="+",
+                   help="output torques, N m (gear rigs; default 0: unloaded, the teeth may "
+                        "separate)")
+    p.add_argument("--radial-load-n", type=float, metavar="N",
+                   help="static radial load on the rotor of a bearing rig, N (default 0)")
     p.add_argument("--speed-rpm", type=float, nargs="+", required=True,
                    help="input shaft speeds, rpm")
     p.add_argument("--duration-s", type=float, default=1.0, help="recorded duration, s")
@@ -380,7 +423,7 @@ def _add_report(sub):
 # ---------------------------------------------------------------------- main
 def build_parser():
     """The argparse parser of ``cmsim``."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="cmsim", description="Vibration of a spur-gear transmission on ball bearings "
                                   "(19-DOF model of Fernandez-del-Rincon et al. 2016).")
     from cmsim import __version__
@@ -388,6 +431,7 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True)
     for add in _COMMANDS:
         add(sub)
+    _apply_ranges(parser)
     return parser
 
 
@@ -485,17 +529,302 @@ def _plain_negative_numbers(argv):
             if _NEGATIVE_EXPONENT_NUMBER.match(a) else a for a in argv]
 
 
-def main(argv=None):
-    """Entry point of the ``cmsim`` console script; returns the exit status."""
-    parser = build_parser()
-    argv = sys.argv[1:] if argv is None else list(argv)
-    args = parser.parse_args(_plain_negative_numbers(argv))
+# ---------------------------------------------------------------------- validation
+# The one way the CLI validates, names and reports:
+# 1. every numeric option has its allowed range here (keyed by argparse dest, or by
+#    (command, dest) where a command differs); argparse checks it while parsing, so the
+#    message names the option as typed ("argument --top: must be an integer in [1, 1000]");
+# 2. every ParameterError raised by the library carries the Python name of its parameter
+#    (``.param``); _user_message rewrites it, and any other Python name of an option of the
+#    command, into the option (``max_peaks`` → ``--top``) through _PARAM_TO_DEST;
+# 3. files named by options are checked (_check_paths) or loaded through _load_file, which
+#    turns any reading error into one line naming the option;
+# 4. anything else is an internal error: exit 1, one line, "please report".
+# tests/test_cli_contract.py checks that every numeric option of every command is in
+# _RANGES or listed in _LIBRARY_VALIDATED, and runs a catalogue of bad inputs.
+_INF = math.inf
+#: dest (or (command, dest)) -> (type, lo, hi, lo_open, hi_open, unit)
+_RANGES = {
+    "speed_rpm": (float, 0.0, 1.0e5, True, False, "rpm"),
+    "torque_nm": (float, 0.0, 1.0e6, False, False, "N m"),
+    ("mesh-table", "torque_nm"): (float, 0.0, 1.0e6, True, False, "N m"),
+    "table_torque_nm": (float, 0.0, 1.0e6, False, False, "N m"),
+    "radial_load_n": (float, 0.0, 1.0e7, False, False, "N"),
+    "duration_s": (float, 0.0, 600.0, True, False, "s"),
+    "fs_hz": (float, 1.0e3, 1.0e7, False, False, "Hz"),
+    "substeps": (int, 1, 1000, False, False, ""),
+    "warmup_s": (float, 0.0, 60.0, False, False, "s"),
+    "clearance_m": (float, -1.0e-3, 1.0e-3, False, False, "m"),
+    "friction": (float, 0.0, 0.3, False, False, ""),
+    "cage_slip": (float, 0.0, 0.2, False, False, ""),
+    "ball_jitter_rad": (float, 0.0, 0.05, False, False, "rad"),
+    "slip_correlation_s": (float, 1.0e-5, 10.0, False, False, "s"),
+    "seed": (int, 0, 2 ** 32 - 1, False, False, ""),
+    "positions": (int, 4, 1000, False, False, ""),
+    "steps": (int, 8, 100_000, False, False, ""),
+    "top": (int, 1, 1000, False, False, ""),
+    ("report", "top"): (int, 1, 100, False, False, ""),
+    "threshold_db": (float, 0.0, 200.0, False, False, "dB"),
+    "max_hz": (float, 0.0, 1.0e7, True, False, "Hz"),
+    "resolution_hz": (float, 0.0, 1.0e6, True, False, "Hz"),
+    "band_hz": (float, 0.0, 1.0e7, False, False, "Hz"),
+    "workers": (int, 1, 1024, False, False, ""),
+}
+#: numeric options whose range depends on other inputs and is checked by the library, which
+#: names them through _PARAM_TO_DEST (none today; clearance is narrowed by the bearing)
+_LIBRARY_VALIDATED = set()
+#: Python names used by the library -> dest of the option that sets them
+_PARAM_TO_DEST = {
+    "max_peaks": "top", "top_n": "top", "n_positions": "positions",
+    "cage_speed_rms": "cage_slip", "ball_rms_rad": "ball_jitter_rad",
+    "correlation_s": "slip_correlation_s", "n_steps": "steps", "torques_nm": "torque_nm",
+    "speeds_rpm": "speed_rpm", "friction_coefficient": "friction", "frictions": "friction",
+    "clearances_m": "clearance_m", "max_freq_hz": "max_hz", "signals": "signal",
+    "mesh": "mesh", "method": "method", "centres": "centres",
+}
+#: path options: dest -> "file" (must exist), "dir" (must exist), "out" (new file), "outdir"
+_PATHS = {"rig": "file", "mesh_table": "file", "run": "file", "dir": "dir", "out": "out",
+          "plot": "out", ("sweep", "out"): "outdir"}
+
+
+class CLIError(Exception):
+    """An error the CLI reports in one line, with its exit status and JSON extras."""
+
+    def __init__(self, message, status=2, *, option=None, extra=None):
+        super().__init__(message)
+        self.status, self.option, self.extra = status, option, dict(extra or {})
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that raises instead of printing usage and exiting (one line, --json aware)."""
+
+    def error(self, message):
+        raise CLIError(f"{message} (see {self.prog} --help)", 2, option=_option_in(message))
+
+
+def _option_in(message):
+    m = re.search(r"argument ([^\s:]+)", message)
+    return m.group(1).split("/")[-1] if m else None
+
+
+def _ranged(kind, lo, hi, lo_open, hi_open, unit):
+    """argparse type: a number of ``kind`` within the range, else a message with the range."""
+    from cmsim.errors import format_range
+
+    allowed = format_range(lo, hi, lo_open=lo_open, hi_open=hi_open, unit=unit,
+                           integer=kind is int)
+
+    def parse(text):
+        try:
+            v = int(text) if kind is int else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {allowed}, got {text!r}") from None
+        if (not math.isfinite(v) or v < lo or v > hi or (lo_open and v == lo)
+                or (hi_open and v == hi)):
+            raise argparse.ArgumentTypeError(f"must be {allowed}, got {text}")
+        return v
+
+    parse.__name__ = kind.__name__
+    parse.allowed = allowed
+    return parse
+
+
+def _subparsers(parser):
+    """{command: subparser} of the ``cmsim`` parser."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
+def _option_name(action):
+    """The option as a user types it (``--top``), or the metavar of a positional."""
+    if action.option_strings:
+        return max(action.option_strings, key=len)
+    return action.metavar or action.dest.upper()
+
+
+def _apply_ranges(parser):
+    """Give every numeric option of every command its range (see _RANGES)."""
+    for command, sub in _subparsers(parser).items():
+        for action in sub._actions:
+            if action.type in (int, float):
+                rng = _RANGES.get((command, action.dest), _RANGES.get(action.dest))
+                if rng is not None:
+                    action.type = _ranged(*rng)
+
+
+def _options_of(parser, command):
+    """{dest: option} of one command."""
+    sub = _subparsers(parser).get(command)
+    if sub is None:
+        return {}
+    return {a.dest: _option_name(a) for a in sub._actions if a.dest != "help"}
+
+
+def _user_message(exc, options):
+    """The message of a ParameterError with Python names replaced by the options typed."""
+    msg = " ".join(str(exc).split())
+    param = getattr(exc, "param", None)
+    names = {}
+    for name, dest in list(_PARAM_TO_DEST.items()) + [(d, d) for d in options]:
+        if dest in options:
+            names[name] = options[dest]
+    option = None
+    if param and param.startswith("-"):
+        option = param
+    elif param in names:
+        option = names[param]
+    for name, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
+        if name == param or "_" in name:
+            msg = re.sub(rf"(?<![\w.\[\-]){re.escape(name)}(?![\w\[])", opt, msg)
+    return msg, option
+
+
+def _check_paths(args, command, options):
+    """Input files exist and are files; outputs are not directories and have a parent."""
+    for dest, option in options.items():
+        kind = _PATHS.get((command, dest), _PATHS.get(dest))
+        value = getattr(args, dest, None)
+        if kind is None or value is None:
+            continue
+        path = Path(value)
+        if kind == "file" and not path.is_file():
+            why = "is a directory" if path.is_dir() else "does not exist"
+            raise CLIError(f"{option} {path}: {why} (expected a file)", option=option)
+        if kind == "dir" and not path.is_dir():
+            why = "is a file" if path.exists() else "does not exist"
+            raise CLIError(f"{option} {path}: {why} (expected a directory)", option=option)
+        if kind in ("out", "outdir"):
+            if kind == "out" and path.is_dir():
+                raise CLIError(f"{option} {path}: is a directory (expected a file name)",
+                               option=option)
+            if kind == "outdir" and path.exists() and not path.is_dir():
+                raise CLIError(f"{option} {path}: is a file (expected a directory, new or "
+                               f"an existing sweep)", option=option)
+            if not path.resolve().parent.is_dir():
+                raise CLIError(f"{option} {path}: directory {path.parent} does not exist",
+                               option=option)
+
+
+def _load_file(option, path, loader, what):
+    """``loader(path)``, any failure to read it reported as one line naming ``option``."""
+    import zipfile
+
     try:
-        res = args.func(args)
-    except (ParameterError, FileNotFoundError) as exc:
-        return _fail(args, str(exc), 2)
-    except IntegrationDiverged as exc:
-        return _fail(args, str(exc), 3)
+        return loader(path)
+    except ParameterError as exc:
+        detail = getattr(exc, "detail", None) or str(exc)
+        raise CLIError(f"{option} {path}: {detail}", option=option) from None
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+        raise CLIError(f"{option} {path}: not {what} ({type(exc).__name__}: "
+                       f"{' '.join(str(exc).split()) or 'unreadable'})", option=option) from None
+
+
+def _warn(args, text):
+    """A plausibility warning: stderr (unless --json) and the result's "warnings" list."""
+    args._warnings.append(text)
+    if not args.json:
+        print(f"cmsim: warning: {text}", file=sys.stderr)
+
+
+#: ISO 6336-5 allowable contact stress of through-hardened steel is ~1500 MPa (case-hardened
+#: up to ~1650); a nominal stress above twice that is far beyond what steel gears carry
+PLAUSIBLE_CONTACT_STRESS_PA = 2 * 1500e6
+#: ISO 76 static load rating factor of deep-groove ball bearings, f0 ~ 12.3 N/mm²
+_F0_N_PER_M2 = 12.3e6
+
+
+def _plausibility(args, rig, op):
+    """Warn about loads far beyond what the rig's steel gears or bearings carry."""
+    if rig.gears is not None and op.torque_nm > 0:
+        sigma = rig.gears.nominal_contact_stress_pa(op.torque_nm)
+        if sigma > PLAUSIBLE_CONTACT_STRESS_PA:
+            _warn(args, f"--torque-nm {op.torque_nm:g} gives a nominal contact stress of "
+                        f"{sigma / 1e6:.0f} MPa on a {1e3 * rig.gears.driving.face_width_m:g} "
+                        f"mm face (ISO 6336); steel gears carry about 1500 MPa (results far "
+                        f"above {PLAUSIBLE_CONTACT_STRESS_PA / 1e6:.0f} MPa are not physical)")
+    if rig.gears is None:
+        b = rig.bearings[0]
+        c0 = _F0_N_PER_M2 * b.n_balls * b.ball_diameter_m ** 2
+        if op.radial_load_n == 0:
+            _warn(args, "a bearing rig without --radial-load-n: the bearings carry no load and "
+                        "every bearing force is zero")
+        elif op.radial_load_n > 2 * c0:
+            _warn(args, f"--radial-load-n {op.radial_load_n:g} N is more than twice the static "
+                        f"load rating C0 ~ {c0:.0f} N of bearing 1b1 (ISO 76)")
+
+
+def _numba_cache_cold():
+    """True when the integration kernel has no up-to-date numba cache (first run compiles)."""
+    import os
+
+    try:
+        import cmsim.dynamics as dyn
+        src = Path(dyn.__file__).parent / "_kernels.py"
+        places = [src.parent / "__pycache__"]
+        if os.environ.get("NUMBA_CACHE_DIR"):
+            places.append(Path(os.environ["NUMBA_CACHE_DIR"]))
+        mtime = src.stat().st_mtime
+        for place in places:
+            for idx in place.rglob("_kernels.integrate_jit*.nbi") if place.is_dir() else ():
+                if idx.stat().st_mtime >= mtime:
+                    return False
+        return True
+    except OSError:
+        return False
+
+
+def _announce_compile(args):
+    if not args.json and args.command in _COMPILING and _numba_cache_cold():
+        print("cmsim: compiling numba kernels (first run only, about 30 s)...", file=sys.stderr)
+
+
+_COMPILING = ("simulate", "modes", "mesh-table", "sweep")
+
+
+def main(argv=None):
+    """Entry point of the ``cmsim`` console script; returns the exit status.
+
+    0 success, 1 internal error (please report), 2 bad input, 3 diverged integration, 130
+    interrupted. With ``--json`` stdout holds exactly one JSON object, also on errors:
+    ``{"error": message, "status": code, "option": "--top" or null}``.
+    """
+    import os
+
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    want_json = "--json" in argv
+    parser = build_parser()
+    args = argparse.Namespace(json=want_json, command=argv[0] if argv else None)
+    try:
+        args = parser.parse_args(_plain_negative_numbers(argv))
+        args._warnings = []
+        options = _options_of(parser, args.command)
+        try:
+            _check_paths(args, args.command, options)
+            _announce_compile(args)
+            res = args.func(args)
+        except ParameterError as exc:
+            msg, option = _user_message(exc, options)
+            raise CLIError(msg, 2, option=option) from None
+        except IntegrationDiverged as exc:
+            msg, option = _user_message(exc, options)
+            extra = {}
+            if getattr(exc, "summary", None) is not None:
+                extra["summary"] = exc.summary.to_dict()
+            raise CLIError(msg, 3, option=option, extra=extra) from None
+    except CLIError as exc:
+        return _fail(args, str(exc), exc.status, exc.option, exc.extra)
+    except KeyboardInterrupt:
+        return _fail(args, "interrupted", 130)
+    except Exception as exc:  # noqa: BLE001 - the last line of defence
+        if os.environ.get("CMSIM_DEBUG"):
+            raise
+        detail = " ".join(str(exc).split())[:300]
+        return _fail(args, f"internal error ({type(exc).__name__}: {detail}); please report "
+                           f"it with the command line (CMSIM_DEBUG=1 shows the traceback)", 1)
+    if isinstance(res, dict) and args._warnings:
+        res = {**res, "warnings": list(args._warnings)}
     if args.json:
         print(json.dumps(_jsonable(res)))
     else:
@@ -503,10 +832,17 @@ def main(argv=None):
     return 0
 
 
-def _fail(args, message, status):
-    print(f"cmsim: error: {message}", file=sys.stderr)
+def _fail(args, message, status, option=None, extra=None):
+    message = " ".join(str(message).split())
+    prog = f"cmsim {args.command}" if getattr(args, "command", None) in _subparsers(
+        build_parser()) else "cmsim"
+    print(f"{prog}: error: {message}", file=sys.stderr)
     if getattr(args, "json", False):
-        print(json.dumps({"error": message}))
+        out = {"error": message, "status": status, "option": option, **(extra or {})}
+        warnings = getattr(args, "_warnings", None)
+        if warnings:
+            out["warnings"] = list(warnings)
+        print(json.dumps(_jsonable(out)))
     return status
 
 

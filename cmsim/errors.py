@@ -61,14 +61,19 @@ def format_range(lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False, uni
     An infinite bound is never printed (infinity is always rejected).
     """
     kind = "an integer" if integer else "a number"
+
+    def num(x):
+        return str(int(x)) if integer else f"{x:g}"
+
     if math.isinf(lo) and math.isinf(hi):
         text = f"{'an integer' if integer else 'a finite number'}"
     elif math.isinf(hi):
-        text = f"{kind} {'>' if lo_open else '>='} {lo:g}"
+        text = f"{kind} {'>' if lo_open else '>='} {num(lo)}"
     elif math.isinf(lo):
-        text = f"{kind} {'<' if hi_open else '<='} {hi:g}"
+        text = f"{kind} {'<' if hi_open else '<='} {num(hi)}"
     else:
-        text = f"{kind} in {'(' if lo_open else '['}{lo:g}, {hi:g}{')' if hi_open else ']'}"
+        text = (f"{kind} in {'(' if lo_open else '['}{num(lo)}, {num(hi)}"
+                f"{')' if hi_open else ']'}")
     return text + (f" {unit}" if unit else "")
 
 

@@ -122,10 +122,28 @@ def sweep_run_files(sweep_dir):
 
 
 # ---------------------------------------------------------------------- per-run digest
+def _read_run(path):
+    """``Run.load(path)`` with its rig and operating point parsed; an unreadable or corrupted
+    file is a :class:`ParameterError` naming it (re-running the sweep recomputes it)."""
+    import zipfile
+
+    try:
+        run = Run.load(path)
+        run.rig, run.operating_point  # noqa: B018 - parse the meta here
+        return run
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+        if isinstance(exc, ParameterError) and "does not exist" not in str(exc):
+            detail = str(exc)
+        else:
+            detail = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+        raise ParameterError(f"run file {path} is unreadable or corrupted ({detail}); run "
+                             f"the sweep command again to recompute it") from None
+
+
 def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
     """Everything the report needs from one run (the run itself is then dropped)."""
     t0 = time.perf_counter()
-    run = Run.load(path)
+    run = _read_run(path)
     t1 = time.perf_counter()
     missing = [s for s in signals if s not in run.signals]
     if missing:
@@ -347,6 +365,10 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
     n_mesh_cycles = positive_int("n_mesh_cycles", n_mesh_cycles, lo=1, hi=100)
     dyn = check_range("dynamic_range_db", dynamic_range_db, 0.0, 200.0, lo_open=True, unit="dB")
 
+    if signals == DEFAULT_SIGNALS:
+        # the defaults name what the rig has: a bearing rig has no DTE
+        present = _read_run(files[0]).signals
+        signals = tuple(s for s in DEFAULT_SIGNALS if s in present) or signals
     digests = []
     for path in tqdm(files, disable=not progress, desc="report", unit="run"):
         digests.append(_digest(path, signals, top_n, max_freq_hz, n_mesh_cycles))
@@ -357,9 +379,12 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
     groups = _groups(digests, axis)
     figures, sections = [], []
 
+    plotting = tqdm(disable=not progress, desc="figures", unit="fig")
+
     def emit(fig, name):
         _save(fig, out_dir / name)
         figures.append(name)
+        plotting.update(1)
         return name
 
     t_plot0 = time.perf_counter()
@@ -367,6 +392,7 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
         sfx = f"_g{gi + 1}" if len(groups) > 1 else ""
         sections.append(_group_section(gi, fixed, members, axis, in_orders, signals,
                                        dom_signal, f_show, dyn, n_mesh_cycles, sfx, emit))
+    plotting.close()
     t_plot1 = time.perf_counter()
 
     runs = []

@@ -271,6 +271,29 @@ class GearPair:
                 - a * math.sin(self.working_pressure_angle_rad))
         return path / g1.base_pitch_m
 
+    def nominal_contact_stress_pa(self, torque_nm):
+        """Nominal contact stress at the pitch point for an output torque, Pa (ISO 6336-2).
+
+        σ_H0 = Z_H·Z_E·sqrt(F_t/(d_1·b)·(u + 1)/u), F_t = torque_nm / r_2 (the driven gear's
+        reference radius), d_1 the driving gear's reference diameter, b the narrower face,
+        u = Z2/Z1, Z_H = sqrt(2/(cos α_w·sin α_w)) (spur gears),
+        Z_E = sqrt(1/(π((1 − ν1²)/E1 + (1 − ν2²)/E2))).
+
+        Parameters
+        ----------
+        torque_nm : float
+            Torque on the driven gear, N·m.
+        """
+        g1, g2 = self.driving, self.driven
+        ft = float(torque_nm) / g2.pitch_radius_m
+        b = min(g1.face_width_m, g2.face_width_m)
+        u = self.ratio
+        aw = self.working_pressure_angle_rad
+        z_h = math.sqrt(2.0 / (math.cos(aw) * math.sin(aw)))
+        z_e = math.sqrt(1.0 / (math.pi * ((1 - g1.poisson_ratio ** 2) / g1.youngs_modulus_pa
+                                          + (1 - g2.poisson_ratio ** 2) / g2.youngs_modulus_pa)))
+        return z_h * z_e * math.sqrt(max(ft, 0.0) / (2 * g1.pitch_radius_m * b) * (u + 1) / u)
+
     @property
     def mesh_stiffness_mass_kg(self):
         """Equivalent mass along the line of action J1·J2/(J1·rb2² + J2·rb1²), kg."""
