@@ -1,0 +1,363 @@
+"""Sensors at the end of the chain: housing accelerometers and a once-per-revolution tacho.
+
+The model emits the forces the bearings transmit to the housing (``F_<bearing>_<x|y>``, N); a
+condition-monitoring engineer measures housing accelerations. :func:`add_sensors` turns a
+:class:`~cmsim.run.Run` into what an acquisition system records:
+
+1. **housing transfer path** — each bearing force through the rig's
+   :class:`~cmsim.rig.HousingPath` (a sum of damped housing modes, accelerance in (m/s²)/N),
+   ``accel_<bearing>_x`` from ``F_<bearing>_x`` and ``accel_<bearing>_y`` from
+   ``F_<bearing>_y`` (:func:`housing_acceleration`);
+2. **anti-alias decimation** to the sensor sample rate ``fs_hz`` (:func:`decimate`): an
+   integer ratio goes through :class:`cmsim.dynamics.decimation.AntiAliasFilter` (linear-phase
+   FIR, ≥ 80 dB from the sensor Nyquist frequency on), a rational one (75 kHz → 12 kHz =
+   4/25) through :func:`scipy.signal.resample_poly` with a Kaiser-window FIR designed to the
+   same specification (pass band flat to 0.8 × Nyquist, ≥ 80 dB from Nyquist on); every
+   signal of the run goes through the same filter, so the record keeps one time axis;
+3. **sensor noise** — white Gaussian, ``noise_rms`` m/s² at the sensor rate, drawn from
+   ``numpy.random.default_rng(seed)`` (the seed is recorded in ``meta["sensor"]``);
+4. **tacho** — a once-per-revolution pulse train from the input shaft's total rotation
+   ``theta_1b1`` (:func:`tacho_signal`): :data:`TACHO_LEVEL_V` (5 V, TTL) while the shaft is
+   within :data:`TACHO_PULSE_WIDTH_RAD` (18°, a strip of reflective tape) past each multiple
+   of 2π, 0 V otherwise. Being a function of the angle, not of time, it is right at any speed
+   profile: a run-up gives pulses closer and closer together, one per revolution.
+
+The housing modes are discretised at the run's own sample rate with the bilinear transform
+prewarped at each mode's natural frequency: the resonance frequency and the peak accelerance
+1/(2ζm) are exact; elsewhere the frequency axis of mode k is scaled by at most
+ω_k·T / sin(ω_k·T) near its resonance (1.01 at 3 kHz / 75 kHz). The filter is causal, as a
+structure is, and starts at rest under the first force sample (the static force gives no
+acceleration: H(0) = 0).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from fractions import Fraction
+
+import numpy as np
+from scipy.signal import firwin, kaiserord, resample_poly, sosfilt, sosfilt_zi
+
+from cmsim.dynamics.decimation import AntiAliasFilter
+from cmsim.errors import ParameterError, check_range
+from cmsim.rig import HousingPath
+from cmsim.run import Run
+
+__all__ = ["housing_sos", "housing_acceleration", "decimate", "tacho_signal", "add_sensors",
+           "TACHO_LEVEL_V", "TACHO_PULSE_WIDTH_RAD", "ANTI_ALIAS_DB", "ANTI_ALIAS_PASSBAND"]
+
+#: High level of the tacho pulse, V (TTL output of an optical or magnetic key-phasor).
+TACHO_LEVEL_V = 5.0
+#: Angular width of the tacho pulse after each multiple of 2π, rad (18°: one tape strip).
+TACHO_PULSE_WIDTH_RAD = 2.0 * math.pi / 20.0
+#: Stop-band attenuation of the sensor's anti-alias filter from its Nyquist frequency on, dB.
+ANTI_ALIAS_DB = 80.0
+#: Pass-band edge of the anti-alias filter as a fraction of the sensor Nyquist frequency
+#: (fs = 2.56·f_max, the usual acquisition-system rule).
+ANTI_ALIAS_PASSBAND = 0.8
+#: Largest denominator of the ratio sensor rate / run rate (up/down of the polyphase filter).
+MAX_RATIO_DENOMINATOR = 1000
+
+_FORCE = re.compile(r"F_(?P<b>\d+b\d+)_(?P<d>x|y)")
+
+
+def housing_sos(path, fs_hz):
+    """Second-order sections of the housing modes, one section per mode (added in parallel).
+
+    Mode k, H_k(s) = s² / (m_k (s² + 2ζ_k ω_k s + ω_k²)), is mapped by the bilinear transform
+    s = c·(1 − z⁻¹)/(1 + z⁻¹) with c = ω_k / tan(ω_k T / 2), so that H_k(e^{jω_k T}) equals
+    H_k(jω_k) exactly.
+
+    Parameters
+    ----------
+    path : HousingPath
+        Housing modes.
+    fs_hz : float
+        Sample rate of the force, Hz; every mode must lie below fs_hz/2.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_modes, 6)
+        ``[b0, b1, b2, 1, a1, a2]`` per mode (scipy's ``sos`` layout), b in (m/s²)/N.
+
+    Raises
+    ------
+    ParameterError
+        If a mode is at or above the Nyquist frequency of ``fs_hz``.
+    """
+    fs = check_range("fs_hz", fs_hz, 0.0, lo_open=True, unit="Hz")
+    sos = np.empty((path.n_modes, 6))
+    for k, (f, z, m) in enumerate(zip(path.natural_frequencies_hz, path.damping_ratios,
+                                      path.modal_masses_kg)):
+        if f >= 0.5 * fs:
+            raise ParameterError(
+                f"housing mode natural_frequencies_hz[{k}] = {f:g} Hz is not below the "
+                f"Nyquist frequency {0.5 * fs:g} Hz of the force (fs_hz = {fs:g}); simulate "
+                f"at fs_hz > {2 * f:g} Hz or drop the mode",
+                param=f"natural_frequencies_hz[{k}]", allowed=f"< {0.5 * fs:g} Hz")
+        w = 2.0 * math.pi * f
+        c = w / math.tan(0.5 * w / fs)
+        a0 = c * c + 2.0 * z * w * c + w * w
+        sos[k] = (c * c / m / a0, -2.0 * c * c / m / a0, c * c / m / a0,
+                  1.0, (2.0 * w * w - 2.0 * c * c) / a0, (c * c - 2.0 * z * w * c + w * w) / a0)
+    return sos
+
+
+def housing_acceleration(force_n, fs_hz, path):
+    """Housing acceleration produced by a bearing force through the housing modes.
+
+    Parameters
+    ----------
+    force_n : array_like, shape (n,)
+        Force transmitted by the bearing to the housing along one direction, N, sampled at
+        ``fs_hz``.
+    fs_hz : float
+        Sample rate, Hz.
+    path : HousingPath
+        Housing modes (:attr:`cmsim.rig.Rig.housing`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        Acceleration along the same direction, m/s², same instants. The filter starts at rest
+        under ``force_n[0]`` (a constant force gives zero acceleration).
+
+    Examples
+    --------
+    >>> fs, f = 75_000.0, 2500.0
+    >>> t = np.arange(30_000) / fs
+    >>> a = housing_acceleration(np.sin(2 * np.pi * f * t), fs, HousingPath((f,), (0.03,), (2.0,)))
+    >>> round(float(np.abs(a[-1500:]).max()), 2)    # 1 / (2 ζ m) = 8.33 (m/s²)/N
+    8.33
+    """
+    x = np.asarray(force_n, dtype=float)
+    if x.ndim != 1 or x.size < 1:
+        raise ParameterError(f"force_n must be a 1-D array with samples, got shape {x.shape}",
+                             param="force_n")
+    if not np.all(np.isfinite(x)):
+        raise ParameterError("force_n must be finite (no NaN or inf)", param="force_n")
+    sos = housing_sos(path, fs_hz)
+    out = np.zeros_like(x)
+    for section in sos:
+        s = section[None, :]
+        out += sosfilt(s, x, zi=sosfilt_zi(s) * x[0])[0]
+    return out
+
+
+def _kaiser_lowpass(fs_hz, fs_out_hz):
+    """Linear-phase FIR at ``fs_hz``: flat to 0.8 × and ≥ 80 dB from the Nyquist of fs_out."""
+    nyq_out = 0.5 * fs_out_hz
+    width = (1.0 - ANTI_ALIAS_PASSBAND) * nyq_out / (0.5 * fs_hz)
+    numtaps, beta = kaiserord(ANTI_ALIAS_DB, width)
+    numtaps += 1 - numtaps % 2                       # odd: symmetric about its centre tap
+    cutoff = 0.5 * (1.0 + ANTI_ALIAS_PASSBAND) * nyq_out
+    return firwin(numtaps, cutoff, window=("kaiser", beta), fs=fs_hz)
+
+
+def decimate(x, fs_hz, fs_out_hz):
+    """Low-pass and resample the columns of ``x`` to a lower sensor sample rate.
+
+    Parameters
+    ----------
+    x : array_like, shape (n, C)
+        Samples at ``fs_hz``, row i at time i/fs_hz from the first row.
+    fs_hz : float
+        Input sample rate, Hz.
+    fs_out_hz : float
+        Sensor sample rate, Hz, <= fs_hz; fs_out_hz/fs_hz must be a fraction up/down with
+        down <= 1000 (75 kHz → 12 kHz is 4/25).
+
+    Returns
+    -------
+    y : numpy.ndarray, shape (m, C)
+        Samples at ``fs_out_hz``; only instants whose filter window lies inside the input.
+    offset_s : float
+        Time of ``y[0]`` after ``x[0]``, s.
+    info : dict
+        JSON-ready description: ``method``, ``up``, ``down``, ``numtaps``, ``passband_hz``,
+        ``stopband_hz`` (the sensor Nyquist frequency), ``attenuation_db``.
+
+    Raises
+    ------
+    ParameterError
+        If fs_out_hz > fs_hz, the ratio is not such a fraction, or the record is shorter than
+        the filter.
+    """
+    fs = check_range("fs_hz", fs_hz, 0.0, lo_open=True, unit="Hz")
+    fs_out = check_range("fs_out_hz", fs_out_hz, 0.0, fs, lo_open=True,
+                         unit="Hz (at most the run's sample rate)")
+    x = np.asarray(x, dtype=float)
+    ratio = Fraction(fs_out / fs).limit_denominator(MAX_RATIO_DENOMINATOR)
+    up, down = ratio.numerator, ratio.denominator
+    if abs(up * fs / down - fs_out) > 1e-9 * fs_out:
+        raise ParameterError(
+            f"sensor fs_hz = {fs_out:g} Hz is not a fraction up/down (down <= "
+            f"{MAX_RATIO_DENOMINATOR}) of the run's {fs:g} Hz", param="fs_hz",
+            allowed=f"{fs:g}·up/down Hz")
+    if up == down:
+        return x.copy(), 0.0, {"method": "none", "up": 1, "down": 1}
+    if up == 1:
+        aa = AntiAliasFilter(int(down), fs, attenuation_db=ANTI_ALIAS_DB,
+                             passband=ANTI_ALIAS_PASSBAND)
+        y = aa.apply(x)
+        info = {"method": "AntiAliasFilter", "up": 1, **aa.to_dict(), "down": int(down)}
+        offset = aa.half_length / fs
+    else:
+        h = _kaiser_lowpass(fs * up, fs_out)
+        half = (h.size - 1) // 2                      # upsampled samples each side
+        # output n is input time n·down/up samples; keep n whose window lies inside x
+        first = math.ceil(half / down)
+        last = ((x.shape[0] - 1) * up - half) // down
+        full = resample_poly(x, up, down, axis=0, window=h)
+        y = full[first:last + 1] if last >= first else np.empty((0,) + x.shape[1:])
+        offset = first * down / (up * fs)
+        info = {"method": "resample_poly", "up": int(up), "down": int(down),
+                "numtaps": int(h.size), "passband_hz": ANTI_ALIAS_PASSBAND * 0.5 * fs_out,
+                "stopband_hz": 0.5 * fs_out, "attenuation_db": ANTI_ALIAS_DB}
+    if y.shape[0] < 2:
+        raise ParameterError(f"record of {x.shape[0]} samples is too short for the "
+                             f"anti-alias filter to {fs_out:g} Hz; simulate longer",
+                             param="duration_s")
+    return y, offset, info
+
+
+def tacho_signal(theta_rad, *, level_v=TACHO_LEVEL_V, pulse_width_rad=TACHO_PULSE_WIDTH_RAD):
+    """Once-per-revolution pulse train from a shaft's total rotation.
+
+    Parameters
+    ----------
+    theta_rad : array_like, shape (n,)
+        Total rotation of the shaft, rad (nominal rotation plus vibration, increasing).
+    level_v : float
+        Pulse level, V.
+    pulse_width_rad : float
+        Pulse width, rad of shaft rotation, in (0, π).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        ``level_v`` while theta mod 2π < ``pulse_width_rad``, 0 otherwise: a rising edge
+        within one sample after each crossing of a multiple of 2π.
+
+    Raises
+    ------
+    ParameterError
+        If the shaft turns more than half a pulse width between two samples (the pulse
+        would span fewer than 2 samples and could be missed).
+    """
+    theta = np.asarray(theta_rad, dtype=float)
+    width = check_range("pulse_width_rad", pulse_width_rad, 0.0, math.pi, lo_open=True,
+                        hi_open=True, unit="rad")
+    if theta.size > 1:
+        step = float(np.max(np.abs(np.diff(theta))))
+        if step > 0.5 * width:
+            raise ParameterError(
+                f"the shaft turns up to {step:.3g} rad per sample, more than half the tacho "
+                f"pulse width {width:.3g} rad: raise the sensor fs_hz", param="fs_hz")
+    return np.where(np.mod(theta, 2.0 * math.pi) < width, float(level_v), 0.0)
+
+
+def _force_bearings(run):
+    """Bearings with both ``F_<b>_x`` and ``F_<b>_y`` in the run, in the run's order."""
+    found = {}
+    for name in run.signals:
+        m = _FORCE.fullmatch(name)
+        if m:
+            found.setdefault(m["b"], set()).add(m["d"])
+    order = list(run.meta.get("rig") and run.rig.bearing_names or sorted(found))
+    return [b for b in order if found.get(b) == {"x", "y"}]
+
+
+def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearings=None):
+    """The run as an acquisition system records it: housing accelerations and a tacho.
+
+    Parameters
+    ----------
+    run : Run
+        A run with bearing forces ``F_<bearing>_x``, ``F_<bearing>_y`` (N) and, for the tacho,
+        the input shaft's total rotation ``theta_1b1`` (rad).
+    path : HousingPath, optional
+        Housing transfer path; default the run's rig's :attr:`~cmsim.rig.Rig.housing` (the
+        documented defaults of :class:`~cmsim.rig.HousingPath` for a run without a rig).
+    noise_rms : float
+        RMS of white Gaussian sensor noise at the sensor rate, m/s² (>= 0).
+    fs_hz : float, optional
+        Sensor sample rate, Hz (<= the run's rate); default the run's own rate.
+    seed : int, optional
+        Seed of the noise generator; default the run's ``meta["seed"]`` (else 0).
+    bearings : sequence of str, optional
+        Bearings to instrument (``"1b1"``, ...); default every bearing with x and y forces.
+
+    Returns
+    -------
+    Run
+        At the run's own rate: the run plus ``accel_<bearing>_<x|y>`` (m/s²) and ``tacho``
+        (V). At a lower ``fs_hz``: every signal of the run and the new ones brought to
+        ``fs_hz`` through the same anti-alias filter (edges without a full filter window are
+        dropped, so ``t`` starts a little later). ``meta["fs_hz"]`` is the new rate and
+        ``meta["sensor"]`` describes the sensor (path, noise, seed, anti-alias filter, tacho).
+
+    Raises
+    ------
+    ParameterError
+        For a bearing without forces in the run, a negative ``noise_rms``, or a sensor rate
+        the run cannot be brought to.
+    """
+    if not isinstance(run, Run):
+        raise ParameterError(f"run must be a cmsim Run, got {type(run).__name__}", param="run")
+    noise = check_range("noise_rms", noise_rms, 0.0, unit="m/s^2")
+    fs_in = run.fs_hz
+    fs_out = fs_in if fs_hz is None else check_range("fs_hz", fs_hz, 0.0, lo_open=True,
+                                                     unit="Hz")
+    if path is None:
+        rig = run.rig
+        path = rig.housing if rig is not None else HousingPath()
+    elif not isinstance(path, HousingPath):
+        raise ParameterError(f"path must be a HousingPath, got {type(path).__name__}",
+                             param="path")
+    available = _force_bearings(run)
+    if bearings is None:
+        chosen = available
+    else:
+        chosen = [bearings] if isinstance(bearings, str) else list(bearings)
+        for b in chosen:
+            if b not in available:
+                raise ParameterError(f"bearing {b!r} has no forces F_{b}_x, F_{b}_y in the run; "
+                                     f"available: {available}", param="bearings",
+                                     allowed=str(available))
+    if not chosen:
+        raise ParameterError("the run has no bearing forces F_<bearing>_<x|y> to feel "
+                             "through the housing", param="run")
+    if seed is None:
+        seed = int(run.meta.get("seed", 0) or 0)
+    new = {f"accel_{b}_{d}": housing_acceleration(run[f"F_{b}_{d}"], fs_in, path)
+           for b in chosen for d in ("x", "y")}
+
+    signals = {**run.signals, **new}
+    t = np.asarray(run.t, dtype=float)
+    if fs_out != fs_in:
+        names = list(signals)
+        y, offset, aa = decimate(np.column_stack([signals[k] for k in names]), fs_in, fs_out)
+        signals = {k: np.ascontiguousarray(y[:, i]) for i, k in enumerate(names)}
+        t = t[0] + offset + np.arange(y.shape[0]) / fs_out
+    else:
+        aa = {"method": "none", "up": 1, "down": 1}
+    rng = np.random.default_rng(seed)
+    if noise > 0.0:
+        for name in new:
+            signals[name] = signals[name] + noise * rng.standard_normal(t.size)
+    tacho_meta = None
+    if "theta_1b1" in signals:
+        signals["tacho"] = tacho_signal(signals["theta_1b1"])
+        tacho_meta = {"from": "theta_1b1", "level_v": TACHO_LEVEL_V,
+                      "pulse_width_rad": TACHO_PULSE_WIDTH_RAD, "pulses_per_rev": 1}
+    sensor = {"housing": {k: list(v) for k, v in dataclasses.asdict(path).items()},
+              "discretisation": "bilinear, prewarped at each mode", "fs_hz": fs_out,
+              "noise_rms_m_s2": noise, "seed": int(seed), "bearings": chosen,
+              "anti_alias": aa, "tacho": tacho_meta}
+    meta = {**run.meta, "fs_hz": fs_out, "sensor": sensor}
+    if "duration_s" in meta:
+        meta["duration_s"] = t.size / fs_out
+    return Run(t, signals, meta, run.source)
