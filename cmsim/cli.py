@@ -29,7 +29,7 @@ def _load_rig(args):
         rig = rig.with_clearance(args.clearance_m)
     if getattr(args, "friction", None) is not None:
         if rig.gears is None:
-            raise ParameterError("--friction needs a rig with gears")
+            raise CLIError("--friction needs a rig with gears", option="--friction")
         rig = rig.with_friction(args.friction)
     return rig
 
@@ -130,7 +130,7 @@ def _resolve_mesh_options(args, rig, torque_nm):
     from cmsim.dynamics.mesh_choice import resolve_mesh
     mesh = _mesh_argument(args, [torque_nm])
     if rig.gears is None and args.mesh_table:
-        raise ParameterError("--mesh-table needs a rig with gears")
+        raise CLIError("--mesh-table needs a rig with gears", option="--mesh-table")
     return resolve_mesh(rig, mesh, torque_nm, progress=False if args.json else None)
 
 
@@ -389,9 +389,14 @@ def _add_sweep(sub):
 def _cmd_report(args):
     from cmsim.report import DEFAULT_SIGNALS, build_report
 
-    res = build_report(args.dir, tuple(args.signal) if args.signal else DEFAULT_SIGNALS,
-                       top_n=args.top, max_freq_hz=args.max_hz,
-                       progress=not args.json and sys.stderr.isatty())
+    try:
+        res = build_report(args.dir, tuple(args.signal) if args.signal else DEFAULT_SIGNALS,
+                           top_n=args.top, max_freq_hz=args.max_hz,
+                           progress=not args.json and sys.stderr.isatty())
+    except ParameterError as exc:
+        if exc.param is None:  # about the directory or its runs
+            raise CLIError(f"DIR {args.dir}: {exc}", option="DIR") from None
+        raise
     return res.to_dict()
 
 
@@ -443,7 +448,7 @@ def _cmd_mesh_table(args):
 
     rig = _load_rig(args)
     if rig.gears is None:
-        raise ParameterError("cmsim mesh-table needs a rig with gears")
+        raise CLIError(f"--rig {args.rig}: mesh-table needs a rig with gears", option="--rig")
     start = time.perf_counter()
     mesh_model = None
     cache = None
@@ -596,7 +601,15 @@ class CLIError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse that raises instead of printing usage and exiting (one line, --json aware)."""
+    """argparse that raises instead of printing usage and exiting (one line, --json aware).
+
+    Abbreviated options are refused (``--torque`` is not ``--torque-nm``): an abbreviation
+    that works today would silently mean another option when one is added.
+    """
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
 
     def error(self, message):
         raise CLIError(f"{message} (see {self.prog} --help)", 2, option=_option_in(message))
@@ -678,6 +691,8 @@ def _user_message(exc, options):
     for name, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
         if name == param or "_" in name:
             msg = re.sub(rf"(?<![\w.\[\-]){re.escape(name)}(?![\w\[])", opt, msg)
+    if option is not None and option not in msg:
+        msg = f"{option}: {msg}"
     return msg, option
 
 
@@ -722,10 +737,9 @@ def _load_file(option, path, loader, what):
 
 
 def _warn(args, text):
-    """A plausibility warning: stderr (unless --json) and the result's "warnings" list."""
+    """A plausibility warning: stderr (unless --json) and the result's "warnings" list, given
+    with the result (an error stays one line; with --json its object lists them)."""
     args._warnings.append(text)
-    if not args.json:
-        print(f"cmsim: warning: {text}", file=sys.stderr)
 
 
 #: ISO 6336-5 allowable contact stress of through-hardened steel is ~1500 MPa (case-hardened
@@ -825,6 +839,9 @@ def main(argv=None):
                            f"it with the command line (CMSIM_DEBUG=1 shows the traceback)", 1)
     if isinstance(res, dict) and args._warnings:
         res = {**res, "warnings": list(args._warnings)}
+        if not args.json:
+            for text in args._warnings:
+                print(f"cmsim {args.command}: warning: {text}", file=sys.stderr)
     if args.json:
         print(json.dumps(_jsonable(res)))
     else:

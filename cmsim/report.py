@@ -147,7 +147,8 @@ def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
     t1 = time.perf_counter()
     missing = [s for s in signals if s not in run.signals]
     if missing:
-        raise ParameterError(f"signal(s) {missing} not in {path.name}; available: {run.names}")
+        raise ParameterError(f"signal(s) {missing} not in {path.name}; available: {run.names}",
+                             param="signals")
     meta, rig, op = run.meta, run.rig, run.operating_point
     freqs = rig_frequencies(rig, op)
     bearings = rig.bearing_names

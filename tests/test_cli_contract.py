@@ -1,0 +1,448 @@
+"""The CLI contract, for every command: a catalogue of bad inputs and what each must give.
+
+Tier (c) behaviour (issue 10): exit 2 for bad input (3 for a diverged run), exactly one line on
+stderr naming the option as typed (``--top``, not ``max_peaks``) and, for a numeric option, its
+allowed range; with ``--json`` exactly one JSON object on stdout (``error``, ``status``,
+``option``); never a traceback; no file left behind in the working directory.
+
+To add a command: give it a base command line in ``BASE`` (its required arguments, valid) and
+its hand-written rows in ``CATALOGUE``; every numeric option then gets the generated rows
+(``nan``, ``inf``, ``abc``) and the coverage test checks that the option has a range.
+Run ids are ``<command>-<what>``.
+"""
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import cmsim
+from cmsim import cli
+from cmsim.cli import main
+from cmsim.rig import Rig
+from cmsim.run import Run
+
+TABLES = Path(cmsim.__file__).parent / "data" / "paper_2016_hybrid_tables.npz"
+
+
+@dataclass(frozen=True)
+class Row:
+    """One bad input: ``argv`` (``{name}`` = a fixture path), the exit status, and the words
+    the one-line message must hold (the option as typed first)."""
+
+    id: str
+    argv: tuple
+    names: tuple
+    status: int = 2
+    numeric: bool = False
+
+
+def R(id, argv, *names, status=2, numeric=False):
+    return Row(id, tuple(argv.split()), names, status, numeric)
+
+
+# every command with the required arguments of a valid call ({run}, {sweep}: fixtures)
+BASE = {
+    "simulate": "simulate --speed-rpm 1000 --duration-s 0.01",
+    "modes": "modes --torque-nm 10",
+    "mesh-table": "mesh-table --torque-nm 10",
+    "spectrum": "spectrum {run}",
+    "sweep": "sweep --speed-rpm 1000 --out {work}/sw",
+    "report": "report {sweep}",
+}
+
+CATALOGUE = [
+    # ---- simulate: issue items 4, 7, 8 and kin
+    R("simulate-seed-negative", "simulate --speed-rpm 1000 --seed -1", "--seed", numeric=True),
+    R("simulate-seed-float", "simulate --speed-rpm 1000 --seed 1.5", "--seed", numeric=True),
+    R("simulate-speed-zero", "simulate --speed-rpm 0", "--speed-rpm", numeric=True),
+    R("simulate-speed-missing", "simulate --torque-nm 5", "--speed-rpm"),
+    R("simulate-speed-no-value", "simulate --speed-rpm", "--speed-rpm"),
+    R("simulate-unknown-option", "simulate --speed-rpm 1000 --torque 5", "--torque"),
+    R("simulate-torque-huge", "simulate --speed-rpm 1000 --torque-nm 1e7", "--torque-nm",
+      numeric=True),
+    R("simulate-radial-negative", "simulate --speed-rpm 1000 --radial-load-n -5",
+      "--radial-load-n", numeric=True),
+    R("simulate-substeps-zero", "simulate --speed-rpm 1000 --substeps 0", "--substeps",
+      numeric=True),
+    R("simulate-fs-low", "simulate --speed-rpm 1000 --fs-hz 10", "--fs-hz", numeric=True),
+    R("simulate-duration-zero", "simulate --speed-rpm 1000 --duration-s 0", "--duration-s",
+      numeric=True),
+    R("simulate-duration-memory", "simulate --speed-rpm 1000 --duration-s 600 --fs-hz 1e7",
+      "--duration-s"),
+    R("simulate-warmup-negative", "simulate --speed-rpm 1000 --warmup-s -1", "--warmup-s",
+      numeric=True),
+    R("simulate-clearance-parse", "simulate --speed-rpm 1000 --clearance-m 0.02",
+      "--clearance-m", numeric=True),
+    R("simulate-clearance-bearing", "simulate --speed-rpm 1000 --clearance-m 0.0009",
+      "--clearance-m", numeric=True),
+    R("simulate-friction", "simulate --speed-rpm 1000 --friction 0.5", "--friction",
+      numeric=True),
+    R("simulate-friction-bearing-rig", "simulate --speed-rpm 1000 --friction 0.1 --rig "
+      "{bearing_rig}", "--friction"),
+    R("simulate-cage-slip", "simulate --speed-rpm 1000 --cage-slip 0.5", "--cage-slip",
+      numeric=True),
+    R("simulate-ball-jitter", "simulate --speed-rpm 1000 --ball-jitter-rad 1", "--ball-jitter-rad",
+      numeric=True),
+    R("simulate-slip-correlation", "simulate --speed-rpm 1000 --slip-correlation-s 0",
+      "--slip-correlation-s", numeric=True),
+    R("simulate-rig-directory", "simulate --speed-rpm 1000 --rig {work}", "--rig"),
+    R("simulate-rig-missing", "simulate --speed-rpm 1000 --rig {work}/none.toml", "--rig"),
+    R("simulate-rig-text", "simulate --speed-rpm 1000 --rig {text}", "--rig"),
+    R("simulate-rig-binary", "simulate --speed-rpm 1000 --rig {run}", "--rig"),
+    R("simulate-rig-empty", "simulate --speed-rpm 1000 --rig {empty}", "--rig", "missing key"),
+    R("simulate-rig-missing-key", "simulate --speed-rpm 1000 --rig {rig_no_balls}", "--rig",
+      "shafts[0].bearing_1.n_balls"),
+    R("simulate-rig-bool-mass", "simulate --speed-rpm 1000 --rig {rig_bool_mass}", "--rig",
+      "gears.driving.mass_kg"),
+    R("simulate-rig-two-modules", "simulate --speed-rpm 1000 --rig {rig_two_modules}", "--rig",
+      "module_mm"),
+    R("simulate-rig-strings-pair", "simulate --speed-rpm 1000 --rig {rig_strings}", "--rig",
+      "shafts[1].flexural_stiffness_n_per_m"),
+    R("simulate-rig-stiffness-1e20", "simulate --speed-rpm 1000 --rig {rig_stiff}", "--rig",
+      "shafts[0].flexural_stiffness_n_per_m", numeric=True),
+    R("simulate-rig-teeth-100000", "simulate --speed-rpm 1000 --rig {rig_teeth}", "--rig",
+      "gears.driven.n_teeth", numeric=True),
+    R("simulate-rig-nan-clearance", "simulate --speed-rpm 1000 --rig {rig_nan}", "--rig",
+      "shafts[1].bearing_2.clearance_m", numeric=True),
+    R("simulate-rig-unknown-key", "simulate --speed-rpm 1000 --rig {rig_unknown}", "--rig",
+      "modul_m"),
+    R("simulate-out-directory", "simulate --speed-rpm 1000 --out {work}", "--out"),
+    R("simulate-out-no-parent", "simulate --speed-rpm 1000 --out {work}/no/run.npz", "--out"),
+    R("simulate-mesh-choice", "simulate --speed-rpm 1000 --mesh bogus", "--mesh"),
+    R("simulate-mesh-and-table", "simulate --speed-rpm 1000 --mesh potential-energy "
+      "--mesh-table {tables}", "--mesh"),
+    R("simulate-mesh-table-run-file", "simulate --speed-rpm 1000 --mesh-table {run}",
+      "--mesh-table"),
+    R("simulate-mesh-table-text", "simulate --speed-rpm 1000 --mesh-table {text}", "--mesh-table"),
+    R("simulate-mesh-table-torque", "simulate --speed-rpm 1000 --torque-nm 500 --mesh-table "
+      "{tables}", "--torque-nm", numeric=True),
+    R("simulate-table-torque-outside", "simulate --speed-rpm 1000 --mesh-table {tables} "
+      "--table-torque-nm 1000", "--table-torque-nm", numeric=True),
+    R("simulate-table-torque-alone", "simulate --speed-rpm 1000 --table-torque-nm 10",
+      "--table-torque-nm"),
+    R("simulate-diverges", "simulate --speed-rpm 1000 --torque-nm 100 --fs-hz 2000 --substeps 1 "
+      "--warmup-s 0 --duration-s 0.2", "--substeps", status=3),
+    # ---- modes
+    R("modes-positions", "modes --torque-nm 10 --positions 3", "--positions", numeric=True),
+    R("modes-torque-negative", "modes --torque-nm -5", "--torque-nm", numeric=True),
+    R("modes-torque-missing", "modes", "--torque-nm"),
+    R("modes-rig-bool-mass", "modes --torque-nm 10 --rig {rig_bool_mass}", "--rig", "mass_kg"),
+    R("modes-mesh-table-text", "modes --torque-nm 10 --mesh-table {text}", "--mesh-table"),
+    # ---- mesh-table
+    R("mesh-table-speed-negative", "mesh-table --torque-nm 10 --speed-rpm -1", "--speed-rpm",
+      numeric=True),
+    R("mesh-table-torque-zero", "mesh-table --torque-nm 0", "--torque-nm", numeric=True),
+    R("mesh-table-steps", "mesh-table --torque-nm 10 --steps 2", "--steps", numeric=True),
+    R("mesh-table-method", "mesh-table --torque-nm 10 --method fe", "--method"),
+    R("mesh-table-out-directory", "mesh-table --torque-nm 10 --out {work}", "--out"),
+    R("mesh-table-bearing-rig", "mesh-table --torque-nm 10 --rig {bearing_rig}", "--rig"),
+    # ---- spectrum
+    R("spectrum-text-file", "spectrum {text}", "RUN.npz"),
+    R("spectrum-empty-file", "spectrum {empty}", "RUN.npz"),
+    R("spectrum-toml-file", "spectrum {rig_ok}", "RUN.npz"),
+    R("spectrum-directory", "spectrum {work}", "RUN.npz"),
+    R("spectrum-missing", "spectrum {work}/none.npz", "RUN.npz"),
+    R("spectrum-meta-not-json", "spectrum {bad_meta}", "RUN.npz"),
+    R("spectrum-meta-bad-rig", "spectrum {bad_rig_meta}", "RUN.npz"),
+    R("spectrum-table-file", "spectrum {tables}", "RUN.npz"),
+    R("spectrum-signal", "spectrum {run} --signal nosuch", "--signal"),
+    R("spectrum-bearing", "spectrum {run} --bearing 9z9", "--bearing"),
+    R("spectrum-kind", "spectrum {run} --kind cepstrum", "--kind"),
+    R("spectrum-band-reversed", "spectrum {run} --kind envelope --band-hz 500 100", "--band-hz"),
+    R("spectrum-band-amplitude", "spectrum {run} --band-hz 100 500", "--band-hz"),
+    R("spectrum-resolution", "spectrum {run} --resolution-hz 0.001", "--resolution-hz"),
+    R("spectrum-top-zero", "spectrum {run} --top 0", "--top", numeric=True),
+    R("spectrum-threshold", "spectrum {run} --threshold-db -3", "--threshold-db", numeric=True),
+    R("spectrum-plot-directory", "spectrum {run} --plot {work}", "--plot"),
+    R("spectrum-plot-no-parent", "spectrum {run} --plot {work}/no/x.png", "--plot"),
+    # ---- sweep
+    R("sweep-out-file", "sweep --speed-rpm 1000 --out {text}", "--out"),
+    R("sweep-out-missing", "sweep --speed-rpm 1000", "--out"),
+    R("sweep-torque-negative", "sweep --speed-rpm 1000 --torque-nm -1 --out {work}/s",
+      "--torque-nm", numeric=True),
+    R("sweep-workers-zero", "sweep --speed-rpm 1000 --workers 0 --out {work}/s", "--workers",
+      numeric=True),
+    R("sweep-seed-policy", "sweep --speed-rpm 1000 --seed-policy each --out {work}/s",
+      "--seed-policy"),
+    R("sweep-torque-bearing-rig", "sweep --speed-rpm 1000 --torque-nm 10 --rig {bearing_rig} "
+      "--out {work}/s", "--torque-nm"),
+    R("sweep-radial-gear-rig", "sweep --speed-rpm 1000 --radial-load-n 10 --out {work}/s",
+      "--radial-load-n"),
+    R("sweep-radial-negative", "sweep --speed-rpm 1000 --radial-load-n -10 --rig {bearing_rig} "
+      "--out {work}/s", "--radial-load-n", numeric=True),
+    R("sweep-mesh-table-text", "sweep --speed-rpm 1000 --mesh-table {text} --out {work}/s",
+      "--mesh-table"),
+    R("sweep-mesh-table-torque", "sweep --speed-rpm 1000 --torque-nm 10 5000 --mesh-table "
+      "{tables} --out {work}/s", "--torque-nm", numeric=True),
+    R("sweep-clearance", "sweep --speed-rpm 1000 --clearance-m 0.002 --out {work}/s",
+      "--clearance-m", numeric=True),
+    R("sweep-rig-missing-key", "sweep --speed-rpm 1000 --rig {rig_no_balls} --out {work}/s",
+      "--rig", "shafts[0].bearing_1.n_balls"),
+    # ---- report
+    R("report-missing-dir", "report {work}/none", "DIR"),
+    R("report-file", "report {text}", "DIR"),
+    R("report-empty-dir", "report {empty_dir}", "DIR"),
+    R("report-corrupted-run", "report {corrupt_sweep}", "DIR", "corrupted"),
+    R("report-top", "report {sweep} --top 0", "--top", numeric=True),
+    R("report-max-hz", "report {sweep} --max-hz -1", "--max-hz", numeric=True),
+    R("report-max-hz-nyquist", "report {sweep} --max-hz 1e6", "--max-hz", numeric=True),
+    R("report-signal", "report {sweep} --signal nosuch", "--signal"),
+    # ---- no command
+    R("cmsim-no-command", "", "command"),
+    R("cmsim-unknown-command", "frobnicate", "frobnicate"),
+    R("cmsim-unknown-option", "modes --torque-nm 10 --frobnicate", "--frobnicate"),
+]
+
+
+def _numeric_options():
+    """(command, option, dest) of every int/float option of every command."""
+    parser = cli.build_parser()
+    out = []
+    for command, sub in cli._subparsers(parser).items():
+        for a in sub._actions:
+            if a.option_strings and (a.type in (int, float) or hasattr(a.type, "allowed")):
+                out.append((command, max(a.option_strings, key=len), a.dest, a.nargs))
+    return out
+
+
+def _generated_rows():
+    rows = []
+    for command, option, dest, nargs in _numeric_options():
+        n = nargs if isinstance(nargs, int) else 1
+        for bad in ("nan", "inf", "abc"):
+            argv = f"{BASE[command]} {option} {' '.join([bad] * n)}"
+            rows.append(R(f"{command}{option}-{bad}", argv, option, numeric=True))
+    return rows
+
+
+ALL_ROWS = CATALOGUE + _generated_rows()
+
+
+# ---------------------------------------------------------------------- fixtures
+def _synthetic_run(rig, signals, fs=20_000.0, n=8192, meta_extra=None):
+    t = np.arange(n) / fs
+    rng = np.random.default_rng(0)
+    sig = {name: np.sin(2 * np.pi * 466.67 * t) + 0.01 * rng.standard_normal(n)
+           for name in signals}
+    meta = {"rig": rig.to_dict(), "fs_hz": fs,
+            "operating_point": {"speed_rpm": 1000.0, "torque_nm": 10.0, "radial_load_n": 0.0,
+                                "radial_load_angle_rad": -math.pi / 2}, "seed": 0,
+            **(meta_extra or {})}
+    return Run(t, sig, meta)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    """Fixture files; ``work`` is the directory outputs would go to."""
+    d = tmp_path_factory.mktemp("contract")
+    f = {"work": d / "work", "tables": TABLES}
+    f["work"].mkdir()
+    (d / "text.txt").write_text("just some text\n")
+    f["text"] = d / "text.txt"
+    (d / "empty.toml").write_text("")
+    f["empty"] = d / "empty.toml"
+    (d / "empty_dir").mkdir()
+    f["empty_dir"] = d / "empty_dir"
+    paper = Rig.paper_2016()
+    paper.save(d / "rig_ok.toml")
+    f["rig_ok"] = d / "rig_ok.toml"
+    bearing_rig = Rig.rotor_on_bearings(paper.bearings[0], cmsim.Rotor(3.0, 0.01))
+    bearing_rig.save(d / "bearing_rig.toml")
+    f["bearing_rig"] = d / "bearing_rig.toml"
+    text = (d / "rig_ok.toml").read_text()
+
+    def variant(name, old, new, nth=1):
+        """The rig file with the ``nth`` occurrence of ``old`` replaced by ``new``."""
+        i = -1
+        for _ in range(nth):
+            i = text.index(old, i + 1)
+        (d / f"{name}.toml").write_text(text[:i] + new + text[i + len(old):])
+        f[name] = d / f"{name}.toml"
+
+    pair = "flexural_stiffness_n_per_m = [\n    624000000.0,\n    624000000.0,\n]"
+    variant("rig_no_balls", "n_balls = 9\n", "")
+    variant("rig_bool_mass", "mass_kg = 0.79999", "mass_kg = true")
+    variant("rig_two_modules", "module_m = 0.003175\n", "module_m = 0.003175\nmodule_mm = 3.2\n")
+    variant("rig_strings", pair, 'flexural_stiffness_n_per_m = ["a", "b"]', nth=2)
+    variant("rig_stiff", "    624000000.0,", "    1e20,")
+    variant("rig_teeth", "n_teeth = 28", "n_teeth = 100000", nth=2)
+    variant("rig_nan", "clearance_m = 1.5e-05", "clearance_m = nan", nth=4)
+    variant("rig_unknown", "module_m = ", "modul_m = ")
+    run = _synthetic_run(paper, ["F_1b1_loa", "F_1b1_oloa", "x_1b1", "y_1b1", "x_2b1", "y_2b1",
+                                 "dte_um"])
+    f["run"] = run.save(d / "run.npz")
+    np.savez(d / "bad_meta.npz", t=run.t, meta="{not json", F_1b1_loa=run.t)
+    f["bad_meta"] = d / "bad_meta.npz"
+    np.savez(d / "bad_rig_meta.npz", t=run.t, meta=json.dumps({"rig": {"name": "x"}}),
+             F_1b1_loa=run.t)
+    f["bad_rig_meta"] = d / "bad_rig_meta.npz"
+    sweep = d / "sweep"
+    (sweep / "runs").mkdir(parents=True)
+    run.save(sweep / "runs" / "r0.npz")
+    f["sweep"] = sweep
+    corrupt = d / "corrupt_sweep"
+    (corrupt / "runs").mkdir(parents=True)
+    raw = bytearray((sweep / "runs" / "r0.npz").read_bytes())
+    raw[len(raw) // 2: len(raw) // 2 + 64] = b"\0" * 64
+    (corrupt / "runs" / "r0.npz").write_bytes(bytes(raw))
+    f["corrupt_sweep"] = corrupt
+    f["root"] = d
+    return f
+
+
+def _argv(row, files):
+    return [a.format(**{k: str(v) for k, v in files.items()}) for a in row.argv]
+
+
+def _tree(root):
+    return sorted(str(p.relative_to(root)) for p in Path(root).rglob("*"))
+
+
+def _check_message(row, line):
+    assert "Traceback" not in line
+    assert line.startswith("cmsim"), line
+    for word in row.names:
+        assert word in line, f"{word!r} not in {line!r}"
+    assert "np.float64" not in line and "inf]" not in line and "-inf" not in line, line
+    if row.numeric:
+        assert any(s in line for s in (" in [", " in (", ">", "<", "one of", "allowed")), line
+
+
+# ---------------------------------------------------------------------- tests
+@pytest.mark.parametrize("row", ALL_ROWS, ids=[r.id for r in ALL_ROWS])
+@pytest.mark.parametrize("as_json", [False, True], ids=["text", "json"])
+def test_bad_input(row, as_json, files, capsys):
+    before = _tree(files["root"])
+    argv = _argv(row, files) + (["--json"] if as_json else [])
+    status = main(argv)
+    cap = capsys.readouterr()
+    assert status == row.status, cap.err
+    lines = cap.err.strip().splitlines()
+    assert len(lines) == 1, cap.err
+    _check_message(row, lines[0])
+    if as_json:
+        obj = json.loads(cap.out)
+        assert isinstance(obj, dict) and obj["status"] == row.status
+        assert obj["error"] in lines[0]
+    else:
+        assert cap.out == ""
+    assert _tree(files["root"]) == before
+
+
+def test_catalogue_size_and_commands():
+    """Every command `cmsim --help` lists has rows, and the catalogue has ~60+ hand rows."""
+    commands = set(cli._subparsers(cli.build_parser()))
+    assert commands == set(BASE)
+    covered = {r.argv[0] for r in CATALOGUE if r.argv}
+    assert commands <= covered
+    assert len(CATALOGUE) >= 60
+
+
+def test_every_option_is_validated():
+    """Each numeric option has a range (parse time) or is checked by the library under a name
+    that maps to it; each other option has choices, is a path, a flag, or a name checked
+    against the run."""
+    parser = cli.build_parser()
+    free_text = {"signal", "bearing"}  # checked against the run's signals / bearings
+    for command, sub in cli._subparsers(parser).items():
+        for a in sub._actions:
+            if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):
+                continue
+            if a.type in (int, float):
+                assert a.dest in cli._LIBRARY_VALIDATED, (command, a.dest)
+            elif hasattr(a.type, "allowed"):
+                continue
+            else:
+                assert (a.choices is not None or a.dest in free_text
+                        or (command, a.dest) in cli._PATHS or a.dest in cli._PATHS), \
+                    (command, a.dest)
+
+
+def test_param_names_map_to_options():
+    """A ParameterError naming a Python field reads as the option typed."""
+    from cmsim.errors import ParameterError, check_range
+    options = cli._options_of(cli.build_parser(), "spectrum")
+    try:
+        check_range("max_peaks", 0, 1, 100)
+    except ParameterError as exc:
+        msg, option = cli._user_message(exc, options)
+    assert option == "--top" and msg.startswith("--top must be") and "max_peaks" not in msg
+    options = cli._options_of(cli.build_parser(), "simulate")
+    for param, opt in (("cage_speed_rms", "--cage-slip"), ("torque_nm", "--torque-nm"),
+                       ("clearance_m", "--clearance-m")):
+        msg, option = cli._user_message(ParameterError(f"{param} must be >= 0, got -1"), options)
+        assert option == opt and msg.startswith(opt)
+    msg, _ = cli._user_message(ParameterError("n_positions must be an integer >= 4"),
+                               cli._options_of(cli.build_parser(), "modes"))
+    assert msg.startswith("--positions")
+
+
+def test_internal_error_is_one_line_status_1(capsys, monkeypatch):
+    def boom(args):
+        raise ZeroDivisionError("x")
+
+    parser = cli.build_parser
+    monkeypatch.setattr(cli, "_cmd_modes", boom)
+
+    def patched():
+        p = parser()
+        cli._subparsers(p)["modes"].set_defaults(func=boom)
+        return p
+
+    monkeypatch.setattr(cli, "build_parser", patched)
+    assert main(["modes", "--torque-nm", "10", "--json"]) == 1
+    cap = capsys.readouterr()
+    assert len(cap.err.strip().splitlines()) == 1 and "please report" in cap.err
+    assert json.loads(cap.out)["status"] == 1
+
+
+def test_report_bearing_rig_without_dte(files, tmp_path, capsys):
+    """report works on a bearing rig's sweep: the default signals skip dte_um."""
+    bearing_rig = Rig.load(files["bearing_rig"])
+    run = _synthetic_run(bearing_rig, ["F_1b1_loa", "F_1b1_oloa", "x_1b1", "y_1b1"])
+    (tmp_path / "runs").mkdir()
+    run.save(tmp_path / "runs" / "r0.npz")
+    assert main(["report", str(tmp_path), "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert Path(res["html"]).is_file()
+
+
+def test_plausibility_warning_in_json(monkeypatch, capsys):
+    """1000 N m on the paper's 6.35 mm face: warned (stderr without --json, listed with it)."""
+    from cmsim.rig import OperatingPoint
+    args = argparse.Namespace(json=True, _warnings=[])
+    rig = Rig.paper_2016()
+    cli._plausibility(args, rig, OperatingPoint(1000.0, 1000.0))
+    assert len(args._warnings) == 1 and "MPa" in args._warnings[0]
+    args = argparse.Namespace(json=False, _warnings=[])
+    cli._plausibility(args, rig, OperatingPoint(1000.0, 100.0))
+    assert args._warnings == []
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize("argv, status, word", [
+    (["simulate", "--speed-rpm", "nan"], 2, "--speed-rpm"),
+    (["spectrum", "/"], 2, "RUN.npz"),
+    (["modes", "--torque-nm", "10", "--positions", "2"], 2, "--positions"),
+    (["frobnicate"], 2, "frobnicate"),
+    (["sweep", "--speed-rpm", "1000", "--out", "/etc/hostname"], 2, "--out"),
+])
+@pytest.mark.parametrize("as_json", [False, True], ids=["text", "json"])
+def test_subprocess_exit_codes(argv, status, word, as_json):
+    """The real process: exit code, one stderr line, nothing else on stdout."""
+    cmd = [sys.executable, "-m", "cmsim.cli", *argv] + (["--json"] if as_json else [])
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == status
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0] and "Traceback" not in proc.stderr
+    if as_json:
+        assert json.loads(proc.stdout)["status"] == status
+    else:
+        assert proc.stdout == ""
