@@ -1,0 +1,380 @@
+"""Rolling-bearing faults: localized race and ball defects, wear, an off-size ball, slip.
+
+Localized defects (``outer_race``, ``inner_race``, ``ball``) follow Sawalhi & Randall [1]: as
+a ball rolls over a defect of length L along the race it loses part of its overlap (its
+deflection) — at most the depth it can fall, which the ball's curvature limits to the sagitta
+of the chord L on the ball, R_b − sqrt(R_b² − (L/2)²), and the defect depth limits to
+``depth_m`` (:func:`ball_drop_m`). The ball rolls down the entry edge (the loss rises over the
+distance the ball needs to reach that depth, sqrt(2 R_b d − d²) ≤ L/2) and is pushed back up
+abruptly at the exit edge (over :data:`EXIT_RAMP_FRACTION` of the entry distance, our choice;
+[1] describe the exit as a sudden restoration). The kernel applies the trapezoid of
+:func:`defect_profile` (columns of :class:`~cmsim.faults.compile.FaultArrays`
+``bearing_defects``).
+
+* outer race: fixed in the housing at ``angle_rad`` (x axis = 0, counter-clockwise +); by
+  default in the load zone: the direction of the radial load on a bearing rig (the CWRU
+  "@6" position for a downward load), the line of action of the mesh force on the bearing's
+  shaft on a gear rig;
+* inner race: turns with the shaft (``angle_rad`` on the ring from its reference);
+* ball: one defect on one ball that strikes the outer race and the inner race once each per
+  spin revolution (2 × BSF).
+
+Sizes are lengths along the race (ball: along the ball's surface) in m; a race defect longer
+than the ball spacing on that race, or a ball defect longer than the ball diameter, is refused.
+``wear`` is clearance growth (a plain rig change, :func:`~cmsim.faults.compile.rig_with_faults`),
+``off_size_ball`` one ball larger (or smaller) by Δd, ``rolling_slip`` the random slip of
+paper 001 (§5, §6.2.1) as a catalogue entry.
+
+References
+----------
+.. [1] N. Sawalhi, R. B. Randall, "Simulating gear and bearing interactions in the presence
+   of faults. Part I. The combined gear bearing dynamic model and the simulation of localised
+   bearing faults", MSSP 22 (2008) 1924-1951, §3.3 and Figs. 6-8.
+.. [2] R. B. Randall, J. Antoni, "Rolling element bearing diagnostics — a tutorial", MSSP 25
+   (2011) 485-520, eqs. (1)-(4) (defect frequencies).
+.. [3] A. Fernandez-del-Rincon et al., MSSP 2016, §5 (rolling slip).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from cmsim.errors import ParameterError, check_range
+from cmsim.faults.base import Fault, check_bearing, check_int, mm, register
+
+__all__ = ["OuterRaceDefect", "InnerRaceDefect", "BallDefect", "BearingWear", "OffSizeBall",
+           "RollingSlip", "ball_drop_m", "defect_profile", "EXIT_RAMP_FRACTION",
+           "KIND_OUTER", "KIND_INNER", "KIND_BALL"]
+
+#: Kind codes of the ``bearing_defects`` rows.
+KIND_OUTER, KIND_INNER, KIND_BALL = 1.0, 2.0, 3.0
+
+#: Exit ramp as a fraction of the entry ramp (abrupt exit of [1]); our choice.
+EXIT_RAMP_FRACTION = 0.2
+
+
+def ball_drop_m(ball_radius_m, length_m, depth_m):
+    """Largest loss of ball overlap in a defect of length L and depth d, m.
+
+    min(d, R_b − sqrt(R_b² − (L/2)²)) (Sawalhi & Randall [1]); the ball reaches the defect
+    bottom when L/2 >= R_b.
+
+    Examples
+    --------
+    >>> round(ball_drop_m(3.97e-3, 1.0e-3, 1e-3) * 1e6, 3)     # 6205 ball, 1 mm defect
+    31.561
+    """
+    half = 0.5 * length_m
+    sag = ball_radius_m - math.sqrt(max(ball_radius_m ** 2 - half * half, 0.0))
+    return min(depth_m, sag)
+
+
+def _entry_distance_m(ball_radius_m, length_m, drop_m):
+    """Distance the ball rolls over the entry edge to fall by ``drop_m``, <= L/2, m."""
+    x = math.sqrt(max(2.0 * ball_radius_m * drop_m - drop_m * drop_m, 0.0))
+    return min(x, 0.5 * length_m)
+
+
+def defect_profile(angle_rad, centre_rad, half_width_rad, entry_rad, exit_rad):
+    """Trapezoid of a defect row: 0 outside, linear entry and exit ramps, 1 in between.
+
+    The ball enters at ``centre − half_width`` (moving towards increasing angle) and leaves
+    at ``centre + half_width``. Reference implementation of what the kernel evaluates.
+
+    Parameters
+    ----------
+    angle_rad : ndarray
+        Angle of the ball relative to the defect frame, rad (wrapped to (−π, π] about the
+        centre).
+    centre_rad, half_width_rad, entry_rad, exit_rad : float
+        Columns 2, 3, 5, 6 of a ``bearing_defects`` row, rad.
+
+    Returns
+    -------
+    ndarray
+        Profile in [0, 1], same shape as ``angle_rad``.
+    """
+    import numpy as np
+    a = np.mod(np.asarray(angle_rad, dtype=float) - centre_rad + math.pi, 2 * math.pi) - math.pi
+    x = a + half_width_rad                      # distance since the entry edge
+    y = half_width_rad - a                      # distance to the exit edge
+    up = np.clip(x / entry_rad, 0.0, 1.0) if entry_rad > 0 else (x >= 0).astype(float)
+    down = np.clip(y / exit_rad, 0.0, 1.0) if exit_rad > 0 else (y >= 0).astype(float)
+    return np.where((x >= 0) & (y >= 0), np.minimum(up, down), 0.0)
+
+
+def _check_size(name, value, unit="m"):
+    return check_range(name, value, 0.0, 0.1, lo_open=True, unit=unit)
+
+
+@dataclass(frozen=True)
+class _RaceDefect(Fault):
+    """Common part of the outer- and inner-race defects."""
+
+    bearing: str
+    size_m: float
+    depth_m: float
+    angle_rad: float | None = None
+
+    def __post_init__(self):
+        if not isinstance(self.bearing, str):
+            raise ParameterError(f"bearing must be a bearing name such as '1b1', got "
+                                 f"{self.bearing!r}", param="bearing")
+        _check_size("size_m", self.size_m)
+        check_range("depth_m", self.depth_m, 0.0, 0.01, lo_open=True, unit="m")
+        if self.angle_rad is not None:
+            check_range("angle_rad", self.angle_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+
+    @property
+    def label(self):
+        return f"{self.name}@{self.bearing} size={mm(self.size_m)} depth={mm(self.depth_m)}"
+
+    def race_radius_m(self, brg):
+        raise NotImplementedError
+
+    def validate(self, rig):
+        brg = rig.bearings[check_bearing(rig, self.bearing)]
+        r = self.race_radius_m(brg)
+        spacing = 2 * math.pi * r / brg.n_balls
+        check_range("size_m", self.size_m, 0.0, spacing, lo_open=True,
+                    unit=f"m (up to the ball spacing on the {self.race} race of "
+                         f"{self.bearing}, 2*pi*{r * 1e3:.4g} mm / {brg.n_balls})")
+        check_range("depth_m", self.depth_m, 0.0, 0.5 * brg.ball_diameter_m, lo_open=True,
+                    unit=f"m (up to the ball radius of {self.bearing})")
+        return self
+
+    def defect_row(self, rig, default_angle_rad):
+        """Row of ``FaultArrays.bearing_defects`` (8 floats) for this defect on ``rig``."""
+        self.validate(rig)
+        ib = check_bearing(rig, self.bearing)
+        brg = rig.bearings[ib]
+        rb, r = 0.5 * brg.ball_diameter_m, self.race_radius_m(brg)
+        drop = ball_drop_m(rb, self.size_m, self.depth_m)
+        entry = _entry_distance_m(rb, self.size_m, drop)
+        centre = default_angle_rad if self.angle_rad is None else self.angle_rad
+        return [float(ib), self.kind, float(centre), 0.5 * self.size_m / r, drop, entry / r,
+                EXIT_RAMP_FRACTION * entry / r, -1.0]
+
+
+@register
+@dataclass(frozen=True)
+class OuterRaceDefect(_RaceDefect):
+    """Localized defect on the outer race, fixed in the housing.
+
+    Attributes
+    ----------
+    bearing : str
+        Bearing name (``rig.bearing_names``, e.g. ``"1b1"``).
+    size_m : float
+        Defect length along the race, m (> 0, at most the ball spacing on the race).
+    depth_m : float
+        Defect depth, m (> 0, at most the ball radius).
+    angle_rad : float or None
+        Position in the housing, rad (x axis = 0, counter-clockwise +); ``None`` = the centre
+        of the load zone (:mod:`cmsim.faults.bearing`).
+    """
+
+    name = "outer_race"
+    kind = KIND_OUTER
+    race = "outer"
+
+    def race_radius_m(self, brg):
+        """Outer raceway radius, m."""
+        return 0.5 * brg.outer_raceway_diameter_m
+
+
+@register
+@dataclass(frozen=True)
+class InnerRaceDefect(_RaceDefect):
+    """Localized defect on the inner race, turning with the shaft.
+
+    Attributes
+    ----------
+    bearing : str
+        Bearing name.
+    size_m : float
+        Defect length along the race, m (> 0, at most the ball spacing on the race).
+    depth_m : float
+        Defect depth, m (> 0, at most the ball radius).
+    angle_rad : float or None
+        Position on the ring from its reference (turning with it), rad; ``None`` = 0.
+    """
+
+    name = "inner_race"
+    kind = KIND_INNER
+    race = "inner"
+
+    def race_radius_m(self, brg):
+        """Inner raceway radius, m."""
+        return 0.5 * brg.inner_raceway_diameter_m
+
+
+@register
+@dataclass(frozen=True)
+class BallDefect(Fault):
+    """Localized defect (a spall) on one ball, striking both races (2 × BSF).
+
+    Attributes
+    ----------
+    bearing : str
+        Bearing name.
+    size_m : float
+        Defect length along the ball's surface, m (> 0, below the ball diameter).
+    depth_m : float
+        Defect depth, m (> 0, at most the ball radius).
+    ball : int
+        Index of the faulty ball in the cage (0 .. n_balls − 1).
+    phase_rad : float
+        Phase of the defect on the ball's spin, rad (0 = facing the outer race at t = 0).
+    """
+
+    name = "ball"
+
+    bearing: str
+    size_m: float
+    depth_m: float
+    ball: int = 0
+    phase_rad: float = 0.0
+
+    def __post_init__(self):
+        if not isinstance(self.bearing, str):
+            raise ParameterError(f"bearing must be a bearing name such as '1b1', got "
+                                 f"{self.bearing!r}", param="bearing")
+        _check_size("size_m", self.size_m)
+        check_range("depth_m", self.depth_m, 0.0, 0.01, lo_open=True, unit="m")
+        check_int("ball", self.ball, 0)
+        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+
+    @property
+    def label(self):
+        return (f"ball@{self.bearing}#{self.ball} size={mm(self.size_m)} "
+                f"depth={mm(self.depth_m)}")
+
+    def validate(self, rig):
+        brg = rig.bearings[check_bearing(rig, self.bearing)]
+        check_range("size_m", self.size_m, 0.0, brg.ball_diameter_m, lo_open=True,
+                    hi_open=True, unit=f"m (below the ball diameter of {self.bearing})")
+        check_range("depth_m", self.depth_m, 0.0, 0.5 * brg.ball_diameter_m, lo_open=True,
+                    unit=f"m (up to the ball radius of {self.bearing})")
+        check_int("ball", self.ball, 0, brg.n_balls - 1)
+        return self
+
+    def defect_row(self, rig, default_angle_rad=0.0):
+        """Row of ``FaultArrays.bearing_defects`` (angles on the ball, radius R_b)."""
+        self.validate(rig)
+        ib = check_bearing(rig, self.bearing)
+        rb = 0.5 * rig.bearings[ib].ball_diameter_m
+        drop = ball_drop_m(rb, self.size_m, self.depth_m)
+        entry = _entry_distance_m(rb, self.size_m, drop)
+        return [float(ib), KIND_BALL, float(self.phase_rad), 0.5 * self.size_m / rb, drop,
+                entry / rb, EXIT_RAMP_FRACTION * entry / rb, float(self.ball)]
+
+
+@register
+@dataclass(frozen=True)
+class BearingWear(Fault):
+    """Distributed wear of a bearing: its radial clearance grows.
+
+    Attributes
+    ----------
+    bearing : str
+        Bearing name.
+    clearance_growth_m : float
+        Increase of ``clearance_m``, m (> 0; the worn clearance must stay within the
+        bearing's allowed range, 5 % of the ball diameter).
+    """
+
+    name = "wear"
+
+    bearing: str
+    clearance_growth_m: float
+
+    def __post_init__(self):
+        check_range("clearance_growth_m", self.clearance_growth_m, 0.0, 1e-3, lo_open=True,
+                    unit="m")
+
+    @property
+    def label(self):
+        return f"wear@{self.bearing} +{1e6 * self.clearance_growth_m:.3g}um"
+
+    def validate(self, rig):
+        brg = rig.bearings[check_bearing(rig, self.bearing)]
+        check_range("clearance_growth_m", self.clearance_growth_m, 0.0,
+                    0.05 * brg.ball_diameter_m - brg.clearance_m, lo_open=True,
+                    unit=f"m (worn clearance of {self.bearing} at most 5 % of its ball "
+                         "diameter)")
+        return self
+
+
+@register
+@dataclass(frozen=True)
+class OffSizeBall(Fault):
+    """One ball larger (or smaller) than the others by Δd: a extra overlap of Δd.
+
+    Attributes
+    ----------
+    bearing : str
+        Bearing name.
+    ball : int
+        Index of the ball in the cage.
+    diameter_excess_m : float
+        Δd, m, signed (+: larger ball), |Δd| at most 1 % of the ball diameter.
+    """
+
+    name = "off_size_ball"
+
+    bearing: str
+    diameter_excess_m: float
+    ball: int = 0
+
+    def __post_init__(self):
+        check_range("diameter_excess_m", self.diameter_excess_m, -1e-3, 1e-3, unit="m")
+        check_int("ball", self.ball, 0)
+
+    @property
+    def label(self):
+        return f"off_size_ball@{self.bearing}#{self.ball} {1e6 * self.diameter_excess_m:+.3g}um"
+
+    def validate(self, rig):
+        brg = rig.bearings[check_bearing(rig, self.bearing)]
+        lim = 0.01 * brg.ball_diameter_m
+        check_range("diameter_excess_m", self.diameter_excess_m, -lim, lim,
+                    unit=f"m (1 % of the ball diameter of {self.bearing})")
+        check_int("ball", self.ball, 0, brg.n_balls - 1)
+        return self
+
+
+@register
+@dataclass(frozen=True)
+class RollingSlip(Fault):
+    """Random rolling slip of all bearings (paper 001 §5, §6.2.1) as a catalogue entry.
+
+    The same fields as the dynamics' ``SlipModel`` (handed over by
+    :func:`~cmsim.faults.compile.slip_from_faults`).
+
+    Attributes
+    ----------
+    cage_speed_rms : float
+        Standard deviation of the relative cage-speed fluctuation, in [0, 0.2].
+    ball_rms_rad : float
+        Standard deviation of each ball's angular deviation, rad, in [0, 0.05].
+    correlation_s : float
+        Correlation time of both processes, s, in [1e-5, 10].
+    """
+
+    name = "rolling_slip"
+
+    cage_speed_rms: float = 0.01
+    ball_rms_rad: float = 0.0
+    correlation_s: float = 5e-3
+
+    def __post_init__(self):
+        check_range("cage_speed_rms", self.cage_speed_rms, 0.0, 0.2)
+        check_range("ball_rms_rad", self.ball_rms_rad, 0.0, 0.05, unit="rad")
+        check_range("correlation_s", self.correlation_s, 1e-5, 10.0, unit="s")
+
+    @property
+    def label(self):
+        return (f"rolling_slip cage={100 * self.cage_speed_rms:.3g}% "
+                f"ball={1e3 * self.ball_rms_rad:.3g}mrad")

@@ -1,0 +1,230 @@
+"""Stiffness of a tooth pair with a root crack, by the potential-energy method.
+
+The healthy method is :mod:`cmsim.mesh_stiffness.potential_energy` (Yang-Lin cantilever on the
+rack-generated tooth, Sainsot fillet foundation, Hertz). A straight root crack of depth q at
+the angle ν to the tooth centreline starts in the loaded-side fillet (the tension side,
+Chaari et al. [1]) at the critical section of ISO 6336-3 [4], where the fillet's tangent is at
+30° to the centreline (the usual crack initiation point), and runs into the tooth; its tip is
+at the distance h_q = h_c − q sin ν from the centreline (h_c: half the tooth thickness at
+the crack start, :func:`crack_start`). As in Tian [2] and Wu, Zuo & Parey [3], the material on the cracked side beyond the
+line through the crack tip parallel to the centreline carries no stress, so a section at
+height u above the crack start whose half-thickness h_u exceeds h_q keeps the thickness h_u + h_q:
+
+    A_u = (h_u + h_q) b,   I_u = (h_u + h_q)³ b / 12     (h_u > h_q)
+    A_u = 2 h_u b,         I_u = (2 h_u)³ b / 12          (h_u <= h_q)
+
+(sections below the crack start are intact) and the bending, shear and axial energies of the cantilever are integrated with them (the
+shift of the neutral axis is neglected, as in [1]-[3]); the Hertz and fillet-foundation terms
+stay healthy. The crack may reach the centreline (q sin ν <= h_c); deeper cracks are outside
+the model (a tooth that deep is better modelled as ``tooth_breakage``).
+
+The result used by the dynamics is the ratio k_cracked(s)/k_healthy(s) of the pair stiffness
+when the cracked tooth is in contact at s (:func:`crack_stiffness_factor`); it multiplies the
+run's own table (hybrid or potential energy) for that tooth only.
+
+References
+----------
+.. [1] F. Chaari, T. Fakhfakh, M. Haddar, "Analytical modelling of spur gear tooth crack and
+   influence on gearmesh stiffness", Eur. J. Mech. A/Solids 28 (2009) 461-468.
+.. [2] X. Tian, "Dynamic simulation for system response of gearbox including localized gear
+   faults", M.Sc. thesis, University of Alberta (2004).
+.. [3] S. Wu, M. J. Zuo, A. Parey, "Simulation of spur gear dynamics and estimation of fault
+   growth", J. Sound Vib. 317 (2008) 608-624.
+.. [4] ISO 6336-3:2006, *Calculation of load capacity of spur and helical gears — Part 3:
+   tooth bending strength*, §6 (critical section at the 30° tangent).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cmsim.errors import ParameterError, check_range
+from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
+from cmsim.mesh_stiffness.potential_energy import (
+    ToothCompliance, _involute_domain, _path_length, cantilever_compliance,
+    fillet_foundation_compliance, pair_compliance_potential_energy)
+
+__all__ = ["crack_start", "crack_tip_offset_m", "max_crack_depth_m", "cracked_tooth_compliance",
+           "crack_stiffness_factor", "mesh_stiffness_loss"]
+
+
+#: Tangent angle to the centreline at the critical section (ISO 6336-3), rad.
+CRITICAL_TANGENT_RAD = math.radians(30.0)
+
+_START_CACHE = {}
+
+
+def crack_start(profile):
+    """(y_s, h_c): height from the gear centre and half-thickness of the crack start, m.
+
+    The point of the loaded-side fillet where the tangent makes 30° with the tooth centreline
+    (ISO 6336-3 critical section), found on the tooth outline by finite differences.
+    """
+    key = profile.gear
+    if key not in _START_CACHE:
+        y = np.linspace(profile.root_chord_y_m, profile.tip_radius_m, 4001)
+        h = profile.half_thickness_at(y)
+        slope = np.abs(np.gradient(h, y))
+        below = np.nonzero(slope <= math.tan(CRITICAL_TANGENT_RAD))[0]
+        i = int(below[0]) if below.size else 0
+        _START_CACHE[key] = (float(y[i]), float(h[i]))
+    return _START_CACHE[key]
+
+
+def max_crack_depth_m(gear, angle_rad):
+    """Deepest crack the model takes: its tip on the centreline, h_c / sin ν, m."""
+    return crack_start(ToothProfile.from_gear(gear))[1] / math.sin(angle_rad)
+
+
+def crack_tip_offset_m(profile, depth_m, angle_rad):
+    """h_q = h_c − q sin ν: distance of the crack tip from the centreline, m."""
+    return crack_start(profile)[1] - depth_m * math.sin(angle_rad)
+
+
+def _check_crack(profile, depth_m, angle_rad):
+    nu = check_range("angle_rad", angle_rad, 0.0, 0.5 * math.pi, lo_open=True, unit="rad")
+    qmax = crack_start(profile)[1] / math.sin(nu)
+    q = check_range("depth_m", depth_m, 0.0, qmax, unit=f"m (crack tip at most on the tooth "
+                    f"centreline: h_c/sin(angle) = {qmax * 1e3:.4g} mm)")
+    return q, nu
+
+
+def cracked_tooth_compliance(profile, contact_radius_m, depth_m, angle_rad, n_nodes=1001):
+    """Compliances of one tooth with a root crack, loaded on its involute at radii r.
+
+    Parameters
+    ----------
+    profile : ToothProfile
+        Generated tooth.
+    contact_radius_m : array_like, shape (n,)
+        Contact radii on the involute, m.
+    depth_m : float
+        Crack depth q, m, in [0, h_c / sin ν] (0 = healthy).
+    angle_rad : float
+        Crack angle ν to the tooth centreline, rad, in (0, π/2].
+    n_nodes : int
+        Nodes of the beam integration.
+
+    Returns
+    -------
+    ToothCompliance
+        Bending, shear and axial with the cracked sections; the healthy foundation term.
+
+    References
+    ----------
+    .. [1] F. Chaari, T. Fakhfakh, M. Haddar, Eur. J. Mech. A/Solids 28 (2009) 461-468.
+    .. [2] S. Wu, M. J. Zuo, A. Parey, J. Sound Vib. 317 (2008) 608-624, eqs. (14)-(17).
+    """
+    q, nu = _check_crack(profile, depth_m, angle_rad)
+    gear = profile.gear
+    r = np.atleast_1d(np.asarray(contact_radius_m, dtype=float))
+    lo, hi = profile.form_radius_m, profile.tip_round_start_radius_m
+    if not np.all(np.isfinite(r)) or np.any(r < lo - 1e-9) or np.any(r > hi + 1e-9):
+        raise ParameterError(f"contact radii must lie on the involute, in [{lo:g}, {hi:g}] m")
+    r = np.clip(r, lo, hi)
+    rb = gear.base_radius_m
+    alpha_r = np.arccos(rb / r)
+    theta_c = involute_half_angle(r, rb, gear.base_half_thickness_angle_rad)
+    x_c, y_c = r * np.sin(theta_c), r * np.cos(theta_c)
+    a1 = alpha_r - theta_c
+    y0 = profile.root_chord_y_m
+    h_q = crack_tip_offset_m(profile, q, nu)
+    y_s = crack_start(profile)[0]
+
+    def h_eff(u):
+        y = np.minimum(y0 + u, profile.tip_radius_m)
+        h = profile.half_thickness_at(y)
+        cut = (y >= y_s) & (h > h_q)                # thickness h + h_q behind the crack
+        return np.where(cut, 0.5 * (h + h_q), h)
+
+    bending, shear, axial = cantilever_compliance(
+        h_eff, y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio,
+        gear.face_width_m, n_nodes=n_nodes)
+    u_f = y_c - x_c * np.tan(a1) - y0
+    foundation = fillet_foundation_compliance(profile, u_f, a1)
+    return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
+
+
+def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1001):
+    """k_cracked(s) / k_healthy(s) of the pair whose tooth on ``gear`` carries the crack.
+
+    Positions outside the involute-involute range are clipped into it (the corner-contact
+    zones keep the factor of the path ends, as the potential-energy tables do).
+
+    Parameters
+    ----------
+    pair : GearPair
+    gear : int
+        1 (driving) or 2 (driven): which gear's tooth is cracked.
+    depth_m, angle_rad : float
+        Crack depth q (m) and angle ν (rad), see :func:`cracked_tooth_compliance`.
+    position_m : array_like, shape (n,)
+        Positions s on the line of action from T1, m.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Stiffness factor in (0, 1].
+
+    Examples
+    --------
+    >>> from cmsim.rig import Rig
+    >>> pair = Rig.paper_2016().gears
+    >>> s = [0.5 * sum(_involute_domain(pair))]
+    >>> bool(0.0 < crack_stiffness_factor(pair, 1, 1e-3, math.pi / 4, s)[0] < 1.0)
+    True
+    """
+    s = np.atleast_1d(np.asarray(position_m, dtype=float))
+    lo, hi = _involute_domain(pair)
+    s = np.clip(s, lo, hi)
+    healthy = pair_compliance_potential_energy(pair, s, n_nodes=n_nodes)
+    if gear == 1:
+        g, rad = pair.driving, np.sqrt(pair.driving.base_radius_m ** 2 + s ** 2)
+        other = healthy.driven
+    elif gear == 2:
+        g = pair.driven
+        rad = np.sqrt(g.base_radius_m ** 2 + (_path_length(pair) - s) ** 2)
+        other = healthy.driving
+    else:
+        raise ParameterError(f"gear must be 1 or 2, got {gear!r}", param="gear",
+                             allowed="1 or 2")
+    cracked = cracked_tooth_compliance(ToothProfile.from_gear(g), rad, depth_m, angle_rad,
+                                       n_nodes=n_nodes)
+    total = healthy.hertz + other.total + cracked.total
+    return healthy.total / total
+
+
+def mesh_stiffness_loss(pair, gear, depth_m, angle_rad, n_points=200):
+    """Loss of total mesh stiffness while the cracked tooth is in mesh (potential energy).
+
+    The cracked tooth's pair runs over the involute path [s0, s1]; the other pairs in contact
+    (one base pitch ahead or behind) stay healthy.
+
+    Returns
+    -------
+    dict
+        ``max_loss`` (largest relative drop of the total mesh stiffness, in the single-contact
+        zone), ``mean_loss`` (relative drop of its mean over the cracked tooth's passage),
+        ``pair_loss_mean`` (mean relative drop of the cracked pair alone), ``crack_ratio``
+        (q sin ν / h_c: 1 = crack tip on the centreline).
+    """
+    lo, hi = _involute_domain(pair)
+    pb = pair.driving.base_pitch_m
+    s = np.linspace(lo, hi, n_points)
+    k = pair_compliance_potential_energy(pair, s).stiffness
+    f = crack_stiffness_factor(pair, gear, depth_m, angle_rad, s)
+    healthy = k.copy()
+    for shift in (-pb, pb, -2 * pb, 2 * pb):
+        sj = s + shift
+        on = (sj >= lo) & (sj <= hi)
+        if np.any(on):
+            healthy[on] += pair_compliance_potential_energy(pair, sj[on]).stiffness
+    cracked = healthy - k * (1.0 - f)
+    g = pair.driving if gear == 1 else pair.driven
+    h_c = crack_start(ToothProfile.from_gear(g))[1]
+    return {"max_loss": float(np.max(1.0 - cracked / healthy)),
+            "mean_loss": float(1.0 - cracked.mean() / healthy.mean()),
+            "pair_loss_mean": float(np.mean(1.0 - f)),
+            "crack_ratio": float(depth_m * math.sin(angle_rad) / h_c)}
