@@ -62,6 +62,10 @@ def _cmd_simulate(args):
     rig = _load_rig(args)
     op = _operating_point(args, rig)
     table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
+    if not args.json and args.duration_s + args.warmup_s > LONG_RUN_S:
+        print(f"cmsim simulate: integrating {args.duration_s + args.warmup_s:g} s of simulated "
+              f"time (about {(args.duration_s + args.warmup_s) / 10:.0f}-"
+              f"{(args.duration_s + args.warmup_s) / 3:.0f} s on one core)...", file=sys.stderr)
     slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                      correlation_s=args.slip_correlation_s)
     run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
@@ -75,6 +79,10 @@ def _cmd_simulate(args):
            "bpf_hz": freqs.bearing(first).bpf_hz, **run.summary(),
            "out": str(args.out) if args.out else None}
     return out
+
+
+#: simulated seconds above which simulate says how long it will take (realtime factor ~3-10)
+LONG_RUN_S = 2.0
 
 
 def _add_mesh_options(p):
@@ -326,12 +334,8 @@ def _cmd_sweep(args):
         summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,
                             progress=progress)
     except KeyboardInterrupt:
-        msg = (f"interrupted; finished runs are kept in {args.out}/manifest.json, re-run the "
-               f"same command to resume")
-        print(f"cmsim: {msg}", file=sys.stderr)
-        if args.json:
-            print(json.dumps({"error": msg}))
-        raise SystemExit(130) from None
+        raise CLIError(f"interrupted; finished runs are kept in {args.out}/manifest.json, "
+                       f"re-run the same command to resume", 130) from None
     return summary.to_dict()
 
 
