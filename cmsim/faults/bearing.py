@@ -63,7 +63,7 @@ def ball_drop_m(ball_radius_m, length_m, depth_m):
     Examples
     --------
     >>> round(ball_drop_m(3.97e-3, 1.0e-3, 1e-3) * 1e6, 3)     # 6205 ball, 1 mm defect
-    31.561
+    31.612
     """
     half = 0.5 * length_m
     sag = ball_radius_m - math.sqrt(max(ball_radius_m ** 2 - half * half, 0.0))
