@@ -62,7 +62,7 @@ def _cmd_simulate(args):
     rig = _load_rig(args)
     op = _operating_point(args, rig)
     table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
-    if not args.json and args.duration_s + args.warmup_s > LONG_RUN_S:
+    if not args.json and args.duration_s + args.warmup_s > LONG_RUN_S and _fits(args, rig):
         print(f"cmsim simulate: integrating {args.duration_s + args.warmup_s:g} s of simulated "
               f"time (about {(args.duration_s + args.warmup_s) / 10:.0f}-"
               f"{(args.duration_s + args.warmup_s) / 3:.0f} s on one core)...", file=sys.stderr)
@@ -83,6 +83,16 @@ def _cmd_simulate(args):
 
 #: simulated seconds above which simulate says how long it will take (realtime factor ~3-10)
 LONG_RUN_S = 2.0
+
+
+def _fits(args, rig):
+    """False when simulate will refuse the run for its memory (then say nothing before)."""
+    from cmsim.dynamics import simulate as sim
+    try:
+        sim._check_memory(args.duration_s, args.fs_hz, rig.n_dof, 4 * len(rig.bearings) + 8)
+    except (ParameterError, AttributeError, TypeError):
+        return False
+    return True
 
 
 def _add_mesh_options(p):
@@ -591,6 +601,8 @@ _PARAM_TO_DEST = {
     "clearances_m": "clearance_m", "max_freq_hz": "max_hz", "signals": "signal",
     "mesh": "mesh", "method": "method", "centres": "centres",
 }
+#: one-word Python names the library uses in messages for what an option sets
+_ALWAYS_REWRITE = {"substeps"}
 #: path options: dest -> "file" (must exist), "dir" (must exist), "out" (new file), "outdir"
 _PATHS = {"rig": "file", "mesh_table": "file", "run": "file", "dir": "dir", "out": "out",
           "plot": "out", ("sweep", "out"): "outdir"}
@@ -693,7 +705,7 @@ def _user_message(exc, options):
     elif param in names:
         option = names[param]
     for name, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
-        if name == param or "_" in name:
+        if name == param or "_" in name or name in _ALWAYS_REWRITE:
             msg = re.sub(rf"(?<![\w.\[\-]){re.escape(name)}(?![\w\[])", opt, msg)
     if option is not None and option not in msg:
         msg = f"{option}: {msg}"
