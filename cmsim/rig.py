@@ -886,17 +886,25 @@ class Rig:
         fields of the same stem.
         """
         data = dict(data)
+        data.pop("faults", None)     # a [[faults]] list: read by cmsim.faults.load_faults
         version = data.pop("format_version", RIG_FORMAT_VERSION)
         if version != RIG_FORMAT_VERSION:
             raise ParameterError(f"rig format_version {version} is not supported "
                                  f"(this cmsim reads version {RIG_FORMAT_VERSION})")
         return _from_plain(cls, data, "rig")
 
-    def save(self, path):
-        """Write the rig as TOML (atomically)."""
+    def save(self, path, faults=()):
+        """Write the rig as TOML (atomically), with an optional ``[[faults]]`` list.
+
+        ``faults`` are :mod:`cmsim.faults` values (anything with ``to_dict()``); read them
+        back with :func:`cmsim.faults.load_faults` (:meth:`load` ignores the list).
+        """
+        data = _drop_none(self.to_dict())
+        if faults:
+            data["faults"] = [_drop_none(f.to_dict()) for f in faults]
         text = ("# cmsim rig description — auto-generated, SI units (m, kg, N, s, rad).\n"
                 "# Keys ending in _deg or _mm are accepted on reading and converted.\n"
-                + tomli_w.dumps(_drop_none(self.to_dict())))
+                + tomli_w.dumps(data))
         atomic_write_text(Path(path), text)
 
     @classmethod

@@ -277,3 +277,12 @@ def test_gear_fault_frequencies(rig):
     assert a["gmf_hz"] == pytest.approx(466.6667, rel=1e-6)
     assert a["shaft_hz"] == pytest.approx(1000 / 60 * 28 / 28)
     assert len(key) == 2                                           # duplicate labels kept
+
+
+def test_rig_toml_with_faults(tmp_path, rig):
+    """A rig file carries a [[faults]] list: Rig.load reads the rig, load_faults the faults."""
+    faults = tuple(parse_fault(t) for t in ALL[:4])
+    path = tmp_path / "rig.toml"
+    rig.save(path, faults=faults)
+    assert Rig.load(path) == rig
+    assert load_faults(path) == faults
