@@ -31,7 +31,9 @@ def sdof_packed():
             np.zeros((0, 1)), np.zeros((0, 1)), np.zeros((0, 1, 1)),
             np.zeros(K.MI_SIZE, dtype=np.int64), np.zeros(K.MP_SIZE), np.zeros(14),
             np.zeros(2), np.zeros(2), np.zeros((1, 2)), np.zeros((1, 2)),
-            np.array([[0, 0, 1]], dtype=np.int64), *K.no_hybrid())
+            np.array([[0, 0, 1]], dtype=np.int64), *K.no_hybrid(), np.zeros((0, K.DF_SIZE)),
+            np.zeros((0, 1)), np.zeros((0, 1)), np.ones((1, 1)), np.ones((1, 1)),
+            np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 3)), K.no_profile())
 
 
 def sdof_exact(t):
@@ -127,10 +129,10 @@ def test_rigid_mesh_static_transmission_error():
     """Constant pair stiffness on near-rigid supports, pair at the pitch point (single
     contact): the quasi-static DTE along the line of action is F/k."""
     rig = cmsim.Rig.paper_2016()
-    stiff = replace(rig.bearings[0], clearance_m=0.0, stiffness_n_per_m_p=1e16)
+    stiff = replace(rig.bearings[0], clearance_m=0.0, stiffness_n_per_m_p=1e14)
     shafts = tuple(replace(s, bearing_1=replace(stiff, mass_kg=s.bearing_1.mass_kg),
                            bearing_2=replace(stiff, mass_kg=s.bearing_2.mass_kg),
-                           flexural_stiffness_n_per_m=(1e13, 1e13)) for s in rig.shafts)
+                           flexural_stiffness_n_per_m=(1e12, 1e12)) for s in rig.shafts)
     rig = replace(rig, shafts=shafts)
     k_pair = 2.0e8
     for torque in (10.0, 100.0):
@@ -139,7 +141,13 @@ def test_rigid_mesh_static_transmission_error():
         q = quasi_static_state(model, 0.0)
         rb = rig.gears.driving.base_radius_m
         dte = q[model.index("theta_1G1")] - q[model.index("theta_2G1")]
-        assert dte * rb == pytest.approx(torque / rb / k_pair, rel=2e-3)
+        # compatibility along the line of action: r_b·DTE + n·(c1 − c2) = F/k, the stiff
+        # (but plausible: 1e14 N/m^1.5, 1e12 N/m) supports moving the centres by ~1 %
+        g = model.mesh_jacobian()
+        centres = g @ q - g[model.index("theta_1G1")] * q[model.index("theta_1G1")] \
+            - g[model.index("theta_2G1")] * q[model.index("theta_2G1")]
+        assert abs(centres) < 0.02 * torque / rb / k_pair
+        assert dte * rb + centres == pytest.approx(torque / rb / k_pair, rel=2e-3)
 
 
 def test_rotor_on_two_bearings_static_deflection(bearing_rig):

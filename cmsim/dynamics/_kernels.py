@@ -369,17 +369,42 @@ def _mesh_frame(c1x, c1y, c2x, c2y, rb1, rb2, mp):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag, want_diag,
-                 hp, hd1, hc1, hd2, hc2, S, hw, hdelta, hrho1, hrho2, hchi1, hchi2, hout,
-                 hstat, psi_anchor):
+def _tooth_lookup(tk, te, k, s, x0, dx):
+    """Factor and extra separation of tooth ``k`` at table position ``s`` (linear, clamped)."""
+    m = tk.shape[1]
+    u = (s - x0) / dx
+    if u <= 0.0:
+        return tk[k, 0], te[k, 0]
+    if u >= m - 1:
+        return tk[k, m - 1], te[k, m - 1]
+    i = int(u)
+    f = u - i
+    return (tk[k, i] + f * (tk[k, i + 1] - tk[k, i]),
+            te[k, i] + f * (te[k, i + 1] - te[k, i]))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
     """Forces of the tooth pairs in the potential-contact zone: exact rigid-body geometry,
     elastic force from the table (``MI_MODE`` 0) or from the on-line hybrid contact solve
     (1, paper 001 model A), stiffness-proportional hysteretic damping (``MP_BETA``) or Koster
-    squeeze damping, smoothed Coulomb friction.
+    squeeze damping, smoothed Coulomb friction. ``t`` is the equivalent time τ of the
+    nominal rotation and ``sr`` the speed over the reference speed (1 at constant speed).
+
+    Faults: per-tooth stiffness factors and separations (``MI_TEETH``; the factors act on
+    the table path only — the on-line solve takes the separations), and eccentric gears
+    (``MI_ECC``: the contact geometry uses each gear's geometric centre, turning about its
+    shaft; moments and contact velocities use the shaft centre).
 
     Pass 1 stores each slot's geometry in ``S`` (columns ``SG_*``); in hybrid mode the
     interferences of all slots are then solved together (out-of-zone slots enter with a
-    large negative interference, so they stay unloaded); pass 2 applies the forces."""
+    large negative interference, so they stay unloaded); pass 2 applies the forces.
+    Inlined into the integrator, so taking the arrays out of ``P`` and ``W`` costs nothing."""
+    m_int, mp, geo, tab_k, tab_e = P.m_int, P.m_par, P.geo, P.tab_k, P.tab_e
+    teeth1, teeth2, hp, hd1, hc1, hd2, hc2 = P.teeth1, P.teeth2, P.hp, P.hd1, P.hc1, P.hd2, P.hc2
+    tk1, tk2, te1, te2, ecc = P.tk1, P.tk2, P.te1, P.te2, P.ecc
+    S, hw, hdelta, hrho1, hrho2 = W.slots, W.hwork, W.hdelta, W.hrho1, W.hrho2
+    hchi1, hchi2, hout, hstat, psi_anchor = W.hchi1, W.hchi2, W.hout, W.hstat, W.psi
     z1 = teeth1.shape[0]
     z2 = teeth2.shape[0]
     i1 = m_int[MI_G1]
@@ -393,12 +418,26 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
     c1y = y[i1 + 1]
     c2x = y[i2]
     c2y = mp[MP_A0] + y[i2 + 1]
-    phi_t1, length, cos_t1, sin_t1 = _mesh_frame(c1x, c1y, c2x, c2y, rb1, rb2, mp)
     # physical involute origins of the reference pair (tooth 0 on both gears)
     psi1 = mp[MP_OM1] * t + y[i1 + 2] + mp[MP_PSI10]
     psi2 = mp[MP_PSI20] - (mp[MP_OM2] * t + y[i2 + 2])
     trig_done = False
     cp1 = sp1 = cp2 = sp2 = 0.0
+    # geometric centres (the shaft centres unless a gear is eccentric)
+    gx1 = c1x
+    gy1 = c1y
+    gx2 = c2x
+    gy2 = c2y
+    if m_int[MI_ECC] != 0:
+        cp1, sp1 = _anchored_cos_sin(psi_anchor, 0, psi1)
+        cp2, sp2 = _anchored_cos_sin(psi_anchor, 1, psi2)
+        trig_done = True
+        gx1 += ecc[0, 0] * (cp1 * ecc[0, 1] - sp1 * ecc[0, 2])
+        gy1 += ecc[0, 0] * (sp1 * ecc[0, 1] + cp1 * ecc[0, 2])
+        gx2 += ecc[1, 0] * (cp2 * ecc[1, 1] - sp2 * ecc[1, 2])
+        gy2 += ecc[1, 0] * (sp2 * ecc[1, 1] + cp2 * ecc[1, 2])
+    phi_t1, length, cos_t1, sin_t1 = _mesh_frame(gx1, gy1, gx2, gy2, rb1, rb2, mp)
+    teeth_on = m_int[MI_TEETH] != 0
     # interference: nominal rolling cancels exactly (rb1·Ω1 = rb2·Ω2)
     delta_inv = (rb1 * (y[i1 + 2] + mp[MP_PSI10] - phi_t1)
                  + rb2 * (mp[MP_PSI20] - y[i2 + 2] - (phi_t1 + math.pi))
@@ -406,8 +445,8 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
     s_ref = rb1 * (psi1 - phi_t1)
     m0f = math.floor((s_ref - mp[MP_SLO]) / pb)
     m0 = int(m0f)
-    w1 = mp[MP_OM1] + y[n + i1 + 2]
-    w2 = -(mp[MP_OM2] + y[n + i2 + 2])
+    w1 = mp[MP_OM1] * sr + y[n + i1 + 2]
+    w2 = -(mp[MP_OM2] * sr + y[n + i2 + 2])
     lo = length - geo[3] - mp[MP_ZBEFORE]
     hi = geo[2] + mp[MP_ZAFTER]
     # tooth numbers of the first slot's pair, m0 mod Z (float floor: integer % is slow)
@@ -442,7 +481,13 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
         c2n = cp2 * teeth2[k2, 0] - sp2 * teeth2[k2, 1]
         s2n = sp2 * teeth2[k2, 0] + cp2 * teeth2[k2, 1]
         delta, nx, ny, px, py, s_eq, chi1, chi2 = pair_contact_jit(
-            s, delta_inv, c1n, s1n, c2n, s2n, c1x, c1y, c2x, c2y, cos_t1, sin_t1, length, geo)
+            s, delta_inv, c1n, s1n, c2n, s2n, gx1, gy1, gx2, gy2, cos_t1, sin_t1, length, geo)
+        f_teeth = 1.0
+        if teeth_on:
+            fa, ea = _tooth_lookup(tk1, te1, k1, s, mp[MP_TAB0], mp[MP_TABD])
+            fb, eb = _tooth_lookup(tk2, te2, k2, s, mp[MP_TAB0], mp[MP_TABD])
+            f_teeth = fa * fb
+            delta -= ea + eb
         S[j, SG_NX] = nx
         S[j, SG_NY] = ny
         S[j, SG_PX] = px
@@ -459,6 +504,7 @@ def _mesh_forces(t, y, n, g, m_int, mp, geo, tab_k, tab_e, teeth1, teeth2, diag,
             # contact's s_eq falls inside the involute path, where the stiffer involute values
             # sit: read there, B doubled the corner forces, issue 9 model A/B/C)
             k_pair, e_pair = table_lookup2_jit(s, mp[MP_TAB0], mp[MP_TABD], tab_k, tab_e)
+            k_pair *= f_teeth
             overlap = delta - e_pair
             S[j, SG_ELASTIC] = k_pair * overlap if overlap > 0.0 else 0.0
             S[j, SG_GAP] = -overlap
@@ -577,6 +623,28 @@ def make_work(P):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def profile_at(prof, t0, dt, t):
+    """(Θ, Ω, dΩ/dt, torque) of the profile table at time ``t`` (linear, clamped)."""
+    m = prof.shape[0]
+    u = (t - t0) / dt
+    if u <= 0.0:
+        i = 0
+        f = 0.0
+    elif u >= m - 1:
+        i = m - 2
+        f = 1.0
+    else:
+        i = int(u)
+        f = u - i
+    if m == 1:
+        return prof[0, 0], prof[0, 1], prof[0, 2], prof[0, 3]
+    a = prof[i]
+    b = prof[i + 1]
+    return (a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2]),
+            a[3] + f * (b[3] - a[3]))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     """Equations of motion (module docstring); writes ``dydt[row]`` and optionally ``diag``."""
     minv = P.minv
@@ -585,6 +653,19 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     g = W.g
     for i in range(n):
         g[i] = fext[i]
+    # nominal rotation: τ = t, Ω/Ω_ref = 1, no acceleration at constant speed
+    tau = t
+    sr = 1.0
+    ar = 0.0
+    if P.m_int[MI_PROFILE] != 0:
+        theta, omega_in, alpha_in, torque = profile_at(P.prof, P.m_par[MP_PT0],
+                                                       P.m_par[MP_PDT], t)
+        inv_ref = 1.0 / P.m_par[MP_OMREF]
+        tau = theta * inv_ref
+        sr = omega_in * inv_ref
+        ar = alpha_in * inv_ref
+        if P.m_int[MI_TDOF] >= 0:
+            g[P.m_int[MI_TDOF]] = -torque
     if P.jitter.shape[2] > 1:
         _slip_offsets(t, P.b_int, P.b_cos, P.b_sin, P.jitter, P.m_par[MP_JDT], W.slip_cos,
                       W.slip_sin, W.cage_slip)
@@ -594,14 +675,15 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
         ball_cos = P.b_cos
         ball_sin = P.b_sin
     if P.b_int.shape[0] > 0:
-        _bearing_forces(t, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
-                        W.cage_slip, diag, want_diag)
+        _bearing_forces(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
+                        W.cage_slip, diag, want_diag, P.b_ang, P.b_off, P.b_def)
     if P.m_int[MI_ON] != 0:
-        _mesh_forces(t, y, n, g, P.m_int, P.m_par, P.geo, P.tab_k, P.tab_e, P.teeth1,
-                     P.teeth2, diag, want_diag, P.hp, P.hd1, P.hc1, P.hd2, P.hc2, W.slots,
-                     W.hwork, W.hdelta, W.hrho1, W.hrho2, W.hchi1, W.hchi2, W.hout, W.hstat,
-                     W.psi)
+        _mesh_forces(tau, sr, y, n, g, P, W, diag, want_diag)
     linear_accel_jit(y, g, minv, P.springs, P.spring_ends, dydt, row)
+    if ar != 0.0:
+        # deviation coordinates: the nominal rotation's acceleration acts as an inertia load
+        for i in range(n):
+            dydt[row, n + i] -= P.omega[i] * ar
 
 
 class IntegratorBuffers(NamedTuple):

@@ -103,6 +103,8 @@ class RigModel:
         Bearing parameters; the phase column is set per run.
     b_cos, b_sin : ndarray, shape (nb, max_balls)
         cos and sin of the ball offsets in each cage.
+    b_ang : ndarray, shape (nb, max_balls)
+        The ball offsets in each cage, rad.
     mesh : dict
         Tooth geometry of the kernels (``geo``, ``teeth1``, ``teeth2``, slots, phases, zone
         limits); empty without gears.
@@ -119,6 +121,7 @@ class RigModel:
     b_par: np.ndarray = field(repr=False)
     b_cos: np.ndarray = field(repr=False)
     b_sin: np.ndarray = field(repr=False)
+    b_ang: np.ndarray = field(repr=False, default=None)
     mesh: dict = field(repr=False, default_factory=dict)
 
     @property
@@ -154,20 +157,24 @@ def rig_model(rig):
     b_par = np.zeros((nb, K.BP_SIZE))
     b_cos = np.zeros((nb, max_balls))
     b_sin = np.zeros((nb, max_balls))
+    b_ang = np.zeros((nb, max_balls))
     node_of = {name: k for k, name in enumerate(rig.node_names)}
     for ib, (bname, brg) in enumerate(zip(rig.bearing_names, bearings)):
         node = node_of[bname]
         k_in, k_out = cage_ratios(brg)
-        b_int[ib] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls)
+        b_int[ib, :K.BI_DEF0] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls)
         b_par[ib, K.BP_K] = bearing_contact_stiffness(brg)
         b_par[ib, K.BP_P] = brg.load_exponent
         b_par[ib, K.BP_C] = brg.clearance_m
         b_par[ib, K.BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio
         b_par[ib, K.BP_SENSE] = 1.0 if bname.startswith("1") else -1.0
         b_par[ib, K.BP_DAMP] = brg.damping_n_s_per_m
+        b_par[ib, K.BP_SPIN] = (brg.pitch_diameter_m - brg.ball_diameter_m
+                                * math.cos(brg.effective_contact_angle_rad)) / brg.ball_diameter_m
         co, so = ball_offsets(brg)
         b_cos[ib, :brg.n_balls] = co
         b_sin[ib, :brg.n_balls] = so
+        b_ang[ib, :brg.n_balls] = np.arctan2(so, co)
     mesh = {}
     if rig.gears is not None:
         pair = rig.gears
@@ -185,10 +192,10 @@ def rig_model(rig):
                 "phi_t0": 0.5 * math.pi - alpha,
                 "koster": 12 * math.pi * lub.dynamic_viscosity_pa_s * min(
                     pair.driving.face_width_m, pair.driven.face_width_m)}
-    for arr in (mass, kmat, cmat, springs, spring_ends, b_int, b_par, b_cos, b_sin):
+    for arr in (mass, kmat, cmat, springs, spring_ends, b_int, b_par, b_cos, b_sin, b_ang):
         arr.setflags(write=False)
     return RigModel(rig, names, mass, kmat, cmat, springs, spring_ends, b_int, b_par, b_cos,
-                    b_sin, mesh)
+                    b_sin, b_ang, mesh)
 
 
 @dataclass(frozen=True)
@@ -407,7 +414,7 @@ def _dof_names(rig):
 
 
 def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
-                cage_phases_rad=None):
+                cage_phases_rad=None, fault_arrays=None, profile=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
 
     Parameters
@@ -421,6 +428,13 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
         (model A); or an explicit table, table set or hybrid model.
     slip, duration_s, seed, cage_phases_rad
         Per-run values, as in :meth:`DynamicModel.for_run`.
+    fault_arrays : FaultArrays, optional
+        Compiled faults (:func:`cmsim.faults.compile_faults`; fields documented in
+        :class:`cmsim.dynamics._kernels.KernelParams`): race and ball defects, off-size
+        balls, per-tooth stiffness factors and separations, eccentric gears.
+    profile : KernelProfile, optional
+        Input speed and output torque against time (:mod:`cmsim.dynamics.profiles`);
+        ``op`` then gives the reference (initial) speed.
 
     Returns
     -------
@@ -451,6 +465,7 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
 
     nb = len(rig.bearings)
     m_int = np.zeros(K.MI_SIZE, dtype=np.int64)
+    m_int[K.MI_TDOF] = -1
     m_par = np.zeros(K.MP_SIZE)
     m_par[K.MP_JDT] = 1.0
     m_par[K.MP_DIAGB] = 2 * nb
@@ -458,7 +473,7 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     if rig.gears is not None:
         pair, geom = rig.gears, rm.mesh
         mode = K.MODE_TABLE if mesh_model is None else K.MODE_HYBRID
-        m_int[:] = (geom["g1"], geom["g2"], geom["n_slots"], 1, mode)
+        m_int[:K.MI_TEETH] = (geom["g1"], geom["g2"], geom["n_slots"], 1, mode)
         mc = rig.mesh_contact
         k_mean = mesh_table.mean_mesh_stiffness(pair)
         m_par[K.MP_A0] = pair.working_centre_distance_m
@@ -494,14 +509,68 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
         hybrid = tuple(np.ascontiguousarray(a, dtype=float) for a in mesh_model.kernel_args())
     else:
         hybrid = K.no_hybrid()
-    packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, rm.b_int, rm.b_par,
+    b_int, faults = _fault_fields(rm, m_int, fault_arrays)
+    prof = K.no_profile()
+    if profile is not None:
+        m_int[K.MI_PROFILE] = 1
+        m_int[K.MI_TDOF] = n - 1 if rig.gears is not None else -1
+        m_par[K.MP_PT0] = profile.t0_s
+        m_par[K.MP_PDT] = profile.dt_s
+        m_par[K.MP_OMREF] = op.omega_rad_s
+        prof = np.ascontiguousarray(profile.table, dtype=float)
+    packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, b_int, rm.b_par,
                             rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
                             m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
-                            *hybrid)
+                            *hybrid, faults[0], rm.b_ang, *faults[1:], prof)
     model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
                          SlipModel(), mesh_model, np.zeros(nb))
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
                          seed=seed)
+
+
+def _fault_fields(rm, m_int, fa):
+    """``(b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc))`` for the kernel from FaultArrays."""
+    nb, max_balls = rm.b_cos.shape
+    if fa is None:
+        return rm.b_int, K.no_faults(nb, max_balls)
+    b_def = np.ascontiguousarray(fa.bearing_defects, dtype=float).reshape(-1, K.DF_SIZE)
+    b_off = np.ascontiguousarray(fa.ball_offset_m, dtype=float)
+    if b_off.shape != (nb, max_balls):
+        raise ParameterError(f"ball_offset_m must have shape {(nb, max_balls)}, "
+                             f"got {b_off.shape}")
+    order = np.argsort(b_def[:, K.DF_BRG], kind="stable")
+    b_def = np.ascontiguousarray(b_def[order])
+    b_int = rm.b_int.copy()
+    for ib in range(nb):
+        rows = np.flatnonzero(b_def[:, K.DF_BRG] == ib)
+        b_int[ib, K.BI_DEF0] = rows[0] if rows.size else 0
+        b_int[ib, K.BI_NDEF] = rows.size
+        b_int[ib, K.BI_FAULTY] = int(rows.size > 0 or np.any(b_off[ib] != 0.0))
+    rig = rm.rig
+    tk1, tk2, te1, te2 = (np.ascontiguousarray(a, dtype=float) for a in
+                          (fa.tooth_factor1, fa.tooth_factor2, fa.tooth_sep1, fa.tooth_sep2))
+    teeth = rig.gears is not None and (np.any(tk1 != 1.0) or np.any(tk2 != 1.0)
+                                       or np.any(te1 != 0.0) or np.any(te2 != 0.0))
+    if teeth:
+        z1, z2 = rig.gears.driving.n_teeth, rig.gears.driven.n_teeth
+        if tk1.shape[0] != z1 or te1.shape[0] != z1 or tk2.shape[0] != z2 \
+                or te2.shape[0] != z2:
+            raise ParameterError(f"per-tooth tables need {z1} rows for gear 1 and {z2} for "
+                                 f"gear 2")
+        m_int[K.MI_TEETH] = 1
+    else:
+        tk1 = tk2 = np.ones((1, 1))
+        te1 = te2 = np.zeros((1, 1))
+    ecc_in = np.asarray(fa.eccentricity, dtype=float).reshape(2, 2)
+    ecc = np.zeros((2, 3))
+    if rig.gears is not None and np.any(ecc_in[:, 0] != 0.0):
+        m_int[K.MI_ECC] = 1
+        # the kernel turns the offset with the gear's involute origin ψ = θ + ψ0
+        refs = (rm.mesh["psi10"], rm.mesh["psi20"])
+        for gear in range(2):
+            ecc[gear] = (ecc_in[gear, 0], math.cos(ecc_in[gear, 1] - refs[gear]),
+                         math.sin(ecc_in[gear, 1] - refs[gear]))
+    return b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc)
 
 
 def _pitch_multiples(n_teeth):
