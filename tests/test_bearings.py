@@ -179,15 +179,39 @@ def test_cage_speed_with_both_rings_rotating(b209, ratio):
     """Paper 002 Table 1: n_c = n_i K1 + n_o K2 (same sense) and n_i K1 − |n_o| K2 (counter),
     K1 = (1 − d/D cos α)/2, K2 = (1 + d/D cos α)/2."""
     from dataclasses import replace
+    from cmsim.bearings.kinematics import ball_angles, cage_angle
+    from cmsim.dynamics import _kernels as kern
+    from cmsim.dynamics.model import rig_model
     brg = replace(b209, outer_ring_speed_ratio=ratio)
-    gamma = brg.ball_diameter_m / brg.pitch_diameter_m * math.cos(brg.effective_contact_angle_rad)
+    d, pd = brg.ball_diameter_m, brg.pitch_diameter_m
+    cos_a = math.cos(brg.effective_contact_angle_rad)
+    gamma = d / pd * cos_a
     k1, k2 = (1 - gamma) / 2, (1 + gamma) / 2
-    n_i = 1000.0
-    n_c = n_i * k1 + (abs(ratio) * n_i * k2 if ratio > 0 else -abs(ratio) * n_i * k2)
-    assert cage_ratios(brg) == pytest.approx((k1, k2))
-    assert ball_pass_cycles_per_rev(brg) * n_i == pytest.approx(brg.n_balls * abs(n_c))
+    assert cage_ratios(brg) == pytest.approx((k1, k2), rel=1e-12)
+    # rolling without slip, from the contact radii: the ball centre moves at the mean of the
+    # two raceway contact speeds, the cage carries it at radius D/2
+    w_i = 2 * math.pi * 1000.0 / 60.0
+    w_o = ratio * w_i
+    r_in, r_out = (pd - d * cos_a) / 2, (pd + d * cos_a) / 2
+    w_c = 0.5 * (w_i * r_in + w_o * r_out) / (pd / 2)
+    t = np.linspace(0.0, 0.1, 7)
+    np.testing.assert_allclose(cage_angle(brg, w_i * t, w_o * t), w_c * t, rtol=1e-12,
+                               atol=1e-15)
+    balls = ball_angles(brg, w_i * t, w_o * t)
+    assert balls.shape == (t.size, brg.n_balls)
+    np.testing.assert_allclose(balls[:, 3] - balls[:, 0], 3 * 2 * math.pi / brg.n_balls)
+    np.testing.assert_allclose(balls[:, 0], w_c * t, rtol=1e-12, atol=1e-15)
+    assert ball_pass_cycles_per_rev(brg) == pytest.approx(brg.n_balls * abs(w_c / w_i),
+                                                          rel=1e-12)
+    # the dynamics turns its cages at the same rate (bearing 1b1 of a rig with this bearing)
+    rig = Rig.paper_2016()
+    s1 = replace(rig.shafts[0], bearing_1=brg)
+    model = rig_model(replace(rig, shafts=(s1, rig.shafts[1])))
+    assert model.b_par[0, kern.BP_CAGE] == pytest.approx(w_c / w_i, rel=1e-12)
     if ratio == 1.0:  # rings turning together: the cage turns with them
-        assert n_c == pytest.approx(n_i)
+        assert cage_angle(brg, 2.0, 2.0) == pytest.approx(2.0, rel=1e-12)
+    if ratio < 0:     # counter-rotating outer ring slows the cage below K_in
+        assert abs(w_c) < k1 * w_i
 
 
 def test_slip_jitter_statistics():
