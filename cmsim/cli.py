@@ -71,6 +71,9 @@ def _cmd_simulate(args):
     run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
                    mesh=mesh_model if mesh_model is not None else table, slip=slip,
                    seed=args.seed, warmup_s=args.warmup_s)
+    if args.sensors or args.sensor_noise or args.sensor_fs_hz is not None:
+        from cmsim.sensors import add_sensors
+        run = add_sensors(run, noise_rms=args.sensor_noise, fs_hz=args.sensor_fs_hz)
     if args.out:
         run.save(args.out)
     freqs = rig_frequencies(rig, op)
@@ -189,6 +192,15 @@ def _add_simulate(sub):
                    help="correlation time of the slip processes, s")
     p.add_argument("--seed", type=int, help="random seed (recorded in the run)")
     p.add_argument("--out", type=Path, metavar="RUN.npz", help="write the run here")
+    p.add_argument("--sensors", action="store_true",
+                   help="add housing accelerometers accel_<bearing>_<x|y> (m/s^2, bearing "
+                        "forces through the rig's [housing] modes) and a once-per-rev tacho "
+                        "(implied by --sensor-noise or --sensor-fs-hz)")
+    p.add_argument("--sensor-noise", type=float, default=0.0, metavar="RMS",
+                   help="white sensor noise, m/s^2 rms (seeded by --seed)")
+    p.add_argument("--sensor-fs-hz", type=float, metavar="FS",
+                   help="sensor sample rate, Hz (<= --fs-hz, e.g. 12000); the whole run is "
+                        "decimated through an 80 dB anti-alias filter")
     _add_rig_options(p)
     p.set_defaults(func=_cmd_simulate, text=_text_simulate)
 

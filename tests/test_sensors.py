@@ -10,14 +10,16 @@ ramp; impacts at a fault rate ringing the housing show that rate in the envelope
 the band the kurtogram picks.
 """
 
+import json
 import math
 
 import numpy as np
 import pytest
 from scipy.signal import sosfreqz
 
+from cmsim.cli import main
 from cmsim.errors import ParameterError
-from cmsim.rig import HousingPath, Rig
+from cmsim.rig import HousingPath, Rig, RollingBearing, Rotor
 from cmsim.run import Run
 from cmsim.sensors import (STEPS_PER_MODE_PERIOD, TACHO_LEVEL_V, TACHO_PULSE_WIDTH_RAD, add_sensors, decimate,
                            housing_acceleration, housing_sos, tacho_signal)
@@ -325,3 +327,31 @@ def test_impacts_ringing_the_housing_show_the_fault_rate_in_the_envelope_spectru
     raw = amplitude_spectrum(acc, out.fs_hz, window="hann")
     near = np.abs(raw.freq_hz - fault_hz) < 1.0
     assert raw.amplitude[near].max() < 0.01 * raw.amplitude.max()
+
+
+# ---------------------------------------------------------------------- command line
+def _cwru_like_rig():
+    brg = RollingBearing.from_pitch(9, 7.94e-3, 39.04e-3)
+    return Rig.rotor_on_bearings(brg, Rotor(mass_kg=5.0, inertia_kg_m2=0.01))
+
+
+def test_cli_simulate_with_sensors_writes_accelerations_and_tacho(tmp_path, capsys):
+    rig_file = tmp_path / "rig.toml"
+    _cwru_like_rig().save(rig_file)
+    out = tmp_path / "run.npz"
+    status = main(["simulate", "--rig", str(rig_file), "--speed-rpm", "1797",
+                   "--radial-load-n", "50", "--duration-s", "0.2", "--fs-hz", "48000",
+                   "--sensor-fs-hz", "12000", "--sensor-noise", "0.01", "--seed", "4",
+                   "--out", str(out), "--json"])
+    assert status == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["fs_hz"] == pytest.approx(12_000.0) and res["accel_1b1_y_rms_m_s2"] > 0.005
+    run = Run.load(out)
+    assert {"accel_1b1_x", "accel_1b1_y", "accel_1b2_x", "accel_1b2_y", "tacho"} <= set(run.names)
+    times = tacho_pulse_times(run["tacho"], run.fs_hz)
+    assert 1 / np.mean(np.diff(times)) == pytest.approx(1797 / 60, rel=0.01)
+    assert run.meta["sensor"]["seed"] == 4 and run.meta["sensor"]["noise_rms_m_s2"] == 0.01
+    plain = tmp_path / "plain.npz"
+    assert main(["simulate", "--rig", str(rig_file), "--speed-rpm", "1797", "--radial-load-n",
+                 "50", "--duration-s", "0.05", "--out", str(plain)]) == 0
+    assert not any(k.startswith("accel_") or k == "tacho" for k in Run.load(plain).names)
