@@ -57,11 +57,12 @@ def test_modes_json(capsys):
 
 
 @pytest.mark.parametrize("argv, word", [
-    (["simulate", "--speed-rpm", "0"], "speed_rpm"),
-    (["simulate", "--speed-rpm", "1000", "--torque-nm", "nan"], "torque_nm"),
-    (["simulate", "--speed-rpm", "1000", "--clearance-m", "0.02"], "clearance_m"),
+    (["simulate", "--speed-rpm", "0"], "--speed-rpm"),
+    (["simulate", "--speed-rpm", "1000", "--torque-nm", "nan"], "--torque-nm"),
+    (["simulate", "--speed-rpm", "1000", "--clearance-m", "0.02"], "--clearance-m"),
+    (["simulate", "--speed-rpm", "1000", "--clearance-m", "0.0009"], "--clearance-m"),
     (["simulate", "--speed-rpm", "1000", "--rig", "/nonexistent.toml"], "does not exist"),
-    (["modes", "--torque-nm", "-5"], "torque_nm"),
+    (["modes", "--torque-nm", "-5"], "--torque-nm"),
 ])
 def test_bad_input_exit_code_and_message(capsys, argv, word):
     status = main(argv + ["--json"])
@@ -81,3 +82,36 @@ def test_divergence_exit_code(capsys):
 def test_text_output(capsys):
     assert main(["modes", "--torque-nm", "10"]) == 0
     assert "natural frequencies" in capsys.readouterr().out
+
+
+def test_unloaded_default_operating_point_runs(capsys):
+    """Issue 10 item 1/10: no torque given is a valid operating point (exit 0)."""
+    status, res = run_json(capsys, ["simulate", "--speed-rpm", "1000", "--duration-s", "0.02"])
+    assert status == 0 and "warnings" not in res
+
+
+def test_implausible_torque_warns(capsys):
+    """1000 N m on a 6.35 mm face: a warning on stderr and in the JSON object."""
+    status, res = run_json(capsys, ["modes", "--torque-nm", "1000"])
+    assert status == 0
+    assert len(res["warnings"]) == 1 and "MPa" in res["warnings"][0]
+    assert main(["modes", "--torque-nm", "1000"]) == 0
+    assert "warning: --torque-nm 1000" in capsys.readouterr().err
+
+
+def test_bearing_rig_sweep_radial_load_and_report(capsys, tmp_path):
+    """Issue 10 item 10: a bearing rig sweeps with --radial-load-n and no --torque-nm, and
+    report works without dte_um."""
+    import cmsim
+    from cmsim.rig import Rig
+    rig = Rig.rotor_on_bearings(Rig.paper_2016().bearings[0], cmsim.Rotor(3.0, 0.01))
+    rig.save(tmp_path / "b.toml")
+    out = tmp_path / "sw"
+    status, res = run_json(capsys, ["sweep", "--speed-rpm", "1800", "--radial-load-n", "500",
+                                    "--rig", str(tmp_path / "b.toml"), "--duration-s", "0.05",
+                                    "--out", str(out), "--workers", "1"])
+    assert status == 0 and res["completed"] == 1
+    run = Run.load(next((out / "runs").glob("*.npz")))
+    assert run.meta["operating_point"]["radial_load_n"] == pytest.approx(500.0)
+    status, res = run_json(capsys, ["report", str(out)])
+    assert status == 0 and "dte_um" not in " ".join(res["figures"])
