@@ -32,6 +32,7 @@ import html
 import io
 import math
 import time
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -125,8 +126,6 @@ def sweep_run_files(sweep_dir):
 def _read_run(path):
     """``Run.load(path)`` with its rig and operating point parsed; an unreadable or corrupted
     file is a :class:`ParameterError` naming it (re-running the sweep recomputes it)."""
-    import zipfile
-
     try:
         run = Run.load(path)
         run.rig, run.operating_point  # noqa: B018 - parse the meta here
