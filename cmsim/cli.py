@@ -600,6 +600,8 @@ _RANGES = {
     "resolution_hz": (float, 0.0, 1.0e6, True, False, "Hz"),
     "band_hz": (float, 0.0, 1.0e7, False, False, "Hz"),
     "workers": (int, 1, 1024, False, False, ""),
+    "sensor_noise": (float, 0.0, 1.0e6, False, False, "m/s^2"),
+    "sensor_fs_hz": (float, 0.0, 1.0e7, True, False, "Hz (and <= --fs-hz)"),
 }
 #: numeric options whose range depends on other inputs and is checked by the library, which
 #: names them through _PARAM_TO_DEST (none today; clearance is narrowed by the bearing)
@@ -612,6 +614,7 @@ _PARAM_TO_DEST = {
     "speeds_rpm": "speed_rpm", "friction_coefficient": "friction", "frictions": "friction",
     "clearances_m": "clearance_m", "max_freq_hz": "max_hz", "signals": "signal",
     "mesh": "mesh", "method": "method", "centres": "centres",
+    "noise_rms": "sensor_noise", "fs_out_hz": "sensor_fs_hz",
 }
 #: one-word Python names the library uses in messages for what an option sets
 _ALWAYS_REWRITE = {"substeps"}

@@ -127,6 +127,8 @@ CATALOGUE = [
       "--table-torque-nm 1000", "--table-torque-nm", numeric=True),
     R("simulate-table-torque-alone", "simulate --speed-rpm 1000 --table-torque-nm 10",
       "--table-torque-nm"),
+    R("simulate-sensor-fs-above-fs", "simulate --speed-rpm 1000 --fs-hz 20000 --sensor-fs-hz "
+      "40000", "--sensor-fs-hz", numeric=True),
     R("simulate-diverges", "simulate --speed-rpm 1000 --torque-nm 100 --fs-hz 2000 --substeps 1 "
       "--warmup-s 0 --duration-s 0.2", "--substeps", status=3),
     # ---- modes
