@@ -39,12 +39,31 @@ def test_simulate_json_and_npz(capsys, tmp_path):
 def test_simulate_with_options(capsys, tmp_path):
     rig = tmp_path / "rig.toml"
     from cmsim.rig import Rig
-    Rig.paper_2016().save(rig)
-    status, res = run_json(capsys, ["simulate", "--speed-rpm", "1500", "--torque-nm", "20",
-                                    "--duration-s", "0.05", "--rig", str(rig), "--friction",
-                                    "0.03", "--clearance-m", "-1e-6", "--seed", "1"])
-    assert status == 0
-    assert res["gmf_hz"] == pytest.approx(28 * 25)
+    from dataclasses import replace
+    replace(Rig.paper_2016(), name="rig from a file").save(rig)
+    runs = {}
+    for label, extra in (("options", ["--rig", str(rig), "--friction", "0.03",
+                                      "--clearance-m", "-1e-6"]), ("plain", [])):
+        out = tmp_path / f"{label}.npz"
+        status, res = run_json(capsys, ["simulate", "--speed-rpm", "1500", "--torque-nm", "20",
+                                        "--duration-s", "0.05", "--seed", "1", "--out",
+                                        str(out)] + extra)
+        assert status == 0
+        assert res["gmf_hz"] == pytest.approx(28 * 25)
+        runs[label] = Run.load(out)
+    meta = runs["options"].meta
+    assert meta["rig"]["name"] == "rig from a file"
+    assert meta["rig"]["mesh_contact"]["friction_coefficient"] == pytest.approx(0.03)
+    clearances = {s[b]["clearance_m"] for s in meta["rig"]["shafts"]
+                  for b in ("bearing_1", "bearing_2")}
+    assert clearances == {-1e-6}
+    assert meta["operating_point"]["speed_rpm"] == pytest.approx(1500.0)
+    assert meta["operating_point"]["torque_nm"] == pytest.approx(20.0)
+    # preload and friction change the physics: a stiffer support, friction across the LOA
+    a, b = runs["options"], runs["plain"]
+    assert abs(a["dte"].mean() - b["dte"].mean()) > 0.02 * abs(b["dte"].mean())
+    diff = a["F_1b1_oloa"] - b["F_1b1_oloa"]           # same seed: the options make it
+    assert np.sqrt(np.mean(diff ** 2)) > 0.1 * b["F_1b1_oloa"].std()
 
 
 def test_modes_json(capsys):

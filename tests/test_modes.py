@@ -73,3 +73,31 @@ def test_bearing_rig_modes():
     assert res.frequencies_hz.shape == (9,)
     assert res.mean_mesh_stiffness_n_per_m == 0.0
     assert np.all(res.frequencies_hz > 0)
+    # closed form: without gears torsion and translation decouple. Torsion: the chain
+    # ground (imposed speed) -k_c- J_b1 -k_t1- J_disk -k_t2- J_b2
+    import scipy.linalg
+    s = rig.shafts[0]
+    kc, (kt1, kt2) = rig.input_coupling.stiffness_nm_per_rad, s.torsional_stiffness_nm_per_rad
+    k_rot = np.array([[kc + kt1, -kt1, 0.0], [-kt1, kt1 + kt2, -kt2], [0.0, -kt2, kt2]])
+    j_rot = np.diag([b.inertia_kg_m2, 0.01, b.inertia_kg_m2])
+    f_rot = np.sqrt(scipy.linalg.eigvalsh(k_rot, j_rot)) / (2 * np.pi)
+    # translation: b1 -k_f1- disk -k_f2- b2 in x and y, each bearing's 2x2 stiffness to ground
+    k_tr = np.zeros((6, 6))
+    for i, j, k in ((0, 1, s.flexural_stiffness_n_per_m[0]), (1, 2, s.flexural_stiffness_n_per_m[1])):
+        for d in range(2):
+            a, c = 2 * i + d, 2 * j + d
+            k_tr[[a, c], [a, c]] += k
+            k_tr[a, c] -= k
+            k_tr[c, a] -= k
+    kb = res.bearing_stiffness_n_per_m
+    assert kb.shape == (2, 2, 2)
+    np.testing.assert_allclose(kb, np.transpose(kb, (0, 2, 1)), rtol=1e-9)
+    assert np.all(np.linalg.eigvalsh(kb) > 1e6)        # loaded: positive definite
+    k_tr[0:2, 0:2] += kb[0]
+    k_tr[4:6, 4:6] += kb[1]
+    m_tr = np.diag(np.repeat([b.mass_kg, 4.0, b.mass_kg], 2))
+    f_tr = np.sqrt(scipy.linalg.eigvalsh(k_tr, m_tr)) / (2 * np.pi)
+    rot = [f for f, t in zip(res.frequencies_hz, res.types) if t == "R"]
+    trans = [f for f, t in zip(res.frequencies_hz, res.types) if t == "T"]
+    np.testing.assert_allclose(rot, f_rot, rtol=1e-6)
+    np.testing.assert_allclose(trans, f_tr, rtol=1e-6)

@@ -81,9 +81,26 @@ def test_plot_kurtogram():
     x = rng.standard_normal(20_000)
     x[::500] += 20.0
     kg = kurtogram(x, FS)
-    fig = plot_kurtogram(kg)
+    fig = plot_kurtogram(kg, n_freq=256)
     ax = fig.axes[0]
     assert "[Hz]" in ax.get_xlabel() and "[Hz]" in ax.get_ylabel()
+    # the map shows the kurtogram's own values: one row per level, each frequency sample
+    # holding the spectral kurtosis of the bin it falls in (negative values clipped to 0)
+    (mesh,) = ax.collections
+    image = np.asarray(mesh.get_array()).reshape(len(kg.nperseg), 256)
+    grid = np.linspace(0.0, FS / 2, 256)
+    for row, f, sk in zip(image, kg.freq_hz, kg.kurtosis):
+        nearest = np.abs(f[None, :] - grid[:, None]).argmin(axis=1)
+        np.testing.assert_allclose(row, np.clip(np.nan_to_num(sk[nearest]), 0.0, None),
+                                   rtol=1e-12)
+    assert image.max() == pytest.approx(kg.kurtosis_max, rel=0.2)
+    assert kg.kurtosis_max > 5.0                    # impulses: strongly non-Gaussian
+    # the best band is drawn where the kurtogram found it, on its level's row
+    (line,) = [ln for ln in ax.get_lines() if ln.get_label() == "best band"]
+    np.testing.assert_allclose(line.get_xdata(), kg.band_hz, rtol=1e-12)
+    assert list(line.get_ydata()) == [kg.nperseg.index(kg.best_nperseg)] * 2
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    assert labels == [f"{kg.bandwidth_of(n):.0f}" for n in kg.nperseg]
 
 
 @pytest.mark.parametrize("call, name", [
