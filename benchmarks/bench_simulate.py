@@ -126,9 +126,9 @@ def numpy_rhs_factory(model):
             dvx = (v[i1] - w1 * (py - c1y)) - (v[i2] - w2 * (py - c2y))
             dvy = (v[i1 + 1] + w1 * (px - c1x)) - (v[i2 + 1] + w2 * (px - c2x))
             approach = dvx * nx + dvy * ny
-            overlap = delta - np.interp(s_eq, s_tab, tab_e)
+            overlap = delta - np.interp(s, s_tab, tab_e)
             if overlap > 0:
-                k_pair = np.interp(s_eq, s_tab, tab_k)
+                k_pair = np.interp(s, s_tab, tab_k)
                 fn = max(k_pair * (overlap + mp[K.MP_BETA] * approach), 0.0)
             elif approach > 0:
                 gap = max(-overlap, mp[K.MP_DTHR])

@@ -58,9 +58,11 @@ DF_BRG, DF_KIND, DF_CENTRE, DF_HALF, DF_DEPTH, DF_ENTRY, DF_EXIT, DF_BALL = rang
 DF_SIZE = 8
 DEF_OUTER, DEF_INNER, DEF_BALL = 1, 2, 3
 # m_int entries: DOF index of each gear's x, number of slots, mesh on, elastic-force mode,
-# per-tooth tables on, eccentricity on, speed/torque profile on, DOF of the output torque
+# per-tooth tables on, eccentricity on, speed/torque profile on, DOF of the output torque,
+# off-size balls present
 MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE, MI_TEETH, MI_ECC, MI_PROFILE, MI_TDOF = range(9)
-MI_SIZE = 9
+MI_FAULTY_BALLS = 9     # 1 when any bearing has off-size balls
+MI_SIZE = 10
 MODE_TABLE, MODE_HYBRID = 0, 1
 # columns of the per-slot scratch ``W.slots`` of the mesh kernel
 SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP, SG_KPAIR = range(9)
@@ -292,13 +294,50 @@ def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b
     return k * fx, k * fy
 
 
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _faulty_bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
+                           cage_slip, diag, want_diag, b_ang, b_off, b_def):
+    """Forces of the bearings with defects or off-size balls (``BI_FAULTY``), ball by ball
+    (:func:`_faulty_ball_loop`); the others are left to :func:`_bearing_forces`. Kept apart
+    so that the healthy ball loop stays vectorised."""
+    for ib in range(b_int.shape[0]):
+        if b_int[ib, BI_FAULTY] == 0:
+            continue
+        ix = b_int[ib, BI_X]
+        iy = b_int[ib, BI_Y]
+        it = b_int[ib, BI_T]
+        rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
+        turned = omega[it] * t + y[it]
+        angle = rate * turned + b_par[ib, BP_PHASE] + cage_slip[ib]
+        cc, sc = _anchored_cos_sin(anchor, ib, angle)
+        xr = y[ix] * cc + y[iy] * sc
+        yr = y[iy] * cc - y[ix] * sc
+        sense = b_par[ib, BP_SENSE]
+        shaft = sense * turned
+        forward = 1.0 if omega[it] >= 0.0 else -1.0
+        fxr, fyr = _faulty_ball_loop(
+            xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
+            b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_off, b_def, b_int[ib, BI_DEF0],
+            b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
+            forward * (1.0 if rate >= 0.0 else -1.0),
+            forward * (1.0 if rate - sense >= 0.0 else -1.0),
+            forward * (1.0 if sense - rate >= 0.0 else -1.0))
+        fx = fxr * cc - fyr * sc
+        fy = fyr * cc + fxr * sc
+        g[ix] -= fx
+        g[iy] -= fy
+        if want_diag:
+            diag[2 * ib] = fx + b_par[ib, BP_DAMP] * y[n + ix]
+            diag[2 * ib + 1] = fy + b_par[ib, BP_DAMP] * y[n + iy]
+
+
 @njit(cache=True, fastmath=True, error_model="numpy", _nrt=False)
 def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor, cage_slip,
-                    diag, want_diag, b_ang, b_off, b_def):
+                    diag, want_diag):
     """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage
     and cages shifted by the slip angles ``cage_slip`` (zeros without slip); ``t`` is the
     equivalent time τ of the nominal rotation (``KernelParams``). Bearings with defects or
-    off-size balls (``BI_FAULTY``) take :func:`_faulty_ball_loop`.
+    off-size balls (``BI_FAULTY``) are skipped here (:func:`_faulty_bearing_forces`).
 
     Written flat on purpose: with helper functions inlined, a jitter branch, or arrays taken
     out of ``P`` inside the loop, numba stops vectorising the ball loop (2-3× slower).
@@ -309,30 +348,18 @@ def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
     copies its arguments.
     """
     for ib in range(b_int.shape[0]):
+        if b_int[ib, BI_FAULTY] != 0:
+            continue
         ix = b_int[ib, BI_X]
         iy = b_int[ib, BI_Y]
         it = b_int[ib, BI_T]
         rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
-        turned = omega[it] * t + y[it]
-        angle = rate * turned + b_par[ib, BP_PHASE] + cage_slip[ib]
+        angle = rate * (omega[it] * t + y[it]) + b_par[ib, BP_PHASE] + cage_slip[ib]
         cc, sc = _anchored_cos_sin(anchor, ib, angle)
         xr = y[ix] * cc + y[iy] * sc
         yr = y[iy] * cc - y[ix] * sc
-        if b_int[ib, BI_FAULTY] == 0:
-            fxr, fyr = ball_forces_cage_frame_jit(xr, yr, ball_cos, ball_sin, ib,
-                                                  b_int[ib, BI_NB], b_par[ib, BP_K],
-                                                  b_par[ib, BP_P], b_par[ib, BP_C])
-        else:
-            sense = b_par[ib, BP_SENSE]
-            shaft = sense * turned
-            forward = 1.0 if omega[it] >= 0.0 else -1.0
-            fxr, fyr = _faulty_ball_loop(
-                xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
-                b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_off, b_def, b_int[ib, BI_DEF0],
-                b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
-                forward * (1.0 if rate >= 0.0 else -1.0),
-                forward * (1.0 if rate - sense >= 0.0 else -1.0),
-                forward * (1.0 if sense - rate >= 0.0 else -1.0))
+        fxr, fyr = ball_forces_cage_frame_jit(xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB],
+                                              b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
         fx = fxr * cc - fyr * sc
         fy = fyr * cc + fxr * sc
         g[ix] -= fx
@@ -676,7 +703,11 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
         ball_sin = P.b_sin
     if P.b_int.shape[0] > 0:
         _bearing_forces(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
-                        W.cage_slip, diag, want_diag, P.b_ang, P.b_off, P.b_def)
+                        W.cage_slip, diag, want_diag)
+        if P.b_def.shape[0] > 0 or P.m_int[MI_FAULTY_BALLS] != 0:
+            _faulty_bearing_forces(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos,
+                                   ball_sin, W.cage, W.cage_slip, diag, want_diag, P.b_ang,
+                                   P.b_off, P.b_def)
     if P.m_int[MI_ON] != 0:
         _mesh_forces(tau, sr, y, n, g, P, W, diag, want_diag)
     linear_accel_jit(y, g, minv, P.springs, P.spring_ends, dydt, row)

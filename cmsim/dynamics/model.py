@@ -35,6 +35,7 @@ from cmsim.bearings.kinematics import cage_ratios, slip_jitter
 from cmsim.dynamics import _kernels as K
 from cmsim.dynamics.mesh_choice import resolve_mesh
 from cmsim.errors import ParameterError, check_range
+from cmsim.faults import check_faults, compile_faults, rig_with_faults
 from cmsim.mesh_stiffness._kernels import GEO_SIZE
 from cmsim.mesh_stiffness.contact import (contact_geometry, corner_zone_m, potential_slots,
                                           reference_phases, table_range_m)
@@ -223,6 +224,8 @@ class DynamicModel:
         On-line hybrid contact model (model A), or ``None`` for the table.
     cage_phases_rad : ndarray, shape (n_bearings,)
         Initial cage angle of each bearing, rad.
+    faults : tuple of Fault
+        The faults built into the model.
     """
 
     rig_model: RigModel
@@ -235,6 +238,7 @@ class DynamicModel:
     slip: SlipModel = SlipModel()
     mesh_model: object = None
     cage_phases_rad: np.ndarray = field(default=None, repr=False)
+    faults: tuple = ()
 
     @property
     def rig(self):
@@ -414,7 +418,7 @@ def _dof_names(rig):
 
 
 def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
-                cage_phases_rad=None, fault_arrays=None, profile=None):
+                cage_phases_rad=None, faults=(), profile=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
 
     Parameters
@@ -428,10 +432,12 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
         (model A); or an explicit table, table set or hybrid model.
     slip, duration_s, seed, cage_phases_rad
         Per-run values, as in :meth:`DynamicModel.for_run`.
-    fault_arrays : FaultArrays, optional
-        Compiled faults (:func:`cmsim.faults.compile_faults`; fields documented in
-        :class:`cmsim.dynamics._kernels.KernelParams`): race and ball defects, off-size
-        balls, per-tooth stiffness factors and separations, eccentric gears.
+    faults : sequence of Fault
+        Catalogue entries (:mod:`cmsim.faults`) felt through the model: race and ball
+        defects, off-size balls, per-tooth stiffness factors and separations, eccentric gears
+        (compiled against the run's mesh table by :func:`cmsim.faults.compile_faults`);
+        clearance growth (wear) changes the rig first. Slip and speed or torque modulations
+        are per-run inputs of :func:`cmsim.dynamics.simulate`.
     profile : KernelProfile, optional
         Input speed and output torque against time (:mod:`cmsim.dynamics.profiles`);
         ``op`` then gives the reference (initial) speed.
@@ -447,9 +453,12 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     β = 2ξ√(M_eq/k̄), so the mesh has 2ξ√(k̄·M_eq) on average (k̄: mean mesh stiffness at the
     torque) and does not double in double contact.
     """
+    faults = check_faults(rig, faults)
+    rig = rig_with_faults(rig, faults)
     rm = rig_model(rig)
     n = rm.n_dof
     mesh_table, mesh_model = resolve_mesh(rig, mesh, op.torque_nm)
+    fault_arrays = compile_faults(rig, faults, mesh_table, op=op) if faults else None
     omega = np.zeros(n)
     ratio = rig.gears.driving.n_teeth / rig.gears.driven.n_teeth if rig.gears else 0.0
     speeds = (op.omega_rad_s, op.omega_rad_s * ratio)
@@ -509,7 +518,8 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
         hybrid = tuple(np.ascontiguousarray(a, dtype=float) for a in mesh_model.kernel_args())
     else:
         hybrid = K.no_hybrid()
-    b_int, faults = _fault_fields(rm, m_int, fault_arrays)
+    b_int, fields = _fault_fields(rm, m_int, fault_arrays,
+                                  (m_par[K.MP_TAB0], m_par[K.MP_TABD]))
     prof = K.no_profile()
     if profile is not None:
         m_int[K.MI_PROFILE] = 1
@@ -521,17 +531,17 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, b_int, rm.b_par,
                             rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
                             m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
-                            *hybrid, faults[0], rm.b_ang, *faults[1:], prof)
+                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof)
     model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
-                         SlipModel(), mesh_model, np.zeros(nb))
+                         SlipModel(), mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
                          seed=seed)
 
 
-def _fault_fields(rm, m_int, fa):
+def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
     """``(b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc))`` for the kernel from FaultArrays."""
     nb, max_balls = rm.b_cos.shape
-    if fa is None:
+    if fa is None or not fa.active:
         return rm.b_int, K.no_faults(nb, max_balls)
     b_def = np.ascontiguousarray(fa.bearing_defects, dtype=float).reshape(-1, K.DF_SIZE)
     b_off = np.ascontiguousarray(fa.ball_offset_m, dtype=float)
@@ -546,12 +556,17 @@ def _fault_fields(rm, m_int, fa):
         b_int[ib, K.BI_DEF0] = rows[0] if rows.size else 0
         b_int[ib, K.BI_NDEF] = rows.size
         b_int[ib, K.BI_FAULTY] = int(rows.size > 0 or np.any(b_off[ib] != 0.0))
+    if np.any(b_off != 0.0):
+        m_int[K.MI_FAULTY_BALLS] = 1
     rig = rm.rig
     tk1, tk2, te1, te2 = (np.ascontiguousarray(a, dtype=float) for a in
                           (fa.tooth_factor1, fa.tooth_factor2, fa.tooth_sep1, fa.tooth_sep2))
     teeth = rig.gears is not None and (np.any(tk1 != 1.0) or np.any(tk2 != 1.0)
                                        or np.any(te1 != 0.0) or np.any(te2 != 0.0))
     if teeth:
+        s0, ds = (float(v) for v in fa.tooth_grid_m)
+        if abs(s0 - m_par_grid[0]) > 1e-12 or abs(ds - m_par_grid[1]) > 1e-12 * abs(ds):
+            raise ParameterError("per-tooth tables must be on the run's mesh table grid")
         z1, z2 = rig.gears.driving.n_teeth, rig.gears.driven.n_teeth
         if tk1.shape[0] != z1 or te1.shape[0] != z1 or tk2.shape[0] != z2 \
                 or te2.shape[0] != z2:

@@ -17,6 +17,8 @@ from cmsim.dynamics.model import SlipModel, build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
+from cmsim.faults import (check_faults, fault_frequencies, operating_modulation,
+                          slip_from_faults)
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
 
@@ -186,7 +188,7 @@ def _compile_seconds():
 
 def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
              scheme="ode3", slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
-             profile=None):
+             profile=None, faults=()):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -231,6 +233,12 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         (:class:`~cmsim.dynamics.profiles.SpeedProfile`: a run-up, coast-down or measured
         trace); ``op`` then gives only the torque when the profile has none. The cage
         kinematics, the mesh angle and the imposed input rotation follow it.
+    faults : sequence of Fault
+        Faults of the catalogue (:mod:`cmsim.faults`), felt only through the model: race and
+        ball defects, tooth cracks, spalls, breakage, profile errors, eccentricity, wear,
+        off-size balls, rolling slip (overrides ``slip``), speed fluctuation and torque
+        ripple (laid on the speed/torque, with or without ``profile``). The run's meta lists
+        them with their characteristic frequencies (the answer key).
     cage_phases_rad : "random", sequence of float or None
         Initial cage angle of each bearing: drawn uniformly from ``seed`` (default — the
         relative phase of independent cages is arbitrary, and equal phases can cancel the
@@ -257,19 +265,27 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
                                  f"bearing, got {cage_phases_rad!r}")
         cage_phases_rad = rng.uniform(0.0, 2.0 * math.pi, len(rig.bearings))
     _check_memory(duration_s, fs_hz, rig.n_dof, 4 * len(rig.bearings) + 8)
+    faults = check_faults(rig, faults)
+    fault_slip = slip_from_faults(faults)
+    if fault_slip is not None:
+        slip = SlipModel(**fault_slip)
+    speed_factor, torque_factor = operating_modulation(faults, op, rig)
     kprof = None
-    if profile is not None:
+    if profile is not None or speed_factor is not None or torque_factor is not None:
+        if profile is None:
+            profile = SpeedProfile((0.0,), (op.speed_rpm,))
         if not isinstance(profile, SpeedProfile):
             raise ParameterError(f"profile must be a SpeedProfile, got {type(profile).__name__}")
         op = replace(op, speed_rpm=profile.initial_rpm,
                      torque_nm=op.torque_nm if profile.torques_nm is None
                      else profile.torques_nm[0])
         kprof = kernel_profile(profile, op.torque_nm, warmup_s + duration_s + 0.1,
-                               PROFILE_STEP_S)
+                               PROFILE_STEP_S, speed_factor=speed_factor,
+                               torque_factor=torque_factor)
     compile_s = _compile_seconds()
     model = build_model(rig, op, mesh, slip=slip, duration_s=warmup_s + duration_s,
                         seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad,
-                        profile=kprof)
+                        profile=kprof, faults=faults)
     n = model.n_dof
     q0, start_method = initial_state(model, 0.0)
     y0 = np.concatenate([q0, np.zeros(n)])
@@ -318,6 +334,8 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
             "hybrid_unconverged": stats["hybrid_unconverged"]} if model.mesh_model is not None
            else {}),
         "speed_profile": None if profile is None else profile.to_dict(),
+        "faults": [dict(f.to_dict(), label=f.label) for f in faults],
+        "fault_frequencies": fault_frequencies(rig, op, faults) if faults else {},
         "sim_s": (n_warm + n_rec) / fs_hz, "wall_s": wall, "compile_s": compile_s,
         "realtime_factor": (n_warm + n_rec) / fs_hz / wall if wall > 0 else math.inf,
         "dof_names": list(model.dof_names),
