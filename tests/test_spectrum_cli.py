@@ -75,12 +75,12 @@ def test_other_kinds_and_shaft_two(capsys, run_file):
 
 @pytest.mark.parametrize("extra, words", [
     (["--signal", "F_9b9_loa"], ["signal must be one of", "F_1b1_loa", "dte_um"]),
-    (["--resolution-hz", "1"], ["record too short", "resolution_hz=1", "75000 samples"]),
+    (["--resolution-hz", "1"], ["record too short", "--resolution-hz=1", "75000 samples"]),
     (["--kind", "order", "--resolution-hz", "1"], ["record too short", "revolutions"]),
-    (["--band-hz", "100", "200"], ["band_hz", "envelope"]),
-    (["--kind", "envelope", "--band-hz", "100", "90000"], ["band_hz", "fs/2"]),
-    (["--max-hz", "-3"], ["max_hz"]),
-    (["--top", "0"], ["max_peaks"]),
+    (["--band-hz", "100", "200"], ["--band-hz", "envelope"]),
+    (["--kind", "envelope", "--band-hz", "100", "90000"], ["--band-hz", "fs/2"]),
+    (["--max-hz", "-3"], ["--max-hz"]),
+    (["--top", "0"], ["--top"]),
     (["--bearing", "3b1"], ["bearing must be one of"]),
 ])
 def test_errors_name_the_parameter(capsys, run_file, extra, words):

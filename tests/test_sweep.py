@@ -258,7 +258,7 @@ def test_cli_sweep_errors(tmp_path, capsys):
     status = main(["sweep", "--torque-nm", "10", "--speed-rpm", "-5", "--out", str(tmp_path),
                    "--json"])
     assert status == 2
-    assert "speeds_rpm[0]" in json.loads(capsys.readouterr().out)["error"]
+    assert "--speed-rpm" in json.loads(capsys.readouterr().out)["error"]
 
 
 def test_spawned_workers_give_the_same_arrays(tiny_sweep, tmp_path):
