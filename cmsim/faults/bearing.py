@@ -40,6 +40,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults.base import Fault, check_bearing, check_int, mm, register
 
@@ -95,7 +97,6 @@ def defect_profile(angle_rad, centre_rad, half_width_rad, entry_rad, exit_rad):
     ndarray
         Profile in [0, 1], same shape as ``angle_rad``.
     """
-    import numpy as np
     a = np.mod(np.asarray(angle_rad, dtype=float) - centre_rad + math.pi, 2 * math.pi) - math.pi
     x = a + half_width_rad                      # distance since the entry edge
     y = half_width_rad - a                      # distance to the exit edge
