@@ -20,12 +20,12 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_text
-from cmsim.datasets.spec import mesh_key
+from cmsim.datasets.spec import SweepSpec, mesh_key
 from cmsim.errors import ParameterError
 from cmsim.features import N_GMF_HARMONICS, run_features
 
 __all__ = ["MANIFEST_NAME", "RUNS_DIR", "FEATURE_SIGNALS", "read_manifest", "write_manifest",
-           "new_manifest", "case_entry", "run_file", "file_matches",
+           "new_manifest", "spec_difference", "case_entry", "run_file", "file_matches",
            "manifest_features"]
 
 #: File name of the manifest inside a sweep directory.
@@ -85,6 +85,37 @@ def write_manifest(out_dir, manifest):
     """Stamp ``manifest["updated"]`` and write it atomically to ``out_dir``."""
     manifest["updated"] = _now()
     atomic_write_text(Path(out_dir) / MANIFEST_NAME, json.dumps(manifest, indent=1) + "\n")
+
+
+def spec_difference(old, new):
+    """What differs between a stored spec dict ``old`` and the spec ``new``, as a list of
+    setting names (``"duration_s"``, ``"variations: torque_nm"``, ``"fixed: speed_rpm"``).
+
+    Both are compared in the variations form, so a spec stored in the older form and one
+    written with variations are compared setting by setting.
+    """
+    new_d = json.loads(json.dumps(new.to_dict(older_form=False)))
+    try:
+        old_d = json.loads(json.dumps(SweepSpec.from_dict(old).to_dict(older_form=False)))
+    except (ParameterError, TypeError, ValueError):
+        old_d = old
+    out = []
+    for key in sorted(set(old_d) | set(new_d)):
+        a, b = old_d.get(key), new_d.get(key)
+        if a == b:
+            continue
+        if key == "variations" and isinstance(a, list) and isinstance(b, list):
+            va = {v.get("name"): v.get("values") for v in a if isinstance(v, dict)}
+            vb = {v["name"]: v["values"] for v in b}
+            names = [n for n in [*vb, *va] if va.get(n) != vb.get(n)]
+            if [v.get("name") for v in a if isinstance(v, dict)] != list(vb) and not names:
+                names = ["order"]
+            out += [f"variations: {n}" for n in dict.fromkeys(names)]
+        elif key == "fixed" and isinstance(a, dict) and isinstance(b, dict):
+            out += [f"fixed: {n}" for n in sorted(set(a) | set(b)) if a.get(n) != b.get(n)]
+        else:
+            out.append(key)
+    return out
 
 
 def manifest_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS, top_n=5):

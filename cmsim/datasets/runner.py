@@ -39,8 +39,9 @@ import numpy as np
 from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (MANIFEST_NAME, RUNS_DIR, case_entry, file_matches,
                                      manifest_features, new_manifest, normalised,
-                                     read_manifest, run_file, write_manifest)
-from cmsim.datasets.spec import SweepSpec, mesh_key, spec_difference
+                                     read_manifest, run_file, spec_difference,
+                                     write_manifest)
+from cmsim.datasets.spec import SweepSpec, mesh_key
 from cmsim.dynamics.simulate import _compile_seconds, simulate
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.run import Run

@@ -44,7 +44,7 @@ from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
 from cmsim.rig import OperatingPoint, Rig
 
-__all__ = ["SweepSpec", "SweepCase", "SEED_POLICIES", "mesh_key", "spec_difference"]
+__all__ = ["SweepSpec", "SweepCase", "SEED_POLICIES", "mesh_key"]
 
 #: Seed policies of :class:`SweepSpec`.
 SEED_POLICIES = ("per_run", "shared")
@@ -381,33 +381,3 @@ class SweepSpec:
         variations = data.pop("variations", ())
         return cls(variations, **data)
 
-
-def spec_difference(old, new):
-    """What differs between a stored spec dict ``old`` and the spec ``new``, as a list of
-    setting names (``"duration_s"``, ``"variations: torque_nm"``, ``"fixed: speed_rpm"``).
-
-    Both are compared in the variations form, so a spec stored in the older form and one
-    written with variations are compared setting by setting.
-    """
-    new_d = json.loads(json.dumps(new.to_dict(older_form=False)))
-    try:
-        old_d = json.loads(json.dumps(SweepSpec.from_dict(old).to_dict(older_form=False)))
-    except (ParameterError, TypeError, ValueError):
-        old_d = old
-    out = []
-    for key in sorted(set(old_d) | set(new_d)):
-        a, b = old_d.get(key), new_d.get(key)
-        if a == b:
-            continue
-        if key == "variations" and isinstance(a, list) and isinstance(b, list):
-            va = {v.get("name"): v.get("values") for v in a if isinstance(v, dict)}
-            vb = {v["name"]: v["values"] for v in b}
-            names = [n for n in [*vb, *va] if va.get(n) != vb.get(n)]
-            if [v.get("name") for v in a if isinstance(v, dict)] != list(vb) and not names:
-                names = ["order"]
-            out += [f"variations: {n}" for n in dict.fromkeys(names)]
-        elif key == "fixed" and isinstance(a, dict) and isinstance(b, dict):
-            out += [f"fixed: {n}" for n in sorted(set(a) | set(b)) if a.get(n) != b.get(n)]
-        else:
-            out.append(key)
-    return out
