@@ -41,36 +41,34 @@ import math
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
+from cmsim.mesh_stiffness.fe_mesh import (CRITICAL_TANGENT_RAD, MeshSpec, RootCrack,
+                                          crack_start_point)
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
+from cmsim.mesh_stiffness.influence import influence_table
+from cmsim.mesh_stiffness.local_deflection import (contact_modulus, hertz_half_width,
+                                                   local_approach)
 from cmsim.mesh_stiffness.potential_energy import (
     ToothCompliance, _involute_domain, _path_length, cantilever_compliance,
     fillet_foundation_compliance, pair_compliance_potential_energy)
 
 __all__ = ["crack_start", "crack_tip_offset_m", "max_crack_depth_m", "cracked_tooth_compliance",
-           "crack_stiffness_factor", "mesh_stiffness_loss"]
+           "crack_stiffness_factor", "fe_pair_compliance", "mesh_stiffness_loss",
+           "CRACK_METHODS", "DEFAULT_FE_LOAD_N"]
 
-
-#: Tangent angle to the centreline at the critical section (ISO 6336-3), rad.
-CRITICAL_TANGENT_RAD = math.radians(30.0)
-
-_START_CACHE = {}
+#: Methods of the cracked-pair stiffness: potential energy (fast) and finite elements.
+CRACK_METHODS = ("pe", "fe")
+#: Pair force of the FE variant's local term, N (≈ 42 N·m on the paper pinion, r_b 41.8 mm).
+DEFAULT_FE_LOAD_N = 1000.0
 
 
 def crack_start(profile):
     """(y_s, h_c): height from the gear centre and half-thickness of the crack start, m.
 
     The point of the loaded-side fillet where the tangent makes 30° with the tooth centreline
-    (ISO 6336-3 critical section), found on the tooth outline by finite differences.
+    (ISO 6336-3 critical section), found on the tooth outline by finite differences
+    (:func:`cmsim.mesh_stiffness.fe_mesh.crack_start_point`, shared with the FE crack).
     """
-    key = profile.gear
-    if key not in _START_CACHE:
-        y = np.linspace(profile.root_chord_y_m, profile.tip_radius_m, 4001)
-        h = profile.half_thickness_at(y)
-        slope = np.abs(np.gradient(h, y))
-        below = np.nonzero(slope <= math.tan(CRITICAL_TANGENT_RAD))[0]
-        i = int(below[0]) if below.size else 0
-        _START_CACHE[key] = (float(y[i]), float(h[i]))
-    return _START_CACHE[key]
+    return crack_start_point(profile)
 
 
 def max_crack_depth_m(gear, angle_rad):
@@ -147,7 +145,8 @@ def cracked_tooth_compliance(profile, contact_radius_m, depth_m, angle_rad, n_no
     return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
 
 
-def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1001):
+def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1001,
+                           method="pe", load_n=DEFAULT_FE_LOAD_N, use_cache=True):
     """k_cracked(s) / k_healthy(s) of the pair whose tooth on ``gear`` carries the crack.
 
     Positions outside the involute-involute range are clipped into it (the corner-contact
@@ -162,6 +161,17 @@ def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1
         Crack depth q (m) and angle ν (rad), see :func:`cracked_tooth_compliance`.
     position_m : array_like, shape (n,)
         Positions s on the line of action from T1, m.
+    n_nodes : int
+        Nodes of the beam integration (``method="pe"``).
+    method : {'pe', 'fe'}
+        ``"pe"``: potential energy with the cracked section (module docstring);
+        ``"fe"``: finite elements with the crack cut into the mesh
+        (:func:`fe_pair_compliance`).
+    load_n : float
+        Normal force of the pair for the local (Hertz/Weber-Banaschek) term of
+        ``method="fe"``, N.
+    use_cache : bool
+        Read/write the on-disk cache of the FE influence tables (``method="fe"``).
 
     Returns
     -------
@@ -176,31 +186,114 @@ def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1
     >>> bool(0.0 < crack_stiffness_factor(pair, 1, 1e-3, math.pi / 4, s)[0] < 1.0)
     True
     """
+    if method not in CRACK_METHODS:
+        raise ParameterError(f"method must be one of {CRACK_METHODS}, got {method!r}",
+                             param="method", allowed=" or ".join(CRACK_METHODS))
     s = np.atleast_1d(np.asarray(position_m, dtype=float))
     lo, hi = _involute_domain(pair)
     s = np.clip(s, lo, hi)
+    if gear not in (1, 2):
+        raise ParameterError(f"gear must be 1 or 2, got {gear!r}", param="gear",
+                             allowed="1 or 2")
+    if method == "fe":
+        g = pair.driving if gear == 1 else pair.driven
+        _check_crack(ToothProfile.from_gear(g), depth_m, angle_rad)
+        if depth_m == 0.0:
+            return np.ones(s.size)
+        healthy = fe_pair_compliance(pair, s, load_n=load_n, use_cache=use_cache)
+        cracked = fe_pair_compliance(pair, s, load_n=load_n, use_cache=use_cache,
+                                     crack_gear=gear, depth_m=depth_m, angle_rad=angle_rad)
+        return healthy / cracked
     healthy = pair_compliance_potential_energy(pair, s, n_nodes=n_nodes)
     if gear == 1:
         g, rad = pair.driving, np.sqrt(pair.driving.base_radius_m ** 2 + s ** 2)
         other = healthy.driven
-    elif gear == 2:
+    else:
         g = pair.driven
         rad = np.sqrt(g.base_radius_m ** 2 + (_path_length(pair) - s) ** 2)
         other = healthy.driving
-    else:
-        raise ParameterError(f"gear must be 1 or 2, got {gear!r}", param="gear",
-                             allowed="1 or 2")
     cracked = cracked_tooth_compliance(ToothProfile.from_gear(g), rad, depth_m, angle_rad,
                                        n_nodes=n_nodes)
     total = healthy.hertz + other.total + cracked.total
     return healthy.total / total
 
 
-def mesh_stiffness_loss(pair, gear, depth_m, angle_rad, n_points=200):
-    """Loss of total mesh stiffness while the cracked tooth is in mesh (potential energy).
+def fe_pair_compliance(pair, position_m, load_n=DEFAULT_FE_LOAD_N, use_cache=True,
+                       crack_gear=None, depth_m=0.0, angle_rad=math.pi / 4, spec=MeshSpec()):
+    """Compliance of one tooth pair alone from the FE influence coefficients, m/N.
+
+    The documented simplified route of the hybrid tables (paper 001 eq. 2 with one contact):
+
+        c(s) = λ^p(0; ρ1, ρ1) + λ^w(0; ρ2, ρ2) + [u^p_L(F) + u^w_L(F)] / F,
+
+    ρ1 = s and ρ2 = T1T2 − s the roll lengths of the contact on both gears, λ(0) the FE
+    influence coefficient of the loaded tooth at the depth h
+    (:func:`~cmsim.mesh_stiffness.influence.influence_table`: bending, shear, rim and web of
+    the whole gear body clamped at its bore) and u_L the Hertz/Weber-Banaschek local
+    approach (:func:`~cmsim.mesh_stiffness.local_deflection.local_approach`) at the force F.
+    With a crack, the cracked gear's λ(0) comes from its mesh with the crack cut in
+    (:class:`~cmsim.mesh_stiffness.fe_mesh.RootCrack`, traction-free faces, cached on disk
+    keyed by geometry and crack). The coupling of the pair to the other pairs in contact
+    (λ(d ≠ 0)) is left out, as in the potential-energy method; it changes little with the
+    crack (module docstring).
+
+    Parameters
+    ----------
+    pair : GearPair
+    position_m : array_like, shape (n,)
+        Positions s on the line of action from T1, m (clamped to the tables' roll ranges).
+    load_n : float
+        F, N (> 0).
+    use_cache : bool
+        On-disk cache of the influence tables.
+    crack_gear : int, optional
+        1 or 2: the gear whose tooth in this pair is cracked (None: healthy pair).
+    depth_m, angle_rad : float
+        Crack depth q (m) and angle ν (rad).
+    spec : MeshSpec
+        FE mesh sizes.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        c(s), m/N.
+    """
+    f = check_range("load_n", load_n, 0.0, 1e7, lo_open=True, unit="N")
+    s = np.atleast_1d(np.asarray(position_m, dtype=float))
+    tables = []
+    for k, g in ((1, pair.driving), (2, pair.driven)):
+        crack = RootCrack(depth_m, angle_rad) if crack_gear == k else None
+        tables.append(influence_table(g, spec=spec, use_cache=use_cache, crack=crack))
+    rho = (s, _path_length(pair) - s)
+    lam = sum(np.interp(r, t.roll_m, t.diagonal_m_per_n) for r, t in zip(rho, tables))
+    g1, g2 = pair.driving, pair.driven
+    e_star = contact_modulus(g1.youngs_modulus_pa, g1.poisson_ratio, g2.youngs_modulus_pa,
+                             g2.poisson_ratio)
+    b = min(g1.face_width_m, g2.face_width_m)
+    a = hertz_half_width(f, np.maximum(rho[0], 1e-6), np.maximum(rho[1], 1e-6), b, e_star)
+    local = sum(local_approach(f, a, t.depth_m, g.youngs_modulus_pa, g.poisson_ratio, b)
+                for t, g in zip(tables, (g1, g2)))
+    return lam + local / f
+
+
+def mesh_stiffness_loss(pair, gear, depth_m, angle_rad, n_points=200, method="pe"):
+    """Loss of total mesh stiffness while the cracked tooth is in mesh.
 
     The cracked tooth's pair runs over the involute path [s0, s1]; the other pairs in contact
-    (one base pitch ahead or behind) stay healthy.
+    (one base pitch ahead or behind) stay healthy. The healthy pair stiffness is the
+    potential-energy one for both methods; ``method`` picks the cracked pair's factor
+    (:func:`crack_stiffness_factor`), so the two methods differ only by the crack.
+
+    Parameters
+    ----------
+    pair : GearPair
+    gear : int
+        1 or 2: the cracked gear.
+    depth_m, angle_rad : float
+        Crack depth q (m) and angle ν (rad).
+    n_points : int
+        Positions over the involute path.
+    method : {'pe', 'fe'}
 
     Returns
     -------
@@ -214,7 +307,7 @@ def mesh_stiffness_loss(pair, gear, depth_m, angle_rad, n_points=200):
     pb = pair.driving.base_pitch_m
     s = np.linspace(lo, hi, n_points)
     k = pair_compliance_potential_energy(pair, s).stiffness
-    f = crack_stiffness_factor(pair, gear, depth_m, angle_rad, s)
+    f = crack_stiffness_factor(pair, gear, depth_m, angle_rad, s, method=method)
     healthy = k.copy()
     for shift in (-pb, pb, -2 * pb, 2 * pb):
         sj = s + shift

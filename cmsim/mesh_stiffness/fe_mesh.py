@@ -51,7 +51,12 @@ from cmsim.errors import ParameterError, check_range
 from cmsim.mesh_stiffness.geometry import ToothProfile
 from cmsim.rig import SpurGear
 
-__all__ = ["MeshSpec", "GearMesh", "gear_mesh", "tooth_rotation_rad"]
+__all__ = ["MeshSpec", "GearMesh", "RootCrack", "gear_mesh", "tooth_rotation_rad",
+           "crack_start_point", "CRITICAL_TANGENT_RAD"]
+
+#: Tangent angle to the centreline at the critical section (ISO 6336-3), rad: a root
+#: crack starts where the loaded fillet's tangent makes this angle with the centreline.
+CRITICAL_TANGENT_RAD = math.radians(30.0)
 
 #: DistMesh constants [1]: internal pressure factor, pseudo time step, stop tolerance.
 _FSCALE, _DELTAT, _DPTOL = 1.2, 0.2, 2e-3
@@ -129,6 +134,14 @@ class GearMesh:
         The tooth outline the mesh was built from.
     spec : MeshSpec
         The size specification.
+    crack : RootCrack or None
+        The root crack cut into tooth 0, if any.
+    crack_nodes : ndarray of int, shape (n_crack + 1,) or None
+        Nodes of one crack face (the side towards the gear centre), from the mouth on the
+        fillet to the tip.
+    crack_twin_nodes : ndarray of int, shape (n_crack,) or None
+        Their duplicates on the other face (towards the tooth tip), mouth first; the tip
+        node is shared.
     """
 
     points_m: np.ndarray = field(repr=False)
@@ -136,6 +149,9 @@ class GearMesh:
     bore_nodes: np.ndarray = field(repr=False)
     profile: ToothProfile = field(repr=False)
     spec: MeshSpec
+    crack: "RootCrack | None" = None
+    crack_nodes: np.ndarray = field(default=None, repr=False)
+    crack_twin_nodes: np.ndarray = field(default=None, repr=False)
 
     @property
     def n_points(self):
@@ -167,6 +183,90 @@ class GearMesh:
                        np.ascontiguousarray(self.triangles.T))
         return mesh.with_boundaries(
             {"bore": lambda x: np.hypot(x[0], x[1]) < r_bore + tol})
+
+
+_START_CACHE = {}
+
+
+def crack_start_point(profile):
+    """(y_s, h_c): height from the gear centre and half-thickness of a root crack's start, m.
+
+    The point of the loaded-side (right) fillet where the tangent makes
+    :data:`CRITICAL_TANGENT_RAD` (30°) with the tooth centreline (ISO 6336-3 critical
+    section), found by finite differences on the outline of the default resolution (so
+    the answer does not depend on how finely ``profile`` was sampled).
+
+    Parameters
+    ----------
+    profile : ToothProfile
+
+    Returns
+    -------
+    (float, float)
+    """
+    key = profile.gear
+    if key not in _START_CACHE:
+        profile = ToothProfile.from_gear(key)
+        y = np.linspace(profile.root_chord_y_m, profile.tip_radius_m, 4001)
+        h = profile.half_thickness_at(y)
+        slope = np.abs(np.gradient(h, y))
+        below = np.nonzero(slope <= math.tan(CRITICAL_TANGENT_RAD))[0]
+        i = int(below[0]) if below.size else 0
+        _START_CACHE[key] = (float(y[i]), float(h[i]))
+    return _START_CACHE[key]
+
+
+@dataclass(frozen=True)
+class RootCrack:
+    """A straight root crack in the loaded fillet of tooth 0, cut into the mesh.
+
+    The crack starts (its *mouth*) at the 30° tangent point of the right (loaded, tension
+    side) fillet, (h_c, y_s) of :func:`crack_start_point`, and runs a length q towards the
+    centreline and the gear centre at the angle ν to the centreline, direction
+    (−sin ν, −cos ν); its tip is at h_c − q sin ν from the centreline (Chaari et al. 2009,
+    as :mod:`cmsim.faults.crack`). Its faces are traction-free: contact of the faces when
+    the crack closes (under compression, e.g. load on the other flank) is not modelled.
+
+    Attributes
+    ----------
+    depth_m : float
+        Crack length q, m (> 0, tip at most on the centreline: q sin ν <= h_c).
+    angle_rad : float
+        ν, rad, in (0, π/2].
+    h_crack : float
+        Element size along the crack faces, in modules (0.03); the tip gets half of it.
+    """
+
+    depth_m: float
+    angle_rad: float = math.pi / 4
+    h_crack: float = 0.03
+
+    def __post_init__(self):
+        check_range("depth_m", self.depth_m, 0.0, 0.05, lo_open=True, unit="m")
+        check_range("angle_rad", self.angle_rad, 0.0, 0.5 * math.pi, lo_open=True, unit="rad")
+        check_range("h_crack", self.h_crack, 1e-3, 0.5, unit="modules")
+
+    def as_dict(self):
+        """Plain dict of the fields (for cache keys and provenance)."""
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+    def path_m(self, profile):
+        """Mouth, direction (unit) and tip of the crack in the frame of tooth 0, m."""
+        y_s, h_c = crack_start_point(profile)
+        qmax = h_c / math.sin(self.angle_rad)
+        check_range("depth_m", self.depth_m, 0.0, qmax, lo_open=True,
+                    unit=f"m (crack tip at most on the tooth centreline: {qmax * 1e3:.4g} mm)")
+        mouth = np.array([h_c, y_s])
+        direction = np.array([-math.sin(self.angle_rad), -math.cos(self.angle_rad)])
+        return mouth, direction, mouth + self.depth_m * direction
+
+    def nodes_m(self, profile):
+        """Points along the crack from the mouth to the tip, spaced <= h_crack, m."""
+        mouth, direction, _ = self.path_m(profile)
+        h = self.h_crack * profile.gear.module_m
+        n = max(2, int(math.ceil(self.depth_m / h)))
+        t = self.depth_m * np.arange(n + 1) / n
+        return mouth + t[:, None] * direction
 
 
 def tooth_rotation_rad(gear, offset):
@@ -483,7 +583,68 @@ def _check_boundary(tri, n_outline, n_bore, n_points):
     return used
 
 
-def gear_mesh(gear, spec=MeshSpec()):
+def _clear_crack(p, nf, nodes, geo):
+    """Drop free points inside the diametral circle of any crack segment, re-triangulate.
+
+    A segment whose diametral circle holds no other point is an edge of the Delaunay
+    triangulation, so afterwards every crack segment is a mesh edge (checked by
+    :func:`_cut_crack`).
+    """
+    mid = 0.5 * (nodes[1:] + nodes[:-1])
+    rad = 0.5 * np.hypot(*(nodes[1:] - nodes[:-1]).T)
+    d, i = cKDTree(mid).query(p[nf:])
+    keep = np.ones(p.shape[0], dtype=bool)
+    keep[nf:] = d > 1.15 * rad[i]
+    p = p[keep]
+    return p, _triangulate(p, geo)
+
+
+def _cut_crack(p, tri, nodes, direction):
+    """Split the mesh along the crack: duplicate every crack node but the tip.
+
+    Triangles around a duplicated node that lie on the tooth-tip side of the crack line
+    (centroid test) are renumbered to the duplicates, so the two faces share no edge and
+    move independently (traction-free faces).
+
+    Returns
+    -------
+    (points, triangles, twins)
+    """
+    edges = {tuple(e) for e in np.sort(np.vstack([tri[:, [0, 1]], tri[:, [1, 2]],
+                                                  tri[:, [2, 0]]]), axis=1)}
+    for a, b in zip(nodes[:-1], nodes[1:]):
+        if (min(a, b), max(a, b)) not in edges:
+            raise ParameterError("cracked gear mesh failed: a crack segment is not a mesh edge "
+                                 "(try another h_crack)")
+    split = nodes[:-1]
+    twins = p.shape[0] + np.arange(split.size)
+    remap = np.arange(p.shape[0] + split.size)
+    remap[split] = twins
+    centroid = p[tri].mean(axis=1) - p[nodes[0]]
+    side = direction[0] * centroid[:, 1] - direction[1] * centroid[:, 0]
+    touch = np.isin(tri, split).any(axis=1)
+    upper = touch & (side < 0.0)
+    tri = tri.copy()
+    tri[upper] = remap[tri[upper]]
+    return np.vstack([p, p[split]]), tri, twins
+
+
+def _check_crack_faces(tri, nodes, twins):
+    """Raise unless both crack faces are chains of boundary facets sharing only the tip."""
+    edges = np.sort(np.vstack([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    uniq, count = np.unique(edges, axis=0, return_counts=True)
+    bnd = {tuple(e) for e in uniq[count == 1]}
+    other = np.append(twins, nodes[-1])
+    for face in (nodes, other):
+        for a, b in zip(face[:-1], face[1:]):
+            if (min(a, b), max(a, b)) not in bnd:
+                raise ParameterError("cracked gear mesh failed: the crack faces are not "
+                                     "boundary facets")
+    if np.any(np.isin(tri, nodes[:-1]).any(axis=1) & np.isin(tri, twins).any(axis=1)):
+        raise ParameterError("cracked gear mesh failed: a triangle touches both crack faces")
+
+
+def gear_mesh(gear, spec=MeshSpec(), crack=None):
     """Triangulate the body of ``gear`` from the bore to the tooth outlines.
 
     Parameters
@@ -492,6 +653,10 @@ def gear_mesh(gear, spec=MeshSpec()):
         The gear (tooth outline from :meth:`ToothProfile.from_gear`, bore radius).
     spec : MeshSpec
         Target sizes.
+    crack : RootCrack, optional
+        A root crack to cut into tooth 0: its nodes are fixed points of the mesh (the mouth
+        on the outline), the mesh is refined around it (``h_crack`` along it, half of it at
+        the tip) and the nodes of the faces are duplicated (the tip node is shared).
 
     Returns
     -------
@@ -500,18 +665,36 @@ def gear_mesh(gear, spec=MeshSpec()):
     Raises
     ------
     ParameterError
-        If ``gear`` is not a SpurGear or the triangulation does not follow the boundary.
+        If ``gear`` is not a SpurGear or the triangulation does not follow the boundary
+        (or the crack).
     """
     if not isinstance(gear, SpurGear):
         raise ParameterError(f"gear must be a SpurGear, got {type(gear).__name__}")
     if not isinstance(spec, MeshSpec):
         raise ParameterError(f"spec must be a MeshSpec, got {type(spec).__name__}")
+    if crack is not None and not isinstance(crack, RootCrack):
+        raise ParameterError(f"crack must be a RootCrack, got {type(crack).__name__}")
     profile = ToothProfile.from_gear(gear, n_points=800)
     geo = _Geometry(gear, profile, spec)
+    cnodes = np.zeros((0, 2))
+    if crack is not None:
+        cnodes = crack.nodes_m(profile)
+        hc = crack.h_crack * gear.module_m
+        dense = _densify(cnodes[[0, -1]], 0.25 * hc)
+        geo.sources.append((_CurveDistance(dense, 0.25 * hc), hc, dense))
+        geo.sources.append((_CurveDistance(cnodes[-1:], hc), 0.5 * hc, cnodes[-1:]))
     outline, bore = _boundary_points(gear, profile, geo)
-    fixed = np.vstack([outline, bore])
+    i_mouth = -1
+    if crack is not None:              # the mouth replaces the nearest outline node
+        i_mouth = int(np.argmin(np.hypot(*(outline - cnodes[0]).T)))
+        outline[i_mouth] = cnodes[0]
+    fixed = np.vstack([outline, bore, cnodes[1:]])
     interior = _interior_points(gear, profile, geo, fixed)
     p, tri = _distmesh(fixed, interior, geo, spec.max_iterations)
+    crack_idx = np.concatenate([[i_mouth], outline.shape[0] + bore.shape[0]
+                                + np.arange(cnodes.shape[0] - 1)]).astype(np.int64)
+    if crack is not None:
+        p, tri = _clear_crack(p, fixed.shape[0], cnodes, geo)
     tri, area2 = _orient(p, tri)
     if np.any(area2 <= 1e-12 * geo.h_body ** 2):
         tri = tri[area2 > 1e-12 * geo.h_body ** 2]
@@ -521,8 +704,15 @@ def gear_mesh(gear, spec=MeshSpec()):
     new[used] = np.arange(np.count_nonzero(used))
     p, tri = p[used], new[tri]
     bore_nodes = new[outline.shape[0] + np.arange(bore.shape[0])]
+    nodes = twins = None
+    if crack is not None:
+        nodes = new[crack_idx]
+        p, tri, twins = _cut_crack(p, tri, nodes, crack.path_m(profile)[1])
+        _check_crack_faces(tri, nodes, twins)
+        for arr in (nodes, twins):
+            arr.setflags(write=False)
     p.setflags(write=False)
     tri.setflags(write=False)
     bore_nodes.setflags(write=False)
     return GearMesh(points_m=p, triangles=tri, bore_nodes=bore_nodes, profile=profile,
-                    spec=spec)
+                    spec=spec, crack=crack, crack_nodes=nodes, crack_twin_nodes=twins)

@@ -257,7 +257,7 @@ class GearBodyModel:
     mesh_seconds: float
 
     @classmethod
-    def from_gear(cls, gear, spec=MeshSpec(), plane="strain"):
+    def from_gear(cls, gear, spec=MeshSpec(), plane="strain", crack=None):
         """Mesh, assemble and factorise the body of ``gear``.
 
         Parameters
@@ -268,6 +268,9 @@ class GearBodyModel:
             Mesh sizes.
         plane : {'stress', 'strain'}
             2-D idealisation (module docstring).
+        crack : RootCrack, optional
+            Root crack cut into tooth 0 (:func:`~cmsim.mesh_stiffness.fe_mesh.gear_mesh`);
+            its faces are traction-free.
 
         Returns
         -------
@@ -278,7 +281,7 @@ class GearBodyModel:
         if plane not in PLANE_MODES:
             raise ParameterError(f"plane must be one of {PLANE_MODES}, got {plane!r}")
         t0 = time.perf_counter()
-        gm = gear_mesh(gear, spec)
+        gm = gear_mesh(gear, spec, crack)
         t_mesh = time.perf_counter() - t0
         model = ElasticModel2D.from_mesh(gm.to_skfem(), gear.youngs_modulus_pa,
                                          gear.poisson_ratio, gear.face_width_m, plane, "bore")

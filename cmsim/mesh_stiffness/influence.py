@@ -52,7 +52,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError, check_range
 from cmsim.mesh_stiffness import cache
-from cmsim.mesh_stiffness.fe_mesh import MeshSpec, tooth_rotation_rad
+from cmsim.mesh_stiffness.fe_mesh import MeshSpec, RootCrack, tooth_rotation_rad
 from cmsim.mesh_stiffness.fe_model import PLANE_MODES, GearBodyModel
 from cmsim.mesh_stiffness.geometry import ToothProfile
 from cmsim.rig import SpurGear
@@ -289,6 +289,7 @@ def compute_influence_table(body, roll_m, depth_m, max_offset=3, load="point",
     meta = {"depth_m": h, "load": load, "hertz_half_width_m": hertz_half_width_m,
             "plane": model.plane, "mesh_spec": body.gear_mesh.spec.as_dict(),
             "n_dofs": model.n_dofs, "n_triangles": body.gear_mesh.n_triangles,
+            "crack": None if body.gear_mesh.crack is None else body.gear_mesh.crack.as_dict(),
             "mesh_seconds": body.mesh_seconds, "factor_seconds": model.factor_seconds,
             "solve_seconds": time.perf_counter() - t0}
     return InfluenceTable(roll_m=rho, coefficients_m_per_n=coeff, depth_m=h,
@@ -307,7 +308,7 @@ def _gear_inputs(gear):
 
 def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_step_m=None,
                     max_offset=3, load="point", hertz_half_width_m=None, use_cache=True,
-                    body=None):
+                    body=None, crack=None):
     """Influence coefficients of ``gear``, computed once per design and cached on disk.
 
     Parameters
@@ -330,8 +331,13 @@ def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_st
     use_cache : bool
         Read and write the cache (:mod:`cmsim.mesh_stiffness.cache`).
     body : GearBodyModel, optional
-        An already assembled model of ``gear`` with ``spec`` and ``plane`` to use on a cache
-        miss (saves the mesh generation and factorisation).
+        An already assembled model of ``gear`` with ``spec``, ``plane`` and ``crack`` to use
+        on a cache miss (saves the mesh generation and factorisation).
+    crack : RootCrack, optional
+        A root crack cut into the loaded tooth 0 (:mod:`~cmsim.mesh_stiffness.fe_mesh`):
+        the table then holds the cracked tooth's own coefficients (offset 0) and its
+        coupling to the healthy teeth ±1..±J (load on the cracked tooth). Part of the
+        cache key.
 
     Returns
     -------
@@ -353,6 +359,10 @@ def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_st
               "roll_m": [float(rho[0]), float(rho[-1]), int(rho.size)],
               "max_offset": int(max_offset), "load": load,
               "hertz_half_width_m": hertz_half_width_m}
+    if crack is not None:
+        if not isinstance(crack, RootCrack):
+            raise ParameterError(f"crack must be a RootCrack, got {type(crack).__name__}")
+        inputs["crack"] = crack.as_dict()
     key = cache.cache_key("influence", inputs)
     if use_cache:
         hit = cache.load_entry("influence", key)
@@ -367,10 +377,12 @@ def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_st
                                   face_width_m=gear.face_width_m, meta=meta)
     t0 = time.perf_counter()
     if body is None:
-        body = GearBodyModel.from_gear(gear, spec, plane)
+        body = GearBodyModel.from_gear(gear, spec, plane, crack)
     elif (not isinstance(body, GearBodyModel) or body.gear != gear
-          or body.gear_mesh.spec != spec or body.model.plane != plane):
-        raise ParameterError("body must be a GearBodyModel of this gear, spec and plane")
+          or body.gear_mesh.spec != spec or body.model.plane != plane
+          or body.gear_mesh.crack != crack):
+        raise ParameterError("body must be a GearBodyModel of this gear, spec, plane and "
+                             "crack")
     table = compute_influence_table(body, rho, h, max_offset, load, hertz_half_width_m)
     meta = dict(table.meta, build_seconds=time.perf_counter() - t0, key=key,
                 cache="miss" if use_cache else "off")
