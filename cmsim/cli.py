@@ -61,6 +61,8 @@ def _cmd_simulate(args):
 
     rig = _load_rig(args)
     op = _operating_point(args, rig)
+    faults = _faults_of(args, rig)
+    profile = _speed_profile(args)
     table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
     if not args.json and args.duration_s + args.warmup_s > LONG_RUN_S and _fits(args, rig):
         print(f"cmsim simulate: integrating {args.duration_s + args.warmup_s:g} s of simulated "
@@ -70,7 +72,7 @@ def _cmd_simulate(args):
                      correlation_s=args.slip_correlation_s)
     run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
                    mesh=mesh_model if mesh_model is not None else table, slip=slip,
-                   seed=args.seed, warmup_s=args.warmup_s)
+                   seed=args.seed, warmup_s=args.warmup_s, faults=faults, profile=profile)
     if args.sensors or args.sensor_noise or args.sensor_fs_hz is not None:
         from cmsim.sensors import add_sensors
         run = add_sensors(run, noise_rms=args.sensor_noise, fs_hz=args.sensor_fs_hz)
@@ -80,8 +82,56 @@ def _cmd_simulate(args):
     first = rig.bearing_names[0]
     out = {"shaft_hz": freqs.fr1_hz, "gmf_hz": freqs.gmf_hz,
            "bpf_hz": freqs.bearing(first).bpf_hz, **run.summary(),
+           "faults": [f["label"] for f in run.meta["faults"]],
+           "fault_frequencies": run.meta["fault_frequencies"],
+           "speed_profile": run.meta["speed_profile"],
            "out": str(args.out) if args.out else None}
     return out
+
+
+def _faults_of(args, rig):
+    """The faults of the rig file's ``[[faults]]``, ``--faults FILE`` and each ``--fault``
+    (in that order), each checked against ``rig``; bad input names the option that gave it."""
+    from cmsim.faults import load_faults, parse_fault
+
+    found = []                                    # (where, fault)
+    for option, path in (("--rig", getattr(args, "rig", None)),
+                         ("--faults", getattr(args, "faults", None))):
+        if path:
+            loaded = _load_file(option, path, load_faults, "a TOML file with a [[faults]] list")
+            found += [(f"{option} {path}: faults[{i}] ({f.name})", f)
+                      for i, f in enumerate(loaded)]
+    for text in getattr(args, "fault", None) or ():
+        try:
+            found.append((f"--fault {text}", parse_fault(text)))
+        except ParameterError as exc:
+            raise CLIError(f"--fault {text}: {' '.join(str(exc).split())} (form: "
+                           f"TYPE:key=value,...)", option="--fault") from None
+        except TypeError as exc:                  # a required field left out
+            missing = re.findall(r"'(\w+)'", str(exc))
+            raise CLIError(f"--fault {text}: {', '.join(missing) or 'a parameter'} must be "
+                           f"given (form: TYPE:key=value,...)", option="--fault") from None
+    for where, fault in found:
+        try:
+            fault.validate(rig)
+        except ParameterError as exc:
+            raise CLIError(f"{where}: {' '.join(str(exc).split())}",
+                           option=where.split()[0]) from None
+    return tuple(f for _, f in found)
+
+
+def _speed_profile(args):
+    """The run-up / coast-down of ``--ramp-to-rpm`` and ``--ramp-s`` (None without them)."""
+    if args.ramp_to_rpm is None:
+        if args.ramp_s is not None or args.ramp_start_s is not None:
+            raise CLIError("--ramp-s and --ramp-start-s shape the ramp of --ramp-to-rpm; give "
+                           "--ramp-to-rpm too", option="--ramp-s")
+        return None
+    from cmsim.dynamics.profiles import SpeedProfile
+    start_s = args.ramp_start_s or 0.0
+    ramp_s = args.ramp_s if args.ramp_s is not None else max(
+        args.warmup_s + args.duration_s - start_s, 1e-3)
+    return SpeedProfile.ramp(args.speed_rpm, args.ramp_to_rpm, ramp_s, start_s=start_s)
 
 
 #: simulated seconds above which simulate says how long it will take (realtime factor ~3-10)
@@ -162,6 +212,14 @@ def _text_simulate(res):
     if res["gmf_hz"] is not None:
         lines.append(f"GMF {res['gmf_hz']:.2f} Hz; DTE mean {res['dte_mean_um']:.3f} um, "
                      f"rms {res['dte_rms_um']:.3f} um (mean {res['dte_mean_rad']:.3e} rad)")
+    if res.get("speed_profile"):
+        prof = res["speed_profile"]
+        lines.append(f"speed profile: {prof['speeds_rpm'][0]:g} -> {prof['speeds_rpm'][-1]:g} "
+                     f"rpm over {prof['times_s'][-1]:g} s")
+    for label, freqs in (res.get("fault_frequencies") or {}).items():
+        lines.append(f"fault {label}: " + ", ".join(
+            f"{k[:-3].upper()} {v:.3f} Hz" for k, v in freqs.items()
+            if k.endswith("_hz") and isinstance(v, (int, float))))
     if res["out"]:
         lines.append(f"wrote {res['out']} (seed {res['seed']})")
     return "\n".join(lines)
@@ -201,8 +259,31 @@ def _add_simulate(sub):
     p.add_argument("--sensor-fs-hz", type=float, metavar="FS",
                    help="sensor sample rate, Hz (<= --fs-hz, e.g. 12000); the whole run is "
                         "decimated through an 80 dB anti-alias filter")
+    p.add_argument("--fault", action="append", metavar="TYPE:key=value,...",
+                   help="a fault of the catalogue, felt through the dynamics (repeatable), "
+                        "e.g. outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4 or "
+                        "tooth_crack:gear=1,depth_m=1e-3; types: " + ", ".join(FAULT_NAMES)
+                        + "; a rig file's [[faults]] list is applied too")
+    p.add_argument("--faults", metavar="FILE.toml",
+                   help="faults from a TOML file's [[faults]] list (type = \"...\", fields)")
+    p.add_argument("--ramp-to-rpm", type=float, metavar="RPM",
+                   help="run-up / coast-down: the input speed goes linearly from --speed-rpm "
+                        "to RPM (the cage, mesh and input rotation follow; --sensors adds "
+                        "the tacho for order tracking)")
+    p.add_argument("--ramp-s", type=float, metavar="S",
+                   help="duration of the ramp, s (default: to the end of the record)")
+    p.add_argument("--ramp-start-s", type=float, metavar="S",
+                   help="constant speed until S, then the ramp, s from the start of the "
+                        "warm-up (default 0)")
     _add_rig_options(p)
     p.set_defaults(func=_cmd_simulate, text=_text_simulate)
+
+
+#: the catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
+#: pulls in the mesh-stiffness stack; tests check the two agree)
+FAULT_NAMES = ("outer_race", "inner_race", "ball", "wear", "off_size_ball", "rolling_slip",
+               "eccentricity", "tooth_crack", "tooth_spall", "tooth_breakage", "profile_error",
+               "speed_fluctuation", "torque_ripple")
 
 
 # ---------------------------------------------------------------------- modes
@@ -602,6 +683,9 @@ _RANGES = {
     "workers": (int, 1, 1024, False, False, ""),
     "sensor_noise": (float, 0.0, 1.0e6, False, False, "m/s^2"),
     "sensor_fs_hz": (float, 0.0, 1.0e7, True, False, "Hz (and <= --fs-hz)"),
+    "ramp_to_rpm": (float, 0.0, 1.0e5, True, False, "rpm"),
+    "ramp_s": (float, 0.0, 1.0e5, True, False, "s"),
+    "ramp_start_s": (float, 0.0, 1.0e5, False, False, "s"),
 }
 #: numeric options whose range depends on other inputs and is checked by the library, which
 #: names them through _PARAM_TO_DEST (none today; clearance is narrowed by the bearing)
@@ -619,7 +703,8 @@ _PARAM_TO_DEST = {
 #: one-word Python names the library uses in messages for what an option sets
 _ALWAYS_REWRITE = {"substeps"}
 #: path options: dest -> "file" (must exist), "dir" (must exist), "out" (new file), "outdir"
-_PATHS = {"rig": "file", "mesh_table": "file", "run": "file", "dir": "dir", "out": "out",
+_PATHS = {"rig": "file", "faults": "file", "mesh_table": "file", "run": "file", "dir": "dir",
+          "out": "out",
           "plot": "out", ("sweep", "out"): "outdir"}
 
 

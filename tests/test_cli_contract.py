@@ -129,6 +129,60 @@ CATALOGUE = [
       "--table-torque-nm"),
     R("simulate-sensor-fs-above-fs", "simulate --speed-rpm 1000 --fs-hz 20000 --sensor-fs-hz "
       "40000", "--sensor-fs-hz", numeric=True),
+    # ---- simulate: faults and speed profiles (issue 16)
+    R("simulate-fault-unknown-name", "simulate --speed-rpm 1000 --fault bogus:size_m=1e-3",
+      "--fault", "type", "outer_race"),
+    R("simulate-fault-unknown-bearing", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=9z9,size_m=1e-3,depth_m=1e-4", "--fault", "bearing", "1b1"),
+    R("simulate-fault-unknown-gear", "simulate --speed-rpm 1000 --fault "
+      "tooth_crack:gear=3,depth_m=1e-3", "--fault", "gear", "1 (driving) or 2"),
+    R("simulate-fault-gear-on-bearing-rig", "simulate --speed-rpm 1000 --rig {bearing_rig} "
+      "--fault eccentricity:gear=1,amplitude_m=1e-5", "--fault", "gear"),
+    R("simulate-fault-race-too-large", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=1b1,size_m=0.05,depth_m=1e-4", "--fault", "size_m", "ball spacing",
+      numeric=True),
+    R("simulate-fault-ball-too-large", "simulate --speed-rpm 1000 --fault "
+      "ball:bearing=2b2,size_m=0.02,depth_m=1e-4", "--fault", "size_m", "ball diameter",
+      numeric=True),
+    R("simulate-fault-crack-too-deep", "simulate --speed-rpm 1000 --fault "
+      "tooth_crack:gear=1,depth_m=5e-3", "--fault", "depth_m", numeric=True),
+    R("simulate-fault-breakage-too-high", "simulate --speed-rpm 1000 --fault "
+      "tooth_breakage:gear=2,lost_height_m=0.01", "--fault", "lost_height_m", numeric=True),
+    R("simulate-fault-tooth-index", "simulate --speed-rpm 1000 --fault "
+      "tooth_spall:gear=1,width_m=1e-3,depth_m=1e-5,tooth=99", "--fault", "tooth",
+      numeric=True),
+    R("simulate-fault-negative-size", "simulate --speed-rpm 1000 --fault "
+      "inner_race:bearing=1b1,size_m=-1e-3,depth_m=1e-4", "--fault", "size_m", numeric=True),
+    R("simulate-fault-negative-depth", "simulate --speed-rpm 1000 --fault "
+      "tooth_spall:gear=1,width_m=1e-3,depth_m=-1e-5", "--fault", "depth_m", numeric=True),
+    R("simulate-fault-missing-depth", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3", "--fault", "depth_m"),
+    R("simulate-fault-not-key-value", "simulate --speed-rpm 1000 --fault outer_race:bearing",
+      "--fault", "key=value"),
+    R("simulate-fault-unknown-parameter", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4,width_m=1", "--fault", "width_m",
+      "allowed"),
+    R("simulate-fault-speed-wobble-negative", "simulate --speed-rpm 1000 --fault "
+      "speed_fluctuation:relative_amplitude=1.5,frequency_hz=5", "--fault",
+      "relative_amplitude", numeric=True),
+    R("simulate-faults-file-missing", "simulate --speed-rpm 1000 --faults {work}/none.toml",
+      "--faults"),
+    R("simulate-faults-file-text", "simulate --speed-rpm 1000 --faults {text}", "--faults",
+      "TOML"),
+    R("simulate-faults-file-bad-entry", "simulate --speed-rpm 1000 --faults {faults_bad}",
+      "--faults", "faults[1]", "size_m", numeric=True),
+    R("simulate-faults-file-unknown-bearing", "simulate --speed-rpm 1000 --rig {bearing_rig} "
+      "--faults {faults_gear}", "--faults", "faults[0]", "bearing", "1b1"),
+    R("simulate-rig-bad-faults", "simulate --speed-rpm 1000 --rig {rig_bad_faults}", "--rig",
+      "type", "outer_race"),
+    R("simulate-ramp-negative", "simulate --speed-rpm 1000 --ramp-to-rpm -100",
+      "--ramp-to-rpm", numeric=True),
+    R("simulate-ramp-zero", "simulate --speed-rpm 1000 --ramp-to-rpm 0", "--ramp-to-rpm",
+      numeric=True),
+    R("simulate-ramp-s-zero", "simulate --speed-rpm 1000 --ramp-to-rpm 2000 --ramp-s 0",
+      "--ramp-s", numeric=True),
+    R("simulate-ramp-s-alone", "simulate --speed-rpm 1000 --ramp-s 1", "--ramp-s",
+      "--ramp-to-rpm"),
     R("simulate-diverges", "simulate --speed-rpm 1000 --torque-nm 100 --fs-hz 2000 --substeps 1 "
       "--warmup-s 0 --duration-s 0.2", "--substeps", status=3),
     # ---- modes
@@ -277,6 +331,15 @@ def files(tmp_path_factory):
     variant("rig_teeth", "n_teeth = 28", "n_teeth = 100000", nth=2)
     variant("rig_nan", "clearance_m = 1.5e-05", "clearance_m = nan", nth=4)
     variant("rig_unknown", "module_m = ", "modul_m = ")
+    (d / "rig_bad_faults.toml").write_text(text + '\n[[faults]]\ntype = "bogus"\n')
+    f["rig_bad_faults"] = d / "rig_bad_faults.toml"
+    (d / "faults_bad.toml").write_text(
+        '[[faults]]\ntype = "ball"\nbearing = "1b1"\nsize_m = 5e-4\ndepth_m = 1e-4\n\n'
+        '[[faults]]\ntype = "outer_race"\nbearing = "1b1"\nsize_m = -1e-3\ndepth_m = 1e-4\n')
+    f["faults_bad"] = d / "faults_bad.toml"
+    (d / "faults_gear.toml").write_text(
+        '[[faults]]\ntype = "inner_race"\nbearing = "2b1"\nsize_m = 5e-4\ndepth_m = 1e-4\n')
+    f["faults_gear"] = d / "faults_gear.toml"
     run = _synthetic_run(paper, ["F_1b1_loa", "F_1b1_oloa", "x_1b1", "y_1b1", "x_2b1", "y_2b1",
                                  "dte_um"])
     f["run"] = run.save(d / "run.npz")
@@ -352,7 +415,8 @@ def test_every_option_is_validated():
     that maps to it; each other option has choices, is a path, a flag, or a name checked
     against the run."""
     parser = cli.build_parser()
-    free_text = {"signal", "bearing"}  # checked against the run's signals / bearings
+    # checked against the run's signals / bearings; --fault by cmsim.faults.parse_fault
+    free_text = {"signal", "bearing", "fault"}
     for command, sub in cli._subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):
