@@ -180,7 +180,7 @@ def main():
 
     def linear_only():
         # without the mesh, the load torque spins shaft 2 up: lift the divergence limits
-        status = K.integrate_jit(y0, 0.0, h, n_steps, 1, tab.a, tab.b, tab.c, P,
+        status = K.integrate_jit(y0, 0.0, h, n_steps, 1, 0, tab.a, tab.b, tab.c, P,
                                  K.make_work(P), K.make_integrator_buffers(tab.b, 2 * n, diag.shape[1]),
                                  out, diag, math.inf, math.inf, model.translational_mask)
         assert status == -1

@@ -64,15 +64,25 @@ def _cmd_simulate(args):
     faults = _faults_of(args, rig)
     profile = _speed_profile(args)
     table, mesh_model = _resolve_mesh_options(args, rig, op.torque_nm)
+    bar = None
     if not args.json and args.duration_s + args.warmup_s > LONG_RUN_S and _fits(args, rig):
-        print(f"cmsim simulate: integrating {args.duration_s + args.warmup_s:g} s of simulated "
-              f"time (about {(args.duration_s + args.warmup_s) / 10:.0f}-"
-              f"{(args.duration_s + args.warmup_s) / 3:.0f} s on one core)...", file=sys.stderr)
+        from tqdm import tqdm
+        bar = tqdm(total=round(args.duration_s + args.warmup_s, 3), unit="sim s",
+                   desc="cmsim simulate", file=sys.stderr, leave=False)
+
+    def progress(done_s, total_s):
+        bar.update(round(done_s, 3) - bar.n)
+
     slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                      correlation_s=args.slip_correlation_s)
-    run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
-                   mesh=mesh_model if mesh_model is not None else table, slip=slip,
-                   seed=args.seed, warmup_s=args.warmup_s, faults=faults, profile=profile)
+    try:
+        run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
+                       mesh=mesh_model if mesh_model is not None else table, slip=slip,
+                       seed=args.seed, warmup_s=args.warmup_s, faults=faults, profile=profile,
+                       progress=None if bar is None else progress)
+    finally:
+        if bar is not None:
+            bar.close()
     if args.sensors or args.sensor_noise or args.sensor_fs_hz is not None:
         from cmsim.sensors import add_sensors
         run = add_sensors(run, noise_rms=args.sensor_noise, fs_hz=args.sensor_fs_hz)

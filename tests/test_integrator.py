@@ -50,7 +50,7 @@ def run_sdof(scheme, h, t_end=2e-3):
     P = sdof_packed()
     n_out = int(round(t_end / h)) + 1
     out = np.empty((n_out, 2))
-    status = K.integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, tab.a, tab.b, tab.c, P,
+    status = K.integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, 0, tab.a, tab.b, tab.c, P,
                              K.make_work(P), K.make_integrator_buffers(tab.b, 2, 0), out,
                              np.empty((n_out, 0)), 1.0, 1.0, np.array([True]))
     assert status == -1

@@ -733,15 +733,18 @@ def make_integrator_buffers(tableau_b, dim, n_diag):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, B, out_y, out_diag,
-                  max_disp, max_rot, trans_mask):
+def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, P, W, B, out_y,
+                  out_diag, max_disp, max_rot, trans_mask):
     """Fixed-step explicit Runge-Kutta with output every ``substeps`` steps.
 
     The scheme is data: ``rk_a`` (s, s) strictly lower triangular, ``rk_b`` (s,), ``rk_c`` (s,).
     ``W`` is the :class:`Work` of :func:`make_work`, ``B`` the :class:`IntegratorBuffers` of
     :func:`make_integrator_buffers`. Sample ``m`` of ``out_y`` is the state at
-    ``t0 + m·substeps·h``; ``out_diag[m]`` holds the output forces at that instant (from the
-    first stage of the following step, so they cost nothing extra).
+    ``t0 + (m_offset + m)·substeps·h``; ``out_diag[m]`` holds the output forces at that
+    instant (from the first stage of the following step, so they cost nothing extra). A long
+    run may be integrated in chunks, each starting from the last state of the one before
+    with the same ``W`` and the count of samples before it in ``m_offset``: the chunks then
+    reproduce one call bit for bit.
 
     Returns
     -------
@@ -767,7 +770,7 @@ def integrate_jit(y0, t0, h, n_out, substeps, rk_a, rk_b, rk_c, P, W, B, out_y, 
             if not (math.isfinite(y[i]) and math.isfinite(y[n + i]) and abs(y[i]) <= limit):
                 return m
         for sub in range(substeps):
-            t = t0 + (m * substeps + sub) * h
+            t = t0 + ((m_offset + m) * substeps + sub) * h
             rhs_jit(t, y, k, 0, P, scratch, sub == 0, W)
             if sub == 0:
                 for i in range(scratch.shape[0]):

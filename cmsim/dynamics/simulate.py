@@ -46,7 +46,68 @@ PROFILE_STEP_S = 1e-4
 MAX_ROTATION_DEVIATION_RAD = 0.5
 
 
-def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=None):
+class _Integrator:
+    """The fixed-step kernel run in chunks with one scratch state (bit-identical to one call).
+
+    ``chunks(y0, t0, h, n_out, substeps)`` yields ``(m0, states, diag)`` blocks of at most
+    :data:`CHUNK_STEPS` output samples; sample ``m0 + i`` is the state at
+    ``t0 + (m0 + i)·substeps·h``. The last state of a block is the first of the next one.
+    """
+
+    def __init__(self, model, scheme, progress=None):
+        if scheme not in SCHEMES:
+            raise ParameterError(f"scheme must be one of {tuple(SCHEMES)}, got {scheme!r}")
+        self.model = model
+        self.tab = SCHEMES[scheme]
+        self.progress = progress
+        self.wall = 0.0
+        self.max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
+        self.mask = model.translational_mask
+
+    def chunks(self, y0, t0, h, n_out, substeps):
+        model, tab = self.model, self.tab
+        n_diag = len(model.diag_names)
+        buffers = K.make_integrator_buffers(tab.b, y0.size, n_diag)
+        # compile (or load from cache) outside the timed region, then start from fresh scratch
+        K.integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.packed,
+                        K.make_work(model.packed), buffers, np.empty((1, y0.size)),
+                        np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
+                        self.mask)
+        self.work = K.make_work(model.packed)
+        y, m0 = y0, 0
+        while m0 < n_out:
+            # one sample of overlap: a block's last state starts the next block
+            count = min(CHUNK_STEPS + 1, n_out - m0 + (1 if m0 else 0))
+            states = np.empty((count, y0.size))
+            diag = np.empty((count, n_diag))
+            first = m0 - 1 if m0 else 0
+            start = time.perf_counter()
+            status = K.integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
+                                     model.packed, self.work, buffers, states, diag,
+                                     self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
+            self.wall += time.perf_counter() - start
+            if status >= 0:
+                raise IntegrationDiverged(
+                    f"the integration diverged at t = {t0 + (first + status) * substeps * h:.6g}"
+                    f" s (a displacement exceeded {self.max_disp:g} m, a rotation deviation "
+                    f"{MAX_ROTATION_DEVIATION_RAD:g} rad, or a value became non-finite); use a "
+                    f"smaller step (substeps > {substeps} or a higher fs_hz) or check the rig "
+                    f"parameters")
+            skip = 1 if m0 else 0
+            yield m0, states[skip:], diag[skip:]
+            y = states[-1].copy()
+            m0 = first + count
+            if self.progress is not None:
+                self.progress(m0, n_out)
+
+    def stats(self):
+        """On-line contact solves of model A: ``hybrid_solves``, ``hybrid_unconverged``."""
+        return {"hybrid_solves": int(self.work.hstat[0]),
+                "hybrid_unconverged": int(self.work.hstat[1])}
+
+
+def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=None,
+              progress=None):
     """Run the fixed-step kernel; returns ``(states, diag, wall_s)``.
 
     Parameters
@@ -67,6 +128,9 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     stats : dict, optional
         Receives ``hybrid_solves`` and ``hybrid_unconverged`` (on-line contact solves of
         model A, and those that hit the iteration limit and used their last iterate).
+    progress : callable, optional
+        Called as ``progress(done, total)`` (output samples) after each chunk of
+        :data:`CHUNK_STEPS` samples; chunks do not change the result.
 
     Returns
     -------
@@ -75,35 +139,16 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     wall_s : float
         Wall time of the integration proper (compilation excluded), s.
     """
-    if scheme not in SCHEMES:
-        raise ParameterError(f"scheme must be one of {tuple(SCHEMES)}, got {scheme!r}")
-    tab = SCHEMES[scheme]
-    h = dt_out / substeps
+    runner = _Integrator(model, scheme, progress)
     states = np.empty((n_out, y0.size))
     diag = np.empty((n_out, len(model.diag_names)))
-    max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
-    max_rot = MAX_ROTATION_DEVIATION_RAD
-    mask = model.translational_mask
-    args = (tab.a, tab.b, tab.c, model.packed, K.make_work(model.packed),
-            K.make_integrator_buffers(tab.b, y0.size, len(model.diag_names)))
-    # compile (or load from cache) outside the timed region, then start from fresh scratch
-    K.integrate_jit(y0, t0, h, 1, 1, *args, states[:1], diag[:1], max_disp, max_rot, mask)
-    work = K.make_work(model.packed)
-    args = args[:4] + (work,) + args[5:]
-    start = time.perf_counter()
-    status = K.integrate_jit(y0, t0, h, n_out, substeps, *args, states, diag, max_disp,
-                             max_rot, mask)
-    wall = time.perf_counter() - start
+    for m0, st, dg in runner.chunks(np.asarray(y0, dtype=float), t0, dt_out / substeps, n_out,
+                                    substeps):
+        states[m0:m0 + len(st)] = st
+        diag[m0:m0 + len(dg)] = dg
     if stats is not None:
-        stats["hybrid_solves"] = int(work.hstat[0])
-        stats["hybrid_unconverged"] = int(work.hstat[1])
-    if status >= 0:
-        raise IntegrationDiverged(
-            f"the integration diverged at t = {t0 + status * dt_out:.6g} s (a displacement "
-            f"exceeded {max_disp:g} m, a rotation deviation {max_rot:g} rad, or a value became "
-            f"non-finite); use a smaller step "
-            f"(substeps > {substeps} or a higher fs_hz) or check the rig parameters")
-    return states, diag, wall
+        stats.update(runner.stats())
+    return states, diag, runner.wall
 
 
 def _check_memory(duration_s, fs_hz, n_dof, n_diag):
@@ -117,54 +162,35 @@ def _check_memory(duration_s, fs_hz, n_dof, n_diag):
             f"{MAX_OUTPUT_BYTES / per_second:.0f} s at this fs_hz (split longer records)")
 
 
-def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats):
+def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, progress=None):
     """Integrate at ``aa.factor`` steps per output sample in chunks and decimate through
     ``aa``; returns the recorded ``(q, forces, wall_s)`` at the output instants
     ``n_warm .. n_warm + n_rec − 1``."""
     k, hl = aa.factor, aa.half_length
-    h = dt_out / k
     n = model.n_dof
     first = n_warm * k - hl                       # first fast sample the filter reads
     last = (n_warm + n_rec - 1) * k + hl          # last one
     q_out = np.empty((n_rec, n))
     d_out = np.empty((n_rec, len(model.diag_names)))
-    y, t0, wall = y0, 0.0, 0.0
-    counts = {"hybrid_solves": 0, "hybrid_unconverged": 0}
-
-    def step(y_start, t_start, n_out):
-        part = {}
-        st, dg, w = integrate(model, y_start, t_start, h, n_out, 1, scheme, part)
-        for key in counts:
-            counts[key] += part[key]
-        return st, dg, w
-
-    if first > 0:                                 # warm-up the filter never reads
-        st, _, wall = step(y, 0.0, first + 1)
-        y, t0 = st[-1].copy(), first * h
+    runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
-    tail = None                                   # fast samples carried into the next chunk
-    index0 = first                                # fast index of the first row of the buffer
-    while m0 < n_rec:
-        n_steps = min(CHUNK_STEPS, last - (index0 + (0 if tail is None else len(tail))) + 1)
-        st, dg, w = step(y, t0, n_steps + 1)
-        wall += w
-        block = np.hstack([st[:-1, :n], dg[:-1]])
-        y, t0 = st[-1].copy(), t0 + n_steps * h
+    tail = None                                   # fast samples not yet consumed
+    for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1):
+        if i0 + len(st) <= first:                 # warm-up the filter never reads
+            continue
+        lo = max(first - i0, 0)
+        block = np.hstack([st[lo:, :n], dg[lo:]])
         buf = block if tail is None else np.vstack([tail, block])
-        out = aa.apply(buf)
         # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
+        out = aa.apply(buf)
         take = min(len(out), n_rec - m0)
         if take > 0:
             q_out[m0:m0 + take] = out[:take, :n]
             d_out[m0:m0 + take] = out[:take, n:]
             m0 += take
-        consumed = take * k
-        tail = buf[consumed:]
-        index0 += consumed
-        if n_steps <= 0:
-            break
-    stats.update(counts)
-    return q_out, d_out, wall
+        tail = buf[take * k:]
+    stats.update(runner.stats())
+    return q_out, d_out, runner.wall
 
 
 def _compile_seconds():
@@ -176,7 +202,7 @@ def _compile_seconds():
                             MeshStiffnessTable.constant(rig.gears, 1e8))
         y0 = np.zeros(2 * model.n_dof)
         tab = SCHEMES["ode3"]
-        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, tab.a, tab.b, tab.c, model.packed,
+        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.packed,
                         K.make_work(model.packed),
                         K.make_integrator_buffers(tab.b, y0.size, len(model.diag_names)),
                         np.empty((2, y0.size)),
@@ -188,7 +214,7 @@ def _compile_seconds():
 
 def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
              scheme="ode3", slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
-             profile=None, faults=()):
+             profile=None, faults=(), progress=None):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -239,6 +265,9 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         off-size balls, rolling slip (overrides ``slip``), speed fluctuation and torque
         ripple (laid on the speed/torque, with or without ``profile``). The run's meta lists
         them with their characteristic frequencies (the answer key).
+    progress : callable, optional
+        Called as ``progress(done_s, total_s)`` (simulated seconds, warm-up included) as the
+        integration advances, in chunks that do not change the result.
     cage_phases_rad : "random", sequence of float or None
         Initial cage angle of each bearing: drawn uniformly from ``seed`` (default — the
         relative phase of independent cages is arbitrary, and equal phases can cancel the
@@ -301,15 +330,20 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
     aa = None
     if substeps == 1:
         n_warm = int(round(warmup_s * fs_hz))
-        states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats)
+        report = None if progress is None else (lambda done, total: progress(done * dt,
+                                                                             total * dt))
+        states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
+                                       report)
         states, diag = states[n_warm:, :n], diag[n_warm:]
     else:
         aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
         # the centred filter needs half its length of integration before the first sample
         n_warm = max(int(round(warmup_s * fs_hz)),
                      math.ceil(aa.half_length / substeps))
+        report = None if progress is None else (lambda done, total: progress(
+            done * dt / substeps, total * dt / substeps))
         states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme,
-                                                  stats)
+                                                  stats, report)
     t = (n_warm + np.arange(n_rec)) * dt
     signals = _signals(model, t, states, diag, kprof)
     meta = {
