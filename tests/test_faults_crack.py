@@ -74,3 +74,20 @@ def test_weakest_near_the_tip(pair):
     f2 = crack_stiffness_factor(pair, 2, q, NU, s)       # gear-2 tip at the start
     assert np.argmin(f1) > 30 and np.argmin(f2) < 10
     assert np.all(np.diff(f1) < 1e-12)
+
+
+def test_fe_crack_has_the_pe_geometry(pair):
+    """The FE crack (mesh_stiffness.fe_mesh.RootCrack) starts where the PE crack starts and
+    its tip sits at the PE tip offset h_q = h_c - q sin(nu) from the centreline."""
+    from cmsim.faults.crack import crack_tip_offset_m
+    from cmsim.mesh_stiffness.fe_mesh import RootCrack
+
+    prof = ToothProfile.from_gear(pair.driving, n_points=800)     # the FE mesh's sampling
+    q = 0.6 * max_crack_depth_m(pair.driving, NU)
+    mouth, direction, tip = RootCrack(q, NU).path_m(prof)
+    y_s, h_c = crack_start(ToothProfile.from_gear(pair.driving))
+    np.testing.assert_allclose(mouth, [h_c, y_s], rtol=0, atol=1e-12)
+    assert tip[0] == pytest.approx(crack_tip_offset_m(prof, q, NU), abs=1e-12)
+    assert direction[1] < 0 < mouth[0] - tip[0]                 # inwards and down
+    # the mouth lies on the loaded (right) fillet of the outline
+    assert prof.half_thickness_at(np.array([y_s]))[0] == pytest.approx(h_c, rel=1e-3)
