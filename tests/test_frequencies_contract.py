@@ -80,7 +80,7 @@ def test_bearing_frequencies_mapping_access():
     assert list(bf.to_dict()) == ["shaft_hz", "ftf_hz", "bpfo_hz", "bpfi_hz", "bsf_hz",
                                   "bpf_hz"]
     assert bf["bpfo_hz"] == bf.bpfo_hz
-    with pytest.raises(KeyError, match=re.escape("no bearing frequency 'bpfx_hz'; have ['shaft_hz'")):
+    with pytest.raises(KeyError, match=r"""^"no bearing frequency 'bpfx_hz'; have \['shaft_hz'.*'bpf_hz'\]"$"""):
         bf["bpfx_hz"]
 
 
@@ -94,7 +94,7 @@ def test_rig_frequencies_mapping_and_round_trip():
     assert f["gmf_hz"] == f.gmf_hz and "gmf_hz" in f and "bpfo_hz" not in f
     assert list(iter(f)) == list(d)
     assert f.get("nothing", 7) == 7 and f.get("shaft_hz") == pytest.approx(20.0)
-    with pytest.raises(KeyError, match=re.escape("no frequency 'GMF'; have ['shaft_hz'")):
+    with pytest.raises(KeyError, match=r"""^"no frequency 'GMF'; have \['shaft_hz'.*'2b2'\]"$"""):
         f["GMF"]
     assert f.shaft_rates_hz == {"fr1": 20.0, "fr2": pytest.approx(20.0)}
     assert f.has_gears and f.bearing_names == rig.bearing_names
