@@ -40,7 +40,7 @@ from numba import njit
 from cmsim.bearings._kernels import ball_forces_cage_frame_jit
 from cmsim.mesh_stiffness._hybrid_kernels import (HP_SIZE, WORK_PER_N, WORK_PER_N2,
                                                   hybrid_forces_jit)
-from cmsim.mesh_stiffness._kernels import pair_contact_jit, table_lookup2_jit
+from cmsim.mesh_stiffness._kernels import mesh_line_jit, pair_contact_jit, table_lookup2_jit
 
 # b_int columns: DOF indices, number of balls, first row and count of the bearing's defects
 # in ``b_def``, 1 when the bearing has defects or off-size balls (its balls then take the
@@ -374,16 +374,7 @@ def _mesh_frame(c1x, c1y, c2x, c2y, rb1, rb2, mp):
     """Line of action for the gear centres C1, C2 (as
     :func:`cmsim.mesh_stiffness._kernels.mesh_frame_jit`, with its angle from an ``atan``
     series about the nominal angle instead of ``atan2``)."""
-    dx = c2x - c1x
-    dy = c2y - c1y
-    a = math.sqrt(dx * dx + dy * dy)
-    inv_a = 1.0 / a
-    ca = (rb1 + rb2) * inv_a
-    sa = math.sqrt(1.0 - ca * ca)
-    cg = dx * inv_a
-    sg = dy * inv_a
-    cos_t1 = cg * ca + sg * sa
-    sin_t1 = sg * ca - cg * sa
+    length, cos_t1, sin_t1 = mesh_line_jit(c1x, c1y, c2x, c2y, rb1, rb2)
     cross = mp[MP_COST0] * sin_t1 - mp[MP_SINT0] * cos_t1
     dot = mp[MP_COST0] * cos_t1 + mp[MP_SINT0] * sin_t1
     u = cross / dot
@@ -392,7 +383,7 @@ def _mesh_frame(c1x, c1y, c2x, c2y, rb1, rb2, mp):
         phi = mp[MP_PHIT0] + u * (1.0 - u2 * (1.0 / 3.0 - u2 * (1.0 / 5.0 - u2 * (1.0 / 7.0))))
     else:
         phi = math.atan2(sin_t1, cos_t1)
-    return phi, a * sa, cos_t1, sin_t1
+    return phi, length, cos_t1, sin_t1
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -32,6 +32,21 @@ GEO_SIZE = 14
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def mesh_line_jit(c1x, c1y, c2x, c2y, rb1, rb2):
+    """Length T1T2 = a·sin α_w (m) and the cos and sin of T1's polar angle γ − α_w for the
+    gear centres C1, C2 (a: instantaneous centre distance, γ: direction C1→C2)."""
+    dx = c2x - c1x
+    dy = c2y - c1y
+    a = math.sqrt(dx * dx + dy * dy)
+    inv_a = 1.0 / a
+    ca = (rb1 + rb2) * inv_a
+    sa = math.sqrt(1.0 - ca * ca)
+    cg = dx * inv_a
+    sg = dy * inv_a
+    return a * sa, cg * ca + sg * sa, sg * ca - cg * sa
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def mesh_frame_jit(c1x, c1y, c2x, c2y, rb1, rb2):
     """Line of action for the gear centres C1, C2.
 
@@ -44,17 +59,8 @@ def mesh_frame_jit(c1x, c1y, c2x, c2y, rb1, rb2):
     cos_t1, sin_t1 : float
         cos and sin of ``phi_t1``.
     """
-    dx = c2x - c1x
-    dy = c2y - c1y
-    a = math.sqrt(dx * dx + dy * dy)
-    inv_a = 1.0 / a
-    ca = (rb1 + rb2) * inv_a
-    sa = math.sqrt(1.0 - ca * ca)
-    cg = dx * inv_a
-    sg = dy * inv_a
-    cos_t1 = cg * ca + sg * sa
-    sin_t1 = sg * ca - cg * sa
-    return math.atan2(sin_t1, cos_t1), a * sa, cos_t1, sin_t1
+    length, cos_t1, sin_t1 = mesh_line_jit(c1x, c1y, c2x, c2y, rb1, rb2)
+    return math.atan2(sin_t1, cos_t1), length, cos_t1, sin_t1
 
 
 @njit(cache=True, inline="always", error_model="numpy")
