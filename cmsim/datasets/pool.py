@@ -1,0 +1,267 @@
+"""The one task runner of sweeps and datasets: local processes or a Dask cluster.
+
+:func:`run_tasks` calls a top-level function on each task's arguments in worker processes
+(:class:`concurrent.futures.ProcessPoolExecutor`) or on a ``dask.distributed`` cluster, and
+hands every result to ``on_result`` in the calling process as soon as it arrives.
+
+Interruptions
+    Ctrl-C (SIGINT) and SIGTERM stop the run promptly: the workers are terminated at once
+    (the calling process is the only one that reacts to the signal; workers ignore SIGINT),
+    the results that arrived before are already recorded, and :class:`Interrupted` (a
+    :class:`KeyboardInterrupt`) is raised so that the caller's ``with`` blocks (the directory
+    lock) unwind. Files are written atomically by the task functions, so a terminated
+    worker leaves at most a ``.*.tmp`` file, which the next run removes.
+
+Processes
+    On Linux the pool forks (``start_method="fork"``) after the caller has loaded the numba
+    kernels, so workers start at once and do not compile; elsewhere it spawns. A worker
+    exits on its own when its parent disappears (a killed run leaves no orphans).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+from cmsim.errors import ParameterError
+
+__all__ = ["run_tasks", "Interrupted", "START_METHODS", "default_start_method",
+           "check_workers", "check_start_method"]
+
+#: Process start methods accepted by :func:`run_tasks`.
+START_METHODS = ("fork", "spawn", "forkserver")
+
+
+class Interrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C (SIGINT) or SIGTERM; ``signal_name`` says which."""
+
+    def __init__(self, signal_name="SIGINT"):
+        super().__init__(signal_name)
+        self.signal_name = signal_name
+
+
+def default_start_method():
+    """"fork" on Linux, else "spawn"."""
+    return "fork" if sys.platform.startswith("linux") else "spawn"
+
+
+def check_workers(workers):
+    """``workers`` (default ``os.cpu_count()``) checked to be an integer in [1, 256]."""
+    workers = (os.cpu_count() or 1) if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, int) \
+            and not hasattr(workers, "__index__") or not 1 <= workers <= 256:
+        raise ParameterError(f"workers must be an integer in [1, 256], got {workers!r}",
+                             param="workers")
+    return int(workers)
+
+
+def check_start_method(start_method):
+    """``start_method`` (default :func:`default_start_method`) checked against the platform."""
+    method = default_start_method() if start_method is None else start_method
+    available = [m for m in START_METHODS if m in multiprocessing.get_all_start_methods()]
+    if method not in available:
+        raise ParameterError(f"start_method must be one of {available}, got {start_method!r}",
+                             param="start_method")
+    return method
+
+
+def _watch_parent(parent_pid, period_s=0.5):
+    """Exit this worker as soon as its parent is gone (killed run: no orphans left)."""
+    while True:
+        time.sleep(period_s)
+        if os.getppid() != parent_pid:
+            os._exit(1)
+
+
+def _worker_init(parent_pid):
+    """Pool initializer: only the parent reacts to Ctrl-C/SIGTERM; watch the parent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True,
+                     name="cmsim-parent-watch").start()
+
+
+class _SignalsRaise:
+    """While active (main thread only), SIGTERM and SIGINT raise :class:`Interrupted`."""
+
+    def __enter__(self):
+        self._old = {}
+        if threading.current_thread() is not threading.main_thread():
+            return self
+        for sig in (signal.SIGTERM, signal.SIGINT):
+            def handler(signum, frame):
+                raise Interrupted(signal.Signals(signum).name)
+            try:
+                self._old[sig] = signal.signal(sig, handler)
+            except (ValueError, OSError):      # pragma: no cover - not settable here
+                pass
+        return self
+
+    def __exit__(self, *exc):
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+        return False
+
+
+def run_tasks(fn, tasks, on_result, *, workers, start_method=None, scheduler=None,
+              progress=False, desc="run", unit="run", postfix=None):
+    """Call ``fn(*args)`` for every ``(key, args)`` of ``tasks``; results to ``on_result``.
+
+    Parameters
+    ----------
+    fn : callable
+        A module-level (picklable) function; it must not raise for an expected failure
+        (return a result that says so instead).
+    tasks : sequence of (key, tuple)
+        Task keys (for ``on_result``) and the arguments of ``fn``.
+    on_result : callable
+        ``on_result(key, result)``, called in this process as each task finishes; an
+        exception raised there stops the run (the workers are terminated) and propagates.
+    workers : int
+        Worker processes (local pool; at most the number of tasks).
+    start_method : {"fork", "spawn", "forkserver"}, optional
+        Start method of the local pool.
+    scheduler : str or distributed.Client, optional
+        A ``dask.distributed`` scheduler address (``"tcp://host:8786"``) or client: run the
+        tasks on that cluster instead of a local pool (``workers`` is then ignored). The
+        task functions write to the file system, so the cluster's workers must see the
+        output directory at the same path.
+    progress : bool
+        tqdm progress bar on stderr.
+    desc, unit : str
+        Progress bar label and unit.
+    postfix : callable, optional
+        ``postfix(key, result)`` → text shown beside the bar.
+
+    Returns
+    -------
+    int
+        Workers used (local processes, or the cluster's workers).
+
+    Raises
+    ------
+    Interrupted
+        On Ctrl-C or SIGTERM (the results received before are recorded).
+    """
+    tasks = list(tasks)
+    if not tasks:
+        return 0
+    from tqdm import tqdm
+
+    bar = None
+    with _SignalsRaise():
+        try:
+            bar = tqdm(total=len(tasks), disable=not progress, file=sys.stderr, unit=unit,
+                       desc=desc, dynamic_ncols=True, delay=0.0)
+
+            def done(key, res):
+                on_result(key, res)
+                bar.update(1)
+                if postfix is not None:
+                    bar.set_postfix_str(str(postfix(key, res)), refresh=False)
+
+            if scheduler is not None:
+                return _run_dask(fn, tasks, done, scheduler)
+            return _run_local(fn, tasks, done, min(int(workers), len(tasks)),
+                              check_start_method(start_method))
+        finally:
+            if bar is not None:
+                bar.close()
+
+
+def _run_local(fn, tasks, done, n_workers, method):
+    ctx = multiprocessing.get_context(method)
+    pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
+                               initializer=_worker_init, initargs=(os.getpid(),))
+    futures, delivered = {}, set()
+    try:
+        for key, args in tasks:
+            futures[pool.submit(fn, *args)] = key
+        remaining = set(futures)
+        while remaining:
+            finished, remaining = wait(remaining, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                delivered.add(fut)
+                done(futures[fut], fut.result())
+    except BaseException:
+        # stop now: terminate the busy workers, then record what had already finished
+        _terminate(pool)
+        with _SignalsIgnored():
+            for fut, key in futures.items():
+                if fut not in delivered and fut.done() and not fut.cancelled() \
+                        and fut.exception() is None:
+                    try:
+                        done(key, fut.result())
+                    except Exception:          # pragma: no cover - best effort
+                        pass
+        raise
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+    return n_workers
+
+
+class _SignalsIgnored:
+    """While active (main thread only), a second Ctrl-C/SIGTERM does not cut the clean-up."""
+
+    def __enter__(self):
+        self._old = {}
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGTERM, signal.SIGINT):
+                self._old[sig] = signal.signal(sig, signal.SIG_IGN)
+        return self
+
+    def __exit__(self, *exc):
+        for sig, old in self._old.items():
+            signal.signal(sig, old)
+        return False
+
+
+def _terminate(pool):
+    """Cancel queued tasks and terminate the pool's worker processes at once."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        try:
+            p.terminate()
+        except (OSError, AttributeError):          # pragma: no cover - already gone
+            pass
+    for p in procs:
+        p.join(timeout=5)
+
+
+def _run_dask(fn, tasks, done, scheduler):
+    try:
+        from distributed import Client, as_completed
+    except ImportError:                            # pragma: no cover - optional extra
+        raise ParameterError("scheduler needs dask.distributed: pip install 'cmsim[dask]'",
+                             param="scheduler") from None
+    own = not isinstance(scheduler, Client)
+    if own:
+        try:
+            client = Client(scheduler, timeout=30)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise ParameterError(f"scheduler {scheduler!r}: cannot connect ({exc})",
+                                 param="scheduler") from None
+    else:
+        client = scheduler
+    futures = {}
+    try:
+        for key, args in tasks:
+            futures[client.submit(fn, *args, pure=False, key=f"cmsim-{key}-{os.getpid()}-"
+                                  f"{time.monotonic_ns()}")] = key
+        n_workers = max(len(client.scheduler_info().get("workers", {})), 1)
+        for fut in as_completed(list(futures)):
+            done(futures[fut], fut.result())
+            fut.release()
+        return n_workers
+    except BaseException:
+        client.cancel(list(futures))
+        raise
+    finally:
+        if own:
+            client.close()
