@@ -62,11 +62,12 @@ DEF_OUTER, DEF_INNER, DEF_BALL = 1, 2, 3
 # off-size balls present
 MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE, MI_TEETH, MI_ECC, MI_PROFILE, MI_TDOF = range(9)
 MI_FAULTY_BALLS = 9     # 1 when any bearing has off-size balls
-MI_SIZE = 10
+MI_MUTAB = 10           # 1 when the friction coefficient follows ``mu_tab`` along the path
+MI_SIZE = 11
 MODE_TABLE, MODE_HYBRID = 0, 1
 # columns of the per-slot scratch ``W.slots`` of the mesh kernel
-SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP, SG_KPAIR = range(9)
-SG_SIZE = 9
+SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP, SG_KPAIR, SG_S = range(10)
+SG_SIZE = 10
 # m_par entries. MP_BETA: stiffness-proportional mesh damping coefficient β (s): a loaded
 # pair of stiffness k_j gets the viscous coefficient β·k_j, so the mesh as a whole has
 # 2ξ√(k̄·M_eq) on average whatever the number of pairs in contact. MP_COST1, MP_SINT1: cos
@@ -116,7 +117,10 @@ class KernelParams(NamedTuple):
     ecc : (2, 2) eccentricity (amplitude m, phase rad − the gear's reference phase) of each
         gear's geometric centre.
     prof : (n_t, PR_SIZE) input speed and output torque profile (``PR_*``; (1, PR_SIZE)
-        when ``MI_PROFILE`` is off). Nominal rotations are ``omega[i]·τ(t)`` with the
+        when ``MI_PROFILE`` is off).
+    mu_tab : (m,) mesh friction coefficient against the pair's position on the mesh table's
+        grid (a lubrication model's f(s) at the operating point; (1,) and unused when
+        ``MI_MUTAB`` is off: the constant ``MP_MU``). Nominal rotations are ``omega[i]·τ(t)`` with the
         equivalent time τ = Θ(t)/Ω_ref (τ = t at constant speed).
     """
 
@@ -151,6 +155,7 @@ class KernelParams(NamedTuple):
     te2: np.ndarray
     ecc: np.ndarray
     prof: np.ndarray
+    mu_tab: np.ndarray
 
 
 def no_faults(nb, max_balls):
@@ -488,6 +493,7 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
                 hchi2[j] = 1.0
             continue
         S[j, SG_ON] = 1.0
+        S[j, SG_S] = s
         # involute origins of this pair: gear-1 tooth `pair` pitches back, gear-2 tooth on;
         # only a corner (rounded-tip) contact needs them
         if not trig_done and (s < length - geo[3] or s > geo[2]):
@@ -583,7 +589,10 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
             continue
         # tangent t = (ny, −nx); sliding velocity of gear 1 relative to gear 2 along t
         slide = dvx * ny - dvy * nx
-        ff = mp[MP_MU] * fn * slide / math.sqrt(slide * slide + mp[MP_V0] * mp[MP_V0])
+        mu = mp[MP_MU]
+        if m_int[MI_MUTAB] != 0:
+            mu, _ = table_lookup2_jit(S[j, SG_S], mp[MP_TAB0], mp[MP_TABD], P.mu_tab, P.mu_tab)
+        ff = mu * fn * slide / math.sqrt(slide * slide + mp[MP_V0] * mp[MP_V0])
         # force on gear 2: fn·n + ff·t ; on gear 1: the opposite
         f2x = fn * nx + ff * ny
         f2y = fn * ny - ff * nx

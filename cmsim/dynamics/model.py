@@ -418,7 +418,7 @@ def _dof_names(rig):
 
 
 def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
-                cage_phases_rad=None, faults=(), profile=None):
+                cage_phases_rad=None, faults=(), profile=None, loads=None, friction_table=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
 
     Parameters
@@ -441,6 +441,13 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     profile : KernelProfile, optional
         Input speed and output torque against time (:mod:`cmsim.dynamics.profiles`);
         ``op`` then gives the reference (initial) speed.
+    loads : dict, optional
+        Extra constant generalised forces by DOF name, N or N·m (e.g. resisting torques of
+        windage, oil pumping or bearing friction on ``theta_1G1``; a resisting torque is
+        negative in the DOF's own sense of motion).
+    friction_table : ndarray, shape (m,), optional
+        Mesh friction coefficient against the pair's position on the run's mesh table grid
+        (a mixed-lubrication model at the operating point), in place of the rig's constant.
 
     Returns
     -------
@@ -471,6 +478,8 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     if op.radial_load_n > 0:
         force[3] += op.radial_load_n * math.cos(op.radial_load_angle_rad)
         force[4] += op.radial_load_n * math.sin(op.radial_load_angle_rad)
+    for name, value in (loads or {}).items():
+        force[rm.index(name)] += check_range(f"loads[{name!r}]", value, unit="N or N m")
 
     nb = len(rig.bearings)
     m_int = np.zeros(K.MI_SIZE, dtype=np.int64)
@@ -528,10 +537,18 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
         m_par[K.MP_PDT] = profile.dt_s
         m_par[K.MP_OMREF] = op.omega_rad_s
         prof = np.ascontiguousarray(profile.table, dtype=float)
+    mu_tab = np.zeros(1)
+    if friction_table is not None:
+        mu_tab = np.ascontiguousarray(friction_table, dtype=float)
+        if rig.gears is None or mu_tab.shape != (len(tab_k),) or not np.all(np.isfinite(mu_tab)) \
+                or np.any(mu_tab < 0) or np.any(mu_tab > 1):
+            raise ParameterError(f"friction_table needs {len(tab_k)} values in [0, 1] (one "
+                                 f"per point of the mesh table grid)")
+        m_int[K.MI_MUTAB] = 1
     packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, b_int, rm.b_par,
                             rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
                             m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
-                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof)
+                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab)
     model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
                          SlipModel(), mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
