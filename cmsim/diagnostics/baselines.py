@@ -18,7 +18,8 @@ channels (and bearings / shafts).
 
    * ``outer_race``: h·BPFO, h = 1, 2, 3;
    * ``inner_race``: BPFI, 2·BPFI, BPFI ± fr (fr: the rate of the bearing's shaft);
-   * ``ball``: 2·BSF, 4·BSF, 2·BSF ± FTF (a ball defect hits both races);
+   * ``ball``: 2·BSF, 4·BSF, 2·BSF ± FTF (a ball defect hits both races) and FTF (the
+     defect enters and leaves the load zone with the cage);
 
    label = the class with the largest score when it exceeds :data:`ENVELOPE_THRESHOLD`
    (3: a bin of Gaussian noise reads about 1.5 times its local median), else ``healthy``;
@@ -81,7 +82,7 @@ ENVELOPE_THRESHOLD = 3.0
 #: Relative search half-width around an envelope line (bearing slip, speed error).
 SLIP_TOLERANCE = 0.01
 #: Half-width of the local-median window around an envelope line, × the family fundamental.
-LOCAL_MEDIAN_FRACTION = 0.2
+LOCAL_MEDIAN_FRACTION = 0.5
 #: FM4 above which a local gear fault is declared (3 for Gaussian noise; healthy simulated
 #: and measured gears read 3-5).
 TSA_THRESHOLD = 6.0
@@ -115,7 +116,7 @@ def _family_lines(bf):
             "inner_race": (bf.bpfi_hz, [bf.bpfi_hz, 2 * bf.bpfi_hz, bf.bpfi_hz - fr,
                                         bf.bpfi_hz + fr]),
             "ball": (2 * bf.bsf_hz, [2 * bf.bsf_hz, 4 * bf.bsf_hz, 2 * bf.bsf_hz - bf.ftf_hz,
-                                     2 * bf.bsf_hz + bf.ftf_hz])}
+                                     2 * bf.bsf_hz + bf.ftf_hz, bf.ftf_hz])}
 
 
 def _line_ratio(freq, amp, f_hz, f0_hz, df):
