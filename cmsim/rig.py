@@ -549,12 +549,28 @@ class Lubricant:
     ----------
     dynamic_viscosity_pa_s : float
         Dynamic viscosity η, Pa·s (Koster squeeze-film damping, paper eq. 5).
+    pressure_viscosity_pa_inv : float
+        Barus pressure-viscosity coefficient α, 1/Pa (EHL film thickness, :mod:`cmsim.losses`;
+        mineral oils 1-3e-8).
+    density_kg_m3 : float
+        Oil density, kg/m³ (paper 000 Table 5: 970 for its ISO 46).
+    surface_roughness_m : float
+        Composite RMS roughness σ = sqrt(σ1² + σ2²) of the tooth and race surfaces, m (film
+        ratio λ = h/σ of the mixed-lubrication friction).
     """
 
     dynamic_viscosity_pa_s: float = 0.004
+    pressure_viscosity_pa_inv: float = 2.0e-8
+    density_kg_m3: float = 870.0
+    surface_roughness_m: float = 0.4e-6
 
     def __post_init__(self):
         check_range("dynamic_viscosity_pa_s", self.dynamic_viscosity_pa_s, 0.0, 10.0, unit="Pa s")
+        check_range("pressure_viscosity_pa_inv", self.pressure_viscosity_pa_inv, 0.0, 1e-7,
+                    unit="1/Pa")
+        check_range("density_kg_m3", self.density_kg_m3, 100.0, 3000.0, unit="kg/m^3")
+        check_range("surface_roughness_m", self.surface_roughness_m, 0.0, 50e-6, lo_open=True,
+                    unit="m")
 
 
 @dataclass(frozen=True)
