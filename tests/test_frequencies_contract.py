@@ -99,7 +99,8 @@ def test_rig_frequencies_mapping_and_round_trip():
     assert f.shaft_rates_hz == {"fr1": 20.0, "fr2": pytest.approx(20.0)}
     assert f.has_gears and f.bearing_names == rig.bearing_names
     assert f.bearing() is f.bearings["1b1"] and f.bearing("2b2") is f.bearings["2b2"]
-    with pytest.raises(ParameterError, match=re.escape("bearing must be one of ['1b1', '1b2'")):
+    with pytest.raises(ParameterError, match=r"^bearing must be one of \['1b1', '1b2', "
+                                             r"'2b1', '2b2'\], got '3b1'$"):
         f.bearing("3b1")
     assert peak_families(d, "2b1") == f.families("2b1")
     assert f.families("2b1")["fr"] == pytest.approx(20.0)
@@ -123,3 +124,18 @@ def test_rig_frequencies_without_gears_and_bad_inputs():
     with pytest.raises(ParameterError, match="got list"):
         peak_families([1.0])
     assert isinstance(bearing_frequencies(1.0, **GEOM), BearingFrequencies)
+
+
+def test_bearing_rig_and_slow_shafts():
+    """No gears: no output shaft and no GMF (None, not a falsy placeholder); a shaft slower
+    than 1 Hz keeps its families (only zero rates are dropped)."""
+    brg = Rig.paper_2016().bearings[0]
+    from cmsim.rig import Rotor
+    rig = Rig.rotor_on_bearings(brg, Rotor(mass_kg=5.0, inertia_kg_m2=0.01))
+    f = RigFrequencies.of(rig, OperatingPoint(30.0))
+    assert f.fr2_hz is None and f.gmf_hz is None and not f.has_gears
+    assert f.fr1_hz == pytest.approx(0.5, rel=1e-12)
+    fam = f.families()
+    assert set(fam) == {"fr", "BPF", "BPFO", "BPFI", "BSF", "FTF"}
+    assert fam["fr"] == pytest.approx(0.5, rel=1e-12)
+    assert 0.0 < fam["FTF"] < 1.0
