@@ -88,8 +88,7 @@ import math
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.mesh_stiffness.fe_mesh import (CRITICAL_TANGENT_RAD, MeshSpec, RootCrack,
-                                          crack_start_point)
+from cmsim.mesh_stiffness.fe_mesh import MeshSpec, RootCrack, crack_start_point
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
 from cmsim.mesh_stiffness.influence import influence_table
 from cmsim.mesh_stiffness.local_deflection import (contact_modulus, hertz_half_width,
