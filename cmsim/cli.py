@@ -502,6 +502,60 @@ def _add_sweep(sub):
     p.set_defaults(func=_cmd_sweep, text=_text_sweep)
 
 
+# ---------------------------------------------------------------------- dataset
+def _cmd_dataset(args):
+    from cmsim.datasets import DatasetSpec, generate_dataset
+
+    spec = _load_file("SPEC", args.spec, DatasetSpec.load, "a dataset spec TOML file")
+    progress = not args.json and sys.stderr.isatty()
+    try:
+        summary = generate_dataset(spec, args.out, workers=args.workers,
+                                   scheduler=args.scheduler, progress=progress,
+                                   verify=args.verify, force=args.force)
+    except KeyboardInterrupt as exc:
+        raise CLIError(f"interrupted ({getattr(exc, 'signal_name', 'SIGINT')}); finished "
+                       f"records are kept in {args.out}, re-run the same command to resume",
+                       130) from None
+    res = summary.to_dict()
+    if summary.records_failed:
+        _warn(args, f"{summary.records_failed} records failed (status 'failed' in "
+                    f"{res['manifest']}, with their error)")
+    return res
+
+
+def _text_dataset(res):
+    lines = [f"{res['records_total']} records in {res['dir']}: {res['records_written']} "
+             f"written, {res['records_skipped']} already there, {res['records_failed']} failed",
+             f"wall {res['wall_s']:.2f} s on {res['workers']} {res['runner']} workers; "
+             f"integration {res['integration_s']:.2f} s, setup {res['setup_s']:.2f} s, "
+             f"sensors {res['sensors_s']:.2f} s, save {res['save_s']:.2f} s",
+             f"manifest {res['manifest']}"]
+    lines += [f"failed {f['record_id']}: {f['error']}" for f in res["failed"][:5]]
+    return "\n".join(lines)
+
+
+def _add_dataset(sub):
+    p = sub.add_parser("dataset", help="generate a labelled fault dataset from a TOML spec",
+                       description="Generate the records of a dataset spec (datasets/*.toml) "
+                                   "on local worker processes or a Dask cluster; each record "
+                                   "is saved to DIR/records/ as it finishes and listed in "
+                                   "DIR/manifest.parquet. Re-running the same command "
+                                   "resumes: finished records are not recomputed.")
+    p.add_argument("spec", metavar="SPEC", help="dataset spec (TOML)")
+    p.add_argument("--out", type=Path, required=True, metavar="DIR", help="dataset directory")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: number of CPUs)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="dask.distributed scheduler address (tcp://host:8786); its workers "
+                        "must see DIR (needs the 'dask' extra)")
+    p.add_argument("--verify", action="store_true",
+                   help="check the SHA-256 of every finished record when resuming")
+    p.add_argument("--force", action="store_true",
+                   help="replace a dataset of a different spec in DIR")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.set_defaults(func=_cmd_dataset, text=_text_dataset)
+
+
 # ---------------------------------------------------------------------- report
 def _cmd_report(args):
     from cmsim.report import DEFAULT_SIGNALS, build_report
@@ -693,7 +747,7 @@ def _add_mesh_table(sub):
 
 
 _COMMANDS = [_add_simulate, _add_modes, _add_mesh_table, _add_spectrum, _add_sweep,
-             _add_report, _add_evaluate]
+             _add_dataset, _add_report, _add_evaluate]
 
 
 def _jsonable(obj):
@@ -783,7 +837,8 @@ _ALWAYS_REWRITE = {"substeps"}
 #: path options: dest -> "file" (must exist), "dir" (must exist), "out" (new file), "outdir"
 _PATHS = {"rig": "file", "faults": "file", "mesh_table": "file", "run": "file", "dir": "dir",
           "out": "out",
-          "plot": "out", ("sweep", "out"): "outdir", ("evaluate", "report"): "out"}
+          "plot": "out", ("sweep", "out"): "outdir", ("evaluate", "report"): "out",
+          ("dataset", "spec"): "file", ("dataset", "out"): "outdir"}
 
 
 class CLIError(Exception):
@@ -988,7 +1043,7 @@ def _announce_compile(args):
         print("cmsim: compiling numba kernels (first run only, about 30 s)...", file=sys.stderr)
 
 
-_COMPILING = ("simulate", "modes", "mesh-table", "sweep")
+_COMPILING = ("simulate", "modes", "mesh-table", "sweep", "dataset")
 
 
 def main(argv=None):

@@ -6,7 +6,11 @@
   seeds) and its :class:`SweepCase` s, the Cartesian product of the variations;
 * :mod:`~cmsim.datasets.manifest` — ``DIR/manifest.json``: read, write, resume checks;
 * :mod:`~cmsim.datasets.lock` — one sweep per directory (``fcntl.flock``);
-* :mod:`~cmsim.datasets.runner` — :func:`run_sweep`: local process pool, resumable.
+* :mod:`~cmsim.datasets.runner` — :func:`run_sweep`: local process pool, resumable;
+* :mod:`~cmsim.datasets.pool` — the one task runner (local processes or Dask, Ctrl-C/SIGTERM);
+* :mod:`~cmsim.datasets.dataset_spec` — :class:`DatasetSpec`: a labelled dataset from TOML;
+* :mod:`~cmsim.datasets.generate` — :func:`generate_dataset`: records, Parquet manifest;
+* :mod:`~cmsim.datasets.load` — :func:`load`: the manifest, lazy records, ML arrays.
 
 Example
 -------
@@ -17,7 +21,11 @@ Example
 ['000_T10Nm_c15um', '001_T10Nm_c0um', '002_T100Nm_c15um', '003_T100Nm_c0um']
 """
 
+from cmsim.datasets.dataset_spec import BUILTIN_RIGS, DatasetRecord, DatasetSpec
+from cmsim.datasets.generate import DatasetSummary, generate_dataset
+from cmsim.datasets.load import Dataset, Record, load
 from cmsim.datasets.lock import LOCK_NAME, DirectoryLock
+from cmsim.datasets.pool import Interrupted
 from cmsim.datasets.manifest import (FEATURE_SIGNALS, MANIFEST_NAME, RUNS_DIR,
                                      manifest_features, read_manifest)
 from cmsim.datasets.runner import START_METHODS, SweepSummary, run_sweep
@@ -27,4 +35,6 @@ from cmsim.datasets.variation import OPERATING_POINT_FIELDS, RIG_TRANSFORMS, Var
 __all__ = ["SweepSpec", "SweepCase", "Variation", "SweepSummary", "run_sweep", "read_manifest",
            "manifest_features", "DirectoryLock", "SEED_POLICIES", "START_METHODS",
            "MANIFEST_NAME", "RUNS_DIR", "LOCK_NAME", "FEATURE_SIGNALS",
-           "OPERATING_POINT_FIELDS", "RIG_TRANSFORMS"]
+           "OPERATING_POINT_FIELDS", "RIG_TRANSFORMS", "DatasetSpec", "DatasetRecord",
+           "DatasetSummary", "generate_dataset", "load", "Dataset", "Record", "BUILTIN_RIGS",
+           "Interrupted"]

@@ -1,0 +1,263 @@
+"""Read a generated dataset: :func:`load` → :class:`Dataset` (manifest, lazy records, arrays).
+
+>>> ds = load("out/ci")                                          # doctest: +SKIP
+>>> ds.manifest.groupby("fault_label").size()                    # doctest: +SKIP
+>>> X, y, groups = ds.to_arrays(["accel_1b1_y"], window=2048)    # doctest: +SKIP
+
+Signals are read only when asked for (a record's file is opened when one of its signals is
+accessed), so a dataset larger than memory can be explored from a notebook; for training,
+:meth:`Dataset.iter_arrays` yields fixed-size batches of windows, and :meth:`Dataset.to_arrays`
+takes a subset of records.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from cmsim.datasets.generate import PARQUET_NAME, SPEC_NAME, read_rows
+from cmsim.errors import ParameterError
+from cmsim.frequencies import RigFrequencies
+from cmsim.rig import OperatingPoint, Rig
+
+__all__ = ["load", "Dataset", "Record"]
+
+
+class _LazySignals(Mapping):
+    """Mapping name → float32 array, read from the record file on access."""
+
+    def __init__(self, path, names):
+        self._path, self._names = path, tuple(names)
+
+    def __getitem__(self, name):
+        if name not in self._names:
+            raise KeyError(f"no channel {name!r}; available: {list(self._names)}")
+        with np.load(self._path, allow_pickle=False) as z:
+            return z[name]
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self):
+        return len(self._names)
+
+
+class Record:
+    """One record of a dataset.
+
+    Attributes
+    ----------
+    record_id : str
+    row : dict
+        Its manifest row.
+    signals : Mapping of str to ndarray
+        The channels, float32, read lazily.
+    fs_hz : float
+        Sample rate, Hz.
+    """
+
+    def __init__(self, directory, row, channels, fs_hz):
+        self.record_id = str(row["record_id"])
+        self.row = row
+        self.fs_hz = float(fs_hz)
+        self._path = Path(directory) / row["path"]
+        self.signals = _LazySignals(self._path, channels)
+        self._meta = None
+
+    def __repr__(self):
+        return f"Record({self.record_id!r}, {self.row.get('fault_label')!r})"
+
+    @property
+    def meta(self):
+        """The record's stored meta (rig, operating point, faults, answer key, timing)."""
+        if self._meta is None:
+            with np.load(self._path, allow_pickle=False) as z:
+                self._meta = json.loads(str(z["meta"]))
+        return self._meta
+
+    @property
+    def operating_point(self):
+        """:class:`~cmsim.rig.OperatingPoint` (the start speed of a run-up)."""
+        r = self.row
+        return OperatingPoint(speed_rpm=float(r["speed_rpm"]),
+                              torque_nm=float(r.get("torque_nm", 0.0) or 0.0),
+                              radial_load_n=float(r.get("radial_load_n", 0.0) or 0.0))
+
+    @property
+    def rig(self):
+        """The record's :class:`~cmsim.rig.Rig` (with its drawn friction and clearance)."""
+        return Rig.from_dict(self.meta["rig"])
+
+    @property
+    def frequencies(self):
+        """:class:`~cmsim.frequencies.RigFrequencies` of the rig at the operating point."""
+        return RigFrequencies.of(self.rig, self.operating_point)
+
+    @property
+    def labels(self):
+        """The answer key: fault_label, fault_component, fault_severity, faults."""
+        return dict(self.meta["labels"])
+
+
+class Dataset:
+    """A generated dataset directory (see :func:`load`).
+
+    Attributes
+    ----------
+    directory : Path
+    manifest : pandas.DataFrame
+        One row per record (failed ones included, ``status == "failed"``).
+    channels : tuple of str
+    fs_hz : float
+    spec : dict
+        The resolved spec (``dataset.json``).
+    """
+
+    def __init__(self, directory):
+        self.directory = Path(directory)
+        try:
+            info = json.loads((self.directory / SPEC_NAME).read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            raise ParameterError(f"{self.directory} is not a cmsim dataset (no readable "
+                                 f"{SPEC_NAME})", param="dir") from None
+        self.spec = info["spec"]
+        df = read_rows(self.directory)
+        if df is None:
+            raise ParameterError(f"{self.directory} has no records yet ({PARQUET_NAME})",
+                                 param="dir")
+        self.manifest = df
+        self.channels = tuple(self.spec["channels"])
+        self.fs_hz = float(self.spec["fs_hz"])
+        self._ok = df.index[df["status"] == "ok"].to_numpy()
+
+    def __len__(self):
+        """Number of ok records."""
+        return len(self._ok)
+
+    def __iter__(self):
+        for i in self._ok:
+            yield self._record_at(i)
+
+    def _record_at(self, pos):
+        row = {k: (None if isinstance(v, float) and math.isnan(v) else v)
+               for k, v in self.manifest.iloc[int(pos)].to_dict().items()}
+        return Record(self.directory, row, self.channels, row.get("fs_hz") or self.fs_hz)
+
+    def record(self, key):
+        """A record by ``record_id`` (str) or record index (int)."""
+        col = "record_id" if isinstance(key, str) else "index"
+        hits = np.flatnonzero(self.manifest[col].to_numpy() == key)
+        if hits.size == 0:
+            raise KeyError(f"no record {key!r}")
+        pos = hits[0]
+        if self.manifest["status"].iloc[pos] != "ok":
+            raise KeyError(f"record {key!r} failed: {self.manifest['error'].iloc[pos]}")
+        return self._record_at(pos)
+
+    def _select(self, records):
+        if records is None:
+            return list(self._ok)
+        out = []
+        for key in records:
+            col = "record_id" if isinstance(key, str) else "index"
+            hits = np.flatnonzero((self.manifest[col].to_numpy() == key)
+                                  & (self.manifest["status"].to_numpy() == "ok"))
+            if hits.size == 0:
+                raise KeyError(f"no ok record {key!r}")
+            out.append(int(hits[0]))
+        return out
+
+    def iter_arrays(self, channels=None, window=2048, hop=None, label="fault_label",
+                    records=None, batch_records=64):
+        """Yield ``(X, y, groups)`` batches of windows, ``batch_records`` records at a time
+        (memory bounded by one batch); same layout as :meth:`to_arrays`."""
+        channels = self._channels(channels)
+        window, hop = _check_window(window, hop)
+        if label not in self.manifest.columns:
+            raise ParameterError(f"label must be a manifest column, got {label!r}",
+                                 param="label")
+        chosen = self._select(records)
+        for start in range(0, len(chosen), int(batch_records)):
+            xs, ys, gs = [], [], []
+            for pos in chosen[start:start + int(batch_records)]:
+                rec = self._record_at(pos)
+                with np.load(rec._path, allow_pickle=False) as z:
+                    sig = np.stack([z[c] for c in channels]).astype(np.float32, copy=False)
+                n = (sig.shape[1] - window) // hop + 1
+                if n <= 0:
+                    continue
+                idx = np.arange(window)[None, :] + hop * np.arange(n)[:, None]
+                xs.append(np.transpose(sig[:, idx], (1, 0, 2)))
+                ys.append(np.repeat(np.asarray([rec.row[label]], dtype=object), n))
+                gs.append(np.repeat(np.asarray([rec.record_id]), n))
+            if xs:
+                yield (np.concatenate(xs), np.concatenate(ys), np.concatenate(gs))
+
+    def to_arrays(self, channels=None, window=2048, hop=None, label="fault_label",
+                  records=None):
+        """Windows of every (or the given) ok record as arrays.
+
+        Parameters
+        ----------
+        channels : sequence of str, optional
+            Channels to stack (default all of the dataset's).
+        window : int
+            Samples per window.
+        hop : int, optional
+            Samples between window starts (default ``window``: no overlap).
+        label : str
+            Manifest column giving ``y``.
+        records : sequence of str or int, optional
+            Record ids or indices (default every ok record).
+
+        Returns
+        -------
+        X : ndarray, float32, shape (n_windows, n_channels, window)
+        y : ndarray, shape (n_windows,)
+            The record's ``label`` value per window.
+        groups : ndarray of str, shape (n_windows,)
+            Record id per window: windows of one record share a group, so a grouped split
+            (``sklearn.model_selection.GroupKFold``) never puts one record in two sets.
+        """
+        parts = list(self.iter_arrays(channels, window, hop, label, records, batch_records=256))
+        channels = self._channels(channels)
+        if not parts:
+            return (np.empty((0, len(channels), int(window)), np.float32),
+                    np.empty(0, object), np.empty(0, str))
+        return tuple(np.concatenate(p) for p in zip(*parts))
+
+    def _channels(self, channels):
+        if channels is None:
+            return list(self.channels)
+        channels = [channels] if isinstance(channels, str) else list(channels)
+        for c in channels:
+            if c not in self.channels:
+                raise ParameterError(f"channels: {c!r} is not in this dataset "
+                                     f"{list(self.channels)}", param="channels")
+        return channels
+
+
+def _check_window(window, hop):
+    hop = window if hop is None else hop
+    for name, v in (("window", window), ("hop", hop)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+            raise ParameterError(f"{name} must be a positive integer, got {v!r}", param=name)
+    return int(window), int(hop)
+
+
+def load(directory):
+    """Open a dataset made by :func:`cmsim.datasets.generate_dataset` / ``cmsim dataset``.
+
+    Parameters
+    ----------
+    directory : str or path-like
+
+    Returns
+    -------
+    Dataset
+    """
+    return Dataset(directory)
