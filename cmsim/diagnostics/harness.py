@@ -98,11 +98,21 @@ def load_dataset(path):
     path = Path(path)
     if (path / "metadata.json").is_file():
         return _measured.load_measured(path)
+    if not path.is_dir() or not any(path.glob("manifest*")):
+        raise ParameterError(f"{path}: not a dataset (no metadata.json of measured records, no "
+                             f"manifest of a generated dataset)", param="dataset")
     load = getattr(_datasets, "load", None)
+    load = getattr(load, "load", load)  # the function, not the submodule of that name
     if load is None:
         raise ParameterError(f"{path}: no metadata.json, and this cmsim cannot read generated "
                              f"datasets yet (cmsim.datasets.load)", param="dataset")
-    return load(path)
+    try:
+        return load(path)
+    except ParameterError:
+        raise
+    except (OSError, ValueError, KeyError) as exc:
+        raise ParameterError(f"{path}: unreadable dataset ({type(exc).__name__}: {exc})",
+                             param="dataset") from None
 
 
 @dataclass(frozen=True)
