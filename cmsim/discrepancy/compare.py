@@ -194,7 +194,7 @@ def compare(record, *, budget=DEFAULT_BUDGET, seed=0, seg_s=None, max_segments=8
     names, F = record_features(x, fs, ev.freqs, ev.bearing, seg_s, max_segments)
     if F.shape[0] < 4:
         raise ParameterError(f"record of {duration:.3g} s gives {F.shape[0]} segments of "
-                             f"{seg_s:g} s; needs >= 4", param="RECORD")
+                             f"{seg_s:g} s; needs >= 4", param="record")
     fit_rows, held_rows = F[0::2], F[1::2]
     meas_fit = dict(zip(names, np.nanmean(fit_rows, axis=0)))
     meas_held = dict(zip(names, np.nanmean(held_rows, axis=0)))
@@ -202,7 +202,7 @@ def compare(record, *, budget=DEFAULT_BUDGET, seed=0, seg_s=None, max_segments=8
     nominal = ModelSetup(rig=record.rig, op=record.op, housing=record.rig.housing)
     f_nom = ev.features(nominal, keep="nominal")
     if f_nom is None:
-        raise ParameterError("the nominal model of this record diverged", param="RECORD")
+        raise ParameterError("the nominal model of this record diverged", param="record")
     cols = [k for k in names if math.isfinite(meas_fit[k]) and math.isfinite(meas_held[k])
             and math.isfinite(f_nom.get(k, math.nan))]
     sigma = {k: math.sqrt(spread[k] ** 2 * (2.0 / F.shape[0] + 1.0 / SIM_SEGMENTS)

@@ -117,7 +117,14 @@ def segment_features(x, fs_hz, freqs, bearing):
         band = kurtogram(x, fs_hz, max_fault_hz=f_max).band_hz
     except ParameterError:
         band = (0.05 * fs_hz, 0.45 * fs_hz)
-    ef, ea = envelope_spectrum(x, fs_hz, band, window="hann")
+    lo_b, hi_b = band
+    if hi_b - lo_b < 0.02 * fs_hz:                # a very narrow band: filter ill-conditioned
+        mid = 0.5 * (lo_b + hi_b)
+        lo_b, hi_b = max(mid - 0.01 * fs_hz, 1.0), min(mid + 0.01 * fs_hz, 0.49 * fs_hz)
+    try:
+        ef, ea = envelope_spectrum(x, fs_hz, (lo_b, hi_b), window="hann")
+    except (ParameterError, np.linalg.LinAlgError, ValueError):
+        ef, ea = envelope_spectrum(x, fs_hz, (0.05 * fs_hz, 0.45 * fs_hz), window="hann")
     edf = ef[1]
     esel = (ef >= 0.5 * fr) & (ef <= 4.0 * bf.bpfi_hz)
     efloor = float(np.median(ea[esel])) if np.any(esel) else 1.0

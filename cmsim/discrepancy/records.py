@@ -115,7 +115,7 @@ def _resolve(path):
         if q.exists():
             return q
     where = f" (nor under CMSIM_DATA={root})" if root else " (set CMSIM_DATA to a data root)"
-    raise ParameterError(f"record {path} does not exist{where}", param="RECORD",
+    raise ParameterError(f"record {path} does not exist{where}", param="record",
                          allowed="an existing .npz, .csv or .wav file")
 
 
@@ -140,7 +140,7 @@ def _read_signals(path, names=None):
         if len(names) != x.shape[1]:
             names = [f"ch{i}" for i in range(x.shape[1])]
         return {n: x[:, i] for i, n in enumerate(names)}, float(rate)
-    raise ParameterError(f"record {path}: unsupported file type {suffix!r}", param="RECORD",
+    raise ParameterError(f"record {path}: unsupported file type {suffix!r}", param="record",
                          allowed=".npz, .csv or .wav")
 
 
@@ -148,12 +148,12 @@ def _metadata(path):
     meta_path = path.parent / "metadata.json"
     if not meta_path.exists():
         raise ParameterError(f"no metadata.json next to {path} (the record format is the "
-                             f"metadata.json schema of the datasets README)", param="RECORD",
+                             f"metadata.json schema of the datasets README)", param="record",
                              allowed="a file in a folder with metadata.json")
     try:
         meta = json.loads(meta_path.read_text())
     except (ValueError, OSError) as exc:
-        raise ParameterError(f"{meta_path}: not valid JSON ({exc})", param="RECORD") from None
+        raise ParameterError(f"{meta_path}: not valid JSON ({exc})", param="record") from None
     entry = {}
     for rec in meta.get("recordings") or []:
         if rec.get("file") == path.name:
@@ -311,7 +311,7 @@ def read_record(path, *, channel=None, rig=None):
     sensors = meta.get("sensors") or {}
     signals, wav_rate = _read_signals(p, entry.get("channels"))
     if not signals:
-        raise ParameterError(f"record {p} holds no 1-D channel", param="RECORD")
+        raise ParameterError(f"record {p} holds no 1-D channel", param="record")
     bearings = ((meta.get("geometry") or {}).get("bearings")) or {}
     if channel is None:
         near_bearing = [c for c in signals if (sensors.get(c) or {}).get("near") in bearings]
