@@ -604,8 +604,8 @@ def _cmd_evaluate(args):
     func = load_algorithm(args.algorithm)
     try:
         dataset = load_dataset(args.dir)
-    except ParameterError as exc:
-        raise CLIError(f"DIR {args.dir}: {exc}", option="DIR") from None
+    except ParameterError as exc:  # the message starts with the directory
+        raise CLIError(f"DIR {exc}", option="DIR") from None
     if len(dataset.manifest) == 0:
         raise CLIError(f"DIR {args.dir}: the dataset has no records", option="DIR")
     progress = None

@@ -55,6 +55,8 @@ BASE = {
     "spectrum": "spectrum {run}",
     "sweep": "sweep --speed-rpm 1000 --out {work}/sw",
     "report": "report {sweep}",
+    "evaluate": "evaluate {empty_dir} --algorithm envelope",
+    "dataset": "dataset {ds_spec} --out {work}/ds",
 }
 
 CATALOGUE = [
@@ -250,6 +252,37 @@ CATALOGUE = [
     R("report-max-hz", "report {sweep} --max-hz -1", "--max-hz", numeric=True),
     R("report-max-hz-nyquist", "report {sweep} --max-hz 1e6", "--max-hz", numeric=True),
     R("report-signal", "report {sweep} --signal nosuch", "--signal"),
+    # ---- evaluate
+    R("evaluate-missing-dir", "evaluate {work}/none --algorithm envelope", "DIR"),
+    R("evaluate-dir-is-file", "evaluate {text} --algorithm envelope", "DIR"),
+    R("evaluate-not-a-dataset", "evaluate {empty_dir} --algorithm envelope", "DIR"),
+    R("evaluate-algorithm-missing", "evaluate {empty_dir}", "--algorithm"),
+    R("evaluate-algorithm-unknown", "evaluate {empty_dir} --algorithm nosuch", "--algorithm"),
+    R("evaluate-algorithm-module", "evaluate {empty_dir} --algorithm nosuch_mod_xyz:f",
+      "--algorithm"),
+    R("evaluate-algorithm-function", "evaluate {empty_dir} --algorithm cmsim.rig:nosuch",
+      "--algorithm"),
+    R("evaluate-algorithm-file", "evaluate {empty_dir} --algorithm {work}/none.py:f",
+      "--algorithm"),
+    R("evaluate-report-directory", "evaluate {empty_dir} --algorithm envelope --report {work}",
+      "--report"),
+    R("evaluate-report-no-parent", "evaluate {empty_dir} --algorithm envelope --report "
+      "{work}/no/x.html", "--report"),
+    # ---- dataset
+    R("dataset-spec-missing", "dataset {work}/none.toml --out {work}/d", "SPEC"),
+    R("dataset-spec-directory", "dataset {work} --out {work}/d", "SPEC"),
+    R("dataset-spec-text", "dataset {text} --out {work}/d", "SPEC"),
+    R("dataset-spec-rig-file", "dataset {rig_ok} --out {work}/d", "SPEC", "unknown table"),
+    R("dataset-spec-zero-records", "dataset {ds_zero} --out {work}/d", "SPEC",
+      "dataset.records"),
+    R("dataset-spec-unknown-fault", "dataset {ds_bad_fault} --out {work}/d", "SPEC",
+      "faults.types[0].type"),
+    R("dataset-spec-unknown-key", "dataset {ds_unknown_key} --out {work}/d", "SPEC",
+      "sensor.chanels"),
+    R("dataset-out-file", "dataset {ds_spec} --out {text}", "--out"),
+    R("dataset-out-missing", "dataset {ds_spec}", "--out"),
+    R("dataset-workers-zero", "dataset {ds_spec} --out {work}/d --workers 0", "--workers",
+      numeric=True),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -340,6 +373,15 @@ def files(tmp_path_factory):
     (d / "faults_gear.toml").write_text(
         '[[faults]]\ntype = "inner_race"\nbearing = "2b1"\nsize_m = 5e-4\ndepth_m = 1e-4\n')
     f["faults_gear"] = d / "faults_gear.toml"
+    ds_spec = ('[dataset]\nrecords = 2\n\n[sensor]\nchannels = ["accel_1b1_y"]\n'
+               'duration_s = 0.01\n')
+    for name, text_ in (("ds_spec", ds_spec),
+                        ("ds_zero", ds_spec.replace("records = 2", "records = 0")),
+                        ("ds_unknown_key", ds_spec.replace("channels", "chanels")),
+                        ("ds_bad_fault", ds_spec + '\n[faults]\nhealthy_share = 0.5\n\n'
+                                                   '[[faults.types]]\ntype = "bogus"\n')):
+        (d / f"{name}.toml").write_text(text_)
+        f[name] = d / f"{name}.toml"
     run = _synthetic_run(paper, ["F_1b1_loa", "F_1b1_oloa", "x_1b1", "y_1b1", "x_2b1", "y_2b1",
                                  "dte_um"])
     f["run"] = run.save(d / "run.npz")
@@ -416,7 +458,7 @@ def test_every_option_is_validated():
     against the run."""
     parser = cli.build_parser()
     # checked against the run's signals / bearings; --fault by cmsim.faults.parse_fault
-    free_text = {"signal", "bearing", "fault"}
+    free_text = {"signal", "bearing", "fault", "algorithm"}  # --algorithm: load_algorithm
     for command, sub in cli._subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):
