@@ -31,6 +31,9 @@ LAYERS = [
     ("bearings", {"bearings"}),
     ("mesh_stiffness", {"mesh_stiffness"}),
     ("faults", {"faults"}),
+    # Not in DESIGN.md's list: losses turn a rig and an operating point into the loads and
+    # friction table the dynamics' callers pass to simulate, and read a Run's power balance.
+    ("losses", {"losses"}),
     ("dynamics", {"dynamics"}),
     ("sensors", {"sensors"}),
     ("spectra", {"spectra"}),
