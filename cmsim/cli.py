@@ -507,6 +507,8 @@ def _cmd_dataset(args):
     from cmsim.datasets import DatasetSpec, generate_dataset
 
     spec = _load_file("SPEC", args.spec, DatasetSpec.load, "a dataset spec TOML file")
+    if not args.json and _numba_cache_cold():       # after the spec is known to be good
+        print("cmsim: compiling numba kernels (first run only, about 30 s)...", file=sys.stderr)
     progress = not args.json and sys.stderr.isatty()
     try:
         summary = generate_dataset(spec, args.out, workers=args.workers,
@@ -604,8 +606,8 @@ def _cmd_evaluate(args):
     func = load_algorithm(args.algorithm)
     try:
         dataset = load_dataset(args.dir)
-    except ParameterError as exc:  # the message starts with the directory
-        raise CLIError(f"DIR {exc}", option="DIR") from None
+    except ParameterError as exc:
+        raise CLIError(f"DIR {args.dir}: {exc}", option="DIR") from None
     if len(dataset.manifest) == 0:
         raise CLIError(f"DIR {args.dir}: the dataset has no records", option="DIR")
     progress = None
@@ -661,64 +663,6 @@ def _add_evaluate(sub):
                    help="write an HTML page with the plots")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=_cmd_evaluate, text=_text_evaluate)
-
-
-# ---------------------------------------------------------------------- compare
-def _cmd_compare(args):
-    from cmsim.discrepancy import compare, read_record
-    from cmsim.discrepancy.report import write_report
-
-    rig = _load_file("--rig", args.rig, _rig_loader(), "a rig TOML file") if args.rig else None
-    record = read_record(args.record, channel=args.channel, rig=rig)
-    res = compare(record, budget=args.budget, seed=args.seed)
-    out = res.to_dict()
-    out["report"] = str(write_report(res, args.report)) if args.report else None
-    return out
-
-
-def _rig_loader():
-    from cmsim.rig import Rig
-    return Rig.load
-
-
-def _text_compare(res):
-    lines = [f"finding: {res['finding']}" + (f" on {res['component']}" if res["component"]
-                                              else "") + (f" {res['parameters']}"
-                                                          if res["parameters"] else "")]
-    g = res["gain"]
-    lines.append(f"held-out discrepancy (chi2 per feature): {g['before']:.3g} -> "
-                 f"{g['after']:.3g} (relative gain {g['relative']:.2f})")
-    for c in res["causes"][:5]:
-        lines.append(f"  {c['name']:20s} {str(c['component']):10s} score {c['score']:.3f}")
-    for d in res["discrepancies"][:5]:
-        lines.append(f"  {d['feature']:24s} measured {d['measured']:.3g} simulated "
-                     f"{d['simulated']:.3g} (z {d['z']:.1f})")
-    for k, v in res["inferred"].items():
-        lines.append(f"inferred {k}: {v['value']:.6g} ({v['how']})")
-    lines.append(f"{res['simulations']} simulations, {res['wall_s']:.1f} s")
-    if res["report"]:
-        lines.append(f"wrote {res['report']}")
-    return "\n".join(lines)
-
-
-def _add_compare(sub):
-    p = sub.add_parser("compare", help="compare a measured record with the model, name the "
-                                       "cause, fit it and measure the gain",
-                       description="RECORD is a .npz/.csv/.wav file in a folder whose "
-                                   "metadata.json gives rig, fs, speed and load (relative "
-                                   "paths are also looked up under CMSIM_DATA). The answer "
-                                   "key (condition, fault fields, file name) is never read.")
-    p.add_argument("record", metavar="RECORD", help="measured recording")
-    p.add_argument("--channel", metavar="NAME", help="channel (default: the first near a "
-                                                     "documented bearing)")
-    p.add_argument("--rig", metavar="FILE.toml",
-                   help="model rig (default: built from metadata.json geometry)")
-    p.add_argument("--report", type=Path, metavar="DIR", help="write DIR/compare.html")
-    p.add_argument("--budget", type=int, default=48, metavar="N",
-                   help="most simulations (default 48)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the model simulations")
-    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
-    p.set_defaults(func=_cmd_compare, text=_text_compare)
 
 
 # ---------------------------------------------------------------------- main
@@ -805,7 +749,7 @@ def _add_mesh_table(sub):
 
 
 _COMMANDS = [_add_simulate, _add_modes, _add_mesh_table, _add_spectrum, _add_sweep,
-             _add_dataset, _add_report, _add_evaluate, _add_compare]
+             _add_dataset, _add_report, _add_evaluate]
 
 
 def _jsonable(obj):
@@ -875,7 +819,6 @@ _RANGES = {
     "ramp_to_rpm": (float, 0.0, 1.0e5, True, False, "rpm"),
     "ramp_s": (float, 0.0, 1.0e5, True, False, "s"),
     "ramp_start_s": (float, 0.0, 1.0e5, False, False, "s"),
-    "budget": (int, 4, 1000, False, False, ""),
 }
 #: numeric options whose range depends on other inputs and is checked by the library, which
 #: names them through _PARAM_TO_DEST (none today; clearance is narrowed by the bearing)
@@ -897,8 +840,7 @@ _ALWAYS_REWRITE = {"substeps"}
 _PATHS = {"rig": "file", "faults": "file", "mesh_table": "file", "run": "file", "dir": "dir",
           "out": "out",
           "plot": "out", ("sweep", "out"): "outdir", ("evaluate", "report"): "out",
-          ("dataset", "spec"): "file", ("dataset", "out"): "outdir",
-          ("compare", "report"): "outdir"}
+          ("dataset", "spec"): "file", ("dataset", "out"): "outdir"}
 
 
 class CLIError(Exception):
@@ -1103,7 +1045,7 @@ def _announce_compile(args):
         print("cmsim: compiling numba kernels (first run only, about 30 s)...", file=sys.stderr)
 
 
-_COMPILING = ("simulate", "modes", "mesh-table", "sweep", "dataset")
+_COMPILING = ("simulate", "modes", "mesh-table", "sweep")
 
 
 def main(argv=None):

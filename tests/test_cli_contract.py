@@ -458,7 +458,8 @@ def test_every_option_is_validated():
     against the run."""
     parser = cli.build_parser()
     # checked against the run's signals / bearings; --fault by cmsim.faults.parse_fault
-    free_text = {"signal", "bearing", "fault", "algorithm"}  # --algorithm: load_algorithm
+    # --algorithm: load_algorithm; --scheduler: checked by connecting (names --scheduler)
+    free_text = {"signal", "bearing", "fault", "algorithm", "scheduler"}
     for command, sub in cli._subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):
