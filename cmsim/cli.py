@@ -606,8 +606,8 @@ def _cmd_evaluate(args):
     func = load_algorithm(args.algorithm)
     try:
         dataset = load_dataset(args.dir)
-    except ParameterError as exc:
-        raise CLIError(f"DIR {args.dir}: {exc}", option="DIR") from None
+    except ParameterError as exc:  # the message starts with the directory
+        raise CLIError(f"DIR {exc}", option="DIR") from None
     if len(dataset.manifest) == 0:
         raise CLIError(f"DIR {args.dir}: the dataset has no records", option="DIR")
     progress = None
@@ -663,6 +663,119 @@ def _add_evaluate(sub):
                    help="write an HTML page with the plots")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=_cmd_evaluate, text=_text_evaluate)
+
+
+# ---------------------------------------------------------------------- compare
+def _cmd_compare(args):
+    from cmsim.discrepancy import compare, read_record
+    from cmsim.discrepancy.report import write_report
+
+    rig = _load_file("--rig", args.rig, _rig_loader(), "a rig TOML file") if args.rig else None
+    record = read_record(args.record, channel=args.channel, rig=rig)
+    res = compare(record, budget=args.budget, seed=args.seed)
+    out = res.to_dict()
+    out["report"] = str(write_report(res, args.report)) if args.report else None
+    return out
+
+
+def _rig_loader():
+    from cmsim.rig import Rig
+    return Rig.load
+
+
+def _text_compare(res):
+    lines = [f"finding: {res['finding']}" + (f" on {res['component']}" if res["component"]
+                                              else "") + (f" {res['parameters']}"
+                                                          if res["parameters"] else "")]
+    g = res["gain"]
+    lines.append(f"held-out discrepancy (chi2 per feature): {g['before']:.3g} -> "
+                 f"{g['after']:.3g} (relative gain {g['relative']:.2f})")
+    for c in res["causes"][:5]:
+        lines.append(f"  {c['name']:20s} {str(c['component']):10s} score {c['score']:.3f}")
+    for d in res["discrepancies"][:5]:
+        lines.append(f"  {d['feature']:24s} measured {d['measured']:.3g} simulated "
+                     f"{d['simulated']:.3g} (z {d['z']:.1f})")
+    for k, v in res["inferred"].items():
+        lines.append(f"inferred {k}: {v['value']:.6g} ({v['how']})")
+    lines.append(f"{res['simulations']} simulations, {res['wall_s']:.1f} s")
+    if res["report"]:
+        lines.append(f"wrote {res['report']}")
+    return "\n".join(lines)
+
+
+def _add_compare(sub):
+    p = sub.add_parser("compare", help="compare a measured record with the model, name the "
+                                       "cause, fit it and measure the gain",
+                       description="RECORD is a .npz/.csv/.wav file in a folder whose "
+                                   "metadata.json gives rig, fs, speed and load (relative "
+                                   "paths are also looked up under CMSIM_DATA). The answer "
+                                   "key (condition, fault fields, file name) is never read.")
+    p.add_argument("record", metavar="RECORD", help="measured recording")
+    p.add_argument("--channel", metavar="NAME", help="channel (default: the first near a "
+                                                     "documented bearing)")
+    p.add_argument("--rig", metavar="FILE.toml",
+                   help="model rig (default: built from metadata.json geometry)")
+    p.add_argument("--report", type=Path, metavar="DIR", help="write DIR/compare.html")
+    p.add_argument("--budget", type=int, default=48, metavar="N",
+                   help="most simulations (default 48)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the model simulations")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.set_defaults(func=_cmd_compare, text=_text_compare)
+
+
+# ---------------------------------------------------------------------- losses
+def _cmd_losses(args):
+    from cmsim.losses import LossSettings, operating_losses
+    rig = _load_rig(args)
+    op = _operating_point(args, rig)
+    settings = LossSettings(air_pressure_pa=args.air_pressure_pa,
+                            air_temperature_c=args.air_temperature_c,
+                            oil_jet_kg_s=args.oil_jet_kg_s, roughness_m=args.roughness_m)
+    res = operating_losses(rig, op, settings).to_dict()
+    res["rig"] = rig.name
+    res["plot"] = None
+    if args.plot:
+        from cmsim.losses.plots import loss_breakdown_figure
+        top = max(13000.0, op.speed_rpm)
+        fig = loss_breakdown_figure(rig, np.linspace(top / 13.0, top, 13), op.torque_nm,
+                                    settings)
+        _save_figure(fig, args.plot)
+        res["plot"] = str(args.plot)
+    return res
+
+
+def _text_losses(res):
+    lines = [f"losses of {res['rig']} at {res['speed_rpm']:g} rpm, {res['torque_nm']:g} N m",
+             f"{'source':>16}  {'power_W':>10}"]
+    for name, value in res["power_w"].items():
+        lines.append(f"{name:>16}  {value:10.3f}")
+    lines += [f"{'total':>16}  {res['total_loss_w']:10.3f}",
+              f"output {res['output_power_w']:.1f} W, input {res['input_power_w']:.1f} W, "
+              f"efficiency {100 * res['efficiency']:.2f} % (load-independent "
+              f"{res['load_independent_w']:.2f} W, load-dependent {res['load_dependent_w']:.2f} W)"]
+    if res["plot"]:
+        lines.append(f"wrote {res['plot']}")
+    return "\n".join(lines)
+
+
+def _add_losses(sub):
+    p = sub.add_parser("losses", help="power losses by source and the efficiency",
+                       description="Windage and meshing torques (paper 000 eq. 25-28), oil "
+                                   "jet, Harris-Palmgren bearing torques and mixed-lubrication "
+                                   "tooth friction (paper 004 eq. 21) at one operating point.")
+    p.add_argument("--speed-rpm", type=float, required=True, help="input speed, rpm")
+    p.add_argument("--torque-nm", type=float, required=True, help="output torque, N m")
+    p.add_argument("--air-pressure-pa", type=float, default=101325.0,
+                   help="air pressure around the gears, Pa")
+    p.add_argument("--air-temperature-c", type=float, default=20.0, help="air temperature, C")
+    p.add_argument("--oil-jet-kg-s", type=float, default=0.0,
+                   help="radial oil-jet mass flow per gear, kg/s")
+    p.add_argument("--roughness-m", type=float,
+                   help="composite RMS roughness of the teeth, m (default: the rig's)")
+    p.add_argument("--plot", type=Path, metavar="FILE.png",
+                   help="write the loss breakdown against speed (paper 000 Figs. 53-57)")
+    _add_rig_options(p, friction=False)
+    p.set_defaults(func=_cmd_losses, text=_text_losses)
 
 
 # ---------------------------------------------------------------------- main
@@ -749,7 +862,7 @@ def _add_mesh_table(sub):
 
 
 _COMMANDS = [_add_simulate, _add_modes, _add_mesh_table, _add_spectrum, _add_sweep,
-             _add_dataset, _add_report, _add_evaluate]
+             _add_dataset, _add_report, _add_evaluate, _add_compare, _add_losses]
 
 
 def _jsonable(obj):
@@ -819,6 +932,11 @@ _RANGES = {
     "ramp_to_rpm": (float, 0.0, 1.0e5, True, False, "rpm"),
     "ramp_s": (float, 0.0, 1.0e5, True, False, "s"),
     "ramp_start_s": (float, 0.0, 1.0e5, False, False, "s"),
+    "budget": (int, 4, 1000, False, False, ""),
+    "air_pressure_pa": (float, 0.0, 1.0e7, True, False, "Pa"),
+    "air_temperature_c": (float, -100.0, 500.0, False, False, "C"),
+    "oil_jet_kg_s": (float, 0.0, 100.0, False, False, "kg/s"),
+    "roughness_m": (float, 0.0, 5.0e-5, True, False, "m"),
 }
 #: numeric options whose range depends on other inputs and is checked by the library, which
 #: names them through _PARAM_TO_DEST (none today; clearance is narrowed by the bearing)
@@ -840,7 +958,8 @@ _ALWAYS_REWRITE = {"substeps"}
 _PATHS = {"rig": "file", "faults": "file", "mesh_table": "file", "run": "file", "dir": "dir",
           "out": "out",
           "plot": "out", ("sweep", "out"): "outdir", ("evaluate", "report"): "out",
-          ("dataset", "spec"): "file", ("dataset", "out"): "outdir"}
+          ("dataset", "spec"): "file", ("dataset", "out"): "outdir",
+          ("compare", "report"): "outdir"}
 
 
 class CLIError(Exception):

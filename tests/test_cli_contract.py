@@ -57,6 +57,7 @@ BASE = {
     "report": "report {sweep}",
     "evaluate": "evaluate {empty_dir} --algorithm envelope",
     "dataset": "dataset {ds_spec} --out {work}/ds",
+    "losses": "losses --speed-rpm 1000 --torque-nm 10",
 }
 
 CATALOGUE = [
@@ -283,6 +284,17 @@ CATALOGUE = [
     R("dataset-out-missing", "dataset {ds_spec}", "--out"),
     R("dataset-workers-zero", "dataset {ds_spec} --out {work}/d --workers 0", "--workers",
       numeric=True),
+    # ---- losses
+    R("losses-speed-zero", "losses --speed-rpm 0 --torque-nm 10", "--speed-rpm", numeric=True),
+    R("losses-torque-missing", "losses --speed-rpm 1000", "--torque-nm"),
+    R("losses-roughness-zero", "losses --speed-rpm 1000 --torque-nm 10 --roughness-m 0",
+      "--roughness-m", numeric=True),
+    R("losses-pressure-negative", "losses --speed-rpm 1000 --torque-nm 10 --air-pressure-pa -1",
+      "--air-pressure-pa", numeric=True),
+    R("losses-jet-nan", "losses --speed-rpm 1000 --torque-nm 10 --oil-jet-kg-s nan",
+      "--oil-jet-kg-s", numeric=True),
+    R("losses-plot-dir", "losses --speed-rpm 1000 --torque-nm 10 --plot {work}", "--plot"),
+    R("losses-rig-text", "losses --speed-rpm 1000 --torque-nm 10 --rig {text}", "--rig"),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
