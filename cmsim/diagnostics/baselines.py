@@ -94,7 +94,13 @@ SHAFT_ORDERS_REMOVED = 2
 
 def signal_channels(signals):
     """Names of the channels the baselines read: ``accel_*`` if any, else all but a tacho
-    and shaft angles."""
+    and shaft angles.
+
+    Parameters
+    ----------
+    signals : dict of str to numpy.ndarray
+        Channels of a record.
+    """
     names = [k for k in signals if k.startswith("accel_")]
     if not names:
         names = [k for k in signals if k != "tacho" and not k.startswith("theta")]

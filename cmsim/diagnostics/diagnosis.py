@@ -60,8 +60,13 @@ class Diagnosis:
 
 
 def as_diagnosis(result):
-    """A :class:`Diagnosis` from what a diagnostic function returned (a Diagnosis, a label
-    str, or a dict class → score)."""
+    """A :class:`Diagnosis` from what a diagnostic function returned.
+
+    Parameters
+    ----------
+    result : Diagnosis, str or dict of str to float
+        A Diagnosis, a label, or class → score.
+    """
     if isinstance(result, Diagnosis):
         return result
     if isinstance(result, str):

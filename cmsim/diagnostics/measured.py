@@ -57,7 +57,13 @@ def data_root():
 
 
 def label_of(rec):
-    """Class of a recording from its answer key (see the module docstring)."""
+    """Class of a recording from its answer key (see the module docstring).
+
+    Parameters
+    ----------
+    rec : dict
+        One entry of ``recordings[]`` of ``metadata.json``.
+    """
     if str(rec.get("condition", "")).lower() == "healthy":
         return "healthy"
     loc = str(rec.get("fault_location") or "").lower()

@@ -60,6 +60,11 @@ def _pair(y_true, y_pred):
 def accuracy(y_true, y_pred):
     """Share of correct labels, in [0, 1].
 
+    Parameters
+    ----------
+    y_true, y_pred : sequence of str, shape (n,)
+        True and predicted labels.
+
     Examples
     --------
     >>> accuracy(["a", "b", "b", "c"], ["a", "b", "c", "c"])
@@ -102,6 +107,11 @@ def confusion_matrix(y_true, y_pred, classes=None):
 def f1_scores(y_true, y_pred):
     """F1 = 2·TP / (2·TP + FP + FN) of each class of the union of true and predicted labels.
 
+    Parameters
+    ----------
+    y_true, y_pred : sequence of str, shape (n,)
+        True and predicted labels.
+
     Returns
     -------
     dict of str to float
@@ -115,6 +125,11 @@ def f1_scores(y_true, y_pred):
 
 def macro_f1(y_true, y_pred):
     """Unweighted mean of :func:`f1_scores` over the classes.
+
+    Parameters
+    ----------
+    y_true, y_pred : sequence of str, shape (n,)
+        True and predicted labels.
 
     Examples
     --------

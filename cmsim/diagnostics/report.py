@@ -36,7 +36,12 @@ def _png(fig):
 
 
 def confusion_figure(evaluation):
-    """Confusion matrix (rows true, columns predicted) as a matplotlib Figure."""
+    """Confusion matrix (rows true, columns predicted) as a matplotlib Figure.
+
+    Parameters
+    ----------
+    evaluation : cmsim.diagnostics.harness.Evaluation
+    """
     conf = evaluation.metrics["confusion"]
     classes, m = conf["classes"], np.asarray(conf["matrix"], dtype=float)
     fig = _figure((1.2 + 0.7 * max(len(classes), 2), 1.0 + 0.6 * max(len(classes), 2)))
@@ -57,7 +62,12 @@ def confusion_figure(evaluation):
 
 def detection_figure(evaluation):
     """Fault score against severity per fault class, with the 5 % false-alarm threshold
-    (left), and the detection rate against severity (right)."""
+    (left), and the detection rate against severity (right).
+
+    Parameters
+    ----------
+    evaluation : cmsim.diagnostics.harness.Evaluation
+    """
     det = evaluation.metrics["detection"]
     fig = _figure((10, 3.8))
     ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
@@ -97,7 +107,14 @@ def _fmt(v):
 
 
 def write_report(evaluation, path):
-    """Write the HTML page of ``evaluation`` to ``path`` (atomically); return the path."""
+    """Write the HTML page of ``evaluation`` to ``path`` (atomically); return the path.
+
+    Parameters
+    ----------
+    evaluation : cmsim.diagnostics.harness.Evaluation
+    path : str or pathlib.Path
+        The ``.html`` file.
+    """
     m = evaluation.metrics
     e = html.escape
     rows = "".join(
