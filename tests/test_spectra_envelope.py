@@ -153,3 +153,16 @@ def test_kurtogram_min_bandwidth_removes_the_narrow_levels():
 def test_bad_inputs_name_the_parameter(call, name):
     with pytest.raises(ParameterError, match=name):
         call()
+
+
+def test_kurtogram_band_edges_within_rounding_snap_to_zero_and_nyquist():
+    """A best band whose lower edge is 2e-13 Hz (rounding of centre − bandwidth/2) is the
+    band from 0 (found on the MFPT IR_vload7_300lb record by the envelope baseline)."""
+    from cmsim.spectra.kurtogram import Kurtogram
+    fields = Kurtogram.__dataclass_fields__
+    kw = {name: None for name in fields}
+    kw.update(fs=48828.0, centre_hz=1000.0 + 2e-13, bandwidth_hz=2000.0)
+    k = Kurtogram(**kw)
+    assert k.band_hz == (0.0, 2000.0 + 2e-13)
+    kw.update(centre_hz=24414.0 - 500.0 - 1e-12, bandwidth_hz=1000.0)
+    assert Kurtogram(**kw).band_hz[1] == 24414.0

@@ -156,6 +156,13 @@ class Kurtogram:
         """Best band (lo, hi), Hz, ready for :func:`~cmsim.spectra.envelope.envelope_spectrum`."""
         lo = max(0.0, self.centre_hz - 0.5 * self.bandwidth_hz)
         hi = min(0.5 * self.fs, self.centre_hz + 0.5 * self.bandwidth_hz)
+        # a band edge within rounding of 0 or Nyquist is that edge (a 2e-13 Hz lower edge
+        # would ask the band-pass filter for a singular design)
+        tiny = 1e-9 * self.fs
+        if lo < tiny:
+            lo = 0.0
+        if hi > 0.5 * self.fs - tiny:
+            hi = 0.5 * self.fs
         return (lo, hi)
 
     def bandwidth_of(self, nperseg):
