@@ -1,12 +1,12 @@
 """Mixed-lubrication friction coefficient of the tooth contact, and its table along the path.
 
 The film ratio λ = h_min/σ (σ: composite RMS roughness) splits the load between the fluid
-film and the asperities. The fluid share follows the smooth form
+film and the asperities. The fluid share is our smooth, monotone choice
 
-    ψ(λ) = 1.21·λ^0.64 / (1 + 0.37·λ^1.26)        (clipped to [0, 1])
+    ψ(λ) = 1 − exp(−0.9·λ^1.5)
 
-used for mixed-EHL gear friction (after Zhou & Hoeprich 1991; ψ → 0 in boundary
-lubrication, ψ ≈ 0.99 at λ = 3), and the friction coefficient mixes the two regimes as
+placed on the classic regime bounds (ψ(1) ≈ 0.6: mixed; ψ(3) ≈ 0.99: full film; ψ → 0 in
+boundary lubrication), and the friction coefficient mixes the two regimes as
 in Castro et al. and paper 004 (App. A.2: "in the asperity contact area the friction
 coefficient is a constant depending on the materials, typically 0.08 to 0.15"):
 
@@ -27,9 +27,7 @@ References
 .. [1] Paper 004, eq. 20-21 and App. A.2; paper 000 Table 2.
 .. [2] J. Castro, J. Seabra, Coefficient of friction in mixed film lubrication: gears versus
        twin-discs, Proc. IMechE J 221 (2007) 399-411 (the λ-weighted mixture).
-.. [3] R.Q. Zhou, M.R. Hoeprich, Torque of tapered roller bearings, J. Tribol. 113 (1991)
-       590-597 (form of the fluid load share ψ(λ); quoted, not re-derived here).
-.. [4] S. Bair, W.O. Winer, limiting shear stress of lubricants (γ_L 0.05-0.1).
+.. [3] S. Bair, W.O. Winer, limiting shear stress of lubricants (γ_L 0.05-0.1).
 """
 
 from __future__ import annotations
@@ -58,9 +56,9 @@ def lambda_ratio(film_m, roughness_m):
 
 
 def fluid_load_share(lam):
-    """ψ(λ) = 1.21·λ^0.64/(1 + 0.37·λ^1.26) in [0, 1] (module docstring)."""
+    """ψ(λ) = 1 − exp(−0.9·λ^1.5) in [0, 1) (module docstring)."""
     lam = np.maximum(np.asarray(lam, dtype=float), 0.0)
-    return np.clip(1.21 * lam ** 0.64 / (1.0 + 0.37 * lam ** 1.26), 0.0, 1.0)
+    return 1.0 - np.exp(-0.9 * lam ** 1.5)
 
 
 def film_friction_coefficient(mean_pressure_pa, sliding_m_s, film_m, viscosity_pa_s,
