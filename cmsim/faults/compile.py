@@ -212,7 +212,7 @@ def compile_faults(rig, faults, mesh_table=None, *, op=None):
             ecc[f.gear - 1] = (f.amplitude_m, f.phase_rad)
         elif isinstance(f, ToothCrack):
             fac[f.gear][f.tooth] *= crack_stiffness_factor(pair, f.gear, f.depth_m,
-                                                           f.angle_rad, s)
+                                                           f.angle_rad, s, method=f.method)
         elif isinstance(f, ToothSpall):
             g = pair.driving if f.gear == 1 else pair.driven
             a_lo, a_hi = f.arc_range_m(g)

@@ -120,6 +120,10 @@ class ToothCrack(_ToothFault):
         Crack angle ν to the tooth centreline, rad, in (0, π/2] (default 45°, as in [2]).
     tooth : int
         Cracked tooth, 0 .. Z − 1.
+    method : {"pe", "fe"}
+        Stiffness of the cracked pair: the potential-energy cracked section (fast) or the
+        plane-strain FE model with the crack cut into the mesh (about 30 s per crack, then
+        cached; :func:`cmsim.faults.crack.crack_stiffness_factor`).
     """
 
     name = "tooth_crack"
@@ -128,12 +132,16 @@ class ToothCrack(_ToothFault):
     depth_m: float
     angle_rad: float = math.pi / 4
     tooth: int = 0
+    method: str = "pe"
 
     def __post_init__(self):
         _check_gear_field(self.gear)
         check_range("depth_m", self.depth_m, 0.0, 0.05, lo_open=True, unit="m")
         check_range("angle_rad", self.angle_rad, 0.0, 0.5 * math.pi, lo_open=True, unit="rad")
         check_int("tooth", self.tooth, 0)
+        if self.method not in ("pe", "fe"):
+            raise ParameterError(f"method must be 'pe' or 'fe', got {self.method!r}",
+                                 param="method")
 
     @property
     def label(self):
