@@ -1,0 +1,53 @@
+"""Power balance of simulated runs with every loss on (issue 13).
+
+Tier: closed form (conservation of energy): input power through the input coupling =
+output power + dissipation by source + change of stored energy, from the run's own signals.
+"""
+
+import pytest
+
+from cmsim.dynamics import simulate
+from cmsim.dynamics.model import build_model
+from cmsim.losses import friction_table_for, operating_losses, power_balance
+from cmsim.rig import OperatingPoint, Rig
+
+
+@pytest.fixture(scope="module")
+def setup():
+    rig = Rig.paper_2016()
+    op = OperatingPoint(3000.0, 50.0)
+    tab = build_model(rig, op).mesh_table
+    losses = operating_losses(rig, op, mesh_table=tab)
+    mu = friction_table_for(rig, op, tab, rig.lubricant.surface_roughness_m,
+                            rig.lubricant.dynamic_viscosity_pa_s)
+    return rig, op, tab, losses, mu
+
+
+def test_energy_balance_closes_with_every_loss_on(setup):
+    rig, op, tab, losses, mu = setup
+    loads = losses.loads()
+    run = simulate(rig, op, 0.1, seed=3, warmup_s=0.1, loads=loads, friction_table=mu)
+    pb = power_balance(run, loads, mu, tab)
+    assert pb.closure < 0.01                     # of the input power
+    assert pb.closure_of_losses < 0.01           # of the losses themselves (P_in − P_out)
+    # the sources carry what the loss model put in
+    torque_sources = ("windage", "meshing", "bearing_viscous", "bearing_load", "oil_jet")
+    assert pb.losses_w["loads"] == pytest.approx(
+        sum(losses.power_w[k] for k in torque_sources), rel=0.01)
+    assert pb.losses_w["tooth_friction"] == pytest.approx(losses.power_w["tooth_friction"],
+                                                          rel=0.15)
+    assert pb.efficiency == pytest.approx(losses.efficiency, abs=0.002)
+
+
+def test_balance_of_a_lossless_run_and_a_missing_source(setup):
+    rig, op, tab, losses, mu = setup
+    run = simulate(rig, op, 0.05, seed=4, warmup_s=0.1)
+    pb = power_balance(run)
+    assert pb.losses_w["tooth_friction"] == 0.0 and pb.losses_w["loads"] == 0.0
+    assert pb.closure < 1e-3
+    # forgetting the loads the run was made with leaves them in the residual
+    loads = losses.loads()
+    run2 = simulate(rig, op, 0.05, seed=4, warmup_s=0.1, loads=loads)
+    assert power_balance(run2, loads).closure_of_losses < 0.05
+    assert power_balance(run2).residual_w == pytest.approx(
+        power_balance(run2, loads).losses_w["loads"], rel=0.05)
