@@ -104,7 +104,14 @@ def ring_kinematics(bearing, inner_rpm, outer_rpm=None):
 
 
 def static_load_rating_n(bearing, factor_n_per_m2=ISO76_FACTOR_N_PER_M2):
-    """ISO 76 static load rating C_0 = f_s·Z·D_w²·cos α of a single-row ball bearing, N."""
+    """ISO 76 static load rating C_0 = f_s·Z·D_w²·cos α of a single-row ball bearing, N.
+
+    Parameters
+    ----------
+    bearing : RollingBearing
+    factor_n_per_m2 : float
+        f_s, N/m² (deep-groove ball bearings ~12.3 N/mm²).
+    """
     return (factor_n_per_m2 * bearing.n_balls * bearing.ball_diameter_m ** 2
             * math.cos(bearing.effective_contact_angle_rad))
 

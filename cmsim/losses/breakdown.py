@@ -227,7 +227,17 @@ def operating_losses(rig, op, settings=None, mesh_table=None):
 
 
 def loss_sweep(rig, speeds_rpm, torque_nm, settings=None):
-    """:class:`LossBreakdown` at each speed (same torque): the data of paper 000 Figs. 53-57."""
+    """:class:`LossBreakdown` at each speed (same torque): the data of paper 000 Figs. 53-57.
+
+    Parameters
+    ----------
+    rig : Rig
+    speeds_rpm : sequence of float
+        Input speeds, rpm.
+    torque_nm : float
+        Output torque, N·m.
+    settings : LossSettings, optional
+    """
     return [operating_losses(rig, OperatingPoint(float(n), torque_nm), settings)
             for n in speeds_rpm]
 

@@ -120,6 +120,18 @@ def mesh_mixed_stiffness_damping(rig, op, mesh_table, roughness_m, *, viscosity_
     K_m(s) = (1/k(s) + 1/K_h(s))^−1 and C_m(s) = C_sys + C_h(s) (paper 004 eq. 12, 14-16) on
     the grid of ``mesh_table`` (k(s): the structural pair stiffness of the table).
 
+    Parameters
+    ----------
+    rig : Rig
+    op : OperatingPoint
+    mesh_table : MeshStiffnessTable
+    roughness_m : float
+        Composite RMS roughness σ, m.
+    viscosity_pa_s : float, optional
+        Oil viscosity, Pa·s (default: the rig's).
+    damping_ratio : float, optional
+        ζ of eq. 15 and ξ of eq. 4 (default: the rig's mesh damping ratio).
+
     Returns
     -------
     dict of ndarray

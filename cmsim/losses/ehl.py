@@ -37,6 +37,13 @@ __all__ = ["reduced_modulus_pa", "film_thickness_point", "film_thickness_line",
 def reduced_modulus_pa(e1_pa, nu1, e2_pa=None, nu2=None):
     """E' = 2/((1 − ν1²)/E1 + (1 − ν2²)/E2), Pa (body 2 defaults to body 1).
 
+    Parameters
+    ----------
+    e1_pa, e2_pa : float
+        Young's moduli, Pa.
+    nu1, nu2 : float
+        Poisson ratios.
+
     Examples
     --------
     >>> round(reduced_modulus_pa(210e9, 0.3) / 1e9, 2)
@@ -206,7 +213,12 @@ def mesh_film_along_path(rig, op, positions_m, mesh_table=None, *, viscosity_pa_
 
 
 def ball_race_curvatures(bearing):
-    """((R_x, R_y) inner, (R_x, R_y) outer) effective radii of the ball-race contacts, m."""
+    """((R_x, R_y) inner, (R_x, R_y) outer) effective radii of the ball-race contacts, m.
+
+    Parameters
+    ----------
+    bearing : RollingBearing
+    """
     d = bearing.ball_diameter_m * math.cos(bearing.effective_contact_angle_rad)
     dm = bearing.pitch_diameter_m
     db = bearing.ball_diameter_m

@@ -57,12 +57,24 @@ def _rpm(speed_rpm):
 
 
 def windage_coefficient(speed_rpm):
-    """c_wind = 1.0034 · n^−0.017 (paper 000 eq. 26, n in rpm)."""
+    """c_wind = 1.0034 · n^−0.017 (paper 000 eq. 26, n in rpm).
+
+    Parameters
+    ----------
+    speed_rpm : float or ndarray
+        Gear speed n, rpm.
+    """
     return 1.0034 * _rpm(speed_rpm) ** -0.017
 
 
 def meshing_coefficient(speed_rpm):
-    """c_mesh = 0.7179 · n^0.0387 (paper 000 eq. 28, n in rpm)."""
+    """c_mesh = 0.7179 · n^0.0387 (paper 000 eq. 28, n in rpm).
+
+    Parameters
+    ----------
+    speed_rpm : float or ndarray
+        Gear speed n, rpm.
+    """
     return 0.7179 * _rpm(speed_rpm) ** 0.0387
 
 
@@ -96,7 +108,14 @@ def windage_torque_nm(speed_rpm, pitch_radius_m, air_density_kg_m3=1.2041):
 def meshing_torque_nm(speed_rpm, pitch_radius_m, air_density_kg_m3=1.2041):
     """Meshing (air/oil pumping) resisting torque on one gear, N·m (paper 000 eq. 27).
 
-    Parameters as :func:`windage_torque_nm`.
+    Parameters
+    ----------
+    speed_rpm : float or ndarray
+        Gear speed, rpm.
+    pitch_radius_m : float
+        Pitch radius r_p, m.
+    air_density_kg_m3 : float
+        Density of the surrounding air, kg/m³.
     """
     return _torque(meshing_coefficient(speed_rpm), speed_rpm, pitch_radius_m, air_density_kg_m3)
 

@@ -50,13 +50,27 @@ LIMITING_SHEAR_COEFFICIENT = 0.06
 
 
 def lambda_ratio(film_m, roughness_m):
-    """λ = h/σ (film over composite RMS roughness), same shape as ``film_m``."""
+    """λ = h/σ (film over composite RMS roughness), same shape as ``film_m``.
+
+    Parameters
+    ----------
+    film_m : float or ndarray
+        Film thickness, m.
+    roughness_m : float
+        Composite RMS roughness σ, m.
+    """
     check_range("roughness_m", roughness_m, 0.0, 50e-6, lo_open=True, unit="m")
     return np.asarray(film_m, dtype=float) / roughness_m
 
 
 def fluid_load_share(lam):
-    """ψ(λ) = 1 − exp(−0.9·λ^1.5) in [0, 1) (module docstring)."""
+    """ψ(λ) = 1 − exp(−0.9·λ^1.5) in [0, 1) (module docstring).
+
+    Parameters
+    ----------
+    lam : float or ndarray
+        Film ratio λ.
+    """
     lam = np.maximum(np.asarray(lam, dtype=float), 0.0)
     return 1.0 - np.exp(-0.9 * lam ** 1.5)
 
@@ -64,7 +78,25 @@ def fluid_load_share(lam):
 def film_friction_coefficient(mean_pressure_pa, sliding_m_s, film_m, viscosity_pa_s,
                               pressure_viscosity_pa_inv, *, eyring_stress_pa=EYRING_STRESS_PA,
                               limiting_shear=LIMITING_SHEAR_COEFFICIENT):
-    """Traction coefficient of a full EHL film (Eyring, capped by the limiting shear), ≥ 0."""
+    """Traction coefficient of a full EHL film (Eyring, capped by the limiting shear), ≥ 0.
+
+    Parameters
+    ----------
+    mean_pressure_pa : ndarray
+        Mean Hertz pressure p̄, Pa.
+    sliding_m_s : ndarray
+        Sliding speed v_s, m/s.
+    film_m : ndarray
+        Central film h_c, m.
+    viscosity_pa_s : float
+        η0, Pa·s.
+    pressure_viscosity_pa_inv : float
+        α, 1/Pa.
+    eyring_stress_pa : float
+        τ0, Pa.
+    limiting_shear : float
+        γ_L.
+    """
     p = np.maximum(np.asarray(mean_pressure_pa, dtype=float), 1.0)
     h = np.maximum(np.asarray(film_m, dtype=float), 1e-10)
     eta = viscosity_pa_s * np.exp(np.minimum(pressure_viscosity_pa_inv * p, 25.0))
@@ -73,7 +105,17 @@ def film_friction_coefficient(mean_pressure_pa, sliding_m_s, film_m, viscosity_p
 
 
 def mixed_friction_coefficient(lam, film_friction, boundary_friction=BOUNDARY_FRICTION):
-    """μ = (1 − ψ(λ))·μ_b + ψ(λ)·μ_f (module docstring)."""
+    """μ = (1 − ψ(λ))·μ_b + ψ(λ)·μ_f (module docstring).
+
+    Parameters
+    ----------
+    lam : ndarray
+        Film ratio λ.
+    film_friction : ndarray
+        μ_f of the fluid film.
+    boundary_friction : float
+        μ_b of the asperities.
+    """
     check_range("boundary_friction", boundary_friction, 0.0, 1.0)
     psi = fluid_load_share(lam)
     return (1.0 - psi) * boundary_friction + psi * np.asarray(film_friction, dtype=float)
@@ -85,6 +127,19 @@ def mesh_friction_along_path(rig, op, positions_m, mesh_table=None, *, roughness
 
     Returns the dict of :func:`cmsim.losses.ehl.mesh_film_along_path` plus ``lambda``,
     ``film_friction`` and ``friction`` (arrays like ``positions_m``).
+
+    Parameters
+    ----------
+    rig : Rig
+    op : OperatingPoint
+    positions_m : ndarray
+        Positions s on the line of action, m.
+    mesh_table : MeshStiffnessTable, optional
+        Load sharing between pairs.
+    roughness_m, viscosity_pa_s : float, optional
+        Overrides of the rig lubricant's σ and η0.
+    boundary_friction : float
+        μ_b.
     """
     sigma = rig.lubricant.surface_roughness_m if roughness_m is None else roughness_m
     out = mesh_film_along_path(rig, op, positions_m, mesh_table, viscosity_pa_s=viscosity_pa_s)
