@@ -42,15 +42,21 @@ def main(argv=None):
             rows.append({"effect": eff, "seed": s, "finding": got, "true_value": h.value,
                          "fitted": fitted, "severity_ok": ok_sev,
                          "gain_relative": c.gain["relative"], "simulations": c.simulations,
+                         "chi2_per_feature": c.chi2_per_feature,
+                         "top": c.causes[0]["name"] if c.causes else None,
+                         "top_score": c.causes[0]["score"] if c.causes else None,
                          "wall_s": time.perf_counter() - t0})
             print(f"{eff:20s} seed {s}: {got:20s} true {h.value} fitted {fitted} "
                   f"gain {c.gain['relative']:.2f} sims {c.simulations} "
+                  f"chi2/f {c.chi2_per_feature:.2f} top {rows[-1]['top']} "
+                  f"{rows[-1]['top_score']:.2f} "
                   f"{rows[-1]['wall_s']:.1f} s", flush=True)
     names = sorted({g for c in confusion.values() for g in c} | set(effects))
     print("\nconfusion (rows: hidden effect, columns: finding)")
-    print(" " * 20 + " ".join(f"{n[:8]:>8s}" for n in names))
+    short = {n: "".join(w[:3] for w in n.split("_"))[:7] for n in names}
+    print(" " * 20 + " ".join(f"{short[n]:>7s}" for n in names))
     for eff in effects:
-        print(f"{eff:20s}" + " ".join(f"{confusion[eff][n]:8d}" for n in names))
+        print(f"{eff:20s}" + " ".join(f"{confusion[eff][n]:7d}" for n in names))
     print("\neffect               top1   severity(x2)  mean gain")
     summary = {}
     for eff in effects:

@@ -39,8 +39,8 @@ __all__ = ["segment_features", "record_features", "feature_floor", "N_SHAPE_BAND
 #: Relative tolerance on a line's frequency (bearing slip, speed error).
 LINE_TOLERANCE = 0.02
 
-#: Log-spaced bands of the spectral-shape columns.
-N_SHAPE_BANDS = 8
+#: Bands of the spectral-shape columns (3 log-spaced up to 0.05·fs, then linear to fs/2).
+N_SHAPE_BANDS = 12
 
 #: Least model-uncertainty of a column in its own unit (dB columns 1.5 dB, logs 0.1).
 DB_FLOOR = 1.5
@@ -99,9 +99,11 @@ def segment_features(x, fs_hz, freqs, bearing):
     freq, amp = _spectrum(x, fs_hz)
     df = freq[1]
     power = amp ** 2
-    edges = np.geomspace(max(20.0, 2 * df), fs_hz / 2, N_SHAPE_BANDS + 1)
+    # log-spaced up to 5 % of fs, then linear (the housing modes and noise live up there)
+    edges = np.concatenate([np.geomspace(max(20.0, 2 * df), 0.05 * fs_hz, 4)[:-1],
+                            np.linspace(0.05 * fs_hz, 0.5 * fs_hz, N_SHAPE_BANDS - 2)])
     total = power[(freq >= edges[0])].sum()
-    for i in range(N_SHAPE_BANDS):
+    for i in range(len(edges) - 1):
         e = power[(freq >= edges[i]) & (freq < edges[i + 1])].sum()
         out[f"shape_b{i}_db"] = 10.0 * math.log10(max(e / total, 1e-12))
     fr = freqs.fr1_hz
