@@ -124,7 +124,24 @@ class Distribution:
 
     @classmethod
     def parse(cls, key, raw, bounds=None, numeric=True):
-        """Parse a spec value at ``key``, checked against ``bounds = (lo, hi, unit)``."""
+        """Parse a spec value at ``key``, checked against ``bounds = (lo, hi, unit)``.
+
+        Parameters
+        ----------
+        key : str
+            Dotted spec key (named in errors).
+        raw : object
+            A fixed value, a list of choices, or a table with ``min``/``max`` (and a
+            distribution).
+        bounds : tuple, optional
+            ``(lo, hi, unit)`` every value must lie in.
+        numeric : bool
+            Whether the values are numbers (else labels, left unchecked).
+
+        Returns
+        -------
+        Distribution
+        """
         def check(k, v):
             if not numeric:
                 return v
@@ -334,7 +351,17 @@ class DatasetSpec:
     # ------------------------------------------------------------------ building
     @classmethod
     def load(cls, path):
-        """Read a TOML spec; a rig ``file`` is relative to the spec's folder."""
+        """Read a TOML spec; a rig ``file`` is relative to the spec's folder.
+
+        Parameters
+        ----------
+        path : str or Path
+            The spec file.
+
+        Returns
+        -------
+        DatasetSpec
+        """
         path = Path(path)
         try:
             data = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -346,7 +373,19 @@ class DatasetSpec:
 
     @classmethod
     def from_dict(cls, data, *, base_dir=None):
-        """Spec from a parsed TOML dict (checked in full, and its first records drawn)."""
+        """Spec from a parsed TOML dict (checked in full, and its first records drawn).
+
+        Parameters
+        ----------
+        data : dict
+            The parsed spec.
+        base_dir : str or Path, optional
+            Folder a rig ``file`` is relative to.
+
+        Returns
+        -------
+        DatasetSpec
+        """
         if not isinstance(data, dict):
             raise ParameterError(f"a dataset spec must be a table, got {type(data).__name__}")
         for key in data:

@@ -23,6 +23,7 @@ base seed, index), so they are bit-identical on any number of workers and on Das
 
 from __future__ import annotations
 
+import io
 import json
 import math
 import os
@@ -35,6 +36,10 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_savez, atomic_write_bytes, atomic_write_text
+from cmsim.dynamics import simulate
+from cmsim.dynamics.profiles import SpeedProfile
+from cmsim.faults import fault_frequencies
+from cmsim.sensors import add_sensors
 from cmsim.datasets.dataset_spec import DatasetSpec
 from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import file_sha256
@@ -138,11 +143,6 @@ def simulate_record(spec, index):
     """Simulate record ``index`` of ``spec``: ``(signals, meta)`` with float32 signals of the
     spec's channels at the sensor rate, and the meta stored with it. Raises what
     :func:`cmsim.dynamics.simulate` raises (e.g. :class:`IntegrationDiverged`)."""
-    from cmsim.dynamics import simulate
-    from cmsim.dynamics.profiles import SpeedProfile
-    from cmsim.faults import fault_frequencies
-    from cmsim.sensors import add_sensors
-
     rec = spec.record(index)
     rig = spec.record_rig(rec)
     op = spec.record_operating_point(rec)
@@ -259,10 +259,16 @@ def _read_sidecars(out):
 def consolidate(out_dir):
     """Fold the sidecar rows into ``manifest.parquet`` (atomic), then remove them.
 
-    Returns the number of rows in the manifest.
-    """
-    import io
+    Parameters
+    ----------
+    out_dir : str or Path
+        The dataset folder.
 
+    Returns
+    -------
+    int
+        The number of rows in the manifest.
+    """
     out = Path(out_dir)
     names = [e.name for e in os.scandir(out / ROWS_DIR)] if (out / ROWS_DIR).is_dir() else []
     names = [n for n in names if n.endswith(".json") and not n.startswith(".")]
@@ -369,7 +375,6 @@ def _row_in_file(path, spec):
 def _warm_kernels(spec, pending):
     """Compile/load the kernels here before forking workers: a 3-sample run of the first
     pending record of each fault label (faulty bearings take their own kernels)."""
-    from cmsim.dynamics import simulate
     seen = set()
     for i in pending[:200]:
         rec = spec.record(i)

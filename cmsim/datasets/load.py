@@ -148,7 +148,17 @@ class Dataset:
         return Record(self.directory, row, self.channels, row.get("fs_hz") or self.fs_hz)
 
     def record(self, key):
-        """A record by ``record_id`` (str) or record index (int)."""
+        """A record by ``record_id`` (str) or record index (int).
+
+        Parameters
+        ----------
+        key : str or int
+            The record's id or index.
+
+        Returns
+        -------
+        Record
+        """
         col = "record_id" if isinstance(key, str) else "index"
         hits = np.flatnonzero(self.manifest[col].to_numpy() == key)
         if hits.size == 0:
@@ -174,7 +184,20 @@ class Dataset:
     def iter_arrays(self, channels=None, window=2048, hop=None, label="fault_label",
                     records=None, batch_records=64):
         """Yield ``(X, y, groups)`` batches of windows, ``batch_records`` records at a time
-        (memory bounded by one batch); same layout as :meth:`to_arrays`."""
+        (memory bounded by one batch); same layout as :meth:`to_arrays`.
+
+        Parameters
+        ----------
+        channels, window, hop, label, records
+            As in :meth:`to_arrays`.
+        batch_records : int
+            Records per batch.
+
+        Yields
+        ------
+        tuple
+            ``(X, y, groups)`` of one batch.
+        """
         channels = self._channels(channels)
         window, hop = _check_window(window, hop)
         if label not in self.manifest.columns:

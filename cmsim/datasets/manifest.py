@@ -52,7 +52,19 @@ def normalised(obj):
 
 
 def file_sha256(path, chunk_bytes=1 << 20):
-    """SHA-256 of a file's bytes, hex."""
+    """SHA-256 of a file's bytes, hex.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    chunk_bytes : int
+        Read size, bytes.
+
+    Returns
+    -------
+    str
+    """
     digest = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(chunk_bytes), b""):
