@@ -110,3 +110,36 @@ def test_envelope_removes_the_mean_and_reads_the_modulation():
     assert a[f > 20.0][i] == pytest.approx(0.5, rel=0.01)      # flat-top: no scalloping loss
     with pytest.raises(ParameterError, match="resolution"):
         envelope_spectrum(x, FS, resolution_hz=0.01)
+
+
+def test_default_filter_order_is_four():
+    x = np.random.default_rng(3).standard_normal(8000)
+    band = (1_000.0, 3_000.0)
+    np.testing.assert_array_equal(bandpass(x, FS, band), bandpass(x, FS, band, filter_order=4))
+    assert not np.allclose(bandpass(x, FS, band), bandpass(x, FS, band, filter_order=5))
+    np.testing.assert_array_equal(envelope(x, FS, band), envelope(x, FS, band, filter_order=4))
+    np.testing.assert_array_equal(envelope_spectrum(x, FS, band).amplitude,
+                                  envelope_spectrum(x, FS, band, filter_order=4).amplitude)
+    assert not np.allclose(envelope_spectrum(x, FS, band).amplitude,
+                           envelope_spectrum(x, FS, band, filter_order=5).amplitude)
+
+
+@pytest.mark.parametrize("band", [(0.8, 50.0), (0.8, 20.0)], ids=["high-pass", "band-pass"])
+def test_a_low_edge_below_one_hertz_still_filters(band):
+    """A pass band starting at 0.8 Hz removes a constant offset (only lo = 0 keeps it)."""
+    fs = 100.0
+    t = np.arange(40_000) / fs
+    x = 5.0 + np.sin(2 * math.pi * 10.0 * t)
+    y = bandpass(x, fs, band)
+    mid = slice(10_000, 30_000)
+    assert abs(y[mid].mean()) < 0.01
+    assert np.std(y[mid]) * math.sqrt(2) == pytest.approx(1.0, rel=0.02)
+    kept = bandpass(x, fs, (0.0, 20.0))
+    assert kept[mid].mean() == pytest.approx(5.0, rel=1e-3)
+
+
+def test_band_errors_name_the_argument():
+    with pytest.raises(ParameterError, match=r"^band_hz must satisfy 0 <= lo < hi <= fs/2"):
+        bandpass(np.ones(100), FS, (300.0, 200.0))
+    with pytest.raises(ParameterError, match=r"^band_hz must be a pair"):
+        envelope(np.ones(100), FS, band_hz=5.0)
