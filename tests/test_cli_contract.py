@@ -56,6 +56,7 @@ BASE = {
     "sweep": "sweep --speed-rpm 1000 --out {work}/sw",
     "report": "report {sweep}",
     "evaluate": "evaluate {empty_dir} --algorithm envelope",
+    "compare": "compare {record}",
     "dataset": "dataset {ds_spec} --out {work}/ds",
     "losses": "losses --speed-rpm 1000 --torque-nm 10",
 }
@@ -295,6 +296,16 @@ CATALOGUE = [
       "--oil-jet-kg-s", numeric=True),
     R("losses-plot-dir", "losses --speed-rpm 1000 --torque-nm 10 --plot {work}", "--plot"),
     R("losses-rig-text", "losses --speed-rpm 1000 --torque-nm 10 --rig {text}", "--rig"),
+    # ---- compare
+    R("compare-record-missing-arg", "compare", "RECORD"),
+    R("compare-record-missing", "compare {work}/none.npz", "RECORD", "does not exist"),
+    R("compare-no-metadata", "compare {run}", "RECORD", "metadata.json"),
+    R("compare-channel", "compare {record} --channel nosuch", "--channel", "DE"),
+    R("compare-budget-low", "compare {record} --budget 2", "--budget", numeric=True),
+    R("compare-seed-negative", "compare {record} --seed -1", "--seed", numeric=True),
+    R("compare-rig-missing", "compare {record} --rig {work}/none.toml", "--rig"),
+    R("compare-rig-text", "compare {record} --rig {text}", "--rig"),
+    R("compare-report-file", "compare {record} --report {text}", "--report"),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -412,6 +423,15 @@ def files(tmp_path_factory):
     raw[len(raw) // 2: len(raw) // 2 + 64] = b"\0" * 64
     (corrupt / "runs" / "r0.npz").write_bytes(bytes(raw))
     f["corrupt_sweep"] = corrupt
+    meas = d / "measured"                          # a measured record (cmsim compare)
+    meas.mkdir()
+    np.savez(meas / "rec.npz", DE=np.random.default_rng(0).standard_normal(24000))
+    (meas / "metadata.json").write_text(json.dumps({
+        "fs_hz": 12000.0, "sensors": {"DE": {"near": "de", "direction": "radial"}},
+        "geometry": {"gears": None, "bearings": {"de": {
+            "n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04}}},
+        "recordings": [{"file": "rec.npz", "shaft_speed_rpm": 1797.0}]}))
+    f["record"] = meas / "rec.npz"
     f["root"] = d
     return f
 

@@ -48,11 +48,14 @@ DEFAULT_BUDGET = 48
 #: model's features depend on the relative cage phases of its bearings.
 SIM_SEEDS = 2
 
+#: Points of the coarse grid of the fit (over the cause's bounds, log scale).
+FIT_GRID = 6
+
 #: Simulated time dropped at each end of a model signal (filter edges), s.
 EDGE_S = 0.05
 
 
-def simulate_setup(setup, fs_hz, duration_s, model_signal, seed):
+def simulate_setup(setup, fs_hz, duration_s, model_signal, seed, noise_ref_rms=None):
     """The model's sensor signal for ``setup``.
 
     Parameters
@@ -66,6 +69,9 @@ def simulate_setup(setup, fs_hz, duration_s, model_signal, seed):
         ``accel_<bearing>_<x|y>``.
     seed : int
         Seed of the simulation and of the sensor noise.
+    noise_ref_rms : float, optional
+        RMS the noise ratio refers to (the healthy model's signal, so that a fault raises
+        the signal above a fixed sensor noise); default the signal's own RMS.
 
     Returns
     -------
@@ -81,7 +87,8 @@ def simulate_setup(setup, fs_hz, duration_s, model_signal, seed):
     x = np.asarray(run[model_signal], dtype=float)[edge:edge + n]
     x = x - x.mean()
     rng = np.random.default_rng(seed + 7919)
-    return x + setup.noise_ratio * float(np.std(x)) * rng.standard_normal(x.size)
+    ref = float(np.std(x)) if noise_ref_rms is None else float(noise_ref_rms)
+    return x + setup.noise_ratio * ref * rng.standard_normal(x.size)
 
 
 @dataclass
@@ -125,6 +132,7 @@ class _Evaluator:
         self.bearing = signal_info(record.model_signal).component
         self.cache = {}
         self.signals = {}
+        self.ref_rms = None
 
     def features(self, setup, seed=None, keep=None):
         seed = self.seed if seed is None else seed
@@ -138,7 +146,10 @@ class _Evaluator:
             rows, xs = [], []
             for i in range(SIM_SEEDS):          # independent cage phases, one segment each
                 x = simulate_setup(setup, self.record.fs_hz, self.seg_s,
-                                   self.record.model_signal, seed + 7777 * i)
+                                   self.record.model_signal, seed + 7777 * i,
+                                   noise_ref_rms=self.ref_rms)
+                if self.ref_rms is None:           # the first (nominal) run sets the noise
+                    self.ref_rms = float(np.std(x)) / math.sqrt(1 + setup.noise_ratio ** 2)
                 names, f = record_features(x, self.record.fs_hz, self.freqs, self.bearing,
                                            self.seg_s)
                 rows.append(f[0])
@@ -201,7 +212,7 @@ def compare(record, *, budget=DEFAULT_BUDGET, seed=0, seg_s=None, max_segments=8
     fs = record.fs_hz
     duration = x.size / fs
     seg_s = float(seg_s) if seg_s is not None else min(0.5, duration / 4.0)
-    ev = _Evaluator(record, seg_s, seed, budget)
+    ev = _Evaluator(record, seg_s, seed, budget - 2)     # 2 kept for the held-out runs
     names, F = record_features(x, fs, ev.freqs, ev.bearing, seg_s, max_segments)
     if F.shape[0] < 4:
         raise ParameterError(f"record of {duration:.3g} s gives {F.shape[0]} segments of "
@@ -271,18 +282,27 @@ def compare(record, *, budget=DEFAULT_BUDGET, seed=0, seg_s=None, max_segments=8
             return _chi2(meas_fit, f, sigma, cols, f_nom) if f is not None else chi_nom * 10
 
         best_v, best_c = top["probe"], top["chi2"]
-        n_fit = max(0, budget - ev.count - 2)
-        if n_fit >= 3:
-            res = minimize_scalar(objective, bounds=(tr[0](lo), tr[0](hi)), method="bounded",
-                                  options={"maxiter": n_fit, "xatol": 0.03})
-            v = clamp(cause, tr[1](res.x))
-            if res.fun < best_c:
-                best_v, best_c = v, float(res.fun)
+        # coarse grid over the bounds (the objective may have several minima), then bounded
+        # Brent in the bracket around the best grid point
+        grid = np.linspace(tr[0](lo), tr[0](hi), FIT_GRID)
+        n_left = max(0, ev.budget - ev.count)
+        if n_left >= FIT_GRID + 3:
+            vals = [objective(u) for u in grid]
+            i = int(np.argmin(vals))
+            if vals[i] < best_c:
+                best_v, best_c = clamp(cause, tr[1](grid[i])), float(vals[i])
+            a, b = grid[max(i - 1, 0)], grid[min(i + 1, FIT_GRID - 1)]
+            n_fit = max(0, ev.budget - ev.count)
+            if n_fit >= 3:
+                res = minimize_scalar(objective, bounds=(a, b), method="bounded",
+                                      options={"maxiter": n_fit, "xatol": 0.02})
+                if res.fun < best_c:
+                    best_v, best_c = clamp(cause, tr[1](res.x)), float(res.fun)
         params = {cause.parameter: best_v}
         fitted = cause.apply(nominal, best_v, comp)
         top["fitted"] = params
     # held-out: re-simulate nominal and fitted with a new seed
-    ev.budget = max(ev.budget, ev.count + 2)
+    ev.budget = budget
     f_nom2 = ev.features(nominal, seed=seed + 1)
     before = _chi2(meas_held, f_nom2, sigma, cols) / n
     if fitted is nominal:

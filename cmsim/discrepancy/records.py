@@ -272,7 +272,24 @@ def estimate_shaft_hz(x, fs_hz, *, lo_hz, hi_hz, teeth=None, n_harmonics=4):
             n += 1
         if n and s / n > best[0]:
             best = (s / n, f)
-    return float(best[1]), float(best[0])
+    return _refine(freq, logamp, best[1], mults, fs_hz), float(best[0])
+
+
+def _refine(freq, logamp, f, mults, fs_hz):
+    """Shaft rate from the interpolated peaks of its comb lines (amplitude-weighted)."""
+    df = freq[1]
+    num = den = 0.0
+    for m in mults:
+        k = int(round(m * f / df))
+        if m * f >= fs_hz / 2 or k < 2 or k + 3 >= logamp.size:
+            continue
+        j = k - 2 + int(np.argmax(logamp[k - 2:k + 3]))
+        a, b, c = logamp[j - 1], logamp[j], logamp[j + 1]
+        d = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) < 0 else 0.0
+        w = 10 ** b
+        num += w * (j + d) * df / m
+        den += w
+    return float(num / den) if den > 0 else float(f)
 
 
 def _infer_fs_gear(x, shaft_hz, teeth):
@@ -385,9 +402,7 @@ def read_record(path, *, channel=None, rig=None):
     axis = "x" if ("horizontal" in direction or "3 o'clock" in direction) else "y"
     bearing = "1b1"
     if model_rig.gears is None:
-        for b, key in components.items():
-            if key == near:
-                bearing = b
+        bearing = next((b for b, key in components.items() if key == near), "1b1")
     model_signal = f"accel_{bearing}_{axis}"
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},

@@ -100,6 +100,9 @@ def hidden_effect_record(effect, seed, *, duration_s=DURATION_S):
     setup = ModelSetup(rig=rig, op=true_op, faults=(wobble,), housing=housing,
                        noise_ratio=rng.uniform(0.07, 0.14))
     value = component = None
+    # the sensor noise is fixed by the healthy machine's level (a fault rises above it)
+    ref = float(np.std(simulate_setup(setup, FS_HZ, 0.5, "accel_1b1_y", int(seed) + 200_000,
+                                      noise_ref_rms=0.0)))
     if effect is not None:
         ranges = HIDDEN_EFFECTS[effect]
         lo, hi = ranges[int(rng.integers(len(ranges)))]
@@ -107,7 +110,8 @@ def hidden_effect_record(effect, seed, *, duration_s=DURATION_S):
         cause = CAUSES[effect]()
         component = cause.components(rig, "1b1")[0]
         setup = cause.apply(setup, value, component)
-    x = simulate_setup(setup, FS_HZ, duration_s, "accel_1b1_y", int(seed) + 100_000)
+    x = simulate_setup(setup, FS_HZ, duration_s, "accel_1b1_y", int(seed) + 100_000,
+                       noise_ref_rms=ref)
     run = Run(np.arange(x.size) / FS_HZ, {"DE": x}, {"fs_hz": FS_HZ}, source="measured")
     record = record_from_run(run, "DE", rig, op, model_signal="accel_1b1_y",
                              components={"1b1": "1b1", "1b2": "1b2"})
