@@ -63,7 +63,8 @@ DEF_OUTER, DEF_INNER, DEF_BALL = 1, 2, 3
 MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE, MI_TEETH, MI_ECC, MI_PROFILE, MI_TDOF = range(9)
 MI_FAULTY_BALLS = 9     # 1 when any bearing has off-size balls
 MI_MUTAB = 10           # 1 when the friction coefficient follows ``mu_tab`` along the path
-MI_SIZE = 11
+MI_CTAB = 11            # 1 when the pair damping follows ``c_tab`` along the path
+MI_SIZE = 12
 MODE_TABLE, MODE_HYBRID = 0, 1
 # columns of the per-slot scratch ``W.slots`` of the mesh kernel
 SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP, SG_KPAIR, SG_S = range(10)
@@ -120,7 +121,10 @@ class KernelParams(NamedTuple):
         when ``MI_PROFILE`` is off).
     mu_tab : (m,) mesh friction coefficient against the pair's position on the mesh table's
         grid (a lubrication model's f(s) at the operating point; (1,) and unused when
-        ``MI_MUTAB`` is off: the constant ``MP_MU``). Nominal rotations are ``omega[i]·τ(t)`` with the
+        ``MI_MUTAB`` is off: the constant ``MP_MU``).
+    c_tab : (m,) viscous damping of a loaded pair against its position on the mesh table's
+        grid, N·s/m (e.g. structural + mixed-lubrication contact damping, paper 004 eq. 14-16;
+        (1,) and unused when ``MI_CTAB`` is off: the stiffness-proportional β·k). Nominal rotations are ``omega[i]·τ(t)`` with the
         equivalent time τ = Θ(t)/Ω_ref (τ = t at constant speed).
     """
 
@@ -156,6 +160,7 @@ class KernelParams(NamedTuple):
     ecc: np.ndarray
     prof: np.ndarray
     mu_tab: np.ndarray
+    c_tab: np.ndarray
 
 
 def no_faults(nb, max_balls):
@@ -574,7 +579,12 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
         approach = dvx * nx + dvy * ny
         elastic = S[j, SG_ELASTIC]
         if elastic > 0.0:
-            fn = elastic + mp[MP_BETA] * S[j, SG_KPAIR] * approach
+            if m_int[MI_CTAB] != 0:
+                c_pair, _ = table_lookup2_jit(S[j, SG_S], mp[MP_TAB0], mp[MP_TABD], P.c_tab,
+                                              P.c_tab)
+            else:
+                c_pair = mp[MP_BETA] * S[j, SG_KPAIR]
+            fn = elastic + c_pair * approach
             if fn < 0.0:
                 fn = 0.0
         elif approach > 0.0:

@@ -418,7 +418,8 @@ def _dof_names(rig):
 
 
 def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
-                cage_phases_rad=None, faults=(), profile=None, loads=None, friction_table=None):
+                cage_phases_rad=None, faults=(), profile=None, loads=None, friction_table=None,
+                damping_table=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
 
     Parameters
@@ -448,6 +449,10 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     friction_table : ndarray, shape (m,), optional
         Mesh friction coefficient against the pair's position on the run's mesh table grid
         (a mixed-lubrication model at the operating point), in place of the rig's constant.
+    damping_table : ndarray, shape (m,), optional
+        Viscous damping of a loaded pair against its position on the same grid, N·s/m (e.g.
+        :func:`cmsim.losses.contact_mixed.mesh_mixed_stiffness_damping`), in place of the
+        stiffness-proportional β·k.
 
     Returns
     -------
@@ -545,10 +550,18 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
             raise ParameterError(f"friction_table needs {len(tab_k)} values in [0, 1] (one "
                                  f"per point of the mesh table grid)")
         m_int[K.MI_MUTAB] = 1
+    c_tab = np.zeros(1)
+    if damping_table is not None:
+        c_tab = np.ascontiguousarray(damping_table, dtype=float)
+        if rig.gears is None or c_tab.shape != (len(tab_k),) or not np.all(np.isfinite(c_tab)) \
+                or np.any(c_tab < 0):
+            raise ParameterError(f"damping_table needs {len(tab_k)} finite values >= 0 N s/m "
+                                 f"(one per point of the mesh table grid)")
+        m_int[K.MI_CTAB] = 1
     packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, b_int, rm.b_par,
                             rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
                             m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
-                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab)
+                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab, c_tab)
     model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
                          SlipModel(), mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,

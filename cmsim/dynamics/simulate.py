@@ -214,7 +214,8 @@ def _compile_seconds():
 
 def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
              scheme="ode3", slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
-             profile=None, faults=(), progress=None, loads=None, friction_table=None):
+             profile=None, faults=(), progress=None, loads=None, friction_table=None,
+             damping_table=None):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -265,10 +266,10 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         off-size balls, rolling slip (overrides ``slip``), speed fluctuation and torque
         ripple (laid on the speed/torque, with or without ``profile``). The run's meta lists
         them with their characteristic frequencies (the answer key).
-    loads, friction_table : optional
-        Extra constant generalised forces by DOF name and a mesh friction coefficient along
-        the path (as in :func:`~cmsim.dynamics.model.build_model`; e.g. from a losses and
-        lubrication model).
+    loads, friction_table, damping_table : optional
+        Extra constant generalised forces by DOF name, a mesh friction coefficient and a pair
+        damping along the path (as in :func:`~cmsim.dynamics.model.build_model`; e.g. from
+        :mod:`cmsim.losses`).
     progress : callable, optional
         Called as ``progress(done_s, total_s)`` (simulated seconds, warm-up included) as the
         integration advances, in chunks that do not change the result.
@@ -319,7 +320,7 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
     model = build_model(rig, op, mesh, slip=slip, duration_s=warmup_s + duration_s,
                         seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad,
                         profile=kprof, faults=faults, loads=loads,
-                        friction_table=friction_table)
+                        friction_table=friction_table, damping_table=damping_table)
     n = model.n_dof
     q0, start_method = initial_state(model, 0.0)
     y0 = np.concatenate([q0, np.zeros(n)])

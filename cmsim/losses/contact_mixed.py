@@ -28,7 +28,7 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -36,6 +36,7 @@ from cmsim.errors import check_range
 from cmsim.losses.mixed_friction import fluid_load_share, mesh_friction_along_path
 
 __all__ = ["OIL_BULK_MODULUS_PA", "ContactStiffnessDamping", "mixed_contact_stiffness_damping",
+           "mixed_lubrication_mesh",
            "mesh_mixed_stiffness_damping"]
 
 #: Bulk modulus of a mineral oil, Pa.
@@ -161,3 +162,45 @@ def mesh_mixed_stiffness_damping(rig, op, mesh_table, roughness_m, *, viscosity_
     c_m = np.where(loaded, c_sys + con.contact_damping, 0.0)
     return {"position_m": s, "stiffness_n_per_m": k_m, "damping_n_s_per_m": c_m,
             "contact": con, "system_damping_n_s_per_m": c_sys}
+
+
+def mixed_lubrication_mesh(rig, op, mesh_table, roughness_m, *, viscosity_pa_s=None,
+                           damping_ratio=None):
+    """The mesh under mixed lubrication as the dynamics takes it (``mesh=``, ``damping_table=``).
+
+    Where the quasi-static mesh cycle loads a pair, its stiffness is K_m(s) and its damping
+    C_m(s) of :func:`mesh_mixed_stiffness_damping` (paper 004 eq. 12, 14-16); elsewhere (a
+    pair the dynamics loads earlier or later than the quasi-static cycle) the structural
+    table's stiffness and the default stiffness-proportional damping β·k, β = 2ξ√(M_eq/k̄),
+    are kept, so the dynamics never meets a pair without stiffness.
+
+    Parameters
+    ----------
+    rig : Rig
+    op : OperatingPoint
+    mesh_table : MeshStiffnessTable
+        The structural (dry) table at the operating torque.
+    roughness_m : float
+        Composite RMS roughness σ, m.
+    viscosity_pa_s, damping_ratio : float, optional
+        As in :func:`mesh_mixed_stiffness_damping`.
+
+    Returns
+    -------
+    (MeshStiffnessTable, ndarray)
+        The table with K_m and the pair damping along its grid, N·s/m, for
+        ``cmsim.dynamics.simulate(..., mesh=table, damping_table=c)``.
+    """
+    mixed = mesh_mixed_stiffness_damping(rig, op, mesh_table, roughness_m,
+                                         viscosity_pa_s=viscosity_pa_s,
+                                         damping_ratio=damping_ratio)
+    k_sys = np.asarray(mesh_table.stiffness_n_per_m, dtype=float)
+    loaded = mixed["stiffness_n_per_m"] > 0
+    zeta = rig.mesh_contact.damping_ratio if damping_ratio is None else damping_ratio
+    beta = 2 * zeta * math.sqrt(rig.gears.mesh_stiffness_mass_kg
+                                / mesh_table.mean_mesh_stiffness(rig.gears))
+    k = np.where(loaded, mixed["stiffness_n_per_m"], k_sys)
+    c = np.where(loaded, mixed["damping_n_s_per_m"], beta * k_sys)
+    table = replace(mesh_table, stiffness_n_per_m=k,
+                    meta=dict(mesh_table.meta, mixed_lubrication_roughness_m=float(roughness_m)))
+    return table, c
