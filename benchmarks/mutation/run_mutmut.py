@@ -11,7 +11,8 @@ Usage (from the repository root; needs ``pip install -e .[mutation]``)::
     .venv/bin/python benchmarks/mutation/run_mutmut.py cmsim/frequencies.py
     .venv/bin/python benchmarks/mutation/run_mutmut.py --rev HEAD --max-mutants 300
 
-then ``cd /tmp/cmsim-mutmut/pkg && mutmut results`` / ``mutmut show <id>`` to read the
+then, once it has finished, ``cd /tmp/cmsim-mutmut/pkg && mutmut results`` / ``mutmut show <id>``
+to read the
 survivors. The score is killed / (total − equivalent); the mutants judged equivalent are
 listed in ``benchmarks/mutation/README.md``.
 """
