@@ -9,11 +9,10 @@ Usage (from the repository root; needs ``pip install -e .[mutation]``)::
 
     .venv/bin/python benchmarks/mutation/run_mutmut.py                 # all modules below
     .venv/bin/python benchmarks/mutation/run_mutmut.py cmsim/frequencies.py
-    .venv/bin/python benchmarks/mutation/run_mutmut.py --rev HEAD --max-mutants 300
+    .venv/bin/python benchmarks/mutation/run_mutmut.py --rev HEAD --overlay tests/test_x.py
 
-then, once it has finished, ``cd /tmp/cmsim-mutmut/pkg && mutmut results`` / ``mutmut show <id>``
-to read the
-survivors. The score is killed / (total − equivalent); the mutants judged equivalent are
+then, once it has finished, ``cd /tmp/cmsim-mutmut/pkg && mutmut results`` / ``mutmut show
+<id>`` to read the survivors. The score is killed / (total − equivalent); the mutants judged equivalent are
 listed in ``benchmarks/mutation/README.md``.
 """
 
