@@ -15,7 +15,9 @@ checked, and a bad spec is refused before any work with a message naming the key
                    and any field of the fault as a value (its main size is the severity)
     [nuisances]    sensor_noise_m_s2, speed_wobble (relative amplitude of a speed
                    fluctuation), speed_wobble_hz (default: the input shaft rate), slip
-                   (relative cage-speed fluctuation, a rolling_slip)
+                   (relative cage-speed fluctuation, a rolling_slip), housing_mode_hz and
+                   housing_damping (drawn once per mode of ``rig.housing``: the transfer
+                   path's resonances and damping ratios; absent = the rig's)
     [sensor]       channels (accel_<bearing>_<x|y>, tacho, F_<bearing>_<x|y|loa|oloa}, dte,
                    dte_um, Fmesh_total), fs_hz (output rate; the integration step is chosen
                    from the model's highest mode and the output is anti-alias decimated),
@@ -67,7 +69,11 @@ _OPERATING = {"speed_rpm": (0.0, 1e5, "rpm"), "torque_nm": (0.0, 1e6, "N m"),
               "friction": (0.0, 0.3, ""), "clearance_m": (-1e-3, 1e-3, "m"),
               "radial_load_n": (0.0, 1e7, "N")}
 _NUISANCES = {"sensor_noise_m_s2": (0.0, 1e6, "m/s^2"), "speed_wobble": (0.0, 0.1, ""),
-              "speed_wobble_hz": (0.0, 1e4, "Hz"), "slip": (0.0, 0.2, "")}
+              "speed_wobble_hz": (0.0, 1e4, "Hz"), "slip": (0.0, 0.2, ""),
+              "housing_mode_hz": (1.0, 1e6, "Hz"), "housing_damping": (1e-4, 0.5, "")}
+#: Nuisances drawn once per housing mode (columns ``<name>_1`` .. ``<name>_n``), and only
+#: when the spec gives them: domain randomisation of the transfer path.
+_PER_MODE = {"housing_mode_hz": "natural_frequencies_hz", "housing_damping": "damping_ratios"}
 _TABLES = {"dataset": {"name", "records", "seed"}, "rig": {"builtin", "file"},
            "operating": {"sampling", "runup_share", "runup_to_rpm", *_OPERATING},
            "faults": {"healthy_share", "types"}, "nuisances": set(_NUISANCES),
@@ -516,6 +522,11 @@ class DatasetSpec:
         nuis = {n: d for n, d in self.nuisances}
         for name in _NUISANCES:
             dist = nuis.get(name)
+            if name in _PER_MODE:
+                if dist is not None:
+                    for k in range(self.rig.housing.n_modes):
+                        params[f"{name}_{k + 1}"] = float(dist.draw(rng))
+                continue
             params[name] = float(dist.draw(rng)) if dist is not None else (
                 math.nan if name == "speed_wobble_hz" else 0.0)
         if math.isnan(params["speed_wobble_hz"]):
@@ -531,11 +542,19 @@ class DatasetSpec:
         return rec
 
     def record_rig(self, rec):
-        """The rig of a record: the base rig with its drawn friction and clearance."""
+        """The rig of a record: the base rig with its drawn friction, clearance and housing
+        modes."""
         rig = self.rig
         for name in ("clearance_m", "friction"):
             if name in rec.params:
                 rig = RIG_TRANSFORMS[name].apply(rig, rec.params[name])
+        housing = {}
+        for name, field_name in _PER_MODE.items():
+            if f"{name}_1" in rec.params:
+                housing[field_name] = tuple(rec.params[f"{name}_{k + 1}"]
+                                            for k in range(rig.housing.n_modes))
+        if housing:
+            rig = dataclasses.replace(rig, housing=dataclasses.replace(rig.housing, **housing))
         return rig
 
     def record_operating_point(self, rec):

@@ -117,6 +117,7 @@ class _RaceDefect(Fault):
     size_m: float
     depth_m: float
     angle_rad: float | None = None
+    exit_ramp_fraction: float = EXIT_RAMP_FRACTION
 
     def __post_init__(self):
         if not isinstance(self.bearing, str):
@@ -124,6 +125,7 @@ class _RaceDefect(Fault):
                                  f"{self.bearing!r}", param="bearing")
         _check_size("size_m", self.size_m)
         check_range("depth_m", self.depth_m, 0.0, 0.01, lo_open=True, unit="m")
+        check_range("exit_ramp_fraction", self.exit_ramp_fraction, 0.0, 1.0, unit="")
         if self.angle_rad is not None:
             check_range("angle_rad", self.angle_rad, -2 * math.pi, 2 * math.pi, unit="rad")
 
@@ -155,7 +157,7 @@ class _RaceDefect(Fault):
         entry = _entry_distance_m(rb, self.size_m, drop)
         centre = default_angle_rad if self.angle_rad is None else self.angle_rad
         return [float(ib), self.kind, float(centre), 0.5 * self.size_m / r, drop, entry / r,
-                EXIT_RAMP_FRACTION * entry / r, -1.0]
+                self.exit_ramp_fraction * entry / r, -1.0]
 
 
 @register
@@ -174,6 +176,9 @@ class OuterRaceDefect(_RaceDefect):
     angle_rad : float or None
         Position in the housing, rad (x axis = 0, counter-clockwise +); ``None`` = the centre
         of the load zone (:mod:`cmsim.faults.bearing`).
+    exit_ramp_fraction : float
+        Exit ramp as a fraction of the entry ramp, in [0, 1] (0: an abrupt exit; default
+        :data:`EXIT_RAMP_FRACTION`): the defect's edge profile.
     """
 
     name = "outer_race"
@@ -200,6 +205,9 @@ class InnerRaceDefect(_RaceDefect):
         Defect depth, m (> 0, at most the ball radius).
     angle_rad : float or None
         Position on the ring from its reference (turning with it), rad; ``None`` = 0.
+    exit_ramp_fraction : float
+        Exit ramp as a fraction of the entry ramp, in [0, 1] (0: an abrupt exit; default
+        :data:`EXIT_RAMP_FRACTION`): the defect's edge profile.
     """
 
     name = "inner_race"
@@ -228,6 +236,9 @@ class BallDefect(Fault):
         Index of the faulty ball in the cage (0 .. n_balls − 1).
     phase_rad : float
         Phase of the defect on the ball's spin, rad (0 = facing the outer race at t = 0).
+    exit_ramp_fraction : float
+        Exit ramp as a fraction of the entry ramp, in [0, 1] (0: an abrupt exit; default
+        :data:`EXIT_RAMP_FRACTION`): the defect's edge profile.
     """
 
     name = "ball"
@@ -237,6 +248,7 @@ class BallDefect(Fault):
     depth_m: float
     ball: int = 0
     phase_rad: float = 0.0
+    exit_ramp_fraction: float = EXIT_RAMP_FRACTION
 
     def __post_init__(self):
         if not isinstance(self.bearing, str):
@@ -244,6 +256,7 @@ class BallDefect(Fault):
                                  f"{self.bearing!r}", param="bearing")
         _check_size("size_m", self.size_m)
         check_range("depth_m", self.depth_m, 0.0, 0.01, lo_open=True, unit="m")
+        check_range("exit_ramp_fraction", self.exit_ramp_fraction, 0.0, 1.0, unit="")
         check_int("ball", self.ball, 0)
         check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
 
@@ -269,7 +282,7 @@ class BallDefect(Fault):
         drop = ball_drop_m(rb, self.size_m, self.depth_m)
         entry = _entry_distance_m(rb, self.size_m, drop)
         return [float(ib), KIND_BALL, float(self.phase_rad), 0.5 * self.size_m / rb, drop,
-                entry / rb, EXIT_RAMP_FRACTION * entry / rb, float(self.ball)]
+                entry / rb, self.exit_ramp_fraction * entry / rb, float(self.ball)]
 
 
 @register
