@@ -603,6 +603,14 @@ def _cmd_evaluate(args):
     from cmsim.diagnostics import evaluate, load_algorithm, load_dataset
     from cmsim.diagnostics.report import write_report
 
+    if args.train or args.test is not None or args.classifier is not None:
+        return _cmd_syn2real(args)
+    if args.dir is None:
+        raise CLIError("DIR is required (or --train DIR --test FOLDER --classifier NAME)",
+                       option="DIR")
+    if args.algorithm is None:
+        raise CLIError("argument --algorithm: is required with DIR (see cmsim evaluate "
+                       "--help)", option="--algorithm")
     func = load_algorithm(args.algorithm)
     try:
         dataset = load_dataset(args.dir)
@@ -625,7 +633,53 @@ def _cmd_evaluate(args):
     return out
 
 
+def _cmd_syn2real(args):
+    from cmsim.datasets import load
+    from cmsim.diagnostics.syn2real import evaluate_syn2real, measured_windows
+
+    if args.dir is not None or args.algorithm is not None:
+        raise CLIError("--train: give either DIR --algorithm NAME or --train DIR --test FOLDER "
+                       "--classifier NAME, not both", option="--train")
+    for opt, value in (("--train", args.train), ("--test", args.test),
+                       ("--classifier", args.classifier)):
+        if not value:
+            raise CLIError(f"{opt} is required with --train/--test/--classifier", option=opt)
+    if args.report is not None:
+        raise CLIError("--report: not available with --train (use --json)", option="--report")
+    for d in args.train:
+        try:
+            ds = load(d)
+        except ParameterError as exc:
+            raise CLIError(f"--train {exc}", option="--train") from None
+        if len(ds) == 0:
+            raise CLIError(f"--train {d}: the dataset has no ok record", option="--train")
+    try:
+        test = measured_windows(args.test, window=args.window,
+                                max_windows=args.max_test_windows)
+    except (ParameterError, OSError, ValueError, KeyError) as exc:
+        raise CLIError(f"--test {args.test}: {exc}", option="--test") from None
+    out = evaluate_syn2real(args.train, args.test, args.classifier, test=test,
+                            seed=args.seed or 0)
+    out["train"] = [str(d) for d in args.train]
+    return out
+
+
+def _text_syn2real(res):
+    def ms(v):
+        return f"{100 * v['mean']:.1f} +- {100 * v['std']:.1f} %"
+    lines = [f"{res['classifier']} trained on {len(res['train'])} synthetic set(s), tested on "
+             f"{res['test']} ({res['n_test_windows']} windows of {res['window']} samples, "
+             f"{res['n_test_records']} records)",
+             f"balanced accuracy {ms(res['balanced_accuracy'])}, macro-AUROC "
+             f"{ms(res['macro_auroc'])}",
+             "recall: " + ", ".join(f"{c} {ms(v)}" for c, v in res["per_class_recall"].items()),
+             "confusion (rows truth, summed over runs): " + str(res["confusion_matrix"])]
+    return "\n".join(lines)
+
+
 def _text_evaluate(res):
+    if "classifier" in res:
+        return _text_syn2real(res)
     m = res["metrics"]
     lines = [f"{res['algorithm']} on {res['dataset']}: {m['n_scored']}/{m['n_records']} "
              f"records answered, {m['n_failed']} raised",
@@ -655,10 +709,22 @@ def _add_evaluate(sub):
                                    "matrix, per-class ROC AUC and detection against severity at "
                                    "5 %% false alarms. See cmsim.diagnostics for the function's "
                                    "signature.")
-    p.add_argument("dir", type=Path, metavar="DIR", help="dataset directory")
-    p.add_argument("--algorithm", required=True, metavar="MODULE:FUNCTION",
+    p.add_argument("dir", type=Path, metavar="DIR", nargs="?", help="dataset directory")
+    p.add_argument("--algorithm", metavar="MODULE:FUNCTION",
                    help="built-in (envelope, tsa, sideband), package.module:function or "
-                        "path/file.py:function")
+                        "path/file.py:function (required with DIR)")
+    p.add_argument("--train", type=Path, nargs="+", metavar="DIR",
+                   help="sim-to-real: generated dataset(s) to train on (one per seed; mean "
+                        "and std over them)")
+    p.add_argument("--test", type=Path, metavar="FOLDER",
+                   help="sim-to-real: folder of measured records (metadata.json)")
+    p.add_argument("--classifier", choices=("envelope", "forest", "logistic"),
+                   help="sim-to-real classifier (cmsim.diagnostics.syn2real)")
+    p.add_argument("--window", type=int, metavar="N",
+                   help="sim-to-real: samples per window (default ~0.34 s: 4096 at 12 kHz)")
+    p.add_argument("--max-test-windows", type=int, metavar="N",
+                   help="sim-to-real: first N windows of each test record only")
+    p.add_argument("--seed", type=int, help="sim-to-real: random state of the learned model")
     p.add_argument("--report", type=Path, metavar="OUT.html",
                    help="write an HTML page with the plots")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
@@ -937,6 +1003,8 @@ _RANGES = {
     "air_temperature_c": (float, -100.0, 500.0, False, False, "C"),
     "oil_jet_kg_s": (float, 0.0, 100.0, False, False, "kg/s"),
     "roughness_m": (float, 0.0, 5.0e-5, True, False, "m"),
+    "window": (int, 256, 1 << 20, False, False, ""),
+    "max_test_windows": (int, 1, 100_000, False, False, ""),
 }
 #: numeric options whose range depends on other inputs and is checked by the library, which
 #: names them through _PARAM_TO_DEST (none today; clearance is narrowed by the bearing)
@@ -959,7 +1027,8 @@ _PATHS = {"rig": "file", "faults": "file", "mesh_table": "file", "run": "file", 
           "out": "out",
           "plot": "out", ("sweep", "out"): "outdir", ("evaluate", "report"): "out",
           ("dataset", "spec"): "file", ("dataset", "out"): "outdir",
-          ("compare", "report"): "outdir"}
+          ("compare", "report"): "outdir", ("evaluate", "train"): "dir",
+          ("evaluate", "test"): "dir"}
 
 
 class CLIError(Exception):
@@ -1072,6 +1141,10 @@ def _check_paths(args, command, options):
         kind = _PATHS.get((command, dest), _PATHS.get(dest))
         value = getattr(args, dest, None)
         if kind is None or value is None:
+            continue
+        if isinstance(value, list):                 # nargs="+": check each
+            for v in value:
+                _check_paths(argparse.Namespace(**{dest: v}), command, {dest: option})
             continue
         path = Path(value)
         if kind == "file" and not path.is_file():

@@ -270,6 +270,24 @@ CATALOGUE = [
       "--report"),
     R("evaluate-report-no-parent", "evaluate {empty_dir} --algorithm envelope --report "
       "{work}/no/x.html", "--report"),
+    R("evaluate-dir-missing", "evaluate --algorithm envelope", "DIR"),
+    R("evaluate-train-missing-dir", "evaluate --train {work}/none --test {empty_dir} "
+      "--classifier forest", "--train"),
+    R("evaluate-train-not-a-dataset", "evaluate --train {empty_dir} --test {empty_dir} "
+      "--classifier forest", "--train"),
+    R("evaluate-train-and-dir", "evaluate {empty_dir} --algorithm envelope --train {empty_dir}",
+      "--train"),
+    R("evaluate-test-missing", "evaluate --train {empty_dir} --classifier forest", "--test"),
+    R("evaluate-test-is-file", "evaluate --train {empty_dir} --test {text} --classifier forest",
+      "--test"),
+    R("evaluate-classifier-missing", "evaluate --train {empty_dir} --test {empty_dir}",
+      "--classifier"),
+    R("evaluate-classifier-unknown", "evaluate --train {empty_dir} --test {empty_dir} "
+      "--classifier nosuch", "--classifier"),
+    R("evaluate-window-small", "evaluate --train {empty_dir} --test {empty_dir} --classifier "
+      "forest --window 3", "--window", numeric=True),
+    R("evaluate-max-test-windows-zero", "evaluate --train {empty_dir} --test {empty_dir} "
+      "--classifier forest --max-test-windows 0", "--max-test-windows", numeric=True),
     # ---- dataset
     R("dataset-spec-missing", "dataset {work}/none.toml --out {work}/d", "SPEC"),
     R("dataset-spec-directory", "dataset {work} --out {work}/d", "SPEC"),
