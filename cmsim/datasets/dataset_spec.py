@@ -5,7 +5,7 @@ checked, and a bad spec is refused before any work with a message naming the key
 (``operating.speed_rpm.max``)::
 
     [dataset]      name, records (number of records), seed (base seed)
-    [rig]          builtin = "paper_2016" | "cwru_6205", or file = "rig.toml" (relative to
+    [rig]          builtin = "paper_2016" | "cwru_6205" | "mfpt_nice", or file = "rig.toml" (relative to
                    the spec file)
     [operating]    sampling = "random" | "grid"; speed_rpm, torque_nm, friction, clearance_m,
                    radial_load_n (values, see below); runup_share (share of run-up records),
@@ -54,7 +54,7 @@ from cmsim.faults import FAULT_TYPES, RollingSlip, SpeedFluctuation, check_fault
 from cmsim.rig import OperatingPoint, RollingBearing, Rig, Rotor
 
 __all__ = ["DatasetSpec", "DatasetRecord", "Distribution", "BUILTIN_RIGS", "SEVERITY_FIELDS",
-           "cwru_6205_rig"]
+           "cwru_6205_rig", "mfpt_nice_rig"]
 
 #: Main size of each fault type: the record's ``fault_severity`` (SI).
 SEVERITY_FIELDS = {"outer_race": "size_m", "inner_race": "size_m", "ball": "size_m",
@@ -91,8 +91,17 @@ def cwru_6205_rig():
                                  name="cwru_6205")
 
 
+def mfpt_nice_rig():
+    """A rotor on two MFPT test bearings (NICE, 8 rollers, d = 5.969 mm (0.235 in), pitch
+    D = 31.623 mm (1.245 in), 0 deg), loaded radially through ``radial_load_n``."""
+    brg = RollingBearing.from_pitch(8, 5.969e-3, 31.623e-3)
+    return Rig.rotor_on_bearings(brg, Rotor(mass_kg=5.0, inertia_kg_m2=0.01),
+                                 name="mfpt_nice")
+
+
 #: Built-in rigs by name.
-BUILTIN_RIGS = {"paper_2016": Rig.paper_2016, "cwru_6205": cwru_6205_rig}
+BUILTIN_RIGS = {"paper_2016": Rig.paper_2016, "cwru_6205": cwru_6205_rig,
+                "mfpt_nice": mfpt_nice_rig}
 
 
 def _err(key, msg):
