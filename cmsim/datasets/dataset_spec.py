@@ -552,7 +552,13 @@ class DatasetSpec:
 
     def record_rig(self, rec):
         """The rig of a record: the base rig with its drawn friction, clearance and housing
-        modes."""
+        modes.
+
+        Parameters
+        ----------
+        rec : DatasetRecord
+            A record of this spec (:meth:`record`).
+        """
         rig = self.rig
         for name in ("clearance_m", "friction"):
             if name in rec.params:

@@ -21,12 +21,14 @@ Columns (one row per record and vibration channel):
 
 from __future__ import annotations
 
+import io
 import math
 from pathlib import Path
 
 import numpy as np
 
 from cmsim._io import atomic_write_bytes
+from cmsim.datasets.load import load
 from cmsim.errors import ParameterError
 
 __all__ = ["to_bearing_datasets", "bearing_datasets_frame"]
@@ -59,8 +61,6 @@ def bearing_datasets_frame(dataset, channels=None):
     pandas.DataFrame
     """
     import pandas as pd
-
-    from cmsim.datasets import load
 
     ds = load(dataset) if isinstance(dataset, (str, Path)) else dataset
     chans = list(channels) if channels else [c for c in ds.channels if c.startswith("accel_")]
@@ -126,8 +126,6 @@ def to_bearing_datasets(dataset, out, channels=None):
     -------
     pathlib.Path
     """
-    import io
-
     df = bearing_datasets_frame(dataset, channels)
     buf = io.BytesIO()
     df.to_parquet(buf, index=False)

@@ -44,8 +44,18 @@ from pathlib import Path
 
 import numpy as np
 
+from cmsim.datasets import load
+from cmsim.diagnostics.measured import load_measured
 from cmsim.diagnostics.metrics import confusion_matrix, roc_auc
 from cmsim.errors import ParameterError
+
+try:                                    # optional: pip install cmsim[ml]
+    from sklearn.ensemble import RandomForestClassifier
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+except ImportError:                     # pragma: no cover
+    RandomForestClassifier = None
 
 __all__ = ["WindowSet", "synthetic_windows", "measured_windows", "envelope_features",
            "FEATURE_LINES", "CLASSIFIERS", "make_classifier", "EnvelopeRule",
@@ -139,8 +149,6 @@ def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None
     -------
     WindowSet
     """
-    from cmsim.datasets import load
-
     ds = load(dataset) if isinstance(dataset, (str, Path)) else dataset
     if channel is None:
         accel = [c for c in ds.channels if c.startswith("accel_")]
@@ -204,8 +212,6 @@ def measured_windows(folder, channel=None, window=None, hop=None, bearing=None,
     WindowSet
         Labels from the answer key, for scoring only; the features never read them.
     """
-    from cmsim.diagnostics.measured import load_measured
-
     ds = load_measured(folder)
     ch, key = _measured_channel(folder, bearing) if channel is None else (channel, bearing)
     parts, fs0 = [], None
@@ -342,7 +348,15 @@ class EnvelopeRule:
         return family_ratio[:, cols], [_FAMILIES[i] for i in cols]
 
     def decide(self, family_ratio, threshold):
-        """Labels for a threshold (top family, healthy below it)."""
+        """Labels for a threshold (top family, healthy below it).
+
+        Parameters
+        ----------
+        family_ratio : numpy.ndarray, shape (n, 3)
+            From :func:`envelope_features`.
+        threshold : float
+            Healthy below this ratio.
+        """
         r, fams = self._fam(family_ratio)
         top = np.array(fams, dtype=object)[r.argmax(axis=1)]
         if "healthy" in self.classes:
@@ -350,7 +364,15 @@ class EnvelopeRule:
         return top
 
     def fit(self, family_ratio, y):
-        """Choose the threshold with the best balanced accuracy on the training windows."""
+        """Choose the threshold with the best balanced accuracy on the training windows.
+
+        Parameters
+        ----------
+        family_ratio : numpy.ndarray, shape (n, 3)
+            Of the training windows.
+        y : numpy.ndarray of str, shape (n,)
+            Their labels.
+        """
         if "healthy" in self.classes:
             cands = np.quantile(family_ratio.max(axis=1), np.linspace(0.01, 0.99, 99))
             best = max(cands, key=lambda t: _balanced(y, self.decide(family_ratio, t)))
@@ -358,7 +380,13 @@ class EnvelopeRule:
         return self
 
     def predict(self, family_ratio):
-        """(labels, scores (n, n_classes) in ``self.classes`` order)."""
+        """(labels, scores (n, n_classes) in ``self.classes`` order).
+
+        Parameters
+        ----------
+        family_ratio : numpy.ndarray, shape (n, 3)
+            Of the windows to classify.
+        """
         r, fams = self._fam(family_ratio)
         cols = []
         for c in self.classes:
@@ -368,14 +396,9 @@ class EnvelopeRule:
 
 class _Sklearn:
     def __init__(self, kind, seed):
-        try:
-            from sklearn.ensemble import RandomForestClassifier
-            from sklearn.linear_model import LogisticRegression
-            from sklearn.pipeline import make_pipeline
-            from sklearn.preprocessing import StandardScaler
-        except ImportError:                                   # pragma: no cover
+        if RandomForestClassifier is None:                    # pragma: no cover
             raise ParameterError(f"classifier: {kind!r} needs scikit-learn "
-                                 f"(pip install cmsim[ml])", param="classifier") from None
+                                 f"(pip install cmsim[ml])", param="classifier")
         if kind == "forest":
             self.model = RandomForestClassifier(n_estimators=300, min_samples_leaf=3,
                                                 max_features="sqrt", class_weight="balanced",
@@ -426,7 +449,12 @@ def _balanced(y, pred):
 
 
 def check_disjoint(train, test):
-    """Raise if a record has windows on both sides (leakage)."""
+    """Raise if a record has windows on both sides (leakage).
+
+    Parameters
+    ----------
+    train, test : WindowSet
+    """
     both = set(train.groups) & set(test.groups)
     if both:
         raise ParameterError(f"records on both sides of the split: {sorted(both)[:5]}",
