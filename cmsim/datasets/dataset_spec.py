@@ -573,7 +573,13 @@ class DatasetSpec:
         return rig
 
     def record_operating_point(self, rec):
-        """The :class:`~cmsim.rig.OperatingPoint` of a record (start speed for run-ups)."""
+        """The :class:`~cmsim.rig.OperatingPoint` of a record (start speed for run-ups).
+
+        Parameters
+        ----------
+        rec : DatasetRecord
+            A record of this spec (:meth:`record`).
+        """
         p = rec.params
         return OperatingPoint(speed_rpm=p["speed_rpm"],
                               torque_nm=p.get("torque_nm", 0.0) if self.rig.gears else 0.0,
