@@ -109,6 +109,11 @@ UNDOCUMENTED = frozenset({
     "cmsim.run.Run.load",
     "cmsim.spectra.run_spectrum.signal_bearing",
     "cmsim.studies.model_abc.gmf_harmonics",
+    # public since the check landed (issue 14 closing note): document them, then remove
+    "cmsim.discrepancy.causes.Cause.components",
+    "cmsim.discrepancy.features.feature_floor",
+    "cmsim.discrepancy.features.segments",
+    "cmsim.discrepancy.records.MeasuredRecord.frequencies",
 })
 
 #: Parameters documented elsewhere or not yet (function: names), same rule.
