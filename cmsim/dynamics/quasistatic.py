@@ -52,10 +52,15 @@ def _linear_guess(model, f_ref):
         kmat[ix, ix] += k_lin
         kmat[ix + 1, ix + 1] += k_lin
         offsets[ix:ix + 2] = max(brg.clearance_m, 0.0)
+    rhs = model.force.copy()
     if model.rig.gears is not None:
         g = model.mesh_jacobian()
-        kmat += model.mesh_table.mean_mesh_stiffness(model.rig.gears) * np.outer(g, g)
-    q = np.linalg.solve(kmat, model.force)
+        k_mesh = model.mesh_table.mean_mesh_stiffness(model.rig.gears)
+        kmat += k_mesh * np.outer(g, g)
+        # the mesh force is k̄·(g·q − e) with e the smallest unloaded separation (backlash)
+        gap = max(0.0, float(np.min(model.mesh_table.separation_m)))
+        rhs += k_mesh * gap * g
+    q = np.linalg.solve(kmat, rhs)
     # push each bearing across its clearance in the direction it moves
     for ib in range(nb):
         ix = int(model.packed.b_int[ib, 0])

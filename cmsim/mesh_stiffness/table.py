@@ -141,9 +141,13 @@ class MeshStiffnessTable:
         s = s0 + pb * np.arange(n_points) / n_points
         total = np.zeros(n_points)
         count = np.zeros(n_points, dtype=int)
+        # a pair touches where its unloaded separation is the smallest along the path (a
+        # uniform offset, e.g. backlash, moves every pair alike and separates none of them)
+        inside = (self.position_m >= s0) & (self.position_m <= s1)
+        touch = max(0.0, float(np.min(self.separation_m[inside]))) if inside.any() else 0.0
         for j in range(int(math.ceil((s1 - s0) / pb)) + 1):
             sj = s + j * pb
-            on = (sj >= s0) & (sj <= s1) & (self.separation_at(sj) <= 0.0)
+            on = (sj >= s0) & (sj <= s1) & (self.separation_at(sj) <= touch)
             total += np.where(on, self.stiffness_at(sj), 0.0)
             count += on
         return s, total, count
