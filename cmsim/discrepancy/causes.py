@@ -166,8 +166,8 @@ class FrictionCause(Cause):
 # ---------------------------------------------------------------------- bearing defects
 class _Defect(Cause):
     parameter = "size_m"
-    bounds = (5e-5, 3e-3)
-    probes = (3e-4, 1.2e-3)
+    bounds = (3e-5, 3e-3)
+    probes = (1e-4, 3e-4, 1.2e-3)
     kind = "bearing"
     fault = None
 
