@@ -30,6 +30,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+from scipy.io import wavfile
 
 from cmsim.errors import ParameterError
 from cmsim.frequencies import RigFrequencies
@@ -132,7 +133,6 @@ def _read_signals(path, names=None):
         df = pd.read_csv(path)
         return {str(c): df[c].to_numpy(dtype=float) for c in df.columns}, None
     if suffix == ".wav":
-        from scipy.io import wavfile
         rate, x = wavfile.read(path)
         x = np.asarray(x, dtype=float)
         x = x[:, None] if x.ndim == 1 else x
