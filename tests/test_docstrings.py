@@ -38,8 +38,7 @@ OBJECTS = sorted(public_objects())
 #: not name every parameter yet (the state when this check was added, issue 14). Do not add
 #: to this list: document the parameters instead.
 UNDOCUMENTED = frozenset({
-    "cmsim.datasets.dataset_spec.DatasetSpec.load", "cmsim.diagnostics.syn2real.EnvelopeRule",
-    "cmsim.diagnostics.syn2real.check_disjoint", "cmsim.discrepancy.causes.Cause.components",
+    "cmsim.discrepancy.causes.Cause.components",
     "cmsim.discrepancy.features.feature_floor", "cmsim.discrepancy.features.segments",
     "cmsim.discrepancy.records.MeasuredRecord.frequencies",
     "cmsim.bearings.forces.ball_offsets",
