@@ -811,6 +811,25 @@ class Rig:
         return tuple(b for s in self.shafts for b in s.bearings)
 
     @property
+    def dof_masses(self):
+        """Diagonal of the mass matrix in DOF order (x, y, θ of each node, then θ_2J2):
+        kg for translations, kg·m² for rotations, shape (n_dof,)."""
+        masses = []
+        for i, shaft in enumerate(self.shafts):
+            if self.gears is not None:
+                gear = self.gears.driving if i == 0 else self.gears.driven
+                centre = (gear.mass_kg, gear.inertia_kg_m2)
+            else:
+                centre = (shaft.rotor.mass_kg, shaft.rotor.inertia_kg_m2)
+            for mass, inertia in ((shaft.bearing_1.mass_kg, shaft.bearing_1.inertia_kg_m2),
+                                  centre,
+                                  (shaft.bearing_2.mass_kg, shaft.bearing_2.inertia_kg_m2)):
+                masses += [mass, mass, inertia]
+        if self.gears is not None:
+            masses.append(self.output_inertia_kg_m2)
+        return np.array(masses, dtype=float)
+
+    @property
     def n_dof(self):
         """Number of degrees of freedom (19 for the paper rig, 9 for a bearing rig)."""
         return 3 * len(self.node_names) + (1 if self.has_gears else 0)

@@ -184,21 +184,12 @@ def hybrid_table_set(rig, *, progress=None):
     """
     if rig.gears is None:
         raise ParameterError("hybrid tables need a rig with gears")
-    key = tables_key(rig)
-    if key in _SETS:
-        return _SETS[key]
-    tables = _shipped_set(key)
+    tables = _known_set(rig)
     if tables is None:
-        path = cache.cache_path("hybrid-tables", key)
-        if path.is_file():
-            try:
-                tables = MeshTableSet.load(path)
-            except (OSError, ValueError, KeyError):
-                tables = None
-        if tables is None or tables.meta.get("parameter_key") != key:
-            tables = _build_set(rig, key, progress)
-            tables.save(path)
-    _SETS[key] = tables
+        key = tables_key(rig)
+        tables = _build_set(rig, key, progress)
+        tables.save(cache.cache_path("hybrid-tables", key))
+        _SETS[key] = tables
     return tables
 
 

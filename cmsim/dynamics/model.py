@@ -142,7 +142,7 @@ class RigModel:
 def rig_model(rig):
     """The :class:`RigModel` of ``rig`` (memoised: rigs are frozen values)."""
     n = rig.n_dof
-    mass = _node_masses(rig)
+    mass = rig.dof_masses
     elements = _spring_elements(rig)
     kmat, cmat = _linear_matrices(elements, n)
     names = _dof_names(rig)
@@ -355,22 +355,6 @@ class DynamicModel:
         g[i1 + 2] = self.rig.gears.driving.base_radius_m
         g[i2 + 2] = -self.rig.gears.driven.base_radius_m
         return g
-
-
-def _node_masses(rig):
-    masses = []
-    for i, shaft in enumerate(rig.shafts):
-        if rig.gears is not None:
-            gear = rig.gears.driving if i == 0 else rig.gears.driven
-            centre = (gear.mass_kg, gear.inertia_kg_m2)
-        else:
-            centre = (shaft.rotor.mass_kg, shaft.rotor.inertia_kg_m2)
-        for mass, inertia in ((shaft.bearing_1.mass_kg, shaft.bearing_1.inertia_kg_m2), centre,
-                              (shaft.bearing_2.mass_kg, shaft.bearing_2.inertia_kg_m2)):
-            masses += [mass, mass, inertia]
-    if rig.gears is not None:
-        masses.append(rig.output_inertia_kg_m2)
-    return np.array(masses, dtype=float)
 
 
 def _spring_elements(rig):

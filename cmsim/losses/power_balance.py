@@ -99,22 +99,6 @@ class PowerBalance:
                 "duration_s": float(self.duration_s)}
 
 
-def _node_masses(rig):
-    out = []
-    for i, shaft in enumerate(rig.shafts):
-        if rig.gears is not None:
-            gear = rig.gears.driving if i == 0 else rig.gears.driven
-            centre = (gear.mass_kg, gear.inertia_kg_m2)
-        else:
-            centre = (shaft.rotor.mass_kg, shaft.rotor.inertia_kg_m2)
-        for m, j in ((shaft.bearing_1.mass_kg, shaft.bearing_1.inertia_kg_m2), centre,
-                     (shaft.bearing_2.mass_kg, shaft.bearing_2.inertia_kg_m2)):
-            out += [m, m, j]
-    if rig.gears is not None:
-        out.append(rig.output_inertia_kg_m2)
-    return np.array(out)
-
-
 def _linear_elements(rig, n):
     """(a, b or −1, k, c) of Annex A's shaft springs and couplings (bearing dampers are in
     the recorded housing forces)."""
@@ -182,7 +166,7 @@ def power_balance(run, loads=None, friction_table=None, mesh_table=None):
     for i, nm in enumerate(names):
         q[i] = np.asarray(run[nm], dtype=float) - nominal[i] * t
     v = np.gradient(q, dt, axis=1)
-    mass = _node_masses(rig)
+    mass = rig.dof_masses
     # input, output
     kc, cc = rig.input_coupling.stiffness_nm_per_rad, rig.input_coupling.damping_nm_s_per_rad
     p_in = _mean((-kc * q[2] - cc * v[2]) * omega1, t)
