@@ -190,6 +190,7 @@ class Work(NamedTuple):
     hchi1: np.ndarray
     hchi2: np.ndarray
     hout: np.ndarray
+    hext: np.ndarray       # (slots,) extra compliance of weakened teeth in the hybrid solve
     hstat: np.ndarray      # (2,) hybrid counters [solves, non-converged solves]
     psi: np.ndarray        # (2, AN_SIZE) anchors of the gears' involute origin angles
 
@@ -419,8 +420,9 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
     squeeze damping, smoothed Coulomb friction. ``t`` is the equivalent time τ of the
     nominal rotation and ``sr`` the speed over the reference speed (1 at constant speed).
 
-    Faults: per-tooth stiffness factors and separations (``MI_TEETH``; the factors act on
-    the table path only — the on-line solve takes the separations), and eccentric gears
+    Faults: per-tooth stiffness factors and separations (``MI_TEETH``; on the on-line solve a
+    factor f of a pair becomes the extra compliance (1/f − 1)/k of its own λ, k the run's
+    table stiffness at s, so a pair alone in contact is f times as stiff), and eccentric gears
     (``MI_ECC``: the contact geometry uses each gear's geometric centre, turning about its
     shaft; moments and contact velocities use the shaft centre).
 
@@ -433,6 +435,7 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
     tk1, tk2, te1, te2, ecc = P.tk1, P.tk2, P.te1, P.te2, P.ecc
     S, hw, hdelta, hrho1, hrho2 = W.slots, W.hwork, W.hdelta, W.hrho1, W.hrho2
     hchi1, hchi2, hout, hstat, psi_anchor = W.hchi1, W.hchi2, W.hout, W.hstat, W.psi
+    hext = W.hext
     z1 = teeth1.shape[0]
     z2 = teeth2.shape[0]
     i1 = m_int[MI_G1]
@@ -492,6 +495,7 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
             S[j, SG_ON] = 0.0
             if hybrid:
                 hdelta[j] = -1.0
+                hext[j] = 0.0
                 hrho1[j] = hp[0]
                 hrho2[j] = hp[4]
                 hchi1[j] = 1.0
@@ -528,6 +532,11 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
             hrho2[j] = length - s_eq
             hchi1[j] = max(chi1, 1e-9)
             hchi2[j] = max(chi2, 1e-9)
+            hext[j] = 0.0
+            if f_teeth < 1.0:
+                k_pair, e_pair = table_lookup2_jit(s, mp[MP_TAB0], mp[MP_TABD], tab_k, tab_e)
+                if k_pair > 0.0:
+                    hext[j] = (1.0 / max(f_teeth, 1e-6) - 1.0) / k_pair
         else:
             # tables are functions of the pair's position s on the line of action (a corner
             # contact's s_eq falls inside the involute path, where the stiffer involute values
@@ -539,8 +548,8 @@ def _mesh_forces(t, sr, y, n, g, P, W, diag, want_diag):
             S[j, SG_GAP] = -overlap
             S[j, SG_KPAIR] = k_pair
     if hybrid:
-        it = hybrid_forces_jit(hdelta, hrho1, hrho2, hchi1, hchi2, hp, hd1, hc1, hd2, hc2, hw,
-                               hout)
+        it = hybrid_forces_jit(hdelta, hrho1, hrho2, hchi1, hchi2, hp, hd1, hc1, hd2, hc2, hext,
+                               hw, hout)
         hstat[0] += 1.0
         if it < 0:
             hstat[1] += 1.0
@@ -656,7 +665,7 @@ def make_work(P):
                 np.zeros((slots, SG_SIZE)),
                 np.zeros(WORK_PER_N2 * slots * slots + WORK_PER_N * slots), np.zeros(slots),
                 np.zeros(slots), np.zeros(slots), np.ones(slots), np.ones(slots),
-                np.zeros(slots), np.zeros(2), np.zeros((2, AN_SIZE)))
+                np.zeros(slots), np.zeros(slots), np.zeros(2), np.zeros((2, AN_SIZE)))
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -1,6 +1,6 @@
 """Faults → what the model consumes: :class:`FaultArrays`, a changed rig, slip, modulations.
 
-The contract with the dynamics kernel is /work/notes/FAULTS_INTERFACE.md:
+The contract with the dynamics kernel (:mod:`cmsim.dynamics._kernels` reads these arrays):
 :func:`compile_faults` turns a tuple of faults into one :class:`FaultArrays` (float64 arrays,
 all present, neutral when unused); :func:`rig_with_faults` applies the faults that are plain
 rig changes (bearing wear); :func:`slip_from_faults` gives the rolling-slip parameters,
@@ -54,7 +54,7 @@ class FaultArrays(NamedTuple):
     ----------
     bearing_defects : ndarray, shape (m, 8)
         One row per race/ball defect, columns :data:`DEFECT_COLUMNS` (see
-        FAULTS_INTERFACE.md); m = 0 without defects.
+        :mod:`cmsim.faults.bearing`); m = 0 without defects.
     ball_offset_m : ndarray, shape (nb, max_balls)
         Extra overlap of each ball, m (off-size ball: +Δd).
     tooth_factor1, tooth_factor2 : ndarray, shape (Z1, n_s), (Z2, n_s)
@@ -156,7 +156,7 @@ def _line_range(pair, gear_no, lam_lo, lam_hi):
 
 
 def compile_faults(rig, faults, mesh_table=None, *, op=None):
-    """Arrays of all ``faults`` on ``rig`` for the kernel (FAULTS_INTERFACE.md).
+    """Arrays of all ``faults`` on ``rig`` for the kernel (:class:`FaultArrays`).
 
     Parameters
     ----------

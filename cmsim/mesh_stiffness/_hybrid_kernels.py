@@ -196,7 +196,8 @@ def _add_worst_gap(c, f, delta, act, n, limit):
 
 
 @njit(cache=True)
-def hybrid_forces_jit(delta, rho1, rho2, chi1, chi2, hp, diag1, cpl1, diag2, cpl2, work, out):
+def hybrid_forces_jit(delta, rho1, rho2, chi1, chi2, hp, diag1, cpl1, diag2, cpl2, extra, work,
+                      out):
     """Contact forces of n consecutive tooth pairs (paper 001 eq. 2), N.
 
     Parameters
@@ -212,6 +213,9 @@ def hybrid_forces_jit(delta, rho1, rho2, chi1, chi2, hp, diag1, cpl1, diag2, cpl
     diag1, cpl1, diag2, cpl2 : ndarray
         Influence tables of the two gears: shapes (n1,), (2 J1 + 1, n1, n1), (n2,),
         (2 J2 + 1, n2, n2), m/N.
+    extra : ndarray, shape (n,)
+        Compliance added to each contact's own λ (a weakened tooth in that pair, e.g. a root
+        crack: :mod:`cmsim.faults`), m/N; zeros for healthy teeth.
     work : ndarray, shape (>= 3 n² + 8 n,)
         Scratch space.
     out : ndarray, shape (n,)
@@ -246,6 +250,8 @@ def hybrid_forces_jit(delta, rho1, rho2, chi1, chi2, hp, diag1, cpl1, diag2, cpl
         return 0
     gap_tol = -tol * dmax
     coupling_matrix_jit(rho1, rho2, hp, diag1, cpl1, diag2, cpl2, c)
+    for i in range(n):
+        c[i * n + i] += extra[i]
     # ---- stage 1: linear complementarity with secant local compliances
     fscale = 0.0
     for i in range(n):

@@ -86,10 +86,12 @@ class HybridMeshModel:
     and ``length`` from ``mesh_frame_jit``::
 
         rho1[j] = s_eq; rho2[j] = length - s_eq
-        it = hybrid_forces_jit(delta, rho1, rho2, chi1, chi2, hp, d1, c1, d2, c2, work, out)
+        it = hybrid_forces_jit(delta, rho1, rho2, chi1, chi2, hp, d1, c1, d2, c2, extra, work,
+                               out)
 
-    with ``work`` of :func:`work_size` (n) floats; ``out`` receives the normal forces (N) of
-    gear 1 on gear 2 along each pair's normal.
+    with ``extra`` the compliance a weakened tooth adds to its pair's own λ (zeros for healthy
+    teeth), ``work`` of :func:`work_size` (n) floats; ``out`` receives the normal forces (N)
+    of gear 1 on gear 2 along each pair's normal.
     """
 
     pair: GearPair
@@ -193,7 +195,8 @@ class HybridMeshModel:
         d, r1, r2, c1, c2 = self._check(delta_m, roll1_m, roll2_m, chi1_m, chi2_m)
         out = np.empty(d.size)
         work = np.empty(work_size(d.size))
-        it = hybrid_forces_jit(d, r1, r2, c1, c2, *self.kernel_args(), work, out)
+        it = hybrid_forces_jit(d, r1, r2, c1, c2, *self.kernel_args(), np.zeros(d.size), work,
+                               out)
         if it < 0:
             raise RuntimeError("hybrid contact solve did not converge")
         return out

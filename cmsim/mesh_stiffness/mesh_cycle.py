@@ -146,7 +146,7 @@ class _Evaluator:
         force = np.empty(self.n)
         it = hybrid_forces_jit(np.ascontiguousarray(c["delta_m"]), rho1, rho2,
                                np.maximum(c["chi1_m"], 1e-9), np.maximum(c["chi2_m"], 1e-9),
-                               *self.args, self.work, force)
+                               *self.args, np.zeros(self.n), self.work, force)
         if it < 0:
             raise RuntimeError("hybrid contact solve did not converge")
         cx, cy = c["centre1_m"]
