@@ -162,6 +162,21 @@ class KernelParams(NamedTuple):
     mu_tab: np.ndarray
     c_tab: np.ndarray
 
+    def frozen(self):
+        """The same arrays as C-contiguous read-only views (copies only where not contiguous).
+
+        Numba compiles one specialisation of the integrator per combination of array flags,
+        and a read-only array (a frozen rig's, one loaded from a file) differs in type from a
+        writeable one: mixed flags cost a full recompile (about a minute) for each new mix.
+        The kernels never write into ``P``, so every model hands them read-only arrays.
+        """
+        out = []
+        for a in self:
+            v = np.ascontiguousarray(a).view()
+            v.setflags(write=False)
+            out.append(v)
+        return KernelParams(*out)
+
 
 def no_faults(nb, max_balls):
     """Neutral fault fields ``(b_def, b_off, tk1, tk2, te1, te2, ecc)`` of :class:`KernelParams`."""

@@ -240,6 +240,11 @@ class DynamicModel:
     cage_phases_rad: np.ndarray = field(default=None, repr=False)
     faults: tuple = ()
 
+    def __post_init__(self):
+        # one array-flag signature for the kernels, whatever built the model (numba
+        # recompiles the integrator for each mix of read-only and writeable arrays)
+        object.__setattr__(self, "packed", self.packed.frozen())
+
     @property
     def rig(self):
         """The rig."""
