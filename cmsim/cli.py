@@ -269,13 +269,7 @@ def _add_simulate(sub):
     p.add_argument("--sensor-fs-hz", type=float, metavar="FS",
                    help="sensor sample rate, Hz (<= --fs-hz, e.g. 12000); the whole run is "
                         "decimated through an 80 dB anti-alias filter")
-    p.add_argument("--fault", action="append", metavar="TYPE:key=value,...",
-                   help="a fault of the catalogue, felt through the dynamics (repeatable), "
-                        "e.g. outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4 or "
-                        "tooth_crack:gear=1,depth_m=1e-3; types: " + ", ".join(FAULT_NAMES)
-                        + "; a rig file's [[faults]] list is applied too")
-    p.add_argument("--faults", metavar="FILE.toml",
-                   help="faults from a TOML file's [[faults]] list (type = \"...\", fields)")
+    _add_fault_options(p)
     p.add_argument("--ramp-to-rpm", type=float, metavar="RPM",
                    help="run-up / coast-down: the input speed goes linearly from --speed-rpm "
                         "to RPM (the cage, mesh and input rotation follow; --sensors adds "
@@ -287,6 +281,16 @@ def _add_simulate(sub):
                         "warm-up (default 0)")
     _add_rig_options(p)
     p.set_defaults(func=_cmd_simulate, text=_text_simulate)
+
+
+def _add_fault_options(p):
+    p.add_argument("--fault", action="append", metavar="TYPE:key=value,...",
+                   help="a fault of the catalogue, felt through the dynamics (repeatable), "
+                        "e.g. outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4 or "
+                        "tooth_crack:gear=1,depth_m=1e-3; types: " + ", ".join(FAULT_NAMES)
+                        + "; a rig file's [[faults]] list is applied too")
+    p.add_argument("--faults", metavar="FILE.toml",
+                   help="faults from a TOML file's [[faults]] list (type = \"...\", fields)")
 
 
 #: the catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
@@ -441,7 +445,7 @@ def _cmd_sweep(args):
                      duration_s=args.duration_s, frictions=args.friction or (None,),
                      clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
                      warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
-                     seed_policy=args.seed_policy, mesh=mesh)
+                     seed_policy=args.seed_policy, mesh=mesh, faults=_faults_of(args, rig))
     progress = not args.json and sys.stderr.isatty()
     try:
         summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,
@@ -498,6 +502,7 @@ def _add_sweep(sub):
     p.add_argument("--force", action="store_true",
                    help="replace a manifest written for a different spec")
     _add_mesh_options(p)
+    _add_fault_options(p)
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=_cmd_sweep, text=_text_sweep)
 

@@ -382,3 +382,32 @@ def test_failed_runs_keep_their_summary_in_json(tmp_path, capsys):
     summary = res["summary"]
     assert summary["n_runs"] == 1 and len(summary["failed"]) == 1
     assert summary["completed"] == 0 and "wall_s" in summary
+
+
+def test_cli_sweep_builds_faults_into_every_run(tmp_path, capsys):
+    """``--fault`` reaches every case's model (felt through the dynamics: the faulty runs
+    differ from healthy ones), is recorded in each run's meta with its answer key, and is
+    part of the spec: the same directory with another fault is refused."""
+    out = tmp_path / "faulty"
+    crack = "tooth_crack:gear=1,depth_m=2e-3"
+    argv = ["sweep", "--torque-nm", "10", "100", "--speed-rpm", "1000", "--duration-s", "0.05",
+            "--seed", "7", "--workers", "1", "--fault", crack, "--json"]
+    assert main(argv + ["--out", str(out)]) == 0
+    assert json.loads(capsys.readouterr().out)["completed"] == 2
+    spec = SweepSpec.from_dict(read_manifest(out)["spec"])
+    assert [f.name for f in spec.faults] == ["tooth_crack"]
+    for case in spec.cases():
+        run = Run.load(out / RUNS_DIR / f"{case.name}.npz")
+        (fault,) = run.meta["faults"]
+        assert fault["type"] == "tooth_crack" and fault["depth_m"] == pytest.approx(2e-3)
+        (key,) = run.meta["fault_frequencies"].values()
+        assert key["shaft_hz"] == pytest.approx(1000.0 / 60.0)
+    assert main(argv + ["--out", str(out)]) == 0                       # resumes
+    assert json.loads(capsys.readouterr().out)["skipped"] == 2
+    other = [a if a != crack else "tooth_crack:gear=1,depth_m=1e-3" for a in argv]
+    assert main(other + ["--out", str(out)]) == 2
+    assert "faults" in json.loads(capsys.readouterr().out)["error"]
+    bad = [a if a != crack else "outer_race:bearing=9z9,size_m=1e-3,depth_m=1e-4" for a in argv]
+    assert main(bad + ["--out", str(tmp_path / "bad")]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert "--fault" in err and "bearing" in err

@@ -185,8 +185,9 @@ def file_matches(spec, case, path, entry=None):
     """True if ``path`` is a complete run of ``case`` (and matches ``entry`` if given).
 
     With ``entry``: its status is done, and the file has its size and SHA-256 checksum (a
-    file corrupted in place, even to the same size, is not a match). Compared: case name, seed, operating point, rig, sampling, duration and the spec's mesh
-    (files written before the mesh was recorded count as the default mesh).
+    file corrupted in place, even to the same size, is not a match). Compared: case name,
+    seed, operating point, rig, sampling, duration, the spec's mesh (files written before the
+    mesh was recorded count as the default mesh) and faults.
     """
     path = Path(path)
     if not path.is_file():
@@ -215,4 +216,6 @@ def file_matches(spec, case, path, entry=None):
             and meta.get("fs_hz") == spec.fs_hz and meta.get("warmup_s") == spec.warmup_s
             and meta.get("substeps") == spec.substeps
             and abs(meta.get("duration_s", -1.0) - spec.duration_s) <= 0.5 / spec.fs_hz
-            and normalised(meta.get("rig")) == normalised(spec.case_rig(case).to_dict()))
+            and normalised(meta.get("rig")) == normalised(spec.case_rig(case).to_dict())
+            and [{k: v for k, v in f.items() if k != "label"} for f in meta.get("faults", [])]
+            == normalised([f.to_dict() for f in spec.faults]))

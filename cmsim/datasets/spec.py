@@ -39,6 +39,7 @@ from cmsim.datasets.variation import (OPERATING_POINT_FIELDS, Variation, _check_
                                       apply_rig_setting, setting_kind, value_token)
 from cmsim.dynamics.mesh_choice import MESH_CHOICES
 from cmsim.errors import ParameterError, check_range
+from cmsim.faults import check_faults, fault_from_dict
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
@@ -55,7 +56,7 @@ _LEGACY_KEYS = ("speeds_rpm", "torques_nm", "frictions", "clearances_m", "durati
 _LEGACY_AXES = (("speeds_rpm", "speed_rpm"), ("torques_nm", "torque_nm"),
                 ("frictions", "friction"), ("clearances_m", "clearance_m"))
 _KEYS = ("variations", "fixed", "repeats", "duration_s", "fs_hz", "warmup_s", "substeps",
-         "mesh", "seed", "seed_policy", "rig")
+         "mesh", "seed", "seed_policy", "rig", "faults")
 
 
 @dataclass(frozen=True)
@@ -207,6 +208,9 @@ class SweepSpec:
         ``clearance_m`` (``(None,)`` for the last two = the rig's own), placed first.
     radial_load_n : float, optional
         Shorthand for ``fixed={"radial_load_n": ...}`` (N).
+    faults : sequence of Fault, optional
+        Faults of the catalogue (:mod:`cmsim.faults`) built into every case's model (a
+        cracked gear at every torque, say); checked against every case's rig.
 
     Every case's rig and operating point are built (and so checked) on construction.
     """
@@ -222,11 +226,12 @@ class SweepSpec:
     mesh: object
     seed: int
     seed_policy: str
+    faults: tuple
 
     def __init__(self, variations=(), *, fixed=None, repeats=1, duration_s=1.0, rig=None,
                  fs_hz=75_000.0, warmup_s=0.05, substeps=1, mesh=None, seed=0,
                  seed_policy="per_run", speeds_rpm=None, torques_nm=None, frictions=None,
-                 clearances_m=None, radial_load_n=None):
+                 clearances_m=None, radial_load_n=None, faults=()):
         set_ = object.__setattr__
         rig = Rig.paper_2016() if rig is None else rig
         if not isinstance(rig, Rig):
@@ -276,9 +281,10 @@ class SweepSpec:
                                  f"got {seed_policy!r}")
         set_(self, "seed_policy", seed_policy)
         set_(self, "mesh", _check_mesh(mesh))
+        set_(self, "faults", check_faults(rig, faults))
         for case in self.cases():          # every case must be a valid rig / op
             try:
-                self.case_rig(case)
+                check_faults(self.case_rig(case), self.faults)
                 self.case_operating_point(case)
             except ParameterError as exc:
                 raise ParameterError(f"case {case.name}: {exc}") from None
@@ -346,7 +352,7 @@ class SweepSpec:
                         ([], ["friction"], ["clearance_m"], ["friction", "clearance_m"]))
         return (names in legacy_names
                 and {n for n, _ in self.fixed} <= {"radial_load_n"} and self.mesh is None
-                and self.repeats == 1)
+                and self.repeats == 1 and not self.faults)
 
     def to_dict(self, older_form=True):
         """JSON-ready dict (the rig as :meth:`Rig.to_dict`); with ``older_form``, a speed ×
@@ -359,9 +365,12 @@ class SweepSpec:
             axes = {v.name: list(v.values) for v in self.variations}
             return {**{key: axes.get(name, [None]) for key, name in _LEGACY_AXES}, **common,
                     "radial_load_n": dict(self.fixed).get("radial_load_n", 0.0), **tail}
-        return {"variations": [v.to_dict() for v in self.variations],
-                "fixed": dict(self.fixed), "repeats": self.repeats, **common,
-                "mesh": mesh_key(self.mesh), **tail}
+        out = {"variations": [v.to_dict() for v in self.variations],
+               "fixed": dict(self.fixed), "repeats": self.repeats, **common,
+               "mesh": mesh_key(self.mesh), **tail}
+        if self.faults:
+            out["faults"] = [f.to_dict() for f in self.faults]
+        return out
 
     @classmethod
     def from_dict(cls, data):
@@ -379,5 +388,6 @@ class SweepSpec:
             raise ParameterError(f"the spec's mesh is a {data['mesh'].get('type')} object; "
                                  f"pass the object itself as mesh=")
         variations = data.pop("variations", ())
+        data["faults"] = tuple(fault_from_dict(f) for f in data.get("faults", ()))
         return cls(variations, **data)
 
