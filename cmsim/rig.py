@@ -829,6 +829,36 @@ class Rig:
             masses.append(self.output_inertia_kg_m2)
         return np.array(masses, dtype=float)
 
+    def spring_elements(self, bearing_dampers=True):
+        """Linear spring-dampers of Annex A in DOF indices: list of (a, b, k, c), b = −1 for
+        a spring to ground (k in N/m or N·m/rad, c in N·s/m or N·m·s/rad).
+
+        Shaft segments (x, y, θ between bearing and centre nodes), the bearings' dampers to
+        the housing (``bearing_dampers``; their forces are part of the recorded housing
+        forces), the input coupling (a spring to ground in deviation coordinates: the input
+        rotation is imposed) and, on a gear rig, the output coupling to θ_2J2.
+        """
+        elements = []
+        for i, shaft in enumerate(self.shafts):
+            b1, c, b2 = 9 * i, 9 * i + 3, 9 * i + 6
+            for seg, (na, nb) in enumerate(((b1, c), (c, b2))):
+                for d in (0, 1):
+                    elements.append((na + d, nb + d, shaft.flexural_stiffness_n_per_m[seg],
+                                     shaft.flexural_damping_n_s_per_m[seg]))
+                elements.append((na + 2, nb + 2, shaft.torsional_stiffness_nm_per_rad[seg],
+                                 shaft.torsional_damping_nm_s_per_rad[seg]))
+            if bearing_dampers:
+                for node, brg in ((b1, shaft.bearing_1), (b2, shaft.bearing_2)):
+                    for d in (0, 1):
+                        elements.append((node + d, -1, 0.0, brg.damping_n_s_per_m))
+        elements.append((2, -1, self.input_coupling.stiffness_nm_per_rad,
+                         self.input_coupling.damping_nm_s_per_rad))
+        if self.gears is not None:
+            elements.append((9 + 6 + 2, self.n_dof - 1,
+                             self.output_coupling.stiffness_nm_per_rad,
+                             self.output_coupling.damping_nm_s_per_rad))
+        return elements
+
     @property
     def n_dof(self):
         """Number of degrees of freedom (19 for the paper rig, 9 for a bearing rig)."""

@@ -143,7 +143,7 @@ def rig_model(rig):
     """The :class:`RigModel` of ``rig`` (memoised: rigs are frozen values)."""
     n = rig.n_dof
     mass = rig.dof_masses
-    elements = _spring_elements(rig)
+    elements = rig.spring_elements()
     kmat, cmat = _linear_matrices(elements, n)
     names = _dof_names(rig)
     # kernel layout: two-node springs first, then ground springs (b = a), count in [0, 2]
@@ -360,29 +360,6 @@ class DynamicModel:
         g[i1 + 2] = self.rig.gears.driving.base_radius_m
         g[i2 + 2] = -self.rig.gears.driven.base_radius_m
         return g
-
-
-def _spring_elements(rig):
-    """Two-node spring-dampers of Annex A: list of (dof_a, dof_b or −1, k, c)."""
-    elements = []
-    for i, shaft in enumerate(rig.shafts):
-        b1, c, b2 = 9 * i, 9 * i + 3, 9 * i + 6
-        for seg, (na, nb) in enumerate(((b1, c), (c, b2))):
-            for d in (0, 1):
-                elements.append((na + d, nb + d, shaft.flexural_stiffness_n_per_m[seg],
-                                 shaft.flexural_damping_n_s_per_m[seg]))
-            elements.append((na + 2, nb + 2, shaft.torsional_stiffness_nm_per_rad[seg],
-                             shaft.torsional_damping_nm_s_per_rad[seg]))
-        for node, brg in ((b1, shaft.bearing_1), (b2, shaft.bearing_2)):
-            for d in (0, 1):
-                elements.append((node + d, -1, 0.0, brg.damping_n_s_per_m))
-    # imposed input rotation: the coupling is a spring to ground in deviation coordinates
-    elements.append((2, -1, rig.input_coupling.stiffness_nm_per_rad,
-                     rig.input_coupling.damping_nm_s_per_rad))
-    if rig.gears is not None:
-        elements.append((9 + 6 + 2, rig.n_dof - 1, rig.output_coupling.stiffness_nm_per_rad,
-                         rig.output_coupling.damping_nm_s_per_rad))
-    return elements
 
 
 def _linear_matrices(elements, n):

@@ -99,26 +99,6 @@ class PowerBalance:
                 "duration_s": float(self.duration_s)}
 
 
-def _linear_elements(rig, n):
-    """(a, b or −1, k, c) of Annex A's shaft springs and couplings (bearing dampers are in
-    the recorded housing forces)."""
-    el = []
-    for i, shaft in enumerate(rig.shafts):
-        b1, c, b2 = 9 * i, 9 * i + 3, 9 * i + 6
-        for seg, (na, nb) in enumerate(((b1, c), (c, b2))):
-            for d in (0, 1):
-                el.append((na + d, nb + d, shaft.flexural_stiffness_n_per_m[seg],
-                           shaft.flexural_damping_n_s_per_m[seg]))
-            el.append((na + 2, nb + 2, shaft.torsional_stiffness_nm_per_rad[seg],
-                       shaft.torsional_damping_nm_s_per_rad[seg]))
-    el.append((2, -1, rig.input_coupling.stiffness_nm_per_rad,
-               rig.input_coupling.damping_nm_s_per_rad))
-    if rig.gears is not None:
-        el.append((17, n - 1, rig.output_coupling.stiffness_nm_per_rad,
-                   rig.output_coupling.damping_nm_s_per_rad))
-    return el
-
-
 def _mean(x, t):
     return float(np.trapezoid(x, t) / (t[-1] - t[0]))
 
@@ -186,7 +166,7 @@ def power_balance(run, loads=None, friction_table=None, mesh_table=None):
         ix = names.index(f"x_{b}")
         losses["bearings"] += _mean(run[f"F_{b}_x"] * v[ix] + run[f"F_{b}_y"] * v[ix + 1], t)
     # linear elements
-    for a, b, k, c in _linear_elements(rig, n):
+    for a, b, k, c in rig.spring_elements(bearing_dampers=False):
         dq = q[a] - (q[b] if b >= 0 else 0.0)
         dv = v[a] - (v[b] if b >= 0 else 0.0)
         losses["linear_damping"] += c * _mean(dv * dv, t)
