@@ -75,11 +75,12 @@ def _cmd_simulate(args):
 
     slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                      correlation_s=args.slip_correlation_s)
+    _check_losses_options(args)
     try:
         run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,
                        mesh=mesh_model if mesh_model is not None else table, slip=slip,
                        seed=args.seed, warmup_s=args.warmup_s, faults=faults, profile=profile,
-                       progress=None if bar is None else progress)
+                       progress=None if bar is None else progress, losses=args.losses or None)
     finally:
         if bar is not None:
             bar.close()
@@ -93,6 +94,7 @@ def _cmd_simulate(args):
     out = {"shaft_hz": freqs.fr1_hz, "gmf_hz": freqs.gmf_hz,
            "bpf_hz": freqs.bearing(first).bpf_hz, **run.summary(),
            "faults": [f["label"] for f in run.meta["faults"]],
+           "losses": _losses_summary(run.meta.get("losses")),
            "fault_frequencies": run.meta["fault_frequencies"],
            "speed_profile": run.meta["speed_profile"],
            "out": str(args.out) if args.out else None}
@@ -226,6 +228,15 @@ def _text_simulate(res):
         prof = res["speed_profile"]
         lines.append(f"speed profile: {prof['speeds_rpm'][0]:g} -> {prof['speeds_rpm'][-1]:g} "
                      f"rpm over {prof['times_s'][-1]:g} s")
+    if res.get("losses"):
+        lo = res["losses"]
+        parts = ", ".join(f"{k.replace('_', ' ')} {v:.3g}" for k, v in lo["power_w"].items()
+                          if v > 0)
+        line = f"losses {lo['total_loss_w']:.4g} W ({parts}); efficiency " \
+               f"{100 * lo['efficiency']:.2f} %"
+        if lo.get("closure") is not None:
+            line += f" (the run's power balance closes to {100 * lo['closure']:.3f} %)"
+        lines.append(line)
     for label, freqs in (res.get("fault_frequencies") or {}).items():
         lines.append(f"fault {label}: " + ", ".join(
             f"{k[:-3].upper()} {v:.3f} Hz" for k, v in freqs.items()
@@ -270,6 +281,7 @@ def _add_simulate(sub):
                    help="sensor sample rate, Hz (<= --fs-hz, e.g. 12000); the whole run is "
                         "decimated through an 80 dB anti-alias filter")
     _add_fault_options(p)
+    _add_losses_option(p)
     p.add_argument("--ramp-to-rpm", type=float, metavar="RPM",
                    help="run-up / coast-down: the input speed goes linearly from --speed-rpm "
                         "to RPM (the cage, mesh and input rotation follow; --sensors adds "
@@ -281,6 +293,34 @@ def _add_simulate(sub):
                         "warm-up (default 0)")
     _add_rig_options(p)
     p.set_defaults(func=_cmd_simulate, text=_text_simulate)
+
+
+def _check_losses_options(args):
+    if getattr(args, "losses", False) and getattr(args, "friction", None) is not None:
+        raise CLIError("--losses sets the tooth friction from the lubricant film along the "
+                       "path; leave out --friction", option="--friction")
+
+
+def _losses_summary(info):
+    """The ``losses`` of a run's meta for the CLI: power by source (W), total, efficiency
+    (the run's power balance where there is one, else quasi-static) and the balance's
+    closure."""
+    if not info:
+        return None
+    qs, bal = info["quasi_static"], info.get("balance")
+    return {"power_w": qs["power_w"], "total_loss_w": qs["total_loss_w"],
+            "efficiency": bal["efficiency"] if bal else qs["efficiency"],
+            "quasi_static_efficiency": qs["efficiency"],
+            "closure": bal["closure"] if bal else None,
+            "balance_losses_w": bal["losses_w"] if bal else None}
+
+
+def _add_losses_option(p):
+    p.add_argument("--losses", action="store_true",
+                   help="every loss source in the run: windage, pumping and bearing friction "
+                        "torques resist the rotations, the tooth friction follows the "
+                        "mixed-lubrication film (paper 000, 004); the run's meta carries the "
+                        "breakdown by source and its power balance")
 
 
 def _add_fault_options(p):
@@ -436,6 +476,7 @@ def _cmd_sweep(args):
     _plausibility(args, rig, OperatingPoint(args.speed_rpm[0], max(torques or [0.0]),
                                             args.radial_load_n or 0.0))
     mesh = _mesh_argument(args, torques or ())
+    _check_losses_options(args)
     if mesh == "hybrid-tables" and rig.gears is not None:
         # build (or load) the rig's tables once, before the workers start
         from cmsim.dynamics.mesh_choice import hybrid_table_set
@@ -445,7 +486,8 @@ def _cmd_sweep(args):
                      duration_s=args.duration_s, frictions=args.friction or (None,),
                      clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
                      warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
-                     seed_policy=args.seed_policy, mesh=mesh, faults=_faults_of(args, rig))
+                     seed_policy=args.seed_policy, mesh=mesh, faults=_faults_of(args, rig),
+                     losses=args.losses or None)
     progress = not args.json and sys.stderr.isatty()
     try:
         summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,
@@ -503,6 +545,7 @@ def _add_sweep(sub):
                    help="replace a manifest written for a different spec")
     _add_mesh_options(p)
     _add_fault_options(p)
+    _add_losses_option(p)
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=_cmd_sweep, text=_text_sweep)
 
@@ -802,7 +845,8 @@ def _cmd_losses(args):
     settings = LossSettings(air_pressure_pa=args.air_pressure_pa,
                             air_temperature_c=args.air_temperature_c,
                             oil_jet_kg_s=args.oil_jet_kg_s, roughness_m=args.roughness_m)
-    res = operating_losses(rig, op, settings).to_dict()
+    table, _ = _resolve_mesh_options(args, rig, op.torque_nm)
+    res = operating_losses(rig, op, settings, table).to_dict()
     res["rig"] = rig.name
     res["plot"] = None
     if args.plot:
@@ -833,7 +877,10 @@ def _add_losses(sub):
     p = sub.add_parser("losses", help="power losses by source and the efficiency",
                        description="Windage and meshing torques (paper 000 eq. 25-28), oil "
                                    "jet, Harris-Palmgren bearing torques and mixed-lubrication "
-                                   "tooth friction (paper 004 eq. 21) at one operating point.")
+                                   "tooth friction (paper 004 eq. 21) at one operating point; "
+                                   "the load sharing of the tooth pairs comes from the mesh "
+                                   "model a run would use (--mesh), so the figures match "
+                                   "cmsim simulate --losses.")
     p.add_argument("--speed-rpm", type=float, required=True, help="input speed, rpm")
     p.add_argument("--torque-nm", type=float, required=True, help="output torque, N m")
     p.add_argument("--air-pressure-pa", type=float, default=101325.0,
@@ -845,6 +892,7 @@ def _add_losses(sub):
                    help="composite RMS roughness of the teeth, m (default: the rig's)")
     p.add_argument("--plot", type=Path, metavar="FILE.png",
                    help="write the loss breakdown against speed (paper 000 Figs. 53-57)")
+    _add_mesh_options(p)
     _add_rig_options(p, friction=False)
     p.set_defaults(func=_cmd_losses, text=_text_losses)
 

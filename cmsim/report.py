@@ -43,6 +43,7 @@ from cmsim.datasets import RUNS_DIR, read_manifest
 from cmsim.errors import ParameterError, check_range
 from cmsim.features import N_GMF_HARMONICS, gmf_levels
 from cmsim.frequencies import rig_frequencies
+from cmsim.losses.plots import run_loss_rows, run_losses_figure
 from cmsim.plots import plot_orbit_family, plot_trace_family
 from cmsim.run import Run
 from cmsim.spectra._checks import positive_int
@@ -158,6 +159,7 @@ def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
          "clearance_m": rig.bearings[0].clearance_m, "seed": meta.get("seed"),
          "fs_hz": fs, "duration_s": run.t.size / fs, "shaft_hz": freqs.fr1_hz,
          "gmf_hz": freqs.gmf_hz, "integration_s": float(meta.get("wall_s", 0.0)),
+         "losses": meta.get("losses"),
          "spectra": {}, "peaks": {}, "harmonics": {}, "units": {}, "families": {}}
     d["clearance_um"] = d["clearance_m"] * 1e6
     if max_freq_hz is None:
@@ -392,6 +394,8 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
         sfx = f"_g{gi + 1}" if len(groups) > 1 else ""
         sections.append(_group_section(gi, fixed, members, axis, in_orders, signals,
                                        dom_signal, f_show, dyn, n_mesh_cycles, sfx, emit))
+    if any(d["losses"] for d in digests):
+        sections.append(_losses_section([d for d in digests if d["losses"]], emit))
     plotting.close()
     t_plot1 = time.perf_counter()
 
@@ -488,6 +492,35 @@ def _group_section(gi, fixed, members, axis, in_orders, signals, dom_signal, f_s
                f"{html.escape(vlabel.split(' [')[0].lower())} about their mean "
                "(paper Figs. 8, 15).")
     return "\n".join(parts)
+
+
+def _losses_section(digests, emit):
+    """Loss breakdown of the runs made with every loss on (``simulate(losses=...)``)."""
+    digests = sorted(digests, key=lambda d: (d["speed_rpm"], d["torque_nm"]))
+    labels = [f"{d['speed_rpm']:g} rpm\n{d['torque_nm']:g} N·m" for d in digests]
+    losses = [d["losses"] for d in digests]
+    name = emit(run_losses_figure(losses, labels), "losses.png")
+    rows = run_loss_rows(losses)
+    keys = ["windage", "meshing", "oil_jet", "bearing_viscous", "bearing_load",
+            "tooth_friction", "damping"]
+    table = _table(["run", "speed [rpm]", "torque [N·m]"] + [f"{k.replace('_', ' ')} [W]"
+                                                             for k in keys]
+                   + ["total [W]", "efficiency [%]", "balance closure [%]"],
+                   [(d["name"], _fmt(d["speed_rpm"], "g"), _fmt(d["torque_nm"], "g"),
+                     *(_fmt(r[k], ".3g") for k in keys), _fmt(r["total"], ".4g"),
+                     _fmt(100 * r["efficiency"], ".3f"),
+                     "—" if r["closure"] is None else _fmt(100 * r["closure"], ".3f"))
+                    for d, r in zip(digests, rows)], left=(0,))
+    return "\n".join([
+        "<h2>Power losses</h2>",
+        f'<figure><img src="{html.escape(name)}" alt="loss breakdown"><figcaption>Loss '
+        "power by source of each run made with every loss on: windage and meshing (pumping) "
+        "torques of paper 000 eq. 25-28, oil jet (eq. 30), the bearings' viscous and load "
+        "torques (Harris–Palmgren), the tooth friction with the mixed-lubrication "
+        "coefficient along the path (paper 004 eq. 21) and the damping the run dissipates, "
+        "both from the run's own power balance (input = output + losses + change of stored "
+        "energy; its closure is listed). Right: efficiency of each run.</figcaption>"
+        "</figure>", table])
 
 
 def _html_page(out_dir, digests, runs, axis, signals, dom_signal, sections, top_n, f_show,

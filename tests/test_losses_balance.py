@@ -4,9 +4,12 @@ Tier: closed form (conservation of energy): input power through the input coupli
 output power + dissipation by source + change of stored energy, from the run's own signals.
 """
 
+import json
+
 import pytest
 
 from cmsim.dynamics import simulate
+from cmsim.errors import ParameterError
 from cmsim.dynamics.model import build_model
 from cmsim.losses import friction_table_for, operating_losses, power_balance
 from cmsim.rig import OperatingPoint, Rig
@@ -51,3 +54,36 @@ def test_balance_of_a_lossless_run_and_a_missing_source(setup):
     assert power_balance(run2, loads).closure_of_losses < 0.05
     assert power_balance(run2).residual_w == pytest.approx(
         power_balance(run2, loads).losses_w["loads"], rel=0.05)
+
+
+def test_a_run_made_with_every_loss_on_carries_its_breakdown_and_balance(setup):
+    """``simulate(losses=...)`` puts the same loads and film friction in the run as the
+    hand-made run above, and its meta carries the quasi-static breakdown and the run's own
+    power balance (closing within 1 %)."""
+    rig, op, tab, losses, mu = setup
+    run = simulate(rig, op, 0.1, seed=3, warmup_s=0.1, losses=True)
+    info = run.meta["losses"]
+    assert info["quasi_static"]["power_w"] == pytest.approx(losses.power_w, rel=1e-9)
+    bal = info["balance"]
+    assert bal["closure"] < 0.01
+    assert bal["losses_w"]["loads"] == pytest.approx(
+        sum(v for k, v in losses.power_w.items() if k != "tooth_friction"), rel=0.01)
+    assert bal["losses_w"]["tooth_friction"] == pytest.approx(
+        losses.power_w["tooth_friction"], rel=0.15)
+    hand = simulate(rig, op, 0.1, seed=3, warmup_s=0.1, loads=losses.loads(),
+                    friction_table=mu)
+    assert float(abs(run["dte_um"] - hand["dte_um"]).max()) < 1e-9
+    with pytest.raises(ParameterError, match="losses"):
+        simulate(rig, op, 0.01, losses=True, loads=losses.loads())
+
+
+def test_cli_losses_flag(tmp_path, capsys):
+    from cmsim.cli import main
+    argv = ["simulate", "--speed-rpm", "3000", "--torque-nm", "50", "--duration-s", "0.05",
+            "--losses", "--json"]
+    assert main(argv) == 0
+    res = json.loads(capsys.readouterr().out)["losses"]
+    assert 0.95 < res["efficiency"] < 1.0 and res["closure"] < 0.01
+    assert res["power_w"]["tooth_friction"] > res["power_w"]["windage"] > 0
+    assert main(argv + ["--friction", "0.05"]) == 2
+    assert "--friction" in json.loads(capsys.readouterr().out)["error"]

@@ -103,3 +103,31 @@ def test_cli_report_json(sweep_dir, capsys):
     assert "waterfall_dte_um.png" not in res["figures"]
     assert [r["dominant_gmf_harmonic"] for r in res["runs"]] == [2, 5]
     assert main(["report", str(sweep_dir / MANIFEST_NAME), "--json"]) == 2
+
+
+def test_loss_breakdown_of_a_sweep_whose_runs_carry_it(tmp_path, capsys):
+    """A sweep made with ``--losses``: the report draws the loss power by source and the
+    efficiency of each run, and tabulates them with each run's power-balance closure; a
+    sweep without losses has no such section (the tiny sweep above)."""
+    out = tmp_path / "lossy"
+    assert main(["sweep", "--speed-rpm", "1000", "3000", "--torque-nm", "50", "--duration-s",
+                 "0.05", "--losses", "--out", str(out), "--workers", "1", "--json"]) == 0
+    capsys.readouterr()
+    res = build_report(out)
+    assert "losses.png" in res.figures
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "<h2>Power losses</h2>" in page
+    rows = re.findall(r"<tr><td[^>]*>(\d{3}_[^<]*)</td>(.*?)</tr>",
+                      page.split("<h2>Power losses</h2>")[1].split("</table>")[0])
+    assert len(rows) == 2
+    for _, cells in rows:
+        values = re.findall(r"<td[^>]*>([^<]*)</td>", cells)
+        efficiency, closure = float(values[-2]), float(values[-1])
+        assert 95.0 < efficiency < 100.0 and closure < 1.0
+    img = _pixels(out / "losses.png")
+    assert img.shape[0] > 200 and np.std(img) > 0.05
+
+
+def test_no_loss_section_without_losses(report, sweep_dir):
+    assert "losses.png" not in report.figures
+    assert "Power losses" not in (sweep_dir / "report.html").read_text(encoding="utf-8")

@@ -187,7 +187,7 @@ def file_matches(spec, case, path, entry=None):
     With ``entry``: its status is done, and the file has its size and SHA-256 checksum (a
     file corrupted in place, even to the same size, is not a match). Compared: case name,
     seed, operating point, rig, sampling, duration, the spec's mesh (files written before the
-    mesh was recorded count as the default mesh) and faults.
+    mesh was recorded count as the default mesh), faults and loss settings.
     """
     path = Path(path)
     if not path.is_file():
@@ -218,4 +218,6 @@ def file_matches(spec, case, path, entry=None):
             and abs(meta.get("duration_s", -1.0) - spec.duration_s) <= 0.5 / spec.fs_hz
             and normalised(meta.get("rig")) == normalised(spec.case_rig(case).to_dict())
             and [{k: v for k, v in f.items() if k != "label"} for f in meta.get("faults", [])]
-            == normalised([f.to_dict() for f in spec.faults]))
+            == normalised([f.to_dict() for f in spec.faults])
+            and normalised((meta.get("losses") or {}).get("settings"))
+            == normalised(spec.to_dict().get("losses")))

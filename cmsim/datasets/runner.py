@@ -109,7 +109,7 @@ _PROCESS_RUNS = {"n": 0, "warm": False}
 def _simulate_case(spec, case, duration_s=None, **kw):
     return simulate(spec.case_rig(case), spec.case_operating_point(case),
                     spec.duration_s if duration_s is None else duration_s, mesh=spec.mesh,
-                    fs_hz=spec.fs_hz, faults=spec.faults, **kw)
+                    fs_hz=spec.fs_hz, faults=spec.faults, losses=spec.losses, **kw)
 
 
 def _run_case(spec, case, path):

@@ -40,6 +40,7 @@ from cmsim.datasets.variation import (OPERATING_POINT_FIELDS, Variation, _check_
 from cmsim.dynamics.mesh_choice import MESH_CHOICES
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, fault_from_dict
+from cmsim.losses import LossSettings
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
@@ -56,7 +57,7 @@ _LEGACY_KEYS = ("speeds_rpm", "torques_nm", "frictions", "clearances_m", "durati
 _LEGACY_AXES = (("speeds_rpm", "speed_rpm"), ("torques_nm", "torque_nm"),
                 ("frictions", "friction"), ("clearances_m", "clearance_m"))
 _KEYS = ("variations", "fixed", "repeats", "duration_s", "fs_hz", "warmup_s", "substeps",
-         "mesh", "seed", "seed_policy", "rig", "faults")
+         "mesh", "seed", "seed_policy", "rig", "faults", "losses")
 
 
 @dataclass(frozen=True)
@@ -211,6 +212,9 @@ class SweepSpec:
     faults : sequence of Fault, optional
         Faults of the catalogue (:mod:`cmsim.faults`) built into every case's model (a
         cracked gear at every torque, say); checked against every case's rig.
+    losses : LossSettings or True, optional
+        Every loss source in every run (``simulate(losses=...)``): the runs' meta carry the
+        breakdown by source and the power balance (``cmsim report`` draws them).
 
     Every case's rig and operating point are built (and so checked) on construction.
     """
@@ -227,11 +231,12 @@ class SweepSpec:
     seed: int
     seed_policy: str
     faults: tuple
+    losses: LossSettings | None
 
     def __init__(self, variations=(), *, fixed=None, repeats=1, duration_s=1.0, rig=None,
                  fs_hz=75_000.0, warmup_s=0.05, substeps=1, mesh=None, seed=0,
                  seed_policy="per_run", speeds_rpm=None, torques_nm=None, frictions=None,
-                 clearances_m=None, radial_load_n=None, faults=()):
+                 clearances_m=None, radial_load_n=None, faults=(), losses=None):
         set_ = object.__setattr__
         rig = Rig.paper_2016() if rig is None else rig
         if not isinstance(rig, Rig):
@@ -282,6 +287,14 @@ class SweepSpec:
         set_(self, "seed_policy", seed_policy)
         set_(self, "mesh", _check_mesh(mesh))
         set_(self, "faults", check_faults(rig, faults))
+        if losses is True:
+            losses = LossSettings()
+        elif isinstance(losses, dict):
+            losses = LossSettings(**losses)
+        if losses is not None and losses is not False and not isinstance(losses, LossSettings):
+            raise ParameterError(f"losses must be a LossSettings, True or None, got {losses!r}",
+                                 param="losses")
+        set_(self, "losses", losses or None)
         for case in self.cases():          # every case must be a valid rig / op
             try:
                 check_faults(self.case_rig(case), self.faults)
@@ -352,7 +365,7 @@ class SweepSpec:
                         ([], ["friction"], ["clearance_m"], ["friction", "clearance_m"]))
         return (names in legacy_names
                 and {n for n, _ in self.fixed} <= {"radial_load_n"} and self.mesh is None
-                and self.repeats == 1 and not self.faults)
+                and self.repeats == 1 and not self.faults and self.losses is None)
 
     def to_dict(self, older_form=True):
         """JSON-ready dict (the rig as :meth:`Rig.to_dict`); with ``older_form``, a speed ×
@@ -370,6 +383,9 @@ class SweepSpec:
                "mesh": mesh_key(self.mesh), **tail}
         if self.faults:
             out["faults"] = [f.to_dict() for f in self.faults]
+        if self.losses is not None:
+            out["losses"] = {k: getattr(self.losses, k)
+                             for k in self.losses.__dataclass_fields__}
         return out
 
     @classmethod

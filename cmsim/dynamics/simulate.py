@@ -13,12 +13,14 @@ from cmsim.dynamics import _kernels as K
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
+from cmsim.dynamics.mesh_choice import resolve_mesh
 from cmsim.dynamics.model import SlipModel, build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
 from cmsim.faults import (check_faults, fault_frequencies, operating_modulation,
                           slip_from_faults)
+from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
 
@@ -215,7 +217,7 @@ def _compile_seconds():
 def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
              scheme="ode3", slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
              profile=None, faults=(), progress=None, loads=None, friction_table=None,
-             damping_table=None):
+             damping_table=None, losses=None):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -270,6 +272,13 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         Extra constant generalised forces by DOF name, a mesh friction coefficient and a pair
         damping along the path (as in :func:`~cmsim.dynamics.model.build_model`; e.g. from
         :mod:`cmsim.losses`).
+    losses : LossSettings or True, optional
+        Every loss source in the run (:func:`cmsim.losses.run_losses`; ``True`` = default
+        settings): windage, pumping, oil-jet and bearing torques resist the rotations and the
+        tooth friction follows the mixed-lubrication film along the path of contact. The
+        run's ``meta["losses"]`` then holds the quasi-static breakdown by source and, at
+        constant speed, the run's own power balance (:func:`cmsim.losses.power_balance`).
+        Not with ``loads`` or ``friction_table``.
     progress : callable, optional
         Called as ``progress(done_s, total_s)`` (simulated seconds, warm-up included) as the
         integration advances, in chunks that do not change the result.
@@ -316,6 +325,15 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         kprof = kernel_profile(profile, op.torque_nm, warmup_s + duration_s + 0.1,
                                PROFILE_STEP_S, speed_factor=speed_factor,
                                torque_factor=torque_factor)
+    loss_inputs = None
+    if losses is not None and losses is not False:
+        if loads is not None or friction_table is not None:
+            raise ParameterError("losses sets the run's loads and friction table; give either "
+                                 "losses or loads/friction_table", param="losses")
+        table, mesh_model = resolve_mesh(rig, mesh, op.torque_nm)
+        mesh = mesh_model if mesh_model is not None else table
+        loss_inputs = run_losses(rig, op, table, LossSettings() if losses is True else losses)
+        loads, friction_table = loss_inputs.loads, loss_inputs.friction_table
     compile_s = _compile_seconds()
     model = build_model(rig, op, mesh, slip=slip, duration_s=warmup_s + duration_s,
                         seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad,
@@ -381,7 +399,13 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         "dof_names": list(model.dof_names),
         "initial_state": q0.tolist(), "initial_state_method": start_method,
     }
-    return Run(t, signals, meta)
+    run = Run(t, signals, meta)
+    if loss_inputs is not None:
+        info = loss_inputs.to_dict()
+        info["balance"] = None if kprof is not None else power_balance(
+            run, loads, friction_table, model.mesh_table).to_dict()
+        run = run.with_meta(losses=info)
+    return run
 
 
 def _signals(model, t, states, diag, kprof=None):

@@ -20,7 +20,8 @@ the caller hands to :func:`cmsim.dynamics.simulate`, and reads a finished
 
 from cmsim.losses.bearing_friction import (BearingFriction, bearing_friction_torque,
                                            ring_kinematics)
-from cmsim.losses.breakdown import LossBreakdown, LossSettings, operating_losses
+from cmsim.losses.breakdown import (LossBreakdown, LossSettings, RunLosses, operating_losses,
+                                    run_losses)
 from cmsim.losses.contact_mixed import mixed_contact_stiffness_damping
 from cmsim.losses.ehl import (film_thickness_line, film_thickness_point, mesh_film_along_path,
                               reduced_modulus_pa)
@@ -31,8 +32,8 @@ from cmsim.losses.mixed_friction import (friction_table_for, lambda_ratio,
 from cmsim.losses.power_balance import PowerBalance, power_balance
 
 __all__ = ["BearingFriction", "bearing_friction_torque", "ring_kinematics", "LossBreakdown",
-           "LossSettings", "operating_losses", "mixed_contact_stiffness_damping",
-           "film_thickness_line", "film_thickness_point", "mesh_film_along_path",
+           "LossSettings", "RunLosses", "operating_losses", "run_losses",
+           "mixed_contact_stiffness_damping", "film_thickness_line", "film_thickness_point", "mesh_film_along_path",
            "reduced_modulus_pa", "air_density_kg_m3", "meshing_torque_nm", "oil_jet_torque_nm",
            "windage_torque_nm", "friction_table_for", "lambda_ratio",
            "mixed_friction_coefficient", "PowerBalance", "power_balance"]

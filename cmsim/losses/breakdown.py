@@ -23,10 +23,11 @@ from cmsim.losses.bearing_friction import bearing_friction_torque, ring_kinemati
 from cmsim.losses.gear_losses import (air_density_kg_m3, meshing_torque_nm, oil_jet_torque_nm,
                                       windage_torque_nm)
 from cmsim.losses.ehl import mesh_film_along_path
-from cmsim.losses.mixed_friction import BOUNDARY_FRICTION, mesh_friction_along_path
+from cmsim.losses.mixed_friction import (BOUNDARY_FRICTION, friction_table_for,
+                                         mesh_friction_along_path)
 
-__all__ = ["LossSettings", "LossBreakdown", "operating_losses", "loss_sweep",
-           "rig_with_film_gap", "LOAD_INDEPENDENT", "LOAD_DEPENDENT"]
+__all__ = ["LossSettings", "LossBreakdown", "RunLosses", "operating_losses", "run_losses",
+           "loss_sweep", "rig_with_film_gap", "LOAD_INDEPENDENT", "LOAD_DEPENDENT"]
 
 #: Sources that do not depend on the transmitted torque.
 LOAD_INDEPENDENT = ("windage", "meshing", "oil_jet", "bearing_viscous")
@@ -224,6 +225,72 @@ def operating_losses(rig, op, settings=None, mesh_table=None):
         power["bearing_viscous"] += fr.viscous_torque_nm * omega
         power["bearing_load"] += fr.load_torque_nm * omega
     return LossBreakdown(n1, op.torque_nm, output, power, torques, mean_mu, min_lam)
+
+
+@dataclass(frozen=True)
+class RunLosses:
+    """What a run with every loss on is given, and the breakdown it was made from.
+
+    Attributes
+    ----------
+    breakdown : LossBreakdown
+        Every source at the operating point (quasi-static).
+    loads : dict
+        Resisting torques by DOF name (``simulate(loads=...)``), N·m, negative.
+    friction_table : ndarray or None
+        Mixed-lubrication friction coefficient on the mesh table's grid
+        (``simulate(friction_table=...)``); ``None`` on a rig without gears.
+    settings : LossSettings
+    """
+
+    breakdown: LossBreakdown
+    loads: dict
+    friction_table: np.ndarray | None
+    settings: LossSettings
+
+    def to_dict(self):
+        """Plain dict (run meta): the settings and the quasi-static breakdown."""
+        return {"settings": {k: getattr(self.settings, k)
+                             for k in self.settings.__dataclass_fields__},
+                "quasi_static": self.breakdown.to_dict()}
+
+
+def run_losses(rig, op, mesh_table=None, settings=None):
+    """Every loss source of ``rig`` at ``op`` as the inputs of a run (:class:`RunLosses`).
+
+    The windage, pumping, oil-jet and bearing torques become resisting torques on the gear
+    and bearing rotations, and the tooth friction follows the film: the mixed-lubrication
+    coefficient along the path of contact (the rig lubricant's viscosity, the settings' or
+    the lubricant's roughness) replaces the rig's constant.
+
+    Parameters
+    ----------
+    rig : Rig
+    op : OperatingPoint
+    mesh_table : MeshStiffnessTable, optional
+        The run's table (its grid and load sharing); needed on a gear rig.
+    settings : LossSettings, optional
+
+    Returns
+    -------
+    RunLosses
+    """
+    settings = LossSettings() if settings is None else settings
+    if not isinstance(settings, LossSettings):
+        raise ParameterError(f"losses must be a LossSettings, got {type(settings).__name__}",
+                             param="losses")
+    if rig.gears is not None and mesh_table is None:
+        raise ParameterError("run_losses needs the run's mesh_table on a gear rig",
+                             param="mesh_table")
+    breakdown = operating_losses(rig, op, settings, mesh_table)
+    mu = None
+    if rig.gears is not None:
+        roughness = (rig.lubricant.surface_roughness_m if settings.roughness_m is None
+                     else settings.roughness_m)
+        mu = friction_table_for(rig, op, mesh_table, roughness,
+                                rig.lubricant.dynamic_viscosity_pa_s,
+                                boundary_friction=settings.boundary_friction)
+    return RunLosses(breakdown, breakdown.loads(), mu, settings)
 
 
 def loss_sweep(rig, speeds_rpm, torque_nm, settings=None):
