@@ -294,10 +294,13 @@ def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b
     """
     fx = 0.0
     fy = 0.0
+    hertz = p == 1.5
     for i in range(n_balls):
         co = ball_cos[ib, i]
         so = ball_sin[ib, i]
         d = xr * co + yr * so - c + b_off[ib, i]
+        if d <= 0.0:
+            continue                   # a defect only takes overlap away: still unloaded
         theta = cage_angle + b_ang[ib, i]
         for r in range(d0, d0 + nd):
             kind = int(b_def[r, DF_KIND])
@@ -314,20 +317,134 @@ def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b
             d -= b_def[r, DF_DEPTH] * _defect_profile(u, b_def[r, DF_HALF], b_def[r, DF_ENTRY],
                                                       b_def[r, DF_EXIT])
         if d > 0.0:
-            f = d ** p
+            f = d * math.sqrt(d) if hertz else d ** p
             fx += f * co
             fy += f * so
     return k * fx, k * fy
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _defect_loss(theta, i, b_def, d0, nd, shaft_angle, spin_angle, dirn_cage, dirn_inner,
+                 dirn_spin):
+    """Overlap ball ``i`` (housing angle ``theta``) loses in the defects rows d0..d0+nd, m:
+    an outer-race defect is fixed in the housing, an inner-race one turns with the shaft, a
+    ball defect turns with the ball's spin and meets the outer race at spin phase 0 and the
+    inner race at π (Sawalhi & Randall 2008, MSSP 22)."""
+    loss = 0.0
+    for r in range(d0, d0 + nd):
+        kind = int(b_def[r, DF_KIND])
+        if kind == DEF_OUTER:
+            u = dirn_cage * _wrap(theta - b_def[r, DF_CENTRE])
+        elif kind == DEF_INNER:
+            u = dirn_inner * _wrap(theta - shaft_angle - b_def[r, DF_CENTRE])
+        else:
+            if int(b_def[r, DF_BALL]) != i:
+                continue
+            # both races: the spin phase modulo π
+            v = spin_angle - b_def[r, DF_CENTRE]
+            u = dirn_spin * (v - math.pi * math.floor(v / math.pi + 0.5))
+        loss += b_def[r, DF_DEPTH] * _defect_profile(u, b_def[r, DF_HALF], b_def[r, DF_ENTRY],
+                                                     b_def[r, DF_EXIT])
+    return loss
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _contact(d, p, hertz):
+    """Ball contact law δ^p for δ > 0 (δ·sqrt(δ) for Hertz), 0 otherwise."""
+    if d <= 0.0:
+        return 0.0
+    return d * math.sqrt(d) if hertz else d ** p
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
+def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b_off, b_def,
+                      d0, nd, cage_angle, shaft_angle, spin_angle, dirn_cage, dirn_inner,
+                      dirn_spin):
+    """Eq. 9 ball by ball with defects and off-size balls (cage frame, as
+    :func:`cmsim.bearings._kernels.ball_forces_cage_frame_jit`): ball i's overlap is
+    x_r cos φ_i + y_r sin φ_i − c + Δd_i − Σ depth·profile (:func:`_defect_loss`). Used for
+    bearings with an off-size ball, where every ball differs from the healthy law."""
+    fx = 0.0
+    fy = 0.0
+    hertz = p == 1.5
+    for i in range(n_balls):
+        co = ball_cos[ib, i]
+        so = ball_sin[ib, i]
+        d = xr * co + yr * so - c + b_off[ib, i]
+        if d <= 0.0:
+            continue                   # a defect only takes overlap away: still unloaded
+        d -= _defect_loss(cage_angle + b_ang[ib, i], i, b_def, d0, nd, shaft_angle,
+                          spin_angle, dirn_cage, dirn_inner, dirn_spin)
+        f = _contact(d, p, hertz)
+        fx += f * co
+        fy += f * so
+    return k * fx, k * fy
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _defect_correction(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b_def, d0,
+                       nd, cage_angle, shaft_angle, spin_angle, dirn_cage, dirn_inner,
+                       dirn_spin):
+    """Change the defects of bearing ``ib`` make to its healthy ball-force sum (cage frame).
+
+    Only the balls that can sit in a defect are visited: a race defect is shorter than the
+    ball spacing (:mod:`cmsim.faults.bearing` refuses longer ones), so at most the ball
+    nearest its centre is inside it; a ball defect is on its own ball. Each such ball's
+    overlap loss sums every defect row (:func:`_defect_loss`), so coinciding defects combine
+    exactly as in :func:`_faulty_ball_loop`; a ball seen by two rows is counted once.
+    """
+    fx = 0.0
+    fy = 0.0
+    hertz = p == 1.5
+    pitch = 2.0 * math.pi / n_balls
+    for r in range(d0, d0 + nd):
+        i = _defect_ball(r, b_def, b_ang[ib, 0], pitch, n_balls, cage_angle, shaft_angle)
+        seen = False
+        for r2 in range(d0, r):                  # this ball was corrected by an earlier row
+            if _defect_ball(r2, b_def, b_ang[ib, 0], pitch, n_balls, cage_angle,
+                            shaft_angle) == i:
+                seen = True
+        if seen:
+            continue
+        co = ball_cos[ib, i]
+        so = ball_sin[ib, i]
+        d = xr * co + yr * so - c
+        if d <= 0.0:
+            continue
+        loss = _defect_loss(cage_angle + b_ang[ib, i], i, b_def, d0, nd, shaft_angle,
+                            spin_angle, dirn_cage, dirn_inner, dirn_spin)
+        if loss > 0.0:
+            f = _contact(d - loss, p, hertz) - _contact(d, p, hertz)
+            fx += f * co
+            fy += f * so
+    return k * fx, k * fy
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _defect_ball(r, b_def, ang0, pitch, n_balls, cage_angle, shaft_angle):
+    """Index of the ball nearest defect row ``r`` (its own ball for a ball defect)."""
+    kind = int(b_def[r, DF_KIND])
+    if kind == DEF_BALL:
+        return int(b_def[r, DF_BALL])
+    centre = b_def[r, DF_CENTRE] + (shaft_angle if kind == DEF_INNER else 0.0)
+    a = (centre - cage_angle - ang0) / pitch
+    m = math.floor(a + 0.5)
+    return int(m - n_balls * math.floor(m / n_balls))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _faulty_bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
                            cage_slip, diag, want_diag, b_ang, b_off, b_def):
-    """Forces of the bearings with defects or off-size balls (``BI_FAULTY``), ball by ball
-    (:func:`_faulty_ball_loop`); the others are left to :func:`_bearing_forces`. Kept apart
-    so that the healthy ball loop stays vectorised."""
+    """Forces of the bearings with defects or off-size balls (``BI_FAULTY``).
+
+    ``BI_FAULTY`` = 1 (race or ball defects only): :func:`_bearing_forces` has applied the
+    healthy law, and the defects' change is added (:func:`_defect_correction`, the few balls
+    in a defect); = 2 (an off-size ball): the whole bearing ball by ball
+    (:func:`_faulty_ball_loop`). Kept apart so that the healthy ball loop stays vectorised.
+    """
     for ib in range(b_int.shape[0]):
-        if b_int[ib, BI_FAULTY] == 0:
+        mode = b_int[ib, BI_FAULTY]
+        if mode == 0:
             continue
         ix = b_int[ib, BI_X]
         iy = b_int[ib, BI_Y]
@@ -341,15 +458,30 @@ def _faulty_bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, 
         sense = b_par[ib, BP_SENSE]
         shaft = sense * turned
         forward = 1.0 if omega[it] >= 0.0 else -1.0
-        fxr, fyr = _faulty_ball_loop(
-            xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
-            b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_off, b_def, b_int[ib, BI_DEF0],
-            b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
-            forward * (1.0 if rate >= 0.0 else -1.0),
-            forward * (1.0 if rate - sense >= 0.0 else -1.0),
-            forward * (1.0 if sense - rate >= 0.0 else -1.0))
+        dirn_cage = forward * (1.0 if rate >= 0.0 else -1.0)
+        dirn_inner = forward * (1.0 if rate - sense >= 0.0 else -1.0)
+        dirn_spin = forward * (1.0 if sense - rate >= 0.0 else -1.0)
+        if mode == 1:
+            fxr, fyr = _defect_correction(
+                xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
+                b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_def, b_int[ib, BI_DEF0],
+                b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
+                dirn_cage, dirn_inner, dirn_spin)
+        else:
+            fxr, fyr = _faulty_ball_loop(
+                xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
+                b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_off, b_def, b_int[ib, BI_DEF0],
+                b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
+                dirn_cage, dirn_inner, dirn_spin)
         fx = fxr * cc - fyr * sc
         fy = fyr * cc + fxr * sc
+        if mode == 1:                  # a change to the healthy forces already applied
+            g[ix] -= fx
+            g[iy] -= fy
+            if want_diag:
+                diag[2 * ib] += fx
+                diag[2 * ib + 1] += fy
+            continue
         g[ix] -= fx
         g[iy] -= fy
         if want_diag:
@@ -362,11 +494,13 @@ def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
                     diag, want_diag):
     """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage
     and cages shifted by the slip angles ``cage_slip`` (zeros without slip); ``t`` is the
-    equivalent time τ of the nominal rotation (``KernelParams``). Bearings with defects or
-    off-size balls (``BI_FAULTY``) are skipped here (:func:`_faulty_bearing_forces`).
+    equivalent time τ of the nominal rotation (``KernelParams``).
 
     Written flat on purpose: with helper functions inlined, a jitter branch, or arrays taken
     out of ``P`` inside the loop, numba stops vectorising the ball loop (2-3× slower).
+    Bearings with race or ball defects (``BI_FAULTY`` = 1) get the healthy law here and
+    their defects' change from :func:`_faulty_bearing_forces`; bearings with an off-size ball
+    (``BI_FAULTY`` = 2) are left to it whole.
     The cage angle (nominal rate·Ω·t, phase, slip and the dynamic deviation rate·q_θ) is
     turned into cos and sin by rotating the bearing's anchor (module docstring). Each bearing
     works in its cage frame: the inner-ring offset is turned by −θ_cage once instead of
@@ -374,7 +508,7 @@ def _bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
     copies its arguments.
     """
     for ib in range(b_int.shape[0]):
-        if b_int[ib, BI_FAULTY] != 0:
+        if b_int[ib, BI_FAULTY] == 2:
             continue
         ix = b_int[ib, BI_X]
         iy = b_int[ib, BI_Y]

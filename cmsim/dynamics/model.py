@@ -551,7 +551,9 @@ def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
         rows = np.flatnonzero(b_def[:, K.DF_BRG] == ib)
         b_int[ib, K.BI_DEF0] = rows[0] if rows.size else 0
         b_int[ib, K.BI_NDEF] = rows.size
-        b_int[ib, K.BI_FAULTY] = int(rows.size > 0 or np.any(b_off[ib] != 0.0))
+        # 2: an off-size ball, every ball ball by ball; 1: defects only, healthy law plus
+        # the change of the balls in a defect (the kernels' _faulty_bearing_forces)
+        b_int[ib, K.BI_FAULTY] = 2 if np.any(b_off[ib] != 0.0) else int(rows.size > 0)
     if np.any(b_off != 0.0):
         m_int[K.MI_FAULTY_BALLS] = 1
     rig = rm.rig
