@@ -45,18 +45,31 @@ is an edge, both faces are chains of boundary facets, no triangle touches both f
 
 gmsh
 ----
-cmsim keeps this in-house mesher and does not depend on gmsh. gmsh (GPL ≥ 2, Python API
-as a PyPI wheel) does embed crack curves and size fields natively, but linking it would make
-the MIT package GPL-encumbered, and the crack costs the in-house mesher nothing extra.
-Measured on the paper gear (ν = 45°, 2 shared cores under load from other jobs, so the
-absolute times are ≈ 2.5× those on an idle core): healthy body 15 516 triangles, 66 128 P2
-dofs, mesh 21.7 s + assembly/factorisation 2.9 s + 40 load cases 4.6 s = 29.4 s; cracked
-bodies (q/q_max = 0.02 … 1) 15 664 - 16 346 triangles (+1 … +5 %), 66 748 - 68 196 dofs,
-mesh 16.0 - 26.4 s, factorisation 1.1 - 2.4 s, solve 2.0 - 5.1 s, total 22.5 - 30.1 s, i.e.
-the same as the healthy build within the load noise; each cracked table is built once and
-cached (:func:`~cmsim.mesh_stiffness.influence.influence_table` with ``crack=``). The mesh
-remains ≈ 75 % of a build; gmsh would be the way to make it faster, as an optional extra
-only, never the default.
+Decision: cmsim keeps this in-house mesher as its only mesher and does not depend on gmsh.
+Measured side by side (``benchmarks/bench_mesher.py``, gmsh 4.15.2 from PyPI in a separate
+environment, the same outline and the same size function rebuilt from gmsh's distance
+fields, sizes scaled so the triangle counts match within 0.4 %; best of 3, interleaved, on a
+loaded machine — compare ratios):
+
+===================  =======  ======  =========  =========  ===============
+mesher, case         time, s  nodes   triangles  min angle  minSICN (mean)
+===================  =======  ======  =========  =========  ===============
+in-house, healthy    9.31     8 774   15 516     21.8°      0.557 (0.957)
+gmsh, healthy        0.51     8 660   15 576     31.4°      0.699 (0.969)
+in-house, cracked    17.88    9 046   16 006     22.1°      0.517 (0.957)
+gmsh, cracked        0.49     8 929   16 060     28.8°      0.623 (0.969)
+===================  =======  ======  =========  =========  ===============
+
+gmsh is 18× (healthy) to 37× (cracked) faster with better-shaped triangles, and its
+``Crack`` plugin gives faces that scikit-fem uses as they are (every crack segment a
+boundary facet on both faces, faces sharing only the tip). The crack roughly doubles the
+in-house mesh time. Still the in-house mesher stays: gmsh is GPL-2+ (its only exception
+covers Netgen, METIS, OpenCASCADE and ParaView, not a package importing it), which would
+encumber this MIT package, and every mesh is built once per gear design or crack and then
+cached (:mod:`cmsim.mesh_stiffness.cache`), so the 9-18 s are paid once. Earlier
+measurement of the whole influence build (mesh + assembly/factorisation + 40 load cases):
+healthy 29.4 s, cracked bodies (q/q_max = 0.02 … 1) 22.5 - 30.1 s on the same loaded cores;
+the mesh is ≈ 75 % of a build.
 
 All lengths in m.
 
