@@ -284,7 +284,8 @@ def _force_bearings(run):
     return [b for b in order if found.get(b) == {"x", "y"}]
 
 
-def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearings=None):
+def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearings=None,
+                directions=("x", "y")):
     """The run as an acquisition system records it: housing accelerations and a tacho.
 
     Parameters
@@ -303,6 +304,8 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
         Seed of the noise generator; default the run's ``meta["seed"]`` (else 0).
     bearings : sequence of str, optional
         Bearings to instrument (``"1b1"``, ...); default every bearing with x and y forces.
+    directions : sequence of {"x", "y"}
+        Accelerometer directions on each bearing (default both).
 
     Returns
     -------
@@ -344,10 +347,14 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     if not chosen:
         raise ParameterError("the run has no bearing forces F_<bearing>_<x|y> to feel "
                              "through the housing", param="run")
+    directions = [directions] if isinstance(directions, str) else list(directions)
+    if not directions or any(d not in ("x", "y") for d in directions):
+        raise ParameterError(f"directions must name x and/or y, got {directions!r}",
+                             param="directions", allowed="x, y")
     if seed is None:
         seed = int(run.meta.get("seed", 0) or 0)
     new = {f"accel_{b}_{d}": housing_acceleration(run[f"F_{b}_{d}"], fs_in, path)
-           for b in chosen for d in ("x", "y")}
+           for b in chosen for d in ("x", "y") if d in directions}
 
     signals = {**run.signals, **new}
     t = np.asarray(run.t, dtype=float)

@@ -101,3 +101,20 @@ def test_decimated_record_keeps_its_time_base(runs):
     np.testing.assert_allclose(slow.t[:5], fast.t[:15:3], rtol=0, atol=1e-12)
     # the mean load path is unchanged by the filter (unit DC gain)
     assert np.mean(slow["F_1b1_loa"]) == pytest.approx(np.mean(fast["F_1b1_loa"]), rel=1e-4)
+
+
+def test_recording_a_few_signals_gives_the_same_arrays():
+    """``record=`` filters only the columns the kept signals need: the dynamics and those
+    signals are the same, bit for bit, as in a full run (decimated and not)."""
+    rig = cmsim.Rig.paper_2016()
+    op = cmsim.OperatingPoint(1000.0, 20.0)
+    keep = ("F_1b1_y", "F_2b1_loa", "dte_um", "theta_1b1", "Fmesh_total")
+    for fs in (25_600.0, 75_000.0):          # decimated (3 substeps), and not
+        full = simulate(rig, op, 0.05, fs_hz=fs, seed=2)
+        few = simulate(rig, op, 0.05, fs_hz=fs, seed=2, record=keep)
+        assert set(few.signals) == set(keep)
+        assert few.meta["recorded"] == sorted(keep)
+        for name in keep:
+            np.testing.assert_array_equal(few[name], full[name])
+    with pytest.raises(ParameterError, match="record names an unknown signal 'F_9z9_y'"):
+        simulate(rig, op, 0.01, record=("F_9z9_y",))

@@ -194,6 +194,12 @@ def test_add_sensors_maps_force_direction_to_accelerometer_direction():
     assert "accel_1b1_x" not in only.signals and "accel_1b2_y" in only.signals
     with pytest.raises(ParameterError, match="2b1"):
         add_sensors(run, bearings=["2b1"])
+    x_only = add_sensors(run, path=ONE_MODE, directions="x")
+    assert {"accel_1b1_x", "accel_1b2_x"} <= set(x_only.signals)
+    assert not {"accel_1b1_y", "accel_1b2_y"} & set(x_only.signals)
+    np.testing.assert_array_equal(x_only["accel_1b1_x"], out["accel_1b1_x"])
+    with pytest.raises(ParameterError, match="directions"):
+        add_sensors(run, path=ONE_MODE, directions=("z",))
 
 
 def test_add_sensors_takes_the_path_from_the_run_rig_and_records_the_sensor(tmp_path):

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.signal import lfilter
 
 __all__ = ["cage_speed_ratios", "cage_ratios", "cage_angle", "ball_angles", "ball_pass_cycles_per_rev",
            "slip_jitter"]
@@ -117,7 +118,8 @@ def slip_jitter(n_balls, n_samples, dt_s, rms_rad, correlation_s, rng):
     a = math.exp(-dt_s / correlation_s)
     b = rms_rad * math.sqrt(1.0 - a * a)
     noise = rng.standard_normal((n_balls, n_samples))
-    out[:, 0] = rms_rad * noise[:, 0]
-    for i in range(1, n_samples):
-        out[:, i] = a * out[:, i - 1] + b * noise[:, i]
+    drive = b * noise
+    drive[:, 0] = rms_rad * noise[:, 0]
+    # out[i] = a·out[i−1] + b·noise[i], the recursion run by lfilter (same arithmetic)
+    out[:] = lfilter([1.0], [1.0, -a], drive, axis=1)
     return out

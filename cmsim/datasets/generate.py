@@ -139,6 +139,21 @@ def base_row(spec, rec):
     return row
 
 
+def _simulated_channels(channels):
+    """The simulated signals a record's channels are made from: an accelerometer needs both
+    force components of its bearing, the tacho the input shaft's rotation."""
+    out = set()
+    for c in channels:
+        if c.startswith("accel_"):
+            b = c.split("_")[1]
+            out |= {f"F_{b}_x", f"F_{b}_y"}
+        elif c == "tacho":
+            out.add("theta_1b1")
+        else:
+            out.add(c)
+    return sorted(out)
+
+
 def simulate_record(spec, index):
     """Simulate record ``index`` of ``spec``: ``(signals, meta)`` with float32 signals of the
     spec's channels at the sensor rate, and the meta stored with it. Raises what
@@ -151,16 +166,18 @@ def simulate_record(spec, index):
     if rec.params["runup"]:
         profile = SpeedProfile.ramp(op.speed_rpm, rec.params["end_speed_rpm"], spec.duration_s,
                                     start_s=spec.warmup_s)
+    sensed = [c for c in spec.channels if c.startswith("accel_") or c == "tacho"]
     t0 = time.perf_counter()
     run = simulate(rig, op, spec.duration_s, mesh=spec.mesh, fs_hz=spec.fs_hz,
                    substeps=spec.substeps, seed=rec.sim_seed, warmup_s=spec.warmup_s,
-                   faults=faults, profile=profile)
+                   faults=faults, profile=profile, record=_simulated_channels(spec.channels))
     t1 = time.perf_counter()
-    sensed = [c for c in spec.channels if c.startswith("accel_") or c == "tacho"]
     if sensed:
-        bearings = sorted({c.split("_")[1] for c in sensed if c.startswith("accel_")}) or None
-        run = add_sensors(run, noise_rms=rec.params["sensor_noise_m_s2"],
-                          seed=rec.sim_seed, bearings=bearings)
+        accel = [c.split("_") for c in sensed if c.startswith("accel_")]
+        bearings = sorted({a[1] for a in accel}) or None
+        directions = sorted({a[2] for a in accel}) or ("x", "y")
+        run = add_sensors(run, path=rig.housing, noise_rms=rec.params["sensor_noise_m_s2"],
+                          seed=rec.sim_seed, bearings=bearings, directions=directions)
     t2 = time.perf_counter()
     signals = {c: np.asarray(run[c], dtype=np.float32) for c in spec.channels}
     key = fault_frequencies(rig, op, [rec.fault]) if rec.fault is not None else {}

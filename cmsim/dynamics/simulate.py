@@ -164,16 +164,49 @@ def _check_memory(duration_s, fs_hz, n_dof, n_diag):
             f"{MAX_OUTPUT_BYTES / per_second:.0f} s at this fs_hz (split longer records)")
 
 
-def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, progress=None):
+def _recorded(model, record):
+    """``(names, state columns, force columns)`` a ``record`` list needs (all: None)."""
+    if record is None:
+        return None, None, None
+    if isinstance(record, str):
+        record = (record,)
+    dofs = {name: i for i, name in enumerate(model.dof_names)}
+    diag = {name: j for j, name in enumerate(model.diag_names)}
+    q_cols, d_cols = set(), set()
+    for name in record:
+        if name in dofs:
+            q_cols.add(dofs[name])
+        elif name in diag:
+            d_cols.add(diag[name])
+        elif name.endswith(("_loa", "_oloa")) and name.startswith("F_") \
+                and f"F_{name.split('_')[1]}_x" in diag:
+            b = name.split("_")[1]
+            d_cols |= {diag[f"F_{b}_x"], diag[f"F_{b}_y"]}
+        elif name in ("dte", "dte_um") and "theta_2G1" in dofs:
+            q_cols |= {dofs["theta_1G1"], dofs["theta_2G1"]}
+        elif name == "Fmesh_total" and any(k.startswith("Fmesh_") for k in diag):
+            d_cols |= {j for k, j in diag.items() if k.startswith("Fmesh_")}
+        else:
+            raise ParameterError(f"record names an unknown signal {name!r}; this model has "
+                                 f"{list(dofs) + list(diag)} and the derived F_<b>_loa, "
+                                 f"F_<b>_oloa, dte, dte_um, Fmesh_total", param="record")
+    return set(record), sorted(q_cols), sorted(d_cols)
+
+
+def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, progress=None,
+                         q_cols=None, d_cols=None):
     """Integrate at ``aa.factor`` steps per output sample in chunks and decimate through
     ``aa``; returns the recorded ``(q, forces, wall_s)`` at the output instants
-    ``n_warm .. n_warm + n_rec − 1``."""
+    ``n_warm .. n_warm + n_rec − 1``. With ``q_cols``/``d_cols`` only those state and force
+    columns are filtered (the others are NaN)."""
     k, hl = aa.factor, aa.half_length
     n = model.n_dof
     first = n_warm * k - hl                       # first fast sample the filter reads
     last = (n_warm + n_rec - 1) * k + hl          # last one
-    q_out = np.empty((n_rec, n))
-    d_out = np.empty((n_rec, len(model.diag_names)))
+    q_out = np.full((n_rec, n), np.nan)
+    d_out = np.full((n_rec, len(model.diag_names)), np.nan)
+    qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
+    dc = np.arange(len(model.diag_names)) if d_cols is None else np.asarray(d_cols, dtype=int)
     runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
     tail = None                                   # fast samples not yet consumed
@@ -181,14 +214,14 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
         if i0 + len(st) <= first:                 # warm-up the filter never reads
             continue
         lo = max(first - i0, 0)
-        block = np.hstack([st[lo:, :n], dg[lo:]])
+        block = np.hstack([st[lo:, qc], dg[lo:, dc]])
         buf = block if tail is None else np.vstack([tail, block])
         # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
         out = aa.apply(buf)
         take = min(len(out), n_rec - m0)
         if take > 0:
-            q_out[m0:m0 + take] = out[:take, :n]
-            d_out[m0:m0 + take] = out[:take, n:]
+            q_out[m0:m0 + take, qc] = out[:take, :qc.size]
+            d_out[m0:m0 + take, dc] = out[:take, qc.size:]
             m0 += take
         tail = buf[take * k:]
     stats.update(runner.stats())
@@ -217,7 +250,7 @@ def _compile_seconds():
 def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
              scheme="ode3", slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
              profile=None, faults=(), progress=None, loads=None, friction_table=None,
-             damping_table=None, losses=None):
+             damping_table=None, losses=None, record=None):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -279,6 +312,12 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         run's ``meta["losses"]`` then holds the quasi-static breakdown by source and, at
         constant speed, the run's own power balance (:func:`cmsim.losses.power_balance`).
         Not with ``loads`` or ``friction_table``.
+    record : sequence of str, optional
+        The signals the run keeps (default: all of them): DOFs (``x_1b1``, ``theta_1G1``,
+        …), forces (``F_1b1_x``, ``F_1b1_loa``, ``Fmesh_0``, ``Fmesh_total``), ``dte``,
+        ``dte_um``. Only the columns they need are anti-alias filtered, so a dataset that
+        keeps a few channels does not pay for filtering all of them; the dynamics are the
+        same. A run with ``losses`` then has no power balance (it needs every DOF).
     progress : callable, optional
         Called as ``progress(done_s, total_s)`` (simulated seconds, warm-up included) as the
         integration advances, in chunks that do not change the result.
@@ -340,6 +379,7 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
                         profile=kprof, faults=faults, loads=loads,
                         friction_table=friction_table, damping_table=damping_table)
     n = model.n_dof
+    wanted, q_cols, d_cols = _recorded(model, record)
     q0, start_method = initial_state(model, 0.0)
     y0 = np.concatenate([q0, np.zeros(n)])
     dt = 1.0 / fs_hz
@@ -367,9 +407,11 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         report = None if progress is None else (lambda done, total: progress(
             done * dt / substeps, total * dt / substeps))
         states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme,
-                                                  stats, report)
+                                                  stats, report, q_cols, d_cols)
     t = (n_warm + np.arange(n_rec)) * dt
     signals = _signals(model, t, states, diag, kprof)
+    if wanted is not None:
+        signals = {k: v for k, v in signals.items() if k in wanted}
     meta = {
         "cmsim_version": cmsim.__version__,
         "rig": rig.to_dict(),
@@ -400,9 +442,11 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         "initial_state": q0.tolist(), "initial_state_method": start_method,
     }
     run = Run(t, signals, meta)
+    if wanted is not None:
+        run = run.with_meta(recorded=sorted(wanted))
     if loss_inputs is not None:
         info = loss_inputs.to_dict()
-        info["balance"] = None if kprof is not None else power_balance(
+        info["balance"] = None if kprof is not None or wanted is not None else power_balance(
             run, loads, friction_table, model.mesh_table).to_dict()
         run = run.with_meta(losses=info)
     return run
