@@ -786,7 +786,8 @@ def _cmd_compare(args):
 
     rig = _load_file("--rig", args.rig, _rig_loader(), "a rig TOML file") if args.rig else None
     record = read_record(args.record, channel=args.channel, rig=rig)
-    res = compare(record, budget=args.budget, seed=args.seed)
+    kw = {} if args.budget is None else {"budget": args.budget}
+    res = compare(record, seed=args.seed, **kw)
     out = res.to_dict()
     out["report"] = str(write_report(res, args.report)) if args.report else None
     return out
@@ -830,8 +831,9 @@ def _add_compare(sub):
     p.add_argument("--rig", metavar="FILE.toml",
                    help="model rig (default: built from metadata.json geometry)")
     p.add_argument("--report", type=Path, metavar="DIR", help="write DIR/compare.html")
-    p.add_argument("--budget", type=int, default=48, metavar="N",
-                   help="most simulations (default 48)")
+    p.add_argument("--budget", type=int, default=None, metavar="N",
+                   help="most simulations: ranking, fit and held-out re-simulations "
+                        "(default 140, at least 10)")
     p.add_argument("--seed", type=int, default=0, help="seed of the model simulations")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.set_defaults(func=_cmd_compare, text=_text_compare)
@@ -1051,7 +1053,7 @@ _RANGES = {
     "ramp_to_rpm": (float, 0.0, 1.0e5, True, False, "rpm"),
     "ramp_s": (float, 0.0, 1.0e5, True, False, "s"),
     "ramp_start_s": (float, 0.0, 1.0e5, False, False, "s"),
-    "budget": (int, 4, 1000, False, False, ""),
+    "budget": (int, 10, 10000, False, False, ""),
     "air_pressure_pa": (float, 0.0, 1.0e7, True, False, "Pa"),
     "air_temperature_c": (float, -100.0, 500.0, False, False, "C"),
     "oil_jet_kg_s": (float, 0.0, 100.0, False, False, "kg/s"),

@@ -55,8 +55,9 @@ from cmsim.spectra.tsa import time_synchronous_average
 from cmsim.spectra.waterfall import harmonic_amplitudes
 
 __all__ = ["FeatureRow", "LabelledLine", "extract_features", "run_features", "gmf_levels",
-           "statistics", "N_GMF_HARMONICS", "SIDEBAND_ORDERS", "N_ENVELOPE_HARMONICS",
-           "ENVELOPE_FAMILIES", "MIN_SIDEBAND_BINS"]
+           "statistics", "relative_features", "N_GMF_HARMONICS", "SIDEBAND_ORDERS",
+           "N_ENVELOPE_HARMONICS", "ENVELOPE_FAMILIES", "MIN_SIDEBAND_BINS", "N_SHAPE_BANDS",
+           "LINE_TOLERANCE"]
 
 #: GMF harmonics measured (1..6).
 N_GMF_HARMONICS = 6
@@ -74,6 +75,14 @@ ENVELOPE_FAMILIES = ("bpfo", "bpfi", "bsf", "ftf")
 #: Least sideband offset, in spectrum bins, for a sideband to be read (a flat-top main lobe
 #: spans about ±2.5 bins and the reading window ±1.5 bins).
 MIN_SIDEBAND_BINS = 5.0
+
+#: Bands of the spectral-shape columns of :func:`relative_features` (3 log-spaced up to
+#: 0.05·fs, then linear to fs/2).
+N_SHAPE_BANDS = 12
+
+#: Relative tolerance on a line's frequency in :func:`relative_features` (a bearing's 1-2 %
+#: slip, a slightly wrong speed); the line is the largest bin within ±(tolerance + 1.5 bins).
+LINE_TOLERANCE = 0.02
 
 
 @dataclass(frozen=True)
@@ -388,3 +397,162 @@ def run_features(run, channel, *, freqs=None, bearing=None, **kwargs):
     if bearing is None and freqs.bearings:
         bearing = signal_bearing(channel, freqs.bearing_names)
     return extract_features(run[channel], run.fs_hz, freqs, bearing=bearing, **kwargs)
+
+
+# ---------------------------------------------------------------------- scale-free features
+def _hann_spectrum(x, fs):
+    win = np.hanning(x.size)
+    amp = np.abs(np.fft.rfft((x - x.mean()) * win)) * 2.0 / win.sum()
+    return np.fft.rfftfreq(x.size, 1.0 / fs), amp
+
+
+def _peak(freq, amp, f, df):
+    """Largest bin within f·(1 ± LINE_TOLERANCE) ± 1.5 bins (NaN outside the spectrum)."""
+    half = LINE_TOLERANCE * f + 1.5 * df
+    sel = (freq >= f - half) & (freq <= f + half)
+    if f <= 0 or not np.any(sel):
+        return math.nan
+    return float(np.max(amp[sel]))
+
+
+def _band_excess(freq, amp, f, df, floor):
+    """Power in f·(1 ± LINE_TOLERANCE) ± 1.5 bins over what the local floor puts there:
+    a line smeared by slip or a speed fluctuation keeps its energy (unlike a line that is
+    gone, or drowned in noise)."""
+    half = LINE_TOLERANCE * f + 1.5 * df
+    sel = (freq >= f - half) & (freq <= f + half)
+    if f <= 0 or not np.any(sel) or not floor > 0:
+        return math.nan
+    return float(np.sum(amp[sel] ** 2) / (np.count_nonzero(sel) * floor ** 2))
+
+
+def _db(a, ref):
+    if not (math.isfinite(a) and ref > 0):
+        return math.nan
+    return 20.0 * math.log10(max(a, 1e-30 * ref) / ref)
+
+
+def _shape_bands(freq, power, fs, df):
+    edges = np.concatenate([np.geomspace(max(20.0, 2 * df), 0.05 * fs, 4)[:-1],
+                            np.linspace(0.05 * fs, 0.5 * fs, N_SHAPE_BANDS - 2)])
+    total = power[freq >= edges[0]].sum()
+    return {f"shape_b{i}_db": 10.0 * math.log10(max(
+        power[(freq >= edges[i]) & (freq < edges[i + 1])].sum() / total, 1e-12))
+        for i in range(len(edges) - 1)}
+
+
+def relative_features(signal, fs_hz, freqs, bearings=None):
+    """Features that compare a model with a measurement whose absolute scale is unknown.
+
+    Every column is a ratio (dB) or a shape statistic, never an absolute level, so an
+    unknown sensor gain, unit or transfer-path gain drops out (the measured-data loop of
+    :mod:`cmsim.discrepancy` compares these):
+
+    * ``kurtosis_log``, ``crest_log``: natural log of the kurtosis and crest factor;
+    * ``shape_b{i}_db``: share of the spectrum's energy in each of :data:`N_SHAPE_BANDS`
+      bands (the spectral shape after the transfer path), dB;
+    * ``raw_fr_h1_db``, ``raw_fr_h2_db``: shaft lines of the amplitude spectrum over its
+      median level, dB; per bearing b, ``raw_bpfo_{b}_db`` (the ball-pass line of a fixed
+      outer ring: varying compliance, an outer-race defect) and ``raw_bpfo_{b}_band_db``,
+      the power around it over the floor's (a line smeared by slip keeps it);
+    * envelope spectrum (band: the kurtogram's best, wide enough for the highest defect
+      fundamental of the bearings) over its median level, dB: ``env_fr_h1_db``; per bearing
+      b, ``env_{bpfo|bpfi|bsf2}_{b}_h{1|2}_db`` (bsf2 = 2·BSF, a ball defect hitting both
+      races), ``env_ftf_{b}_db``, ``env_bpfi_{b}_sb_db`` (BPFI ± shaft rate), ``env_bpfo_{b}_sb_db``
+      (BPFO and 2·BPFO ± shaft rate: a once-per-rev speed or load modulation) and
+      ``env_bpfo_{b}_band_db``;
+    * gear rigs: ``gmf{k}_rel_db`` (k = 1..4, relative to the largest), ``sb_fr1_db``,
+      ``sb_fr2_db`` (±1 shaft-rate sidebands of GMF harmonics 1-3 re their carriers, dB)
+      and ``tsa_residual_kurtosis_log``, from :func:`extract_features`.
+
+    Lines are the largest bin within ±(:data:`LINE_TOLERANCE` relative + 1.5 bins) of the
+    nominal frequency (Hann window).
+
+    Parameters
+    ----------
+    signal : array_like, shape (n,)
+        Segment, any unit.
+    fs_hz : float
+        Sample rate, Hz.
+    freqs : RigFrequencies
+        Frequencies of the rig at the record's speed.
+    bearings : sequence of str, optional
+        Bearings whose families are read (default all of ``freqs``).
+
+    Returns
+    -------
+    dict of str to float
+        NaN where a line lies outside the spectrum.
+    """
+    x = signal_1d(signal, "signal")
+    fs = sampling_rate(fs_hz, "fs_hz")
+    x = x - x.mean()
+    names = list(freqs.bearing_names) if bearings is None else list(bearings)
+    bfs = {b: freqs.bearing(b) for b in names}
+    out = {}
+    _, kurt, crest = statistics(x)
+    out["kurtosis_log"] = math.log(max(kurt, 1e-3))
+    out["crest_log"] = math.log(max(crest, 1e-3))
+    freq, amp = _hann_spectrum(x, fs)
+    df = freq[1]
+    out.update(_shape_bands(freq, amp ** 2, fs, df))
+    fr = freqs.fr1_hz
+    top = max([bf.bpfi_hz for bf in bfs.values()] + [4.0 * fr])
+    sel = (freq >= 0.5 * fr) & (freq <= min(fs / 2, 20 * top))
+    floor = float(np.median(amp[sel]))
+    out["raw_fr_h1_db"] = _db(_peak(freq, amp, fr, df), floor)
+    out["raw_fr_h2_db"] = _db(_peak(freq, amp, 2 * fr, df), floor)
+    for b, bf in bfs.items():
+        out[f"raw_bpfo_{b}_db"] = _db(_peak(freq, amp, bf.bpfo_hz, df), floor)
+        e = _band_excess(freq, amp, bf.bpfo_hz, df, floor)
+        out[f"raw_bpfo_{b}_band_db"] = 10.0 * math.log10(max(e, 1e-6)) if e == e else e
+    if bfs:
+        f_max = max(max(bf.bpfo_hz, bf.bpfi_hz, 2 * bf.bsf_hz) for bf in bfs.values())
+        try:
+            lo_b, hi_b = kurtogram(x, fs, max_fault_hz=f_max).band_hz
+        except ParameterError:
+            lo_b, hi_b = 0.05 * fs, 0.45 * fs
+        if hi_b - lo_b < 0.02 * fs:             # a very narrow band: ill-conditioned filter
+            mid = 0.5 * (lo_b + hi_b)
+            lo_b, hi_b = max(mid - 0.01 * fs, 1.0), min(mid + 0.01 * fs, 0.49 * fs)
+        try:
+            ef, ea = envelope_spectrum(x, fs, (lo_b, hi_b), window="hann")
+        except (ParameterError, np.linalg.LinAlgError, ValueError):
+            ef, ea = envelope_spectrum(x, fs, (0.05 * fs, 0.45 * fs), window="hann")
+        edf = ef[1]
+        top_e = max(bf.bpfi_hz for bf in bfs.values())
+        esel = (ef >= 0.5 * fr) & (ef <= 4.0 * top_e)
+        efloor = float(np.median(ea[esel])) if np.any(esel) else 1.0
+        out["env_fr_h1_db"] = _db(_peak(ef, ea, fr, edf), efloor)
+        for b, bf in bfs.items():
+            for fam, f in (("bpfo", bf.bpfo_hz), ("bpfi", bf.bpfi_hz), ("bsf2", 2 * bf.bsf_hz)):
+                for h in (1, 2):
+                    out[f"env_{fam}_{b}_h{h}_db"] = _db(_peak(ef, ea, h * f, edf), efloor)
+            out[f"env_ftf_{b}_db"] = _db(_peak(ef, ea, bf.ftf_hz, edf), efloor)
+            sb = [_peak(ef, ea, bf.bpfi_hz + s * fr, edf) for s in (-1, 1)]
+            out[f"env_bpfi_{b}_sb_db"] = _db(float(np.nanmean(sb)), efloor)
+            sb = [_peak(ef, ea, h * bf.bpfo_hz + s * fr, edf) for h in (1, 2) for s in (-1, 1)]
+            out[f"env_bpfo_{b}_sb_db"] = _db(float(np.nanmean(sb)), efloor)
+            e = _band_excess(ef, ea, bf.bpfo_hz, edf, efloor)
+            out[f"env_bpfo_{b}_band_db"] = 10.0 * math.log10(max(e, 1e-6)) if e == e else e
+    if freqs.gmf_hz is not None:
+        row = extract_features(x, fs, freqs, bearing=names[0] if names else None,
+                               envelope=False, n_gmf_harmonics=4)
+        d = row.to_dict()
+        g = np.array([d[f"gmf{k}_amp"] for k in range(1, 5)], dtype=float)
+        gmax = np.nanmax(g) if np.any(np.isfinite(g)) else math.nan
+        for k in range(1, 5):
+            out[f"gmf{k}_rel_db"] = _db(g[k - 1], gmax)
+        for rate in ("fr1", "fr2"):
+            vals = []
+            for k in range(1, 4):
+                c = d[f"gmf{k}_amp"]
+                for side in ("m1", "p1"):
+                    v = d.get(f"gmf{k}_sb_{rate}_{side}", math.nan)
+                    if math.isfinite(v) and math.isfinite(c) and c > 0:
+                        vals.append(20 * math.log10(max(v, 1e-30) / c))
+            out[f"sb_{rate}_db"] = float(np.mean(vals)) if vals else math.nan
+        tk = row.tsa_residual_kurtosis
+        out["tsa_residual_kurtosis_log"] = math.log(tk) if math.isfinite(tk) and tk > 0 \
+            else math.nan
+    return out

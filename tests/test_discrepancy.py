@@ -17,10 +17,11 @@ import pytest
 
 from cmsim.discrepancy import CAUSES, Cause, compare, read_record, register_cause
 from cmsim.discrepancy.causes import applicable_causes
-from cmsim.discrepancy.features import segment_features
+from cmsim.discrepancy.compare import DEFAULT_BUDGET, MIN_DELTA_CHI2
 from cmsim.discrepancy.records import RECORDING_KEYS, estimate_shaft_hz
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
 from cmsim.errors import ParameterError
+from cmsim.features import relative_features
 from cmsim.frequencies import RigFrequencies
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "datasets"
@@ -55,9 +56,12 @@ def test_catalogue_holds_the_issue_causes():
     assert set(REQUIRED) <= set(CAUSES)
     for name in REQUIRED:
         c = CAUSES[name]()
-        lo, hi = c.bounds
-        assert 0 < lo < hi
-        assert all(lo <= p <= hi for p in c.probes)
+        for p in c.params:
+            lo, hi = p.bounds
+            assert 0 < lo < hi, (name, p.name)
+            assert all(lo <= v <= hi for v in p.probes), (name, p.name)
+            assert lo <= p.middle() <= hi
+        assert c.post_dynamics or all(p.probes for p in c.params), name
     names = {c.name for c in applicable_causes(cwru_like_rig())}
     assert "bearing_outer_race" in names and "eccentricity" not in names
 
@@ -85,8 +89,8 @@ def test_features_do_not_depend_on_scale():
     t = np.arange(6000) / fs
     x = np.sin(2 * np.pi * 30 * t) + 0.3 * rng.standard_normal(t.size)
     freqs = RigFrequencies.of(cwru_like_rig(), __import__("cmsim").OperatingPoint(1800.0))
-    a = segment_features(x, fs, freqs, "1b1")
-    b = segment_features(1234.5 * x, fs, freqs, "1b1")
+    a = relative_features(x, fs, freqs, ["1b1"])
+    b = relative_features(1234.5 * x, fs, freqs, ["1b1"])
     assert a.keys() == b.keys()
     for k in a:
         assert a[k] == pytest.approx(b[k], abs=1e-6), k
@@ -158,20 +162,22 @@ def test_reader_csv_wav_and_errors(tmp_path, monkeypatch):
         read_record(bare / "x.npz")
 
 
-def _hidden(effect, seed):
+def _hidden(effect, seed, sim_seed=0):
+    """A hidden-effect record and its comparison (the seeds of bench_compare.py's seed
+    ``seed - 1000``, so a test row is a benchmark row)."""
     h = hidden_effect_record(effect, seed)
-    return h, compare(h.record, seed=seed, budget=36)
+    return h, compare(h.record, seed=sim_seed)
 
 
 def test_inner_race_is_found_sized_and_the_gain_is_positive():
     h, c = _hidden("bearing_inner_race", 1000)
     assert c.finding == "bearing_inner_race"
-    assert c.component == "1b1"
+    assert c.component == h.component
     fitted = c.parameters["size_m"]
     assert abs(math.log(fitted / h.value)) <= math.log(SEVERITY_FACTOR)
     assert c.gain["relative"] > 0.3
     assert c.gain["after"] < c.gain["before"]
-    assert c.simulations <= 36
+    assert c.simulations <= DEFAULT_BUDGET
     d = c.to_dict()
     for key in ("discrepancies", "causes", "finding", "gain", "simulations", "wall_s"):
         assert key in d
@@ -185,16 +191,25 @@ def test_clean_record_reports_no_discrepancy():
     h, c = _hidden(None, 1000)
     assert c.finding == "none"
     assert c.parameters == {}
+    assert c.causes[0]["delta_chi2"] < MIN_DELTA_CHI2
+
+
+#: Effects named in every seed of the benchmark (benchmarks/bench_compare.py, 4 seeds), with
+#: the factor within which their severity is recovered there (None: not identifiable beyond
+#: a threshold, see docs/validation.md).
+NAMED = {"bearing_outer_race": 2.0, "bearing_ball": 2.0, "clearance": 2.0,
+         "transfer_path": 2.0, "noise": 2.0, "rolling_slip": 2.0, "preload": None}
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("effect", ["bearing_outer_race", "bearing_ball", "noise",
-                                    "rolling_slip", "speed_fluctuation"])
-@pytest.mark.xfail(reason='issue 12: hidden-effect accuracy below target (see closing note)', strict=False)
+@pytest.mark.parametrize("effect", sorted(NAMED))
 def test_hidden_effect_is_named(effect):
     h, c = _hidden(effect, 1000)
     assert c.finding == effect
-    assert c.gain["relative"] > 0.0
+    assert c.gain["relative"] > 0.3
+    if NAMED[effect] is not None:
+        fitted = c.parameters[CAUSES[effect]().params[0].name]
+        assert abs(math.log(fitted / h.value)) <= math.log(NAMED[effect])
 
 
 @pytest.mark.slow
@@ -246,3 +261,41 @@ def test_real_record_reads_with_documented_geometry():
         assert "fs_hz" in g.inferred
         # the metadata's own reading of the spectra: fs ~ 12.97 kHz if the input is at 30 Hz
         assert g.fs_hz == pytest.approx(12970.0, rel=0.02)
+
+
+def test_friction_cause_is_the_mixed_lubrication_model():
+    """Issue 13: the ``friction`` extension is parameterised by the composite roughness and
+    the oil viscosity, and the dynamics' tooth friction follows them through the film ratio
+    (rougher → more asperity friction; more viscous oil → thicker film → less)."""
+    from cmsim import OperatingPoint, Rig
+    from cmsim.discrepancy.causes import ModelSetup
+    from cmsim.losses import LossSettings, run_losses
+    from cmsim.mesh_stiffness.table import MeshStiffnessTable
+
+    cause = CAUSES["friction"]()
+    assert [p.name for p in cause.params] == ["roughness_m", "viscosity_pa_s"]
+    rig, op = Rig.paper_2016(), OperatingPoint(1000.0, 50.0)
+    base = ModelSetup(rig=rig, op=op)
+    table = MeshStiffnessTable.potential_energy(rig.gears)
+
+    def mean_mu(roughness, viscosity):
+        st = cause.extend(base, {"roughness_m": roughness, "viscosity_pa_s": viscosity}, None)
+        assert st.mixed_friction and st.rig.lubricant.surface_roughness_m == roughness
+        mu = run_losses(st.rig, st.op, table, LossSettings()).friction_table
+        return float(np.mean(mu[mu > 0]))
+
+    eta = rig.lubricant.dynamic_viscosity_pa_s
+    smooth, rough = mean_mu(1e-7, eta), mean_mu(2e-6, eta)
+    assert rough > 1.1 * smooth
+    assert mean_mu(2e-6, 5 * eta) < rough
+    assert base.dynamics_key() != cause.extend(base, {"roughness_m": 2e-6,
+                                                      "viscosity_pa_s": eta}, None).dynamics_key()
+
+
+def test_hidden_effect_is_applied_at_its_drawn_severity():
+    """The generator really puts the drawn value in the record (a hidden noise ratio of
+    0.8-3 raises the RMS over the clean record's)."""
+    clean = hidden_effect_record(None, 77).record.signal
+    h = hidden_effect_record("noise", 77)
+    assert 0.8 <= h.value <= 3.0
+    assert np.std(h.record.signal) > math.sqrt(1.0 + 0.5 * h.value ** 2) * np.std(clean)

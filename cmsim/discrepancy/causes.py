@@ -15,6 +15,14 @@ A cause is one small class: a catalogue ``name``, the ``parameter`` it fits with
         def apply(self, setup, value, component):
             return setup.with_faults(TorqueRipple(relative_amplitude=value, order=2.0))
 
+A cause with several parameters lists them as :class:`Param` in ``params`` and its
+``apply`` receives a dict of values (``friction``: roughness and oil viscosity).
+
+Two causes act after the dynamics, on the measurement chain: ``transfer_path`` (the housing
+modes' frequencies) and ``noise`` (sensor and background noise). They are *nuisances* as well:
+:mod:`cmsim.discrepancy.compare` refits them for every simulated setup within a prior range
+(:data:`NUISANCES`), and names them only when the record needs them far outside it.
+
 Layering: imports :mod:`cmsim.faults` and :mod:`cmsim.rig` only.
 """
 
@@ -28,10 +36,10 @@ from cmsim.faults import (BallDefect, Eccentricity, InnerRaceDefect, OuterRaceDe
                           RollingSlip, SpeedFluctuation, ToothBreakage)
 from cmsim.rig import HousingPath, OperatingPoint, Rig
 
-__all__ = ["ModelSetup", "Cause", "CAUSES", "register_cause", "applicable_causes",
-           "NOMINAL_NOISE_RATIO"]
+__all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
+           "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO", "clamp"]
 
-#: Sensor noise of the nominal model, as a fraction of the simulated signal's RMS.
+#: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
 NOMINAL_NOISE_RATIO = 0.1
 
 
@@ -48,7 +56,10 @@ class ModelSetup:
     housing : HousingPath
         Transfer path from bearing forces to the sensor.
     noise_ratio : float
-        Sensor noise RMS relative to the simulated signal's RMS.
+        Sensor noise RMS relative to the healthy nominal model signal's RMS.
+    mixed_friction : bool
+        Tooth friction from the mixed-lubrication film of the rig's lubricant (roughness,
+        viscosity; ``simulate(losses=...)``) instead of the rig's constant coefficient.
     """
 
     rig: Rig
@@ -56,10 +67,74 @@ class ModelSetup:
     faults: tuple = ()
     housing: HousingPath = HousingPath()
     noise_ratio: float = NOMINAL_NOISE_RATIO
+    mixed_friction: bool = False
 
     def with_faults(self, *faults):
         """Same setup with ``faults`` added."""
         return replace(self, faults=self.faults + tuple(faults))
+
+    def dynamics_key(self):
+        """What the simulated forces depend on (not the housing path nor the noise)."""
+        return repr(replace(self, housing=None, noise_ratio=0.0))
+
+
+@dataclass(frozen=True)
+class Param:
+    """One fitted parameter of a cause.
+
+    Attributes
+    ----------
+    name : str
+        Parameter name (SI unit in it).
+    bounds : tuple of float
+        (lo, hi), lo > 0 for a log-scale parameter.
+    probes : tuple of float
+        Values simulated when ranking (the other parameters at their ``default``).
+    log_scale : bool
+        Fit in log(value).
+    default : float or None
+        Value while another parameter is probed (default: the geometric middle).
+    """
+
+    name: str
+    bounds: tuple
+    probes: tuple
+    log_scale: bool = True
+    default: float | None = None
+
+    def middle(self):
+        """``default``, else the geometric (log scale) or arithmetic middle of the bounds."""
+        if self.default is not None:
+            return float(self.default)
+        lo, hi = self.bounds
+        return math.sqrt(lo * hi) if self.log_scale else 0.5 * (lo + hi)
+
+    def clamp(self, value):
+        """``value`` clipped into the bounds."""
+        lo, hi = self.bounds
+        return float(min(max(value, lo), hi))
+
+
+@dataclass(frozen=True)
+class Nuisance:
+    """A measurement-chain parameter refitted for every setup within its prior range.
+
+    Attributes
+    ----------
+    name : str
+        The cause it becomes when released (``transfer_path``, ``noise``).
+    nominal : float
+        Value of the nominal model.
+    prior : tuple of float
+        (lo, hi) allowed without naming the cause (what an uncalibrated chain may differ by).
+    grid : tuple of float
+        Values tried when the nuisance is released (log spaced over the cause's bounds).
+    """
+
+    name: str
+    nominal: float
+    prior: tuple
+    grid: tuple
 
 
 class Cause:
@@ -67,7 +142,7 @@ class Cause:
 
     #: Catalogue name.
     name: typing.ClassVar[str] = ""
-    #: Fitted parameter (SI unit in its name).
+    #: Fitted parameter (SI unit in its name) of a one-parameter cause.
     parameter: typing.ClassVar[str] = ""
     #: (lo, hi) of the parameter.
     bounds: typing.ClassVar[tuple] = (0.0, 1.0)
@@ -79,11 +154,24 @@ class Cause:
     kind: typing.ClassVar[str | None] = None
     #: Needs gears.
     needs_gears: typing.ClassVar[bool] = False
+    #: Acts after the dynamics (transfer path, noise): no simulation of its own.
+    post_dynamics: typing.ClassVar[bool] = False
+
+    @property
+    def params(self):
+        """The fitted parameters (a one-parameter cause: from ``parameter``/``bounds``/
+        ``probes``/``log_scale``)."""
+        return (Param(self.parameter, tuple(self.bounds), tuple(self.probes),
+                      self.log_scale),)
 
     def components(self, rig, sensor_bearing):
-        """Components this cause may sit on (``[None]`` for a rig-wide cause)."""
+        """Components this cause may sit on (``[None]`` for a rig-wide cause): every bearing
+        of a bearing rig, the sensor's shaft's bearings on a gear rig, either gear."""
         if self.kind == "bearing":
-            return [sensor_bearing]
+            if rig.gears is None:
+                return list(rig.bearing_names)
+            shaft = sensor_bearing[0]
+            return [b for b in rig.bearing_names if b[0] == shaft]
         if self.kind == "gear":
             return ["1G1", "2G1"]
         return [None]
@@ -93,8 +181,29 @@ class Cause:
         return rig.gears is not None or not self.needs_gears
 
     def apply(self, setup, value, component):
-        """The setup extended by this cause at ``value`` on ``component``."""
+        """The setup extended by this cause at ``value`` on ``component`` (a dict of values
+        for a several-parameter cause)."""
         raise NotImplementedError
+
+    def extend(self, setup, values, component):
+        """:meth:`apply` with the parameter values as a dict.
+
+        Parameters
+        ----------
+        setup : ModelSetup
+            Setup to extend.
+        values : dict of str to float
+            Parameter name → value (a one-parameter cause's ``apply`` gets the float).
+        component : str or None
+            Component the cause sits on (a bearing or gear key; None rig-wide).
+
+        Returns
+        -------
+        ModelSetup
+        """
+        if len(self.params) == 1:
+            return self.apply(setup, values[self.params[0].name], component)
+        return self.apply(setup, dict(values), component)
 
 
 #: Registered causes, name → class.
@@ -112,6 +221,11 @@ def register_cause(cls):
 def applicable_causes(rig):
     """Instances of the registered causes that apply to ``rig``."""
     return [c() for c in CAUSES.values() if c().applies(rig)]
+
+
+def clamp(cause, value):
+    """``value`` clipped into the bounds of a one-parameter ``cause``."""
+    return cause.params[0].clamp(value)
 
 
 def _gear_index(component):
@@ -135,7 +249,7 @@ class EccentricityCause(Cause):
 
 @register_cause
 class ToothFaultCause(Cause):
-    """A broken (shortened) tooth."""
+    """A broken (shortened) tooth: a local tooth fault's once-per-rev event."""
     name = "tooth_fault"
     parameter = "lost_height_m"
     bounds = (1e-4, 3e-3)
@@ -152,15 +266,23 @@ class ToothFaultCause(Cause):
 
 @register_cause
 class FrictionCause(Cause):
-    """Tooth friction (coefficient)."""
+    """Tooth friction of the mixed-lubrication film (paper 004): the coefficient along the
+    path of contact follows the film ratio λ = h_min/σ of the rig's oil and surfaces, so the
+    fitted parameters are the composite roughness σ and the oil viscosity η0, not a bare
+    coefficient. Vibration sees them mainly through λ (σ and η0^0.7 trade off); the fit
+    reports both, the roughness fitted first at the rig's viscosity."""
     name = "friction"
-    parameter = "friction_coefficient"
-    bounds = (0.005, 0.2)
-    probes = (0.03, 0.08)
     needs_gears = True
+    params = (Param("roughness_m", (5e-8, 5e-6), (1e-7, 1.5e-6)),
+              Param("viscosity_pa_s", (5e-4, 0.2), (0.02,)))
 
-    def apply(self, setup, value, component):
-        return replace(setup, rig=setup.rig.with_friction(value))
+    def apply(self, setup, values, component):
+        lub = setup.rig.lubricant
+        lub = replace(lub, surface_roughness_m=values.get("roughness_m",
+                                                          lub.surface_roughness_m),
+                      dynamic_viscosity_pa_s=values.get("viscosity_pa_s",
+                                                        lub.dynamic_viscosity_pa_s))
+        return replace(setup, rig=replace(setup.rig, lubricant=lub), mixed_friction=True)
 
 
 # ---------------------------------------------------------------------- bearing defects
@@ -210,10 +332,6 @@ class RollingSlipCause(Cause):
         return setup.with_faults(RollingSlip(cage_speed_rms=value))
 
 
-def _with_clearance(rig, clearance_m):
-    return rig.with_clearance(clearance_m)
-
-
 @register_cause
 class ClearanceCause(Cause):
     """Larger radial clearance of every bearing."""
@@ -223,7 +341,7 @@ class ClearanceCause(Cause):
     probes = (2e-5, 5e-5)
 
     def apply(self, setup, value, component):
-        return replace(setup, rig=_with_clearance(setup.rig, value))
+        return replace(setup, rig=setup.rig.with_clearance(value))
 
 
 @register_cause
@@ -235,7 +353,7 @@ class PreloadCause(Cause):
     probes = (2e-6, 8e-6)
 
     def apply(self, setup, value, component):
-        return replace(setup, rig=_with_clearance(setup.rig, -value))
+        return replace(setup, rig=setup.rig.with_clearance(-value))
 
 
 @register_cause
@@ -244,7 +362,7 @@ class TorqueMismatchCause(Cause):
     name = "torque_mismatch"
     parameter = "load_factor"
     bounds = (0.15, 6.0)
-    probes = (0.4, 2.5)
+    probes = (0.3, 3.0)
 
     def apply(self, setup, value, component):
         op = setup.op
@@ -266,39 +384,46 @@ class SpeedFluctuationCause(Cause):
                                                   frequency_hz=setup.op.shaft_hz))
 
 
+# ---------------------------------------------------------------------- measurement chain
 @register_cause
 class TransferPathCause(Cause):
     """Housing modes at other frequencies than the model's (frequency scale factor)."""
     name = "transfer_path"
     parameter = "frequency_factor"
     bounds = (0.3, 3.0)
-    probes = (0.6, 1.6)
+    probes = ()
+    post_dynamics = True
 
     def apply(self, setup, value, component):
-        h = setup.housing
-        return replace(setup, housing=replace(
-            h, natural_frequencies_hz=tuple(f * value for f in h.natural_frequencies_hz)))
+        return replace(setup, housing=_scaled_path(setup.rig.housing, value))
 
 
 @register_cause
 class NoiseCause(Cause):
-    """Sensor/background noise other than the model's (RMS relative to the signal)."""
+    """Sensor/background noise other than the model's (RMS relative to the healthy signal)."""
     name = "noise"
     parameter = "noise_ratio"
     bounds = (0.005, 10.0)
-    probes = (0.02, 1.0)
+    probes = ()
+    post_dynamics = True
 
     def apply(self, setup, value, component):
         return replace(setup, noise_ratio=value)
 
 
-def clamp(cause, value):
-    """``value`` clipped into the cause's bounds."""
-    lo, hi = cause.bounds
-    return float(min(max(value, lo), hi))
+def _scaled_path(path, factor):
+    return replace(path, natural_frequencies_hz=tuple(f * factor
+                                                      for f in path.natural_frequencies_hz))
 
 
-def midpoint(cause):
-    """Geometric (log-scale causes) or arithmetic middle of the bounds."""
-    lo, hi = cause.bounds
-    return math.sqrt(lo * hi) if cause.log_scale else 0.5 * (lo + hi)
+#: The measurement-chain nuisances refitted for every setup: a housing whose modes sit within
+#: ±15 % of the model's and sensor noise within 3-30 % of the healthy signal are what an
+#: uncalibrated chain may differ by; beyond, the cause is named.
+NUISANCES = (
+    Nuisance("transfer_path", 1.0, (0.87, 1.15),
+             tuple(float(v) for v in (0.35, 0.45, 0.55, 0.66, 0.76, 0.87, 1.0, 1.15, 1.32,
+                                      1.52, 1.8, 2.2, 2.8))),
+    Nuisance("noise", NOMINAL_NOISE_RATIO, (0.03, 0.3),
+             tuple(float(v) for v in (0.01, 0.03, 0.06, 0.1, 0.18, 0.3, 0.55, 1.0, 1.8,
+                                      3.2, 6.0))),
+)

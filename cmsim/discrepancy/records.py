@@ -37,8 +37,9 @@ from cmsim.frequencies import RigFrequencies
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
 from cmsim.run import Run
 
-__all__ = ["MeasuredRecord", "read_record", "RECORDING_KEYS", "DEFAULT_ROTOR_MASS_KG",
-           "estimate_shaft_hz", "LBF_N"]
+__all__ = ["MeasuredRecord", "read_record", "record_from_run", "RECORDING_KEYS",
+           "DEFAULT_ROTOR_MASS_KG", "estimate_shaft_hz", "LBF_N", "unit_scale_of",
+           "ACCELERATION_UNITS"]
 
 #: Recording-entry keys the pipeline reads; everything else (the answer key) is ignored.
 RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_hz",
@@ -77,6 +78,9 @@ class MeasuredRecord:
         Quantity → ``{"value": …, "how": …}`` for what was inferred from the signal.
     path : str
         The signal file.
+    unit_scale : float or None
+        Factor from the channel's unit to m/s² (``g`` → 9.80665), or None when the unit is
+        not an acceleration unit cmsim knows: then only scale-free features are compared.
     """
 
     run: Run
@@ -87,6 +91,7 @@ class MeasuredRecord:
     components: dict = field(default_factory=dict)
     inferred: dict = field(default_factory=dict)
     path: str = ""
+    unit_scale: float | None = None
 
     @property
     def fs_hz(self):
@@ -415,11 +420,58 @@ def read_record(path, *, channel=None, rig=None):
                "inferred": inferred}, source="measured")
     return MeasuredRecord(run=run, channel=channel, rig=model_rig, op=op,
                           model_signal=model_signal, components=components,
-                          inferred=inferred, path=str(p))
+                          inferred=inferred, path=str(p),
+                          unit_scale=unit_scale_of((sensors.get(channel) or {}).get("unit")))
 
 
-def record_from_run(run, channel, rig, op, model_signal=None, components=None):
-    """A :class:`MeasuredRecord` from an in-memory measured run (the test generator's way)."""
+def record_from_run(run, channel, rig, op, model_signal=None, components=None,
+                    unit_scale=None):
+    """A :class:`MeasuredRecord` from an in-memory measured run (the test generator's way).
+
+    Parameters
+    ----------
+    run : Run
+        The measured signals.
+    channel : str
+        Channel compared.
+    rig : Rig
+        Model rig.
+    op : OperatingPoint
+        Operating point.
+    model_signal : str, optional
+        Model output of the channel (default: ``channel``).
+    components : dict, optional
+        Model component → dataset name (default: the rig's bearings by their own names).
+    unit_scale : float, optional
+        Factor from the channel's unit to m/s² (None: unknown unit).
+
+    Returns
+    -------
+    MeasuredRecord
+    """
     return MeasuredRecord(run=run, channel=channel, rig=rig, op=op,
                           model_signal=model_signal or channel,
-                          components=components or {b: b for b in rig.bearing_names})
+                          components=components or {b: b for b in rig.bearing_names},
+                          unit_scale=unit_scale)
+
+
+#: Accelerometer units cmsim converts to m/s² (the first word of a metadata ``unit``).
+ACCELERATION_UNITS = {"g": 9.80665, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0, "mm/s2": 1e-3,
+                      "mm/s^2": 1e-3}
+
+
+def unit_scale_of(unit):
+    """Factor from an accelerometer unit (``"g"``, ``"g (believed)"``, ``"m/s^2"``) to m/s²,
+    or None for anything else (volts, an unknown unit).
+
+    Parameters
+    ----------
+    unit : str or None
+
+    Returns
+    -------
+    float or None
+    """
+    if not isinstance(unit, str) or not unit.strip():
+        return None
+    return ACCELERATION_UNITS.get(unit.strip().split()[0].lower())
