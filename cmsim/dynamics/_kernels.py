@@ -301,21 +301,8 @@ def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b
         d = xr * co + yr * so - c + b_off[ib, i]
         if d <= 0.0:
             continue                   # a defect only takes overlap away: still unloaded
-        theta = cage_angle + b_ang[ib, i]
-        for r in range(d0, d0 + nd):
-            kind = int(b_def[r, DF_KIND])
-            if kind == DEF_OUTER:
-                u = dirn_cage * _wrap(theta - b_def[r, DF_CENTRE])
-            elif kind == DEF_INNER:
-                u = dirn_inner * _wrap(theta - shaft_angle - b_def[r, DF_CENTRE])
-            else:
-                if int(b_def[r, DF_BALL]) != i:
-                    continue
-                # both races: the spin phase modulo π
-                v = spin_angle - b_def[r, DF_CENTRE]
-                u = dirn_spin * (v - math.pi * math.floor(v / math.pi + 0.5))
-            d -= b_def[r, DF_DEPTH] * _defect_profile(u, b_def[r, DF_HALF], b_def[r, DF_ENTRY],
-                                                      b_def[r, DF_EXIT])
+        d -= _defect_loss(cage_angle + b_ang[ib, i], i, b_def, d0, nd, shaft_angle,
+                          spin_angle, dirn_cage, dirn_inner, dirn_spin)
         if d > 0.0:
             f = d * math.sqrt(d) if hertz else d ** p
             fx += f * co
