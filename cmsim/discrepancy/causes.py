@@ -37,7 +37,7 @@ from cmsim.faults import (BallDefect, Eccentricity, InnerRaceDefect, OuterRaceDe
 from cmsim.rig import HousingPath, OperatingPoint, Rig
 
 __all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
-           "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO", "clamp"]
+           "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO"]
 
 #: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
 NOMINAL_NOISE_RATIO = 0.1
@@ -221,11 +221,6 @@ def register_cause(cls):
 def applicable_causes(rig):
     """Instances of the registered causes that apply to ``rig``."""
     return [c() for c in CAUSES.values() if c().applies(rig)]
-
-
-def clamp(cause, value):
-    """``value`` clipped into the bounds of a one-parameter ``cause``."""
-    return cause.params[0].clamp(value)
 
 
 def _gear_index(component):

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from cmsim.discrepancy.causes import NUISANCES, ModelSetup, applicable_causes
+from cmsim.discrepancy.causes import CAUSES, NUISANCES, ModelSetup, applicable_causes
 from cmsim.discrepancy.features import feature_floor, record_features, segments
 from cmsim.dynamics import simulate
 from cmsim.errors import IntegrationDiverged, ParameterError
@@ -305,7 +305,6 @@ class _Nuisances:
 
     def __init__(self, ev, score, seeds):
         self.ev, self.score, self.seeds = ev, score, seeds
-        self.nominal_path = ev.record.rig.housing
 
     def grid(self, nuisance, released):
         if released:
@@ -313,11 +312,10 @@ class _Nuisances:
         lo, hi = nuisance.prior
         return tuple(v for v in nuisance.grid if lo <= v <= hi)
 
-    def set(self, setup, name, value):
-        if name == "transfer_path":
-            return replace(setup, housing=replace(self.nominal_path, natural_frequencies_hz=tuple(
-                value * f for f in self.nominal_path.natural_frequencies_hz)))
-        return replace(setup, noise_ratio=value)
+    @staticmethod
+    def set(setup, name, value):
+        """The setup with nuisance ``name`` at ``value`` (its catalogue cause applied)."""
+        return CAUSES[name]().apply(setup, value, None)
 
     @staticmethod
     def value(setup, nominal_path, name):
@@ -593,19 +591,3 @@ def _component_name(record, comp):
     if comp is None:
         return None
     return record.components.get(comp, comp)
-
-
-def with_setup(record, **changes):
-    """The record with its operating point fields replaced (helper for scripts).
-
-    Parameters
-    ----------
-    record : MeasuredRecord
-    **changes
-        OperatingPoint fields.
-
-    Returns
-    -------
-    MeasuredRecord
-    """
-    return replace(record, op=replace(record.op, **changes))
