@@ -41,6 +41,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.interpolate import CubicSpline
+from scipy.ndimage import uniform_filter1d
 
 from cmsim.errors import ParameterError
 from cmsim.frequencies import RigFrequencies
@@ -57,7 +59,8 @@ from cmsim.spectra.waterfall import harmonic_amplitudes
 __all__ = ["FeatureRow", "LabelledLine", "extract_features", "run_features", "gmf_levels",
            "statistics", "relative_features", "N_GMF_HARMONICS", "SIDEBAND_ORDERS",
            "N_ENVELOPE_HARMONICS", "ENVELOPE_FAMILIES", "MIN_SIDEBAND_BINS", "N_SHAPE_BANDS",
-           "LINE_TOLERANCE"]
+           "LINE_TOLERANCE", "N_SIDEBAND_HARMONICS", "SIDEBAND_HALF_WIDTH",
+           "MAX_SIDEBAND_ORDER"]
 
 #: GMF harmonics measured (1..6).
 N_GMF_HARMONICS = 6
@@ -83,6 +86,23 @@ N_SHAPE_BANDS = 12
 #: Relative tolerance on a line's frequency in :func:`relative_features` (a bearing's 1-2 %
 #: slip, a slightly wrong speed); the line is the largest bin within ±(tolerance + 1.5 bins).
 LINE_TOLERANCE = 0.02
+
+#: GMF harmonics whose shaft-rate sideband energies :func:`relative_features` reads.
+N_SIDEBAND_HARMONICS = 8
+
+#: Half width of a sideband energy band, in shaft rates (the bands of a carrier and its
+#: sidebands tile the spectrum around it).
+SIDEBAND_HALF_WIDTH = 0.5
+
+#: Highest shaft order k·Z at which sideband energies are read.
+MAX_SIDEBAND_ORDER = 150
+
+#: Highest shaft order of the line the mesh is tracked on (a wobble ε moves a line at order
+#: q by q·ε shaft rates; it must stay within the ±f_r/2 band: 0.2 % up to order 250).
+TRACK_MAX_ORDER = 200
+
+#: Least level of the tracked line over its neighbourhood's median bin, dB.
+TRACK_MIN_DB = 20.0
 
 
 @dataclass(frozen=True)
@@ -432,6 +452,106 @@ def _db(a, ref):
     return 20.0 * math.log10(max(a, 1e-30 * ref) / ref)
 
 
+def _sideband_energies(x, fs, freqs):
+    """Shaft-rate sideband energy of each GMF harmonic over its carrier's, dB.
+
+    The segment is first order-tracked on its own mesh (:func:`_mesh_tracked`), so a slow
+    speed wobble or a slightly wrong nominal speed does not smear the carriers into their
+    sidebands. Then, for each gear shaft (rate f_r, Z = GMF/f_r teeth) and GMF harmonic
+    k = 1..:data:`N_SIDEBAND_HARMONICS` with k·Z <= :data:`MAX_SIDEBAND_ORDER` and its third
+    sideband below 0.45·fs (NaN otherwise): ``sb1_{fr1|fr2}_k{k}_db`` = energy in the bands
+    k·GMF ± f_r over the energy in the band at k·GMF, and ``sb23_..._k{k}_db`` the same for
+    ± 2 f_r and ± 3 f_r. Each band is k·GMF + n·f_r ± :data:`SIDEBAND_HALF_WIDTH`·f_r: a
+    band, not a bin, so what the tracking leaves of a wobble stays in it, and the ratio of
+    two nearby bands drops the transfer path's gain. Eccentricity and a slow load modulation
+    raise the first sidebands; a local tooth fault spreads energy over many."""
+    y, scale = _mesh_tracked(x, fs, freqs)
+    freq, amp = _hann_spectrum(y, fs)
+    power = amp ** 2
+    gmf = freqs.gmf_hz * scale
+    out = {}
+    rates = [("fr1", freqs.fr1_hz * scale)]
+    if freqs.fr2_hz is not None:
+        rates.append(("fr2", freqs.fr2_hz * scale))
+    for name, fr in rates:
+        w = SIDEBAND_HALF_WIDTH * fr
+        for k in range(1, N_SIDEBAND_HARMONICS + 1):
+            fk = k * gmf
+            if fk / fr > MAX_SIDEBAND_ORDER + 0.5 or fk + 3.5 * fr > 0.45 * fs:
+                out[f"sb1_{name}_k{k}_db"] = out[f"sb23_{name}_k{k}_db"] = math.nan
+                continue
+            e = {n: float(np.sum(power[(freq >= fk + n * fr - w) & (freq < fk + n * fr + w)]))
+                 for n in (-3, -2, -1, 0, 1, 2, 3)}
+            c = e[0]
+            out[f"sb1_{name}_k{k}_db"] = _db_power(e[-1] + e[1], c)
+            out[f"sb23_{name}_k{k}_db"] = _db_power(e[-3] + e[-2] + e[2] + e[3], c)
+    return out
+
+
+def _mesh_tracked(x, fs, freqs):
+    """``x`` resampled at uniform mesh phase (computed order tracking without a tacho).
+
+    The reference is the strongest GMF harmonic up to shaft order :data:`TRACK_MAX_ORDER`:
+    demodulated to zero frequency and averaged over one revolution of each shaft, its phase
+    gives the mesh angle; the average nulls the shaft-rate sidebands, so only wobbles slower
+    than about f_r/2 are tracked out and the modulations under study stay in the signal. Without a line
+    :data:`TRACK_MIN_DB` above its neighbourhood the segment is returned as it is.
+
+    Returns
+    -------
+    (ndarray, float)
+        The resampled segment (same length and rate) and the measured mean speed over the
+        nominal one.
+    """
+    n = x.size
+    fr = min(f for f in (freqs.fr1_hz, freqs.fr2_hz) if f is not None)
+    spec = np.fft.fft(x)
+    f = np.fft.fftfreq(n, 1.0 / fs)
+    best = None
+    k = 1
+    while k * freqs.gmf_hz / freqs.fr1_hz <= TRACK_MAX_ORDER + 0.5 \
+            and k * freqs.gmf_hz + 3 * fr < 0.45 * fs:
+        fc = k * freqs.gmf_hz
+        band = np.abs(f - fc) < 0.5 * fr
+        near = (np.abs(f - fc) < 3.0 * fr) & ~band
+        if np.any(band) and np.any(near):
+            p = np.abs(spec[band]) ** 2
+            snr = 10 * math.log10(max(float(p.max()), 1e-300)
+                                  / max(float(np.median(np.abs(spec[near]) ** 2)), 1e-300))
+            if best is None or float(p.sum()) > best[2]:
+                best = (k, snr, float(p.sum()), band)
+        k += 1
+    if best is None or best[1] < TRACK_MIN_DB:
+        return x, 1.0
+    k = best[0]
+    fc = k * freqs.gmf_hz
+    t = np.arange(n) / fs
+    # complex demodulation, then a moving average over one revolution of each shaft: its
+    # zeros sit on every multiple of the shaft rates (the sidebands under study and the
+    # other mesh harmonics), while a wobble slower than f_r/2 passes
+    base = x * np.exp(-2j * math.pi * fc * t)
+    for rate in {freqs.fr1_hz, freqs.fr2_hz or freqs.fr1_hz}:
+        width = max(1, int(round(fs / rate)))
+        base = (uniform_filter1d(base.real, width, mode="nearest")
+                + 1j * uniform_filter1d(base.imag, width, mode="nearest"))
+    phase = np.unwrap(np.angle(base)) + 2 * math.pi * fc * t
+    if phase[-1] < phase[0]:
+        return x, 1.0
+    if np.any(np.diff(phase) <= 0.0):
+        return x, 1.0
+    # a cubic spline: linear interpolation at ~8 samples per period of a mesh harmonic
+    # would modulate it by ~6 % as the resampling delay slides through the samples
+    y = CubicSpline(phase, x)(np.linspace(phase[0], phase[-1], n))
+    scale = (phase[-1] - phase[0]) / (2 * math.pi * k * freqs.gmf_hz * (n - 1) / fs)
+    return y, scale
+
+
+def _db_power(p, ref):
+    if not (math.isfinite(p) and ref > 0):
+        return math.nan
+    return 10.0 * math.log10(max(p, 1e-30 * ref) / ref)
+
+
 def _shape_bands(freq, power, fs, df):
     edges = np.concatenate([np.geomspace(max(20.0, 2 * df), 0.05 * fs, 4)[:-1],
                             np.linspace(0.05 * fs, 0.5 * fs, N_SHAPE_BANDS - 2)])
@@ -461,9 +581,13 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
       races), ``env_ftf_{b}_db``, ``env_bpfi_{b}_sb_db`` (BPFI ± shaft rate), ``env_bpfo_{b}_sb_db``
       (BPFO and 2·BPFO ± shaft rate: a once-per-rev speed or load modulation) and
       ``env_bpfo_{b}_band_db``;
-    * gear rigs: ``gmf{k}_rel_db`` (k = 1..4, relative to the largest), ``sb_fr1_db``,
-      ``sb_fr2_db`` (±1 shaft-rate sidebands of GMF harmonics 1-3 re their carriers, dB)
-      and ``tsa_residual_kurtosis_log``, from :func:`extract_features`.
+    * gear rigs: ``gmf{k}_rel_db`` (k = 1..4, relative to the largest) and
+      ``tsa_residual_kurtosis_log`` from :func:`extract_features`; per gear shaft and GMF
+      harmonic k = 1..:data:`N_SIDEBAND_HARMONICS` (up to shaft order
+      :data:`MAX_SIDEBAND_ORDER`), ``sb1_{fr1|fr2}_k{k}_db`` and
+      ``sb23_{fr1|fr2}_k{k}_db``: energy of the ±1 and of the ±2, ±3 shaft-rate sidebands
+      over the carrier's (bands, robust to a small speed wobble; each harmonic its own
+      column, since the transfer path favours some and the noise floor hides others).
 
     Lines are the largest bin within ±(:data:`LINE_TOLERANCE` relative + 1.5 bins) of the
     nominal frequency (Hann window).
@@ -543,15 +667,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
         gmax = np.nanmax(g) if np.any(np.isfinite(g)) else math.nan
         for k in range(1, 5):
             out[f"gmf{k}_rel_db"] = _db(g[k - 1], gmax)
-        for rate in ("fr1", "fr2"):
-            vals = []
-            for k in range(1, 4):
-                c = d[f"gmf{k}_amp"]
-                for side in ("m1", "p1"):
-                    v = d.get(f"gmf{k}_sb_{rate}_{side}", math.nan)
-                    if math.isfinite(v) and math.isfinite(c) and c > 0:
-                        vals.append(20 * math.log10(max(v, 1e-30) / c))
-            out[f"sb_{rate}_db"] = float(np.mean(vals)) if vals else math.nan
+        out.update(_sideband_energies(x, fs, freqs))
         tk = row.tsa_residual_kurtosis
         out["tsa_residual_kurtosis_log"] = math.log(tk) if math.isfinite(tk) and tk > 0 \
             else math.nan

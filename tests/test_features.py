@@ -140,3 +140,32 @@ def test_run_features_takes_frequencies_and_bearing_from_the_run():
     assert "gmf1_sb_bpf_2b1_p1" in row.to_dict()
     with pytest.raises(TypeError):
         run_features(run, "F_2b1_loa", n_harmonic=3)
+
+
+def test_sideband_energies_read_an_amplitude_modulation_and_ignore_a_small_wobble():
+    """A carrier at each GMF harmonic amplitude-modulated at the shaft rate with index m:
+    sidebands of m/2 each, so sb1 = 10·log10(m²/2) dB; the ±2, ±3 bands hold only the
+    noise. A 0.2 % speed wobble at 1.3 Hz (it would smear the 5th harmonic over ±3.6 Hz,
+    into the sideband bands) is tracked out: sb1 within 1.5 dB up to order 140. Beyond
+    MAX_SIDEBAND_ORDER (150) no column is read."""
+    from cmsim.features import relative_features
+    fs, fr, z = 20000.0, 16.0, 28
+    freqs = RigFrequencies(fr1_hz=fr, fr2_hz=fr * z / 40, gmf_hz=z * fr, bearings={})
+    t = np.arange(int(0.5 * fs)) / fs
+    rng = np.random.default_rng(3)
+    m = {k: 0.02 * k for k in range(1, 9)}
+
+    def signal(wobble):
+        phase = 2 * np.pi * fr * (t - wobble / (2 * np.pi * 1.3) * np.cos(2 * np.pi * 1.3 * t))
+        x = sum((1 + m[k] * np.cos(phase)) * np.cos(k * z * phase + rng.uniform(0, 6))
+                for k in m)
+        return x + 1e-4 * rng.standard_normal(t.size)
+
+    clean, wobbly = (relative_features(signal(w), fs, freqs, []) for w in (0.0, 0.002))
+    assert all(math.isnan(clean[f"sb1_fr1_k{k}_db"]) for k in (6, 7, 8))       # 168+ orders
+    assert all(math.isnan(clean[f"sb1_fr2_k{k}_db"]) for k in (4, 5, 6, 7, 8))  # 160+
+    for k in range(1, 6):
+        expected = 10 * math.log10(m[k] ** 2 / 2)
+        assert clean[f"sb1_fr1_k{k}_db"] == pytest.approx(expected, abs=0.3), k
+        assert clean[f"sb23_fr1_k{k}_db"] < expected - 30, k
+        assert wobbly[f"sb1_fr1_k{k}_db"] == pytest.approx(expected, abs=1.5), k

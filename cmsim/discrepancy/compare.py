@@ -351,9 +351,10 @@ def _prepare(record, seg_s, max_segments):
     if F.shape[0] < 4:
         raise ParameterError(f"record of {duration:.3g} s gives {F.shape[0]} segments of "
                              f"{seg_s:g} s; needs >= 4", param="record")
-    # one column per distinct feature (the two shafts of a 1:1 gear rig read alike)
-    keep = [i for i in range(F.shape[1])
-            if not any(np.array_equal(F[:, i], F[:, j], equal_nan=True) for j in range(i))]
+    # one column per distinct feature (the two shafts of a 1:1 gear rig read alike), none
+    # that the record never reads (a sideband beyond the spectrum)
+    keep = [i for i in range(F.shape[1]) if np.isfinite(F[:, i]).any()
+            and not any(np.array_equal(F[:, i], F[:, j], equal_nan=True) for j in range(i))]
     names, F = [names[i] for i in keep], F[:, keep]
     if record.unit_scale is not None:
         lv = [20.0 * math.log10(max(float(np.std(x[a:b])) * record.unit_scale, 1e-30)
