@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -279,7 +280,9 @@ class _Evaluator:
         rows = [self.row(setup, s) for s in seeds]
         if any(r is None for r in rows):
             return None
-        return {k: float(np.nanmean([r[k] for r in rows])) for k in rows[0]}
+        with warnings.catch_warnings():          # a column NaN in every run stays NaN
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return {k: float(np.nanmean([r[k] for r in rows])) for k in rows[0]}
 
 
 def _weight(name):
