@@ -198,7 +198,8 @@ def test_clean_record_reports_no_discrepancy():
 #: the factor within which their severity is recovered there (None: not identifiable beyond
 #: a threshold, see docs/validation.md).
 NAMED = {"bearing_outer_race": 2.0, "bearing_ball": 2.0, "clearance": 2.0,
-         "transfer_path": 2.0, "noise": 2.0, "rolling_slip": 2.0, "preload": None}
+         "transfer_path": 2.0, "noise": 2.0, "rolling_slip": 2.0, "preload": None,
+         "speed_fluctuation": 2.0, "tooth_fault": None}
 
 
 @pytest.mark.slow
