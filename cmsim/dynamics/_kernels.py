@@ -280,36 +280,6 @@ def _defect_profile(u, half, entry, exit_):
     return min(1.0, a, b)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b_off, b_def,
-                      d0, nd, cage_angle, shaft_angle, spin_angle, dirn_cage, dirn_inner,
-                      dirn_spin):
-    """Eq. 9 ball by ball with defects and off-size balls (cage frame, as
-    :func:`cmsim.bearings._kernels.ball_forces_cage_frame_jit`).
-
-    Ball i's overlap is x_r cos φ_i + y_r sin φ_i − c + Δd_i − Σ depth·profile: an outer-race
-    defect is fixed in the housing (the ball's housing angle is θ_cage + φ_i), an inner-race
-    one turns with the shaft, a ball defect turns with the ball's spin and meets the outer
-    race at spin phase 0 and the inner race at π (Sawalhi & Randall 2008, MSSP 22).
-    """
-    fx = 0.0
-    fy = 0.0
-    hertz = p == 1.5
-    for i in range(n_balls):
-        co = ball_cos[ib, i]
-        so = ball_sin[ib, i]
-        d = xr * co + yr * so - c + b_off[ib, i]
-        if d <= 0.0:
-            continue                   # a defect only takes overlap away: still unloaded
-        d -= _defect_loss(cage_angle + b_ang[ib, i], i, b_def, d0, nd, shaft_angle,
-                          spin_angle, dirn_cage, dirn_inner, dirn_spin)
-        if d > 0.0:
-            f = d * math.sqrt(d) if hertz else d ** p
-            fx += f * co
-            fy += f * so
-    return k * fx, k * fy
-
-
 @njit(cache=True, inline="always", error_model="numpy")
 def _defect_loss(theta, i, b_def, d0, nd, shaft_angle, spin_angle, dirn_cage, dirn_inner,
                  dirn_spin):
