@@ -494,8 +494,10 @@ def _mesh_tracked(x, fs, freqs):
     The reference is the strongest GMF harmonic up to shaft order :data:`TRACK_MAX_ORDER`:
     demodulated to zero frequency and averaged over one revolution of each shaft, its phase
     gives the mesh angle; the average nulls the shaft-rate sidebands, so only wobbles slower
-    than about f_r/2 are tracked out and the modulations under study stay in the signal. Without a line
-    :data:`TRACK_MIN_DB` above its neighbourhood the segment is returned as it is.
+    than about f_r/2 are tracked out and the modulations under study stay in the signal.
+    Without a line :data:`TRACK_MIN_DB` above its neighbourhood the segment is returned as
+    it is. (:mod:`cmsim.spectra.order` resamples from a known speed or a tacho; here the
+    angle is read from the signal itself.)
 
     Returns
     -------
@@ -507,7 +509,7 @@ def _mesh_tracked(x, fs, freqs):
     fr = min(f for f in (freqs.fr1_hz, freqs.fr2_hz) if f is not None)
     spec = np.fft.fft(x)
     f = np.fft.fftfreq(n, 1.0 / fs)
-    best = None
+    best = None                                   # (energy, snr dB, k) of the strongest line
     k = 1
     while k * freqs.gmf_hz / freqs.fr1_hz <= TRACK_MAX_ORDER + 0.5 \
             and k * freqs.gmf_hz + 3 * fr < 0.45 * fs:
@@ -518,12 +520,12 @@ def _mesh_tracked(x, fs, freqs):
             p = np.abs(spec[band]) ** 2
             snr = 10 * math.log10(max(float(p.max()), 1e-300)
                                   / max(float(np.median(np.abs(spec[near]) ** 2)), 1e-300))
-            if best is None or float(p.sum()) > best[2]:
-                best = (k, snr, float(p.sum()), band)
+            if best is None or float(p.sum()) > best[0]:
+                best = (float(p.sum()), snr, k)
         k += 1
     if best is None or best[1] < TRACK_MIN_DB:
         return x, 1.0
-    k = best[0]
+    k = best[2]
     fc = k * freqs.gmf_hz
     t = np.arange(n) / fs
     # complex demodulation, then a moving average over one revolution of each shaft: its
@@ -535,12 +537,10 @@ def _mesh_tracked(x, fs, freqs):
         base = (uniform_filter1d(base.real, width, mode="nearest")
                 + 1j * uniform_filter1d(base.imag, width, mode="nearest"))
     phase = np.unwrap(np.angle(base)) + 2 * math.pi * fc * t
-    if phase[-1] < phase[0]:
+    if np.any(np.diff(phase) <= 0.0):             # noise, not a line: leave the segment
         return x, 1.0
-    if np.any(np.diff(phase) <= 0.0):
-        return x, 1.0
-    # a cubic spline: linear interpolation at ~8 samples per period of a mesh harmonic
-    # would modulate it by ~6 % as the resampling delay slides through the samples
+    # a cubic spline, as cmsim.spectra.order: linear interpolation at ~8 samples per period
+    # of a mesh harmonic would modulate it by ~6 % as the resampling delay slides by
     y = CubicSpline(phase, x)(np.linspace(phase[0], phase[-1], n))
     scale = (phase[-1] - phase[0]) / (2 * math.pi * k * freqs.gmf_hz * (n - 1) / fs)
     return y, scale

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from cmsim.features import (N_ENVELOPE_HARMONICS, N_GMF_HARMONICS, FeatureRow, extract_features,
-                            run_features, statistics)
+                            relative_features, run_features, statistics)
 from cmsim.frequencies import RigFrequencies, bearing_frequencies, rig_frequencies
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
@@ -148,7 +148,6 @@ def test_sideband_energies_read_an_amplitude_modulation_and_ignore_a_small_wobbl
     noise. A 0.2 % speed wobble at 1.3 Hz (it would smear the 5th harmonic over ±3.6 Hz,
     into the sideband bands) is tracked out: sb1 within 1.5 dB up to order 140. Beyond
     MAX_SIDEBAND_ORDER (150) no column is read."""
-    from cmsim.features import relative_features
     fs, fr, z = 20000.0, 16.0, 28
     freqs = RigFrequencies(fr1_hz=fr, fr2_hz=fr * z / 40, gmf_hz=z * fr, bearings={})
     t = np.arange(int(0.5 * fs)) / fs
