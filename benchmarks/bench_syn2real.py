@@ -1,6 +1,7 @@
 """Sim-to-real benchmark (issue 15): train on cmsim data only, test on the real CWRU and MFPT
 records of ../shared/datasets; mean ± std over seeds of the generation and training; the
-ablation (transfer-path randomisation, load zone, slip, defect edge profile removed in turn).
+ablation (transfer-path randomisation, load zone, slip, defect edge profile removed in turn;
+and a ball pit anywhere on the ball with a wandering spin axis added).
 
     python benchmarks/bench_syn2real.py [--seeds 10] [--records 160] [--ablation-seeds 3]
         [--mfpt-seeds 5] [--mfpt-records 60] [--workers 2] [--cache DIR] [--json OUT]
@@ -40,6 +41,13 @@ def ablate(data, variant):
     elif variant == "no_defect_profile":
         for t in d["faults"]["types"]:
             t.pop("exit_ramp_fraction", None)
+    elif variant == "spin_axis_wander":
+        # added physics, not a removal: the ball's pit anywhere on the ball (sine of its
+        # latitude uniform) and a wandering spin axis (correlation time 0.05-5 s)
+        for t in d["faults"]["types"]:
+            if t["type"] == "ball":
+                t["axis_offset"] = {"distribution": "uniform", "min": -1.0, "max": 1.0}
+                t["wander_s"] = {"distribution": "loguniform", "min": 0.05, "max": 5.0}
     elif variant != "full":
         raise ValueError(variant)
     return d
@@ -107,7 +115,7 @@ def main(argv=None):
         res["ablation"] = [run(cwru, root / "cwru_bearing_12k_de", v, a.ablation_seeds,
                                a.records, a.cache, a.workers, ("forest", "logistic"), log)
                            for v in ("no_transfer_randomisation", "no_load_zone", "no_slip",
-                                     "no_defect_profile")]
+                                     "no_defect_profile", "spin_axis_wander")]
     if "mfpt" not in a.skip:
         res["mfpt"] = run(ROOT / "datasets" / "mfpt_syn2real.toml", root / "mfpt_bearing",
                           "full", a.mfpt_seeds, a.mfpt_records, a.cache, a.workers,

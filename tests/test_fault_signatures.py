@@ -34,7 +34,8 @@ import pytest
 
 import cmsim
 from cmsim.dynamics import simulate
-from cmsim.faults import FAULT_TYPES, parse_fault
+from cmsim.faults import FAULT_TYPES, BallDefect, compile_faults, parse_fault
+from cmsim.faults.compile import DEFECT_COLUMNS
 from cmsim.frequencies import rig_frequencies
 from cmsim.run import Run
 from cmsim.sensors import add_sensors
@@ -167,6 +168,51 @@ def test_ball_fault_on_the_other_bearing_leaves_1b1_quiet():
     own = level(envelope_spectrum(run["F_1b2_y"], run.fs_hz, FORCE_BAND_HZ), f)
     other = level(envelope_spectrum(run["F_1b1_y"], run.fs_hz, FORCE_BAND_HZ), f)
     assert own > 3.0 * other, (own, other)
+
+
+BALL_TRACK_SIZE_M = 2e-4      # drop 1.3 µm: the line grows in proportion with the depth
+
+
+def _ball_2bsf(extra=""):
+    """2×BSF envelope line of F_1b1_y of a 0.2 mm ball defect with ``extra`` options."""
+    env = envelopes(f"ball:bearing=1b1,size_m={BALL_TRACK_SIZE_M},depth_m={DEPTH_M}{extra}")
+    return level(env["F_1b1_y"], _lines("ball")["2xBSF"])
+
+
+def test_ball_defect_off_the_rolling_track_is_silent_and_partly_on_it_is_weaker():
+    """A pit off the ball's rolling track never meets the races (the healthy run, to the
+    bit); one with half its width inside the contact band (cmsim.faults.bearing.track_share)
+    strikes about half as hard."""
+    healthy, _ = bearing_run("")
+    off, _ = bearing_run(f"ball:bearing=1b1,size_m={BALL_TRACK_SIZE_M},depth_m={DEPTH_M},"
+                         f"axis_offset=0.5")
+    np.testing.assert_array_equal(off["F_1b1_y"], healthy["F_1b1_y"])
+    row = dict(zip(DEFECT_COLUMNS, compile_faults(
+        cwru_rig(), [BallDefect("1b1", BALL_TRACK_SIZE_M, DEPTH_M)],
+        op=cwru_op()).bearing_defects[0]))
+    half_in = round(row["track_rad"] - row["half_width_rad"], 4)
+    on, edge = _ball_2bsf(), _ball_2bsf(f",axis_offset={half_in}")
+    assert 0.3 * on < edge < 0.7 * on, (on, edge)
+
+
+def test_wandering_spin_axis_makes_ball_impacts_intermittent():
+    """With a wandering spin axis the defect leaves the track for part of the run: the
+    2×BSF line drops, and the impacts come and go (the force's band energy over 20 ms
+    blocks spreads far more than with the fixed axis on the track)."""
+    on = _ball_2bsf()
+    wander = _ball_2bsf(",wander_s=0.1")
+    assert wander < 0.8 * on, (on, wander)
+
+    def block_spread(extra):
+        run, _ = bearing_run(f"ball:bearing=1b1,size_m={BALL_TRACK_SIZE_M},depth_m={DEPTH_M}"
+                             f"{extra}")
+        x = np.asarray(run["F_1b1_y"], float)
+        e = np.diff(x) ** 2                                 # high-passed power
+        n = int(0.02 * run.fs_hz)
+        blocks = e[:e.size // n * n].reshape(-1, n).sum(axis=1)
+        return np.std(blocks) / np.mean(blocks)
+
+    assert block_spread(",wander_s=0.1") > 2.0 * block_spread("")
 
 
 def test_cwru_characteristic_frequencies_match_published_ratios():

@@ -15,7 +15,8 @@ from cmsim.errors import ParameterError
 from cmsim.faults import (FAULT_TYPES, BallDefect, OuterRaceDefect, ToothCrack,
                           compile_faults, fault_frequencies, fault_from_dict, load_faults,
                           operating_modulation, parse_fault, rig_with_faults, slip_from_faults)
-from cmsim.faults.bearing import ball_drop_m, defect_profile
+from cmsim.faults.bearing import ball_drop_m, defect_profile, track_share, wandering_offset
+from cmsim.faults.compile import DEFECT_COLUMNS
 from cmsim.faults.gear import BREAKAGE_SEPARATION_M, roll_length_m
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
@@ -171,7 +172,7 @@ def test_ball_defect_row(rig):
 def test_healthy_arrays_are_neutral(rig, table):
     fa = compile_faults(rig, [], table)
     assert fa.tooth_factor1.shape == (28, table.position_m.size)
-    assert fa.bearing_defects.shape == (0, 8)
+    assert fa.bearing_defects.shape == (0, len(DEFECT_COLUMNS))
     assert not fa.active
     np.testing.assert_allclose(fa.tooth_grid_m, [table.position_m[0], table.spacing_m])
 
@@ -286,3 +287,38 @@ def test_rig_toml_with_faults(tmp_path, rig):
     rig.save(path, faults=faults)
     assert Rig.load(path) == rig
     assert load_faults(path) == faults
+
+
+def test_ball_track_share_closed_form():
+    """Share of a pit of half-width h (ball radii) inside a band of half-width a: 1 while
+    the pit is inside, linear to 0 as it leaves, 0 beyond a + h."""
+    a, h = 0.2, 0.05
+    z = np.array([0.0, 0.15, 0.2, 0.25, 0.3, -0.2])
+    np.testing.assert_allclose(track_share(z, a + h, h), [1.0, 1.0, 0.5, 0.0, 0.0, 0.5])
+
+
+def test_spin_axis_walk_decorrelates_at_its_correlation_time():
+    """Isotropic rotational diffusion: E[n(t)·p] = exp(−t/τ) n(0)·p (2000 walkers from the
+    defect's pole), and |n| stays 1 so the offset stays in [−1, 1]."""
+    rng = np.random.default_rng(5)
+    tau, dt, n = 0.2, 0.002, 301
+    z = np.array([wandering_offset(1.0, tau, n, dt, rng) for _ in range(2000)])
+    assert np.all(np.abs(z) <= 1.0 + 1e-12)
+    for k in (50, 100, 200, 300):
+        assert abs(z[:, k].mean() - math.exp(-k * dt / tau)) < 0.03, k
+
+
+def test_ball_defect_row_track_width_from_hertz(cwru):
+    """The track half-width is the Hertz band across the track plus half the pit, and grows
+    as the cube root of the ball load."""
+    rig = cwru
+    f = BallDefect("1b1", 4e-4, 2e-4, axis_offset=0.3, wander_s=0.5)
+    cols = dict(zip(DEFECT_COLUMNS, f.defect_row(rig, 100.0)))
+    cols8 = dict(zip(DEFECT_COLUMNS, f.defect_row(rig, 800.0)))
+    rb = 0.5 * rig.bearings[0].ball_diameter_m
+    band, band8 = ((c["track_rad"] - c["half_width_rad"]) * rb for c in (cols, cols8))
+    assert 0.3e-3 < band < 1.0e-3
+    assert band8 / band == pytest.approx(2.0, rel=1e-9)
+    assert (cols["axis_offset"], cols["wander_s"]) == (0.3, 0.5)
+    with pytest.raises(ParameterError, match="axis_offset"):
+        BallDefect("1b1", 4e-4, 2e-4, axis_offset=1.5)

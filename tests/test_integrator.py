@@ -34,7 +34,7 @@ def sdof_packed():
             np.array([[0, 0, 1]], dtype=np.int64), *K.no_hybrid(), np.zeros((0, K.DF_SIZE)),
             np.zeros((0, 1)), np.zeros((0, 1)), np.ones((1, 1)), np.ones((1, 1)),
             np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 3)), K.no_profile(),
-            np.zeros(1), np.zeros(1))
+            np.zeros(1), np.zeros(1), np.ones((0, 1)))
 
 
 def sdof_exact(t):

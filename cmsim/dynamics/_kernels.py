@@ -53,9 +53,13 @@ BI_SIZE = 7
 BP_K, BP_P, BP_C, BP_CAGE, BP_SENSE, BP_DAMP, BP_PHASE, BP_SPIN = 0, 1, 2, 3, 4, 5, 6, 7
 BP_SIZE = 8
 # b_def columns (the FaultArrays.bearing_defects layout of cmsim.faults): bearing, kind,
-# centre angle, half-width, depth, entry ramp, exit ramp, ball index
+# centre angle, half-width, depth, entry ramp, exit ramp, ball index; a ball defect's offset
+# from the rolling track (sine of its latitude), the spin axis' wander time (s) and the
+# track's half-width (contact band + half the defect, in ball radii); read when the run's
+# ``track`` grid is built (cmsim.dynamics.model), not by the kernels
 DF_BRG, DF_KIND, DF_CENTRE, DF_HALF, DF_DEPTH, DF_ENTRY, DF_EXIT, DF_BALL = range(8)
-DF_SIZE = 8
+DF_AXIS, DF_WANDER, DF_TRACK = 8, 9, 10
+DF_SIZE = 11
 DEF_OUTER, DEF_INNER, DEF_BALL = 1, 2, 3
 # m_int entries: DOF index of each gear's x, number of slots, mesh on, elastic-force mode,
 # per-tooth tables on, eccentricity on, speed/torque profile on, DOF of the output torque,
@@ -75,8 +79,8 @@ SG_SIZE = 10
 # and sin of the nominal line-of-action angle.
 (MP_A0, MP_PSI10, MP_PSI20, MP_PB, MP_SLO, MP_OM1, MP_OM2, MP_MU, MP_V0, MP_BETA, MP_KOSTER,
  MP_DTHR, MP_TAB0, MP_TABD, MP_JDT, MP_DIAGB, MP_ZBEFORE, MP_ZAFTER, MP_PHIT0, MP_COST0,
- MP_SINT0, MP_PT0, MP_PDT, MP_OMREF) = range(24)
-MP_SIZE = 24
+ MP_SINT0, MP_PT0, MP_PDT, MP_OMREF, MP_TDT) = range(25)
+MP_SIZE = 25
 # columns of the profile table ``prof``: input-shaft angle Θ (rad), speed Ω (rad/s),
 # acceleration (rad/s²), output torque (N·m), on the uniform grid MP_PT0 + i·MP_PDT
 PR_THETA, PR_OMEGA, PR_ALPHA, PR_TORQUE = 0, 1, 2, 3
@@ -124,8 +128,12 @@ class KernelParams(NamedTuple):
         ``MI_MUTAB`` is off: the constant ``MP_MU``).
     c_tab : (m,) viscous damping of a loaded pair against its position on the mesh table's
         grid, N·s/m (e.g. structural + mixed-lubrication contact damping, paper 004 eq. 14-16;
-        (1,) and unused when ``MI_CTAB`` is off: the stiffness-proportional β·k). Nominal rotations are ``omega[i]·τ(t)`` with the
-        equivalent time τ = Θ(t)/Ω_ref (τ = t at constant speed).
+        (1,) and unused when ``MI_CTAB`` is off: the stiffness-proportional β·k).
+    track : (m, n_grid) share of each defect row's depth the races meet at t = i·``MP_TDT``
+        (ones for race defects; a ball defect off its rolling track meets them partly or not
+        at all, and a wandering spin axis moves it; (m, 1) when constant).
+        Nominal rotations are ``omega[i]·τ(t)`` with the equivalent time τ = Θ(t)/Ω_ref
+        (τ = t at constant speed).
     """
 
     minv: np.ndarray
@@ -161,6 +169,7 @@ class KernelParams(NamedTuple):
     prof: np.ndarray
     mu_tab: np.ndarray
     c_tab: np.ndarray
+    track: np.ndarray
 
     def frozen(self):
         """The same arrays as C-contiguous read-only views (copies only where not contiguous).
@@ -208,6 +217,7 @@ class Work(NamedTuple):
     hext: np.ndarray       # (slots,) extra compliance of weakened teeth in the hybrid solve
     hstat: np.ndarray      # (2,) hybrid counters [solves, non-converged solves]
     psi: np.ndarray        # (2, AN_SIZE) anchors of the gears' involute origin angles
+    def_gain: np.ndarray   # (max(m, 1),) ``track`` of each defect row at the current time
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -247,6 +257,25 @@ def _jitter_at(jitter, ib, iball, t, jdt):
     return jitter[ib, iball, i] + f * (jitter[ib, iball, i + 1] - jitter[ib, iball, i])
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _track_gains(track, tdt, t, gain):
+    """Fill ``gain`` (m,) with each defect row's ``track`` value at ``t`` (linear)."""
+    ng = track.shape[1]
+    u = t / tdt
+    if ng == 1 or u <= 0.0:
+        for r in range(track.shape[0]):
+            gain[r] = track[r, 0]
+        return
+    if u >= ng - 1:
+        for r in range(track.shape[0]):
+            gain[r] = track[r, ng - 1]
+        return
+    i = int(u)
+    f = u - i
+    for r in range(track.shape[0]):
+        gain[r] = track[r, i] + f * (track[r, i + 1] - track[r, i])
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _slip_offsets(t, b_int, b_cos, b_sin, jitter, jdt, jit_cos, jit_sin, cage_slip):
     """Fill ``jit_cos``, ``jit_sin`` (n_bearings, max_balls) with cos, sin of the ball offsets
@@ -282,13 +311,16 @@ def _defect_profile(u, half, entry, exit_):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _defect_loss(theta, i, b_def, d0, nd, shaft_angle, spin_angle, dirn_cage, dirn_inner,
-                 dirn_spin):
+                 dirn_spin, gain):
     """Overlap ball ``i`` (housing angle ``theta``) loses in the defects rows d0..d0+nd, m:
     an outer-race defect is fixed in the housing, an inner-race one turns with the shaft, a
     ball defect turns with the ball's spin and meets the outer race at spin phase 0 and the
-    inner race at π (Sawalhi & Randall 2008, MSSP 22)."""
+    inner race at π (Sawalhi & Randall 2008, MSSP 22); row r's depth is scaled by
+    ``gain[r]`` (the share of a ball defect inside the rolling track, ``W.def_gain``)."""
     loss = 0.0
     for r in range(d0, d0 + nd):
+        if gain[r] <= 0.0:
+            continue
         kind = int(b_def[r, DF_KIND])
         if kind == DEF_OUTER:
             u = dirn_cage * _wrap(theta - b_def[r, DF_CENTRE])
@@ -300,8 +332,8 @@ def _defect_loss(theta, i, b_def, d0, nd, shaft_angle, spin_angle, dirn_cage, di
             # both races: the spin phase modulo π
             v = spin_angle - b_def[r, DF_CENTRE]
             u = dirn_spin * (v - math.pi * math.floor(v / math.pi + 0.5))
-        loss += b_def[r, DF_DEPTH] * _defect_profile(u, b_def[r, DF_HALF], b_def[r, DF_ENTRY],
-                                                     b_def[r, DF_EXIT])
+        loss += gain[r] * b_def[r, DF_DEPTH] * _defect_profile(
+            u, b_def[r, DF_HALF], b_def[r, DF_ENTRY], b_def[r, DF_EXIT])
     return loss
 
 
@@ -316,7 +348,7 @@ def _contact(d, p, hertz):
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b_off, b_def,
                       d0, nd, cage_angle, shaft_angle, spin_angle, dirn_cage, dirn_inner,
-                      dirn_spin):
+                      dirn_spin, gain):
     """Eq. 9 ball by ball with defects and off-size balls (cage frame, as
     :func:`cmsim.bearings._kernels.ball_forces_cage_frame_jit`): ball i's overlap is
     x_r cos φ_i + y_r sin φ_i − c + Δd_i − Σ depth·profile (:func:`_defect_loss`). Used for
@@ -331,7 +363,7 @@ def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b
         if d <= 0.0:
             continue                   # a defect only takes overlap away: still unloaded
         d -= _defect_loss(cage_angle + b_ang[ib, i], i, b_def, d0, nd, shaft_angle,
-                          spin_angle, dirn_cage, dirn_inner, dirn_spin)
+                          spin_angle, dirn_cage, dirn_inner, dirn_spin, gain)
         f = _contact(d, p, hertz)
         fx += f * co
         fy += f * so
@@ -341,7 +373,7 @@ def _faulty_ball_loop(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b
 @njit(cache=True, inline="always", error_model="numpy")
 def _defect_correction(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, b_def, d0,
                        nd, cage_angle, shaft_angle, spin_angle, dirn_cage, dirn_inner,
-                       dirn_spin):
+                       dirn_spin, gain):
     """Change the defects of bearing ``ib`` make to its healthy ball-force sum (cage frame).
 
     Only the balls that can sit in a defect are visited: a race defect is shorter than the
@@ -369,7 +401,7 @@ def _defect_correction(xr, yr, ball_cos, ball_sin, ib, n_balls, k, p, c, b_ang, 
         if d <= 0.0:
             continue
         loss = _defect_loss(cage_angle + b_ang[ib, i], i, b_def, d0, nd, shaft_angle,
-                            spin_angle, dirn_cage, dirn_inner, dirn_spin)
+                            spin_angle, dirn_cage, dirn_inner, dirn_spin, gain)
         if loss > 0.0:
             f = _contact(d - loss, p, hertz) - _contact(d, p, hertz)
             fx += f * co
@@ -391,7 +423,7 @@ def _defect_ball(r, b_def, ang0, pitch, n_balls, cage_angle, shaft_angle):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _faulty_bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
-                           cage_slip, diag, want_diag, b_ang, b_off, b_def):
+                           cage_slip, diag, want_diag, b_ang, b_off, b_def, gain):
     """Forces of the bearings with defects or off-size balls (``BI_FAULTY``).
 
     ``BI_FAULTY`` = 1 (race or ball defects only): :func:`_bearing_forces` has applied the
@@ -423,13 +455,13 @@ def _faulty_bearing_forces(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, 
                 xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
                 b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_def, b_int[ib, BI_DEF0],
                 b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
-                dirn_cage, dirn_inner, dirn_spin)
+                dirn_cage, dirn_inner, dirn_spin, gain)
         else:
             fxr, fyr = _faulty_ball_loop(
                 xr, yr, ball_cos, ball_sin, ib, b_int[ib, BI_NB], b_par[ib, BP_K],
                 b_par[ib, BP_P], b_par[ib, BP_C], b_ang, b_off, b_def, b_int[ib, BI_DEF0],
                 b_int[ib, BI_NDEF], angle, shaft, b_par[ib, BP_SPIN] * (shaft - angle),
-                dirn_cage, dirn_inner, dirn_spin)
+                dirn_cage, dirn_inner, dirn_spin, gain)
         fx = fxr * cc - fyr * sc
         fy = fyr * cc + fxr * sc
         if mode == 1:                  # a change to the healthy forces already applied
@@ -771,7 +803,8 @@ def make_work(P):
                 np.zeros((slots, SG_SIZE)),
                 np.zeros(WORK_PER_N2 * slots * slots + WORK_PER_N * slots), np.zeros(slots),
                 np.zeros(slots), np.zeros(slots), np.ones(slots), np.ones(slots),
-                np.zeros(slots), np.zeros(slots), np.zeros(2), np.zeros((2, AN_SIZE)))
+                np.zeros(slots), np.zeros(slots), np.zeros(2), np.zeros((2, AN_SIZE)),
+                np.ones(max(P.b_def.shape[0], 1)))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -830,9 +863,11 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
         _bearing_forces(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
                         W.cage_slip, diag, want_diag)
         if P.b_def.shape[0] > 0 or P.m_int[MI_FAULTY_BALLS] != 0:
+            if P.b_def.shape[0] > 0:
+                _track_gains(P.track, P.m_par[MP_TDT], t, W.def_gain)
             _faulty_bearing_forces(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos,
                                    ball_sin, W.cage, W.cage_slip, diag, want_diag, P.b_ang,
-                                   P.b_off, P.b_def)
+                                   P.b_off, P.b_def, W.def_gain)
     if P.m_int[MI_ON] != 0:
         _mesh_forces(tau, sr, y, n, g, P, W, diag, want_diag)
     linear_accel_jit(y, g, minv, P.springs, P.spring_ends, dydt, row)

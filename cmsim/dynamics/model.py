@@ -7,7 +7,8 @@ one rig many times rebuilds only what changes:
   geometry (:func:`rig_model`, memoised per rig);
 * :class:`DynamicModel` — per operating point: speeds, loads, the mesh stiffness at the
   torque (:func:`build_model`);
-* per run: cage phases and slip, by :meth:`DynamicModel.for_run` (cheap).
+* per run: cage phases, slip and a ball defect's spin-axis walk, by
+  :meth:`DynamicModel.for_run` (cheap).
 
 The DOFs are ordered as in eq. 1: ``x, y, θ`` of each node (``1b1, 1G1, 1b2, 2b1, 2G1, 2b2``)
 then ``θ_2J2``. Rotations are deviations from the nominal rigid rotation Ω·t (shaft 1 at the
@@ -36,6 +37,7 @@ from cmsim.dynamics import _kernels as K
 from cmsim.dynamics.mesh_choice import resolve_mesh
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, compile_faults, rig_with_faults
+from cmsim.faults.bearing import track_share, wandering_offset
 from cmsim.mesh_stiffness._kernels import GEO_SIZE
 from cmsim.mesh_stiffness.contact import (contact_geometry, corner_zone_m, potential_slots,
                                           reference_phases, table_range_m)
@@ -285,7 +287,8 @@ class DynamicModel:
         return np.array([not d.startswith("theta") for d in self.dof_names])
 
     def for_run(self, *, cage_phases_rad=None, slip=None, duration_s=1.0, seed=None):
-        """The same model with another run's cage phases and slip (nothing else rebuilt).
+        """The same model with another run's cage phases, slip and spin-axis walk (nothing else
+        rebuilt).
 
         Parameters
         ----------
@@ -295,9 +298,9 @@ class DynamicModel:
         slip : SlipModel, optional
             Random rolling slip (default none).
         duration_s : float
-            Span over which the slip is generated (only with ``slip``), s.
+            Span over which the slip and a wandering spin axis are generated, s.
         seed : int, optional
-            Seed of the slip generator.
+            Seed of the slip and spin-axis generators.
         """
         rig = self.rig
         nb = len(rig.bearings)
@@ -312,9 +315,11 @@ class DynamicModel:
                       for ib in range(nb)]
         jitter, jdt = _jitter(rig.bearings, self.rig_model.b_cos.shape[1], cage_rates, slip,
                               duration_s, seed)
+        track, tdt = _track(self.packed.b_def, duration_s, seed)
         m_par = self.packed.m_par.copy()
         m_par[K.MP_JDT] = jdt
-        packed = self.packed._replace(b_par=b_par, jitter=jitter, m_par=m_par)
+        m_par[K.MP_TDT] = tdt
+        packed = self.packed._replace(b_par=b_par, jitter=jitter, m_par=m_par, track=track)
         return replace(self, packed=packed, slip=slip, cage_phases_rad=phases)
 
     def rhs(self, t, y, want_diag=False):
@@ -527,7 +532,8 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, b_int, rm.b_par,
                             rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
                             m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
-                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab, c_tab)
+                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab, c_tab,
+                            np.ones((fields[0].shape[0], 1)))
     model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
                          SlipModel(), mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
@@ -590,6 +596,39 @@ def _pitch_multiples(n_teeth):
     """cos and sin of k·2π/Z for k = 0..Z−1, shape (Z, 2)."""
     a = 2.0 * math.pi * np.arange(n_teeth) / n_teeth
     return np.ascontiguousarray(np.column_stack([np.cos(a), np.sin(a)]))
+
+
+def _track(b_def, duration_s, seed):
+    """Share of each defect row the races meet, on a time grid, and its spacing.
+
+    Race defects: 1. Ball defects: the part of the pit inside the rolling track
+    (:func:`cmsim.faults.bearing.track_share`) at its offset, constant for a fixed spin axis,
+    else along a random walk of the axis (:func:`cmsim.faults.bearing.wandering_offset`,
+    grid spacing a twentieth of the shortest correlation time, its own random stream of
+    ``seed``). Returns ((m, n_grid), dt); n_grid = 1 when nothing varies.
+    """
+    m = b_def.shape[0]
+    ball = (b_def[:, K.DF_KIND] == K.DEF_BALL) if m else np.zeros(0, bool)
+    wander = ball & (b_def[:, K.DF_WANDER] > 0.0) if m else ball
+    if not np.any(wander):
+        out = np.ones((m, 1))
+        for r in np.flatnonzero(ball):
+            out[r] = track_share(b_def[r, K.DF_AXIS], b_def[r, K.DF_TRACK], b_def[r, K.DF_HALF])
+        return out, 1.0
+    dt = float(np.min(b_def[wander, K.DF_WANDER])) / 20.0
+    n_grid = int(math.ceil(duration_s / dt)) + 2
+    rng = np.random.default_rng(None if seed is None else [int(seed), _TRACK_STREAM])
+    out = np.ones((m, n_grid))
+    for r in np.flatnonzero(ball):
+        z = b_def[r, K.DF_AXIS]
+        if wander[r]:
+            z = wandering_offset(z, b_def[r, K.DF_WANDER], n_grid, dt, rng)
+        out[r] = track_share(z, b_def[r, K.DF_TRACK], b_def[r, K.DF_HALF])
+    return out, dt
+
+
+#: Second word of the spin-axis random stream's seed (apart from the slip's stream).
+_TRACK_STREAM = 0x5B1
 
 
 def _jitter(bearings, max_balls, cage_rates, slip, duration_s, seed):

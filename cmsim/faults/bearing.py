@@ -17,7 +17,17 @@ abruptly at the exit edge (over :data:`EXIT_RAMP_FRACTION` of the entry distance
   shaft on a gear rig;
 * inner race: turns with the shaft (``angle_rad`` on the ring from its reference);
 * ball: one defect on one ball that strikes the outer race and the inner race once each per
-  spin revolution (2 × BSF).
+  spin revolution (2 × BSF) — when it lies on the ball's rolling track. A ball rolls on a
+  great circle perpendicular to its spin axis; a pit elsewhere on the ball never meets the
+  races, and one at the track's edge meets them with the part of its width inside the
+  contact band (the Hertz ellipse's half-width across the track, :func:`track_share`).
+  ``axis_offset`` is the sine of the defect's latitude above that circle (0: on the track,
+  the Sawalhi-Randall case; a defect at a random place on the ball has it uniform in
+  [−1, 1]). The spin axis of a real ball is not fixed: cage-pocket friction, gyroscopic
+  moments and misalignment turn it, so the defect drifts on and off the track [4], [5];
+  ``wander_s`` > 0 makes the axis a random walk on the sphere (rotational diffusion with
+  correlation time ``wander_s``: ⟨n(t)·n(0)⟩ = exp(−t/wander_s)), drawn per run from the
+  run's seed, and the defect strikes intermittently and with varying strength.
 
 Sizes are lengths along the race (ball: along the ball's surface) in m; a race defect longer
 than the ball spacing on that race, or a ball defect longer than the ball diameter, is refused.
@@ -33,6 +43,11 @@ References
 .. [2] R. B. Randall, J. Antoni, "Rolling element bearing diagnostics — a tutorial", MSSP 25
    (2011) 485-520, eqs. (1)-(4) (defect frequencies).
 .. [3] A. Fernandez-del-Rincon et al., MSSP 2016, §5 (rolling slip).
+.. [4] W. A. Smith, R. B. Randall, "Rolling element bearing diagnostics using the Case
+   Western Reserve University data: a benchmark study", MSSP 64-65 (2015) 100-131 (ball
+   faults: intermittent, often not diagnosable).
+.. [5] T. A. Harris, M. N. Kotzalas, *Rolling Bearing Analysis*, 5th ed., Wiley 2006,
+   ch. 10 (ball spin-axis orientation set by friction and gyroscopic moments, not fixed).
 """
 
 from __future__ import annotations
@@ -42,11 +57,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cmsim.bearings.hertz import contact_semi_axes_m
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults.base import Fault, check_bearing, check_int, mm, register
 
 __all__ = ["OuterRaceDefect", "InnerRaceDefect", "BallDefect", "BearingWear", "OffSizeBall",
-           "RollingSlip", "ball_drop_m", "defect_profile", "EXIT_RAMP_FRACTION",
+           "RollingSlip", "ball_drop_m", "defect_profile", "track_share", "wandering_offset",
+           "EXIT_RAMP_FRACTION",
            "KIND_OUTER", "KIND_INNER", "KIND_BALL"]
 
 #: Kind codes of the ``bearing_defects`` rows.
@@ -105,6 +122,61 @@ def defect_profile(angle_rad, centre_rad, half_width_rad, entry_rad, exit_rad):
     return np.where((x >= 0) & (y >= 0), np.minimum(up, down), 0.0)
 
 
+def track_share(axis_offset, track_rad, half_width_rad):
+    """Share of a ball defect's width inside the rolling track (0..1).
+
+    The pit spans [s − L/2, s + L/2] across the track at s = R_b·|axis_offset|; the contact
+    band spans [−a, a]: the share is clip((a + L/2 − s)/L, 0, 1) (1 when the whole pit is
+    inside, 0 when it misses the band). In ball radii: ``track_rad`` = (a + L/2)/R_b,
+    ``half_width_rad`` = L/(2 R_b).
+
+    Parameters
+    ----------
+    axis_offset : float or numpy.ndarray
+        Sine of the defect's latitude above the rolling track.
+    track_rad, half_width_rad : float
+        See above.
+    """
+    s = np.abs(np.asarray(axis_offset, dtype=float))
+    return np.clip((track_rad - s) / (2.0 * half_width_rad), 0.0, 1.0)
+
+
+def wandering_offset(axis_offset, wander_s, n_samples, dt_s, rng):
+    """Sine of a ball defect's latitude over time with a wandering spin axis.
+
+    The spin axis n is a random walk on the unit sphere (isotropic rotational diffusion,
+    coefficient D = 1/(2 τ), so ⟨n(t)·n(0)⟩ = exp(−t/τ)); the defect sits at p = e_z in the
+    ball, and the offset is n·p. Each step adds a Gaussian kick sqrt(2 D dt)·ξ perpendicular
+    to n and renormalises.
+
+    Parameters
+    ----------
+    axis_offset : float
+        Offset at t = 0, in [−1, 1].
+    wander_s : float
+        Correlation time τ of the axis, s (> 0).
+    n_samples : int
+        Samples of the result (t = 0, dt_s, ...).
+    dt_s : float
+        Spacing, s (well below τ).
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_samples,)
+    """
+    z = float(axis_offset)
+    n = np.array([math.sqrt(max(1.0 - z * z, 0.0)), 0.0, z])
+    kicks = rng.standard_normal((int(n_samples), 3)) * math.sqrt(dt_s / wander_s)
+    out = np.empty(int(n_samples))
+    for i in range(int(n_samples)):
+        out[i] = n[2]
+        k = kicks[i] - n * (kicks[i] @ n)
+        n = n + k
+        n /= math.sqrt(n @ n)
+    return out
+
+
 def _check_size(name, value, unit="m"):
     return check_range(name, value, 0.0, 0.1, lo_open=True, unit=unit)
 
@@ -148,7 +220,7 @@ class _RaceDefect(Fault):
         return self
 
     def defect_row(self, rig, default_angle_rad):
-        """Row of ``FaultArrays.bearing_defects`` (8 floats) for this defect on ``rig``."""
+        """Row of ``FaultArrays.bearing_defects`` for this defect on ``rig``."""
         self.validate(rig)
         ib = check_bearing(rig, self.bearing)
         brg = rig.bearings[ib]
@@ -157,7 +229,7 @@ class _RaceDefect(Fault):
         entry = _entry_distance_m(rb, self.size_m, drop)
         centre = default_angle_rad if self.angle_rad is None else self.angle_rad
         return [float(ib), self.kind, float(centre), 0.5 * self.size_m / r, drop, entry / r,
-                self.exit_ramp_fraction * entry / r, -1.0]
+                self.exit_ramp_fraction * entry / r, -1.0, 0.0, 0.0, 0.0]
 
 
 @register
@@ -239,6 +311,12 @@ class BallDefect(Fault):
     exit_ramp_fraction : float
         Exit ramp as a fraction of the entry ramp, in [0, 1] (0: an abrupt exit; default
         :data:`EXIT_RAMP_FRACTION`): the defect's edge profile.
+    axis_offset : float
+        Sine of the defect's latitude above the ball's rolling track at t = 0, in [−1, 1]
+        (0: on the track; module docstring).
+    wander_s : float
+        Correlation time of the spin axis' random walk, s (0: a fixed axis, the defect stays
+        at ``axis_offset``).
     """
 
     name = "ball"
@@ -249,6 +327,8 @@ class BallDefect(Fault):
     ball: int = 0
     phase_rad: float = 0.0
     exit_ramp_fraction: float = EXIT_RAMP_FRACTION
+    axis_offset: float = 0.0
+    wander_s: float = 0.0
 
     def __post_init__(self):
         if not isinstance(self.bearing, str):
@@ -259,6 +339,8 @@ class BallDefect(Fault):
         check_range("exit_ramp_fraction", self.exit_ramp_fraction, 0.0, 1.0, unit="")
         check_int("ball", self.ball, 0)
         check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+        check_range("axis_offset", self.axis_offset, -1.0, 1.0, unit="")
+        check_range("wander_s", self.wander_s, 0.0, 1e3, unit="s")
 
     @property
     def label(self):
@@ -274,15 +356,32 @@ class BallDefect(Fault):
         check_int("ball", self.ball, 0, brg.n_balls - 1)
         return self
 
-    def defect_row(self, rig, default_angle_rad=0.0):
-        """Row of ``FaultArrays.bearing_defects`` (angles on the ball, radius R_b)."""
+    def defect_row(self, rig, ball_load_n=100.0):
+        """Row of ``FaultArrays.bearing_defects`` (angles on the ball, radius R_b).
+
+        Parameters
+        ----------
+        rig : Rig
+        ball_load_n : float
+            Load of a ball in the load zone, N: sets the contact band's half-width (the
+            wider of the outer and inner race contacts, :func:`track_share`).
+        """
         self.validate(rig)
         ib = check_bearing(rig, self.bearing)
-        rb = 0.5 * rig.bearings[ib].ball_diameter_m
+        brg = rig.bearings[ib]
+        rb = 0.5 * brg.ball_diameter_m
         drop = ball_drop_m(rb, self.size_m, self.depth_m)
         entry = _entry_distance_m(rb, self.size_m, drop)
+        band = max(contact_semi_axes_m(brg.ball_diameter_m, 0.5 * d, r, ball_load_n,
+                                       inner=inner)[1]
+                   for d, r, inner in ((brg.outer_raceway_diameter_m, brg.outer_groove_radius_m,
+                                        False),
+                                       (brg.inner_raceway_diameter_m, brg.inner_groove_radius_m,
+                                        True)))
         return [float(ib), KIND_BALL, float(self.phase_rad), 0.5 * self.size_m / rb, drop,
-                entry / rb, self.exit_ramp_fraction * entry / rb, float(self.ball)]
+                entry / rb, self.exit_ramp_fraction * entry / rb, float(self.ball),
+                float(self.axis_offset), float(self.wander_s),
+                (band + 0.5 * self.size_m) / rb]
 
 
 @register

@@ -40,7 +40,7 @@ __all__ = ["FaultArrays", "compile_faults", "rig_with_faults", "slip_from_faults
 
 #: Columns of ``FaultArrays.bearing_defects``.
 DEFECT_COLUMNS = ("bearing", "kind", "centre_rad", "half_width_rad", "depth_m", "entry_rad",
-                  "exit_rad", "ball")
+                  "exit_rad", "ball", "axis_offset", "wander_s", "track_rad")
 
 #: Grid points of the tooth tables when no mesh table is given (as
 #: :meth:`~cmsim.mesh_stiffness.table.MeshStiffnessTable.potential_energy`).
@@ -52,7 +52,7 @@ class FaultArrays(NamedTuple):
 
     Attributes
     ----------
-    bearing_defects : ndarray, shape (m, 8)
+    bearing_defects : ndarray, shape (m, 11)
         One row per race/ball defect, columns :data:`DEFECT_COLUMNS` (see
         :mod:`cmsim.faults.bearing`); m = 0 without defects.
     ball_offset_m : ndarray, shape (nb, max_balls)
@@ -127,6 +127,21 @@ def _load_zone_angle(rig, bearing_index, op):
     alpha = rig.gears.working_pressure_angle_rad
     shaft = 0 if bearing_index < 2 else 1
     return -alpha if shaft == 0 else math.pi - alpha
+
+
+def _ball_load_n(rig, bearing_index, op):
+    """Load of the most loaded ball, N (Stribeck: 5 F_r / Z), at least 10 N.
+
+    F_r: the radial load on a bearing rig, half the mesh force T_out / r_b2 on a gear rig
+    (each shaft on two bearings); without ``op`` 100 N per ball.
+    """
+    if op is None:
+        return 100.0
+    if rig.has_gears:
+        fr = 0.5 * abs(op.torque_nm) / rig.gears.driven.base_radius_m
+    else:
+        fr = float(op.radial_load_n)
+    return max(5.0 * fr / rig.bearings[bearing_index].n_balls, 10.0)
 
 
 def _grid(rig, mesh_table):
@@ -205,7 +220,7 @@ def compile_faults(rig, faults, mesh_table=None, *, op=None):
             default = _load_zone_angle(rig, ib, op) if isinstance(f, OuterRaceDefect) else 0.0
             rows.append(f.defect_row(rig, default))
         elif isinstance(f, BallDefect):
-            rows.append(f.defect_row(rig))
+            rows.append(f.defect_row(rig, _ball_load_n(rig, check_bearing(rig, f.bearing), op)))
         elif isinstance(f, OffSizeBall):
             ball_offset[check_bearing(rig, f.bearing), f.ball] += f.diameter_excess_m
         elif isinstance(f, Eccentricity):
