@@ -290,10 +290,13 @@ def test_rig_toml_with_faults(tmp_path, rig):
 
 
 def test_ball_track_share_closed_form():
-    """Share of a pit of half-width h (ball radii) inside a band of half-width a: 1 while
-    the pit is inside, linear to 0 as it leaves, 0 beyond a + h."""
-    a, h = 0.2, 0.05
+    """Overlap of a pit of half-width h with a band of half-width a (ball radii) over the
+    narrower: 1 while the pit is inside the band or covers it, linear to 0 as it leaves,
+    0 beyond a + h."""
     z = np.array([0.0, 0.15, 0.2, 0.25, 0.3, -0.2])
+    a, h = 0.2, 0.05                                   # pit narrower than the band
+    np.testing.assert_allclose(track_share(z, a + h, h), [1.0, 1.0, 0.5, 0.0, 0.0, 0.5])
+    a, h = 0.05, 0.2                                   # pit wider: full depth on the track
     np.testing.assert_allclose(track_share(z, a + h, h), [1.0, 1.0, 0.5, 0.0, 0.0, 0.5])
 
 
@@ -322,3 +325,13 @@ def test_ball_defect_row_track_width_from_hertz(cwru):
     assert (cols["axis_offset"], cols["wander_s"]) == (0.3, 0.5)
     with pytest.raises(ParameterError, match="axis_offset"):
         BallDefect("1b1", 4e-4, 2e-4, axis_offset=1.5)
+
+
+@pytest.mark.parametrize("size_m", [1e-4, 7.5e-4, 3e-3])
+@pytest.mark.parametrize("load_n", [10.0, 1000.0])
+def test_ball_defect_on_the_track_keeps_its_full_depth(cwru, size_m, load_n):
+    """axis_offset = 0 (the default) is the Sawalhi-Randall defect, whatever the pit's width
+    against the contact band: the runs' track grid is all ones."""
+    row = BallDefect("1b1", size_m, 2e-4).defect_row(cwru, load_n)
+    cols = dict(zip(DEFECT_COLUMNS, row))
+    assert track_share(0.0, cols["track_rad"], cols["half_width_rad"]) == 1.0

@@ -19,8 +19,8 @@ abruptly at the exit edge (over :data:`EXIT_RAMP_FRACTION` of the entry distance
 * ball: one defect on one ball that strikes the outer race and the inner race once each per
   spin revolution (2 × BSF) — when it lies on the ball's rolling track. A ball rolls on a
   great circle perpendicular to its spin axis; a pit elsewhere on the ball never meets the
-  races, and one at the track's edge meets them with the part of its width inside the
-  contact band (the Hertz ellipse's half-width across the track, :func:`track_share`).
+  races, and one at the track's edge meets them in part (its overlap with the contact band,
+  the Hertz ellipse's width across the track, :func:`track_share`).
   ``axis_offset`` is the sine of the defect's latitude above that circle (0: on the track,
   the Sawalhi-Randall case; a defect at a random place on the ball has it uniform in
   [−1, 1]). The spin axis of a real ball is not fixed: cage-pocket friction, gyroscopic
@@ -123,12 +123,13 @@ def defect_profile(angle_rad, centre_rad, half_width_rad, entry_rad, exit_rad):
 
 
 def track_share(axis_offset, track_rad, half_width_rad):
-    """Share of a ball defect's width inside the rolling track (0..1).
+    """Share of a ball defect's depth the races meet, by where it sits on the ball (0..1).
 
-    The pit spans [s − L/2, s + L/2] across the track at s = R_b·|axis_offset|; the contact
-    band spans [−a, a]: the share is clip((a + L/2 − s)/L, 0, 1) (1 when the whole pit is
-    inside, 0 when it misses the band). In ball radii: ``track_rad`` = (a + L/2)/R_b,
-    ``half_width_rad`` = L/(2 R_b).
+    The pit spans [s − h, s + h] across the rolling track (s = R_b·|axis_offset|, h = L/2),
+    the contact band [−a, a]; the share is their overlap over the smaller of the two widths:
+    1 while the pit is inside the band or covers it (the Sawalhi-Randall case, whatever its
+    size), falling linearly to 0 as it slides out, 0 once it misses the band. In ball radii:
+    ``track_rad`` = (a + h)/R_b, ``half_width_rad`` = h/R_b.
 
     Parameters
     ----------
@@ -138,7 +139,10 @@ def track_share(axis_offset, track_rad, half_width_rad):
         See above.
     """
     s = np.abs(np.asarray(axis_offset, dtype=float))
-    return np.clip((track_rad - s) / (2.0 * half_width_rad), 0.0, 1.0)
+    h = float(half_width_rad)
+    a = float(track_rad) - h
+    overlap = np.clip(np.minimum(s + h, a) - np.maximum(s - h, -a), 0.0, None)
+    return np.minimum(overlap / (2.0 * min(h, a)), 1.0)
 
 
 def wandering_offset(axis_offset, wander_s, n_samples, dt_s, rng):
