@@ -259,18 +259,11 @@ def _jitter_at(jitter, ib, iball, t, jdt):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _track_gains(track, tdt, t, gain):
-    """Fill ``gain`` (m,) with each defect row's ``track`` value at ``t`` (linear)."""
-    ng = track.shape[1]
-    u = t / tdt
-    if ng == 1 or u <= 0.0:
-        for r in range(track.shape[0]):
-            gain[r] = track[r, 0]
-        return
-    if u >= ng - 1:
-        for r in range(track.shape[0]):
-            gain[r] = track[r, ng - 1]
-        return
-    i = int(u)
+    """Fill ``gain`` (m,) with each defect row's ``track`` value at ``t`` (linear on its
+    grid, held at the ends); only called when the grid varies (a constant one is copied
+    into ``W.def_gain`` once, by :func:`make_work`)."""
+    u = min(max(t / tdt, 0.0), track.shape[1] - 1.0)
+    i = min(int(u), track.shape[1] - 2)
     f = u - i
     for r in range(track.shape[0]):
         gain[r] = track[r, i] + f * (track[r, i + 1] - track[r, i])
@@ -804,7 +797,7 @@ def make_work(P):
                 np.zeros(WORK_PER_N2 * slots * slots + WORK_PER_N * slots), np.zeros(slots),
                 np.zeros(slots), np.zeros(slots), np.ones(slots), np.ones(slots),
                 np.zeros(slots), np.zeros(slots), np.zeros(2), np.zeros((2, AN_SIZE)),
-                np.ones(max(P.b_def.shape[0], 1)))
+                P.track[:, 0].copy() if P.track.shape[0] else np.ones(1))
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -863,7 +856,7 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
         _bearing_forces(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
                         W.cage_slip, diag, want_diag)
         if P.b_def.shape[0] > 0 or P.m_int[MI_FAULTY_BALLS] != 0:
-            if P.b_def.shape[0] > 0:
+            if P.track.shape[1] > 1:
                 _track_gains(P.track, P.m_par[MP_TDT], t, W.def_gain)
             _faulty_bearing_forces(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos,
                                    ball_sin, W.cage, W.cage_slip, diag, want_diag, P.b_ang,

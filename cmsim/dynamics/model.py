@@ -608,8 +608,8 @@ def _track(b_def, duration_s, seed):
     ``seed``). Returns ((m, n_grid), dt); n_grid = 1 when nothing varies.
     """
     m = b_def.shape[0]
-    ball = (b_def[:, K.DF_KIND] == K.DEF_BALL) if m else np.zeros(0, bool)
-    wander = ball & (b_def[:, K.DF_WANDER] > 0.0) if m else ball
+    ball = b_def[:, K.DF_KIND] == K.DEF_BALL
+    wander = ball & (b_def[:, K.DF_WANDER] > 0.0)
     if not np.any(wander):
         out = np.ones((m, 1))
         for r in np.flatnonzero(ball):
