@@ -16,7 +16,8 @@ import numpy as np
 from cmsim.errors import ParameterError
 
 __all__ = ["DELTA_STAR_TABLE", "RacewayContact", "raceway_contact", "contact_stiffness",
-           "ball_stiffness", "bearing_contact_stiffness", "contact_semi_axes_m",
+           "ball_stiffness", "bearing_contact_stiffness", "bearing_raceway_contacts",
+           "contact_semi_axes_m",
            "STEEL_REDUCED_MODULUS_PA"]
 
 #: E' = 2 / ((1 − ν1²)/E1 + (1 − ν2²)/E2) of steel on steel (E = 208 GPa, ν = 0.3), Pa.
@@ -132,6 +133,20 @@ def ball_stiffness(k_inner, k_outer, exponent=1.5):
     return k_inner * k_outer / (k_inner ** (1.0 / p) + k_outer ** (1.0 / p)) ** p
 
 
+def bearing_raceway_contacts(bearing):
+    """(inner, outer) :class:`RacewayContact` of a bearing's balls.
+
+    Parameters
+    ----------
+    bearing : cmsim.rig.Bearing
+    """
+    d = bearing.ball_diameter_m
+    return (raceway_contact(d, 0.5 * bearing.inner_raceway_diameter_m,
+                            bearing.inner_groove_radius_m, inner=True),
+            raceway_contact(d, 0.5 * bearing.outer_raceway_diameter_m,
+                            bearing.outer_groove_radius_m, inner=False))
+
+
 def bearing_contact_stiffness(bearing):
     """k_RE of a :class:`~cmsim.rig.RollingBearing` from Annex B, N/m^p.
 
@@ -150,31 +165,25 @@ def bearing_contact_stiffness(bearing):
         raise ParameterError("Annex B gives ball (point-contact, p = 1.5) stiffness only; "
                              f"load_exponent = {bearing.load_exponent:g} needs "
                              "stiffness_n_per_m_p to be given")
-    d = bearing.ball_diameter_m
-    ci = raceway_contact(d, 0.5 * bearing.inner_raceway_diameter_m, bearing.inner_groove_radius_m,
-                         inner=True)
-    co = raceway_contact(d, 0.5 * bearing.outer_raceway_diameter_m, bearing.outer_groove_radius_m,
-                         inner=False)
+    ci, co = bearing_raceway_contacts(bearing)
     return ball_stiffness(ci.stiffness_n_per_m15, co.stiffness_n_per_m15, bearing.load_exponent)
 
 
-def contact_semi_axes_m(ball_diameter_m, raceway_radius_m, groove_radius_m, ball_load_n, *,
-                        inner, reduced_modulus_pa=STEEL_REDUCED_MODULUS_PA):
+def contact_semi_axes_m(contact, ball_load_n, *, reduced_modulus_pa=STEEL_REDUCED_MODULUS_PA):
     """Semi-axes of the Hertz contact ellipse of a ball on a raceway, m.
 
     Hamrock & Brewe's closed form (ref. [3], ch. 3: ellipticity k = α^(2/π), elliptic
     integral E = 1 + (π/2 − 1)/α with α = R_y/R_x): D_y = 2 (6 k² E w R/(π E'))^(1/3),
-    D_x = 2 (6 E w R/(π k E'))^(1/3), with R_x, R_y the effective radii along and across
-    the rolling direction and 1/R = 1/R_x + 1/R_y.
+    D_x = 2 (6 E w R/(π k E'))^(1/3). The effective radii along (R_x) and across (R_y) the
+    rolling direction come from the contact's curvature sum and difference (eq. B.3-B.4):
+    1/R_x, 1/R_y = Σρ (1 ± F(ρ))/2, and 1/R = Σρ.
 
     Parameters
     ----------
-    ball_diameter_m, raceway_radius_m, groove_radius_m : float
-        Ball diameter d, raceway radius (R_i or R_o) and groove curvature radius, m.
+    contact : RacewayContact
+        The ball-raceway contact (:func:`raceway_contact`).
     ball_load_n : float
         Normal load of the ball on the raceway, N (>= 0).
-    inner : bool
-        Inner raceway (convex along the rolling direction) or outer (concave).
     reduced_modulus_pa : float
         E' of the two bodies, Pa.
 
@@ -188,15 +197,14 @@ def contact_semi_axes_m(ball_diameter_m, raceway_radius_m, groove_radius_m, ball
     --------
     A 6205 ball on its outer raceway at 200 N: a band about 1.5 mm wide across the track.
 
-    >>> ax, ay = contact_semi_axes_m(7.94e-3, 23.49e-3, 4.13e-3, 200.0, inner=False)
+    >>> ax, ay = contact_semi_axes_m(
+    ...     raceway_contact(7.94e-3, 23.49e-3, 4.13e-3, inner=False), 200.0)
     >>> round(ay * 1e3, 2), round(ax * 1e3, 3)
     (0.73, 0.104)
     """
-    ra = 0.5 * ball_diameter_m
-    inv_rx = 1.0 / ra + (1.0 if inner else -1.0) / raceway_radius_m
-    inv_ry = 1.0 / ra - 1.0 / groove_radius_m
-    rx, ry = 1.0 / inv_rx, 1.0 / inv_ry
-    r = 1.0 / (inv_rx + inv_ry)
+    total, diff = contact.curvature_sum_per_m, contact.curvature_difference
+    rx, ry = 2.0 / (total * (1.0 + diff)), 2.0 / (total * (1.0 - diff))
+    r = 1.0 / total
     alpha = ry / rx
     k = alpha ** (2.0 / np.pi)
     e = 1.0 + (0.5 * np.pi - 1.0) / alpha

@@ -57,7 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cmsim.bearings.hertz import contact_semi_axes_m
+from cmsim.bearings.hertz import bearing_raceway_contacts, contact_semi_axes_m
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults.base import Fault, check_bearing, check_int, mm, register
 
@@ -360,7 +360,7 @@ class BallDefect(Fault):
         check_int("ball", self.ball, 0, brg.n_balls - 1)
         return self
 
-    def defect_row(self, rig, ball_load_n=100.0):
+    def defect_row(self, rig, ball_load_n):
         """Row of ``FaultArrays.bearing_defects`` (angles on the ball, radius R_b).
 
         Parameters
@@ -376,12 +376,7 @@ class BallDefect(Fault):
         rb = 0.5 * brg.ball_diameter_m
         drop = ball_drop_m(rb, self.size_m, self.depth_m)
         entry = _entry_distance_m(rb, self.size_m, drop)
-        band = max(contact_semi_axes_m(brg.ball_diameter_m, 0.5 * d, r, ball_load_n,
-                                       inner=inner)[1]
-                   for d, r, inner in ((brg.outer_raceway_diameter_m, brg.outer_groove_radius_m,
-                                        False),
-                                       (brg.inner_raceway_diameter_m, brg.inner_groove_radius_m,
-                                        True)))
+        band = max(contact_semi_axes_m(c, ball_load_n)[1] for c in bearing_raceway_contacts(brg))
         return [float(ib), KIND_BALL, float(self.phase_rad), 0.5 * self.size_m / rb, drop,
                 entry / rb, self.exit_ramp_fraction * entry / rb, float(self.ball),
                 float(self.axis_offset), float(self.wander_s),
