@@ -320,12 +320,6 @@ class _Nuisances:
         """The setup with nuisance ``name`` at ``value`` (its catalogue cause applied)."""
         return CAUSES[name]().apply(setup, value, None)
 
-    @staticmethod
-    def value(setup, nominal_path, name):
-        if name == "transfer_path":
-            return setup.housing.natural_frequencies_hz[0] / nominal_path.natural_frequencies_hz[0]
-        return setup.noise_ratio
-
     def fit(self, setup, release=None):
         """(χ², setup) with both nuisances refitted; ``release`` names the one searched
         beyond its prior."""
@@ -499,9 +493,10 @@ def _rank(cause, nominal, nuis, ev):
     """The cause's best probe: ``{name, cause, component, probe, chi2, setup}`` or None."""
     if cause.post_dynamics:                       # a nuisance released beyond its prior
         chi, st = nuis.fit(nominal, release=cause.name)
-        value = nuis.value(st, nominal.rig.housing, cause.name)
+        name = cause.params[0].name
         return {"name": cause.name, "cause": cause, "component": None,
-                "probe": {cause.params[0].name: value}, "chi2": chi, "setup": st}
+                "probe": {name: _nuisance_params(st, nominal)[name]}, "chi2": chi,
+                "setup": st}
     best = None
     for comp in cause.components(nominal.rig, ev.sensor_bearing):
         for values in _probes(cause):
@@ -545,10 +540,8 @@ def _fit(top, nominal, nuis, ev):
     """Fit the named cause's parameters, one after the other (coarse grid over the bounds,
     then bounded Brent), within the budget; returns (parameters, fitted setup)."""
     cause, comp = top["cause"], top["component"]
-    if cause.post_dynamics:
-        p = cause.params[0]
-        return {p.name: top["probe"][p.name], **_nuisance_params(top["setup"], nominal)}, \
-            top["setup"]
+    if cause.post_dynamics:                       # its value is one of the nuisances
+        return _nuisance_params(top["setup"], nominal), top["setup"]
     values = dict(top["probe"])
     best_c, best_st = top["chi2"], top["setup"]
     for p in cause.params:
@@ -585,7 +578,8 @@ def _fit(top, nominal, nuis, ev):
 
 
 def _nuisance_params(setup, nominal):
-    """The fitted nuisances of a setup: noise ratio and housing frequency factor."""
+    """The fitted nuisances of a setup: noise ratio and housing frequency factor (the
+    parameters of the ``noise`` and ``transfer_path`` causes)."""
     return {"noise_ratio": setup.noise_ratio,
             "frequency_factor": setup.housing.natural_frequencies_hz[0]
             / nominal.rig.housing.natural_frequencies_hz[0]}

@@ -456,7 +456,7 @@ def record_from_run(run, channel, rig, op, model_signal=None, components=None,
 
 
 #: Accelerometer units cmsim converts to m/s² (the first word of a metadata ``unit``).
-ACCELERATION_UNITS = {"g": 9.80665, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0, "mm/s2": 1e-3,
+ACCELERATION_UNITS = {"g": _G, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0, "mm/s2": 1e-3,
                       "mm/s^2": 1e-3}
 
 
