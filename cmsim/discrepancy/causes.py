@@ -92,20 +92,15 @@ class Param:
         Values simulated when ranking (the other parameters at their ``default``).
     log_scale : bool
         Fit in log(value).
-    default : float or None
-        Value while another parameter is probed (default: the geometric middle).
     """
 
     name: str
     bounds: tuple
     probes: tuple
     log_scale: bool = True
-    default: float | None = None
 
     def middle(self):
-        """``default``, else the geometric (log scale) or arithmetic middle of the bounds."""
-        if self.default is not None:
-            return float(self.default)
+        """The geometric (log scale) or arithmetic middle of the bounds."""
         lo, hi = self.bounds
         return math.sqrt(lo * hi) if self.log_scale else 0.5 * (lo + hi)
 
@@ -163,6 +158,20 @@ class Cause:
         ``probes``/``log_scale``)."""
         return (Param(self.parameter, tuple(self.bounds), tuple(self.probes),
                       self.log_scale),)
+
+    def start(self, rig):
+        """Value of each parameter while another one is probed or fitted: the middle of its
+        bounds (a cause whose parameter the rig documents starts from the rig's value).
+
+        Parameters
+        ----------
+        rig : Rig
+
+        Returns
+        -------
+        dict of str to float
+        """
+        return {p.name: p.middle() for p in self.params}
 
     def components(self, rig, sensor_bearing):
         """Components this cause may sit on (``[None]`` for a rig-wide cause): every bearing
@@ -270,6 +279,11 @@ class FrictionCause(Cause):
     needs_gears = True
     params = (Param("roughness_m", (5e-8, 5e-6), (1e-7, 1.5e-6)),
               Param("viscosity_pa_s", (5e-4, 0.2), (0.02,)))
+
+    def start(self, rig):
+        lub = rig.lubricant
+        return {"roughness_m": lub.surface_roughness_m,
+                "viscosity_pa_s": lub.dynamic_viscosity_pa_s}
 
     def apply(self, setup, values, component):
         lub = setup.rig.lubricant

@@ -499,7 +499,7 @@ def _rank(cause, nominal, nuis, ev):
                 "setup": st}
     best = None
     for comp in cause.components(nominal.rig, ev.sensor_bearing):
-        for values in _probes(cause):
+        for values in _probes(cause, nominal.rig):
             try:
                 chi, st = nuis.fit(cause.extend(nominal, values, comp))
             except ParameterError:
@@ -526,14 +526,11 @@ def _refine(r, nominal, nuis, ev):
                 r.update(chi2=chi, setup=st, probe=values)
 
 
-def _probes(cause):
-    """Probe value sets: each parameter's probes with the others at their middle."""
-    params = cause.params
-    out = []
-    for p in params:
-        for v in p.probes:
-            out.append({q.name: (v if q is p else q.middle()) for q in params})
-    return out
+def _probes(cause, rig):
+    """Probe value sets: each parameter's probes with the others at their start
+    (:meth:`~cmsim.discrepancy.causes.Cause.start`)."""
+    start = cause.start(rig)
+    return [{**start, p.name: v} for p in cause.params for v in p.probes]
 
 
 def _fit(top, nominal, nuis, ev):

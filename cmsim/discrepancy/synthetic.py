@@ -147,9 +147,7 @@ def hidden_effect_record(effect, seed, *, duration_s=DURATION_S, rig_kind=None):
         cause = CAUSES[effect]()
         comps = cause.components(rig, "1b1")
         component = comps[int(rng.integers(len(comps)))]
-        params = cause.params
-        values = {p.name: (value if i == 0 else _nominal(rig, p.name, p))
-                  for i, p in enumerate(params)}
+        values = {**cause.start(rig), cause.params[0].name: value}
         setup = cause.extend(setup, values, component)
     x = simulate_setup(setup, fs, duration_s, "accel_1b1_y", int(seed) + 100_000,
                        noise_ref_rms=ref)
@@ -162,9 +160,3 @@ def hidden_effect_record(effect, seed, *, duration_s=DURATION_S, rig_kind=None):
                         component=None if component is None else comps.get(component,
                                                                             component))
 
-
-def _nominal(rig, name, param):
-    """The rig's own value of a secondary cause parameter (e.g. its oil's viscosity)."""
-    if name == "viscosity_pa_s":
-        return rig.lubricant.dynamic_viscosity_pa_s
-    return param.middle()
