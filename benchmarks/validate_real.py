@@ -10,21 +10,16 @@ columns; the pipeline never sees it.
 
 import argparse
 import json
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from cmsim.diagnostics.measured import data_root
 from cmsim.discrepancy import compare, read_record
 
 #: Catalogue finding that matches a metadata fault location or fault (first word of it).
 MATCH = {"inner_race": "bearing_inner_race", "outer_race": "bearing_outer_race",
          "ball": "bearing_ball", "broken": "tooth_fault"}
-
-
-def default_data():
-    env = os.environ.get("CMSIM_DATA")
-    return Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "datasets"
 
 
 def one(path):
@@ -68,7 +63,7 @@ def row(name, c, truth, expected):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--data", type=Path, default=default_data())
+    ap.add_argument("--data", type=Path, default=data_root())
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--json", type=Path, default=None)
