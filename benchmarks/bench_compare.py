@@ -18,6 +18,7 @@ from collections import Counter, defaultdict
 from concurrent.futures import ProcessPoolExecutor
 
 from cmsim.discrepancy import compare
+from cmsim.discrepancy.compare import DEFAULT_BUDGET
 from cmsim.discrepancy.synthetic import HIDDEN_EFFECTS, hidden_effect_record
 
 SEVERITY_FACTOR = 2.0
@@ -51,7 +52,6 @@ def main(argv=None):
     ap.add_argument("--effects", nargs="*", default=None)
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
-    from cmsim.discrepancy.compare import DEFAULT_BUDGET
     budget = a.budget or DEFAULT_BUDGET
     effects = a.effects or (list(HIDDEN_EFFECTS) + ["none", "none_gear"])
     jobs = [(e, s, budget) for s in range(a.seeds) for e in effects]
