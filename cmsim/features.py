@@ -426,22 +426,25 @@ def _hann_spectrum(x, fs):
     return np.fft.rfftfreq(x.size, 1.0 / fs), amp
 
 
-def _peak(freq, amp, f, df):
-    """Largest bin within f·(1 ± LINE_TOLERANCE) ± 1.5 bins (NaN outside the spectrum)."""
+def _line_bins(freq, f, df):
+    """Mask of the bins within f·(1 ± LINE_TOLERANCE) ± 1.5 bins (None if there are none)."""
     half = LINE_TOLERANCE * f + 1.5 * df
     sel = (freq >= f - half) & (freq <= f + half)
-    if f <= 0 or not np.any(sel):
-        return math.nan
-    return float(np.max(amp[sel]))
+    return sel if f > 0 and np.any(sel) else None
+
+
+def _peak(freq, amp, f, df):
+    """Largest bin of the line at ``f`` (:func:`_line_bins`; NaN outside the spectrum)."""
+    sel = _line_bins(freq, f, df)
+    return math.nan if sel is None else float(np.max(amp[sel]))
 
 
 def _band_excess(freq, amp, f, df, floor):
-    """Power in f·(1 ± LINE_TOLERANCE) ± 1.5 bins over what the local floor puts there:
-    a line smeared by slip or a speed fluctuation keeps its energy (unlike a line that is
-    gone, or drowned in noise)."""
-    half = LINE_TOLERANCE * f + 1.5 * df
-    sel = (freq >= f - half) & (freq <= f + half)
-    if f <= 0 or not np.any(sel) or not floor > 0:
+    """Power in the bins of the line at ``f`` (:func:`_line_bins`) over what the local floor
+    puts there: a line smeared by slip or a speed fluctuation keeps its energy (unlike a
+    line that is gone, or drowned in noise)."""
+    sel = _line_bins(freq, f, df)
+    if sel is None or not floor > 0:
         return math.nan
     return float(np.sum(amp[sel] ** 2) / (np.count_nonzero(sel) * floor ** 2))
 
