@@ -8,6 +8,7 @@ import math
 import pytest
 
 import cmsim
+import cmsim.dynamics
 from cmsim.errors import ParameterError
 from cmsim.rig import Rig, RollingBearing, SpurGear
 

@@ -21,7 +21,7 @@ Example
 ['000_T10Nm_c15um', '001_T10Nm_c0um', '002_T100Nm_c15um', '003_T100Nm_c0um']
 """
 
-from cmsim.datasets.dataset_spec import BUILTIN_RIGS, DatasetRecord, DatasetSpec
+from cmsim.datasets.dataset_spec import DatasetRecord, DatasetSpec
 from cmsim.datasets.generate import DatasetSummary, generate_dataset
 from cmsim.datasets.load import Dataset, Record, load
 from cmsim.datasets.lock import LOCK_NAME, DirectoryLock
@@ -36,5 +36,5 @@ __all__ = ["SweepSpec", "SweepCase", "Variation", "SweepSummary", "run_sweep", "
            "manifest_features", "DirectoryLock", "SEED_POLICIES", "START_METHODS",
            "MANIFEST_NAME", "RUNS_DIR", "LOCK_NAME", "FEATURE_SIGNALS",
            "OPERATING_POINT_FIELDS", "RIG_TRANSFORMS", "DatasetSpec", "DatasetRecord",
-           "DatasetSummary", "generate_dataset", "load", "Dataset", "Record", "BUILTIN_RIGS",
+           "DatasetSummary", "generate_dataset", "load", "Dataset", "Record",
            "Interrupted"]

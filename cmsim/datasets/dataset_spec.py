@@ -51,10 +51,9 @@ from cmsim.datasets.variation import RIG_TRANSFORMS
 from cmsim.dynamics.mesh_choice import MESH_CHOICES
 from cmsim.errors import ParameterError
 from cmsim.faults import FAULT_TYPES, RollingSlip, SpeedFluctuation, check_faults
-from cmsim.rig import OperatingPoint, RollingBearing, Rig, Rotor
+from cmsim.rig import PRESETS, OperatingPoint, Rig
 
-__all__ = ["DatasetSpec", "DatasetRecord", "Distribution", "BUILTIN_RIGS", "SEVERITY_FIELDS",
-           "cwru_6205_rig", "mfpt_nice_rig"]
+__all__ = ["DatasetSpec", "DatasetRecord", "Distribution", "SEVERITY_FIELDS"]
 
 #: Main size of each fault type: the record's ``fault_severity`` (SI).
 SEVERITY_FIELDS = {"outer_race": "size_m", "inner_race": "size_m", "ball": "size_m",
@@ -81,27 +80,6 @@ _TABLES = {"dataset": {"name", "records", "seed"}, "rig": {"builtin", "file"},
            "simulation": {"mesh", "substeps"}}
 _DIST_KEYS = {"distribution", "min", "max", "mean", "std", "values"}
 DISTRIBUTIONS = ("constant", "uniform", "loguniform", "normal", "choice")
-
-
-def cwru_6205_rig():
-    """A rotor on two SKF 6205 ball bearings (CWRU drive-end geometry: 9 balls,
-    d = 7.94 mm, pitch D = 39.04 mm), loaded radially through ``radial_load_n``."""
-    brg = RollingBearing.from_pitch(9, 7.94e-3, 39.04e-3)
-    return Rig.rotor_on_bearings(brg, Rotor(mass_kg=5.0, inertia_kg_m2=0.01),
-                                 name="cwru_6205")
-
-
-def mfpt_nice_rig():
-    """A rotor on two MFPT test bearings (NICE, 8 rollers, d = 5.969 mm (0.235 in), pitch
-    D = 31.623 mm (1.245 in), 0 deg), loaded radially through ``radial_load_n``."""
-    brg = RollingBearing.from_pitch(8, 5.969e-3, 31.623e-3)
-    return Rig.rotor_on_bearings(brg, Rotor(mass_kg=5.0, inertia_kg_m2=0.01),
-                                 name="mfpt_nice")
-
-
-#: Built-in rigs by name.
-BUILTIN_RIGS = {"paper_2016": Rig.paper_2016, "cwru_6205": cwru_6205_rig,
-                "mfpt_nice": mfpt_nice_rig}
 
 
 def _err(key, msg):
@@ -639,9 +617,9 @@ def _rig(table, base_dir):
         except ParameterError as exc:
             raise _err("rig.file", f"{path}: {exc}") from None
     name = table.get("builtin", "paper_2016")
-    if name not in BUILTIN_RIGS:
-        raise _err("rig.builtin", f"must be one of {sorted(BUILTIN_RIGS)}, got {name!r}")
-    return BUILTIN_RIGS[name](), f"builtin:{name}"
+    if name not in PRESETS:
+        raise _err("rig.builtin", f"must be one of {sorted(PRESETS)}, got {name!r}")
+    return PRESETS[name](), f"builtin:{name}"
 
 
 def _fault_choice(key, table, rig):
