@@ -6,6 +6,8 @@ belongs to a *unit* (its top-level module or package under ``cmsim``), each unit
 
 * a unit may import only units of its own layer or of a lower one, and the graph of units has no
   cycle (so no two units import each other, as the before-stop hook checks);
+* no two modules import each other, directly or round a circle, inside a unit too (a name taken
+  from a package's ``__init__`` counts as an import of the submodule that defines it);
 * an import of a cmsim module inside a function is not allowed (outside ``cli.py``): it hides
   the layering and is needed only to break an import cycle, which the first rule forbids;
 * other function-local imports are allowed only for heavy optional libraries (matplotlib,
@@ -106,12 +108,32 @@ def imports(module):
                     base = child.module
                 for alias in child.names:
                     sub = f"{base}.{alias.name}"
-                    yield (sub if sub in MODULES else base), child.lineno, local
+                    if sub not in MODULES:
+                        sub = reexported(base).get(alias.name, base)
+                    yield sub, child.lineno, local
             inner = local or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef,
                                                 ast.ClassDef, ast.Lambda))
             yield from visit(child, inner)
 
     yield from dict.fromkeys(visit(tree, False))
+
+
+def reexported(package):
+    """{name: defining module} of the names a package's ``__init__`` imports from its
+    submodules (empty for a plain module or a third-party package)."""
+    path = MODULES.get(package)
+    if path is None or path.name != "__init__.py":
+        return {}
+    found = {}
+    for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.ImportFrom):
+            base = (".".join(package.split(".")[:len(package.split(".")) - node.level + 1]
+                             + ([node.module] if node.module else []))
+                    if node.level else node.module)
+            for alias in node.names:
+                sub = f"{base}.{alias.name}"
+                found[alias.asname or alias.name] = sub if sub in MODULES else base
+    return found
 
 
 def location(module, line):
@@ -172,6 +194,53 @@ def unit_cycles():
     return cycles
 
 
+def module_graph():
+    """Module -> {imported cmsim module: first 'file:line'} (known exceptions left out)."""
+    graph = {}
+    for module in MODULES:
+        for target, line, _ in imports(module):
+            if (is_cmsim(target) and target in MODULES and target != module
+                    and f"{module} -> {target}" not in KNOWN_EXCEPTIONS):
+                graph.setdefault(module, {}).setdefault(target, location(module, line))
+    return graph
+
+
+def module_cycles():
+    """Every circle of imports between modules, as the modules of each strongly connected
+    component with the imports that tie them (``"a -> b (file:line)"``)."""
+    graph = module_graph()
+    index, low, stack, on_stack, found = {}, {}, [], set(), []
+
+    def connect(v):                     # Tarjan's strongly connected components
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, {}):
+            if w not in index:
+                connect(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                members = set(component)
+                ties = [f"{a} -> {b} ({where})" for a in sorted(members)
+                        for b, where in sorted(graph.get(a, {}).items()) if b in members]
+                found.append("; ".join(ties))
+
+    for v in sorted(graph):
+        if v not in index:
+            connect(v)
+    return found
+
+
 def _local():
     """``(exception key, message)`` for every function-local import the rules do not allow."""
     for module in MODULES:
@@ -208,6 +277,11 @@ def test_no_import_of_a_higher_layer():
 def test_no_two_units_import_each_other():
     found = unit_cycles()
     assert not found, "import cycles between parts of cmsim:\n" + "\n".join(found)
+
+
+def test_no_two_modules_import_each_other():
+    found = module_cycles()
+    assert not found, "import circles between modules of cmsim:\n" + "\n".join(found)
 
 
 def test_no_needless_function_local_imports():
@@ -250,7 +324,28 @@ def test_the_checker_sees_local_imports_and_cycles(tmp_path, monkeypatch):
     assert any("run_probe" in c and "bearings" in c for c in unit_cycles())
 
 
+def test_the_checker_sees_circles_inside_a_package(tmp_path, monkeypatch):
+    """Three probe modules of one package, a -> b -> c -> a (one through the package's
+    ``__init__``), form one circle; without the last import they form none."""
+    pkg = tmp_path / "probe"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("from cmsim.dynamics.probe.c import thing\n")
+    (pkg / "a.py").write_text("from cmsim.dynamics.probe import b\n")
+    (pkg / "b.py").write_text("import cmsim.dynamics.probe.c\n")
+    (pkg / "c.py").write_text("from cmsim.dynamics.probe.a import x\nthing = 1\n")
+    for name in ("__init__", "a", "b", "c"):
+        key = "cmsim.dynamics.probe" + ("" if name == "__init__" else f".{name}")
+        monkeypatch.setitem(MODULES, key, pkg / f"{name}.py")
+    circles = [c for c in module_cycles() if "probe" in c]
+    assert len(circles) == 1 and all(f"probe.{m} ->" in circles[0] for m in "abc")
+    (pkg / "c.py").write_text("thing = 1\n")
+    assert not [c for c in module_cycles() if "probe" in c]
+    (pkg / "a.py").write_text("from cmsim.dynamics.probe import thing\n")  # via __init__
+    (pkg / "c.py").write_text("import cmsim.dynamics.probe.a\nthing = 1\n")
+    assert [c for c in module_cycles() if "probe" in c]
+
+
 if __name__ == "__main__":
-    problems = upward_imports() + unit_cycles() + local_imports()
+    problems = upward_imports() + unit_cycles() + module_cycles() + local_imports()
     print("\n".join(problems) or "no layering problems")
     sys.exit(bool(problems))
