@@ -23,8 +23,7 @@ import numpy as np
 import pytest
 
 import cmsim
-from cmsim import cli
-from cmsim.cli import main
+from cmsim.cli import app, build_parser, contract, main
 from cmsim.rig import Rig
 from cmsim.run import Run
 
@@ -333,9 +332,9 @@ CATALOGUE = [
 
 def _numeric_options():
     """(command, option, dest) of every int/float option of every command."""
-    parser = cli.build_parser()
+    parser = build_parser()
     out = []
-    for command, sub in cli._subparsers(parser).items():
+    for command, sub in contract.subparsers(parser).items():
         for a in sub._actions:
             if a.option_strings and (a.type in (int, float) or hasattr(a.type, "allowed")):
                 out.append((command, max(a.option_strings, key=len), a.dest, a.nargs))
@@ -495,7 +494,7 @@ def test_bad_input(row, as_json, files, capsys):
 
 def test_catalogue_size_and_commands():
     """Every command `cmsim --help` lists has rows, and the catalogue has ~60+ hand rows."""
-    commands = set(cli._subparsers(cli.build_parser()))
+    commands = set(contract.subparsers(build_parser()))
     assert commands == set(BASE)
     covered = {r.argv[0] for r in CATALOGUE if r.argv}
     assert commands <= covered
@@ -506,41 +505,41 @@ def test_every_option_is_validated():
     """Each numeric option has a range (parse time) or is checked by the library under a name
     that maps to it; each other option has choices, is a path, a flag, or a name checked
     against the run."""
-    parser = cli.build_parser()
+    parser = build_parser()
     # checked against the run's signals / bearings; --fault by cmsim.faults.parse_fault
     # --algorithm: load_algorithm; --scheduler: checked by connecting (names --scheduler)
     # compare's RECORD may be relative to $CMSIM_DATA: the library checks it (and names it)
     free_text = {"signal", "bearing", "fault", "algorithm", "scheduler", "record", "channel"}
-    for command, sub in cli._subparsers(parser).items():
+    for command, sub in contract.subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):
                 continue
             if a.type in (int, float):
-                assert a.dest in cli._LIBRARY_VALIDATED, (command, a.dest)
+                raise AssertionError(f"{command} {a.dest}: a number without a range")
             elif hasattr(a.type, "allowed"):
                 continue
             else:
                 assert (a.choices is not None or a.dest in free_text
-                        or (command, a.dest) in cli._PATHS or a.dest in cli._PATHS), \
+                        or (command, a.dest) in contract.PATHS or a.dest in contract.PATHS), \
                     (command, a.dest)
 
 
 def test_param_names_map_to_options():
     """A ParameterError naming a Python field reads as the option typed."""
     from cmsim.errors import ParameterError, check_range
-    options = cli._options_of(cli.build_parser(), "spectrum")
+    options = contract.options_of(build_parser(), "spectrum")
     try:
         check_range("max_peaks", 0, 1, 100)
     except ParameterError as exc:
-        msg, option = cli._user_message(exc, options)
+        msg, option = contract.user_message(exc, options)
     assert option == "--top" and msg.startswith("--top must be") and "max_peaks" not in msg
-    options = cli._options_of(cli.build_parser(), "simulate")
+    options = contract.options_of(build_parser(), "simulate")
     for param, opt in (("cage_speed_rms", "--cage-slip"), ("torque_nm", "--torque-nm"),
                        ("clearance_m", "--clearance-m")):
-        msg, option = cli._user_message(ParameterError(f"{param} must be >= 0, got -1"), options)
+        msg, option = contract.user_message(ParameterError(f"{param} must be >= 0, got -1"), options)
         assert option == opt and msg.startswith(opt)
-    msg, _ = cli._user_message(ParameterError("n_positions must be an integer >= 4"),
-                               cli._options_of(cli.build_parser(), "modes"))
+    msg, _ = contract.user_message(ParameterError("n_positions must be an integer >= 4"),
+                               contract.options_of(build_parser(), "modes"))
     assert msg.startswith("--positions")
 
 
@@ -548,15 +547,14 @@ def test_internal_error_is_one_line_status_1(capsys, monkeypatch):
     def boom(args):
         raise ZeroDivisionError("x")
 
-    parser = cli.build_parser
-    monkeypatch.setattr(cli, "_cmd_modes", boom)
+    parser = app.build_parser
 
     def patched():
         p = parser()
-        cli._subparsers(p)["modes"].set_defaults(func=boom)
+        contract.subparsers(p)["modes"].set_defaults(func=boom)
         return p
 
-    monkeypatch.setattr(cli, "build_parser", patched)
+    monkeypatch.setattr(app, "build_parser", patched)
     assert main(["modes", "--torque-nm", "10", "--json"]) == 1
     cap = capsys.readouterr()
     assert len(cap.err.strip().splitlines()) == 1 and "please report" in cap.err
@@ -574,17 +572,24 @@ def test_report_bearing_rig_without_dte(files, tmp_path, capsys):
     assert Path(res["html"]).is_file()
 
 
-def test_plausibility_warning_in_json(monkeypatch, capsys):
-    """1000 N m on the paper's 6.35 mm face: warned (stderr without --json, listed with it)."""
-    from cmsim.rig import OperatingPoint
-    args = argparse.Namespace(json=True, _warnings=[])
-    rig = Rig.paper_2016()
-    cli._plausibility(args, rig, OperatingPoint(1000.0, 1000.0))
-    assert len(args._warnings) == 1 and "MPa" in args._warnings[0]
-    args = argparse.Namespace(json=False, _warnings=[])
-    cli._plausibility(args, rig, OperatingPoint(1000.0, 100.0))
-    assert args._warnings == []
-    assert capsys.readouterr().err == ""
+def test_plausibility_warning_text_and_json(capsys):
+    """1000 N m on the paper's 6.35 mm face: one warning naming --torque-nm, on stderr as
+    text (after the result), in the JSON object's "warnings" with --json and then nothing on
+    stderr; 100 N m: no warning. (The library gives the warning: load_warnings.)"""
+    argv = ["modes", "--torque-nm", "1000", "--positions", "4"]
+    assert main(argv) == 0
+    cap = capsys.readouterr()
+    warned = [line for line in cap.err.splitlines() if "warning" in line]
+    assert len(warned) == 1 and "--torque-nm 1000" in warned[0] and "MPa" in warned[0]
+    assert "torque_nm" not in cap.err
+    assert main(argv + ["--json"]) == 0
+    cap = capsys.readouterr()
+    res = json.loads(cap.out)
+    assert len(res["warnings"]) == 1 and res["warnings"][0].startswith("--torque-nm 1000")
+    assert cap.err == ""
+    assert main(["modes", "--torque-nm", "100", "--positions", "4", "--json"]) == 0
+    cap = capsys.readouterr()
+    assert "warnings" not in json.loads(cap.out) and cap.err == ""
 
 
 @pytest.mark.parametrize("argv, status, word", [

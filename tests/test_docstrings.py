@@ -46,7 +46,6 @@ UNDOCUMENTED = frozenset({
     "cmsim.bearings.kinematics.ball_angles",
     "cmsim.bearings.kinematics.cage_angle",
     "cmsim.bearings.kinematics.cage_ratios",
-    "cmsim.cli.main",
     "cmsim.datasets.manifest.case_entry",
     "cmsim.datasets.manifest.read_manifest",
     "cmsim.datasets.spec.SweepSpec.from_dict",

@@ -395,7 +395,8 @@ def test_crack_on_the_default_mesh_tables():
 def test_cli_fault_and_ramp_reach_the_run(tmp_path, capsys):
     """--fault, --faults and a rig file's [[faults]] reach the run meta; --ramp-to-rpm makes
     the tacho pulse faster at the end than at the start."""
-    from cmsim.cli import FAULT_NAMES, main
+    from cmsim.cli import main
+    from cmsim.cli.options import FAULT_NAMES
     assert sorted(FAULT_NAMES) == sorted(FAULT_TYPES)
     rig = cwru_rig()
     rig.save(tmp_path / "rig.toml", faults=(parse_fault(

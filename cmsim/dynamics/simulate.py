@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -24,8 +26,8 @@ from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
 
-__all__ = ["simulate", "integrate", "MAX_ROTATION_DEVIATION_RAD", "STEPS_PER_PERIOD",
-           "MAX_OUTPUT_BYTES"]
+__all__ = ["simulate", "integrate", "kernels_cached", "MAX_ROTATION_DEVIATION_RAD",
+           "STEPS_PER_PERIOD", "MAX_OUTPUT_BYTES"]
 
 #: Integration steps per period of the highest natural frequency when the step is chosen
 #: automatically: ω_max·h <= 2π/4.7 = 1.34, 77 % of ode3's stability limit √3 on the
@@ -228,6 +230,22 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     return q_out, d_out, runner.wall
 
 
+def kernels_cached():
+    """True when the integration kernel has an up-to-date numba cache (the first run of a
+    fresh install compiles it, about 30 s); False when it will compile or cannot tell."""
+    source = Path(K.__file__)
+    # numba writes its cache to $NUMBA_CACHE_DIR when set, else beside the source
+    places = [Path(os.environ["NUMBA_CACHE_DIR"]) if os.environ.get("NUMBA_CACHE_DIR")
+              else source.parent / "__pycache__"]
+    try:
+        mtime = source.stat().st_mtime
+        pattern = f"{source.stem}.{K.integrate_jit.__name__}*.nbi"
+        return any(index.stat().st_mtime >= mtime for place in places if place.is_dir()
+                   for index in place.rglob(pattern))
+    except OSError:
+        return False
+
+
 def _compile_seconds():
     """Time to compile or load the kernels (measured once per process)."""
     if not hasattr(_compile_seconds, "value"):
@@ -250,7 +268,7 @@ def _compile_seconds():
 def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
              scheme="ode3", slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
              profile=None, faults=(), progress=None, loads=None, friction_table=None,
-             damping_table=None, losses=None, record=None):
+             damping_table=None, losses=None, record=None, on_start=None):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
 
     The run starts from the quasi-static equilibrium at t = 0 (velocities at the nominal
@@ -321,6 +339,10 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
     progress : callable, optional
         Called as ``progress(done_s, total_s)`` (simulated seconds, warm-up included) as the
         integration advances, in chunks that do not change the result.
+    on_start : callable, optional
+        Called once as ``on_start(total_s)`` when every input is checked and the model is
+        built, just before the integration starts (a front end shows its progress bar then,
+        never before a bad-input error).
     cage_phases_rad : "random", sequence of float or None
         Initial cage angle of each bearing: drawn uniformly from ``seed`` (default — the
         relative phase of independent cages is arbitrary, and equal phases can cancel the
@@ -392,6 +414,8 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         substeps = max(1, math.ceil(STEPS_PER_PERIOD * f_max / fs_hz - 1e-9))
     stats = {}
     aa = None
+    if on_start is not None:
+        on_start(warmup_s + duration_s)
     if substeps == 1:
         n_warm = int(round(warmup_s * fs_hz))
         report = None if progress is None else (lambda done, total: progress(done * dt,

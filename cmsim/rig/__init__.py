@@ -9,6 +9,8 @@ One concept per module, all frozen dataclasses in SI units:
 * :mod:`~cmsim.rig.housing` — :class:`HousingPath`;
 * :mod:`~cmsim.rig.operating` — :class:`OperatingPoint`;
 * :mod:`~cmsim.rig.rig` — :class:`Rig`: the components, topology and DOF layout, TOML files;
+* :mod:`~cmsim.rig.sampling` — :class:`Sampling`, :data:`SAMPLING`: how a run is sampled, the
+  one set of defaults;
 * :mod:`~cmsim.rig.ranges` — :data:`RANGES`, the one table of allowed ranges;
 * :mod:`~cmsim.rig.presets` — named rigs (:data:`PRESETS`);
 * :mod:`~cmsim.rig.codec` — dataclasses to plain dicts and back, every key checked.
@@ -22,8 +24,10 @@ from cmsim.rig.operating import OperatingPoint
 from cmsim.rig.presets import PRESETS, preset
 from cmsim.rig.ranges import RANGES, Range
 from cmsim.rig.rig import RIG_FORMAT_VERSION, Rig
+from cmsim.rig.sampling import SAMPLING, Sampling
 from cmsim.rig.shafts import Coupling, Rotor, ShaftLine
 
 __all__ = ["SpurGear", "GearPair", "RollingBearing", "Rotor", "ShaftLine", "Coupling",
            "Lubricant", "MeshContact", "OperatingPoint", "HousingPath", "Rig",
-           "RIG_FORMAT_VERSION", "RANGES", "Range", "PRESETS", "preset"]
+           "RIG_FORMAT_VERSION", "RANGES", "Range", "PRESETS", "preset", "Sampling",
+           "SAMPLING"]

@@ -15,7 +15,10 @@ from cmsim.errors import ParameterError, check_range
 from cmsim.rig.ranges import (MAX_CONTACT_STIFFNESS, MAX_DAMPING_N_S_PER_M, MAX_INERTIA_KG_M2,
                               MAX_MASS_KG)
 
-__all__ = ["RollingBearing"]
+__all__ = ["RollingBearing", "STATIC_LOAD_FACTOR_N_PER_M2"]
+
+#: ISO 76 static load rating factor f0 of deep-groove ball bearings, N/m² (12.3 N/mm²).
+STATIC_LOAD_FACTOR_N_PER_M2 = 12.3e6
 
 
 @dataclass(frozen=True)
@@ -164,6 +167,12 @@ class RollingBearing:
         if play <= 0 or a <= 0:
             return 0.0
         return math.acos(max(-1.0, 1.0 - play / (2 * a)))
+
+    @property
+    def static_load_rating_n(self):
+        """Basic static radial load rating C0 = f0·Z·d² of a deep-groove ball bearing, N
+        (ISO 76, f0 ≈ 12.3 N/mm² at the nominal contact angle 0)."""
+        return STATIC_LOAD_FACTOR_N_PER_M2 * self.n_balls * self.ball_diameter_m ** 2
 
     @property
     def effective_contact_angle_rad(self):

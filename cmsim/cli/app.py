@@ -1,0 +1,133 @@
+"""``main(argv)``: parse, run one command, print its result (text or one JSON object).
+
+Exit status: 0 success, 1 internal error (please report), 2 bad input, 3 diverged
+integration, 130 interrupted. With ``--json`` stdout holds exactly one JSON object, also on
+errors: ``{"error": message, "status": code, "option": "--top" or null}``; warnings go to
+stderr (and, with ``--json``, to the object's ``warnings`` list).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import sys
+
+import numpy as np
+
+from cmsim.cli import (compare, dataset, evaluate, losses, mesh_table, modes, report,
+                       simulate, spectrum, sweep)
+from cmsim.cli.contract import (CLIError, Parser, check_paths, finite, options_of, subparsers,
+                                user_message)
+from cmsim.errors import IntegrationDiverged, ParameterError
+
+__all__ = ["main", "build_parser", "COMMANDS"]
+
+#: The command modules, in ``cmsim --help`` order; each has ``register(sub)``, which gives
+#: its parser the defaults ``func=run`` (``run(args) -> dict``) and ``text`` (``text(dict)
+#: -> str``).
+COMMANDS = (simulate, modes, mesh_table, spectrum, sweep, dataset, report, evaluate, compare,
+            losses)
+
+
+def build_parser():
+    """The argparse parser of ``cmsim``: one subparser per command, each with ``--json``."""
+    from cmsim import __version__
+
+    parser = Parser(prog="cmsim",
+                    description="Vibration of a spur-gear transmission on ball bearings "
+                                "(19-DOF model of Fernandez-del-Rincon et al. 2016).")
+    parser.add_argument("--version", action="version", version=f"cmsim {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for command in COMMANDS:
+        command.register(sub)
+    for p in subparsers(parser).values():
+        p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    return parser
+
+
+_NEGATIVE_EXPONENT_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)e[-+]?\d+$", re.IGNORECASE)
+
+
+def _plain_negative_numbers(argv):
+    """``-1e-6`` → ``-0.000001``: argparse takes a negative number in exponent notation for an
+    option, but a plain decimal for a value, also in lists (``--clearance-m 0 -1e-6``)."""
+    return [np.format_float_positional(float(a), trim="-")
+            if _NEGATIVE_EXPONENT_NUMBER.match(a) else a for a in argv]
+
+
+def _notice_compile(args):
+    """Once per process, before the first heavy step of a command: say that the numba
+    kernels compile when their cache is cold (nothing with ``--json``)."""
+    from cmsim.dynamics.simulate import kernels_cached
+
+    if not args.json and not args._compile_noticed and not kernels_cached():
+        print("cmsim: compiling numba kernels (first run only, about 30 s)...", file=sys.stderr)
+    args._compile_noticed = True
+
+
+def main(argv=None):
+    """Entry point of the ``cmsim`` console script; returns the exit status.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+    """
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    parser = build_parser()
+    args = argparse.Namespace(json="--json" in argv, command=argv[0] if argv else None,
+                              warnings=[])
+    try:
+        args = parser.parse_args(_plain_negative_numbers(argv))
+        args.warnings = []
+        options = options_of(parser, args.command)
+        args.warn = lambda text: args.warnings.append(user_message(text, options)[0])
+        args._compile_noticed = False
+        args.notice_compile = lambda: _notice_compile(args)
+        try:
+            check_paths(args, args.command, options)
+            res = args.func(args)
+        except ParameterError as exc:
+            msg, option = user_message(exc, options)
+            raise CLIError(msg, 2, option=option) from None
+        except IntegrationDiverged as exc:
+            msg, option = user_message(exc, options)
+            extra = {}
+            if getattr(exc, "summary", None) is not None:
+                extra["summary"] = exc.summary.to_dict()
+            raise CLIError(msg, 3, option=option, extra=extra) from None
+    except CLIError as exc:
+        return _fail(parser, args, str(exc), exc.status, exc.option, exc.extra)
+    except KeyboardInterrupt:
+        return _fail(parser, args, "interrupted", 130)
+    except Exception as exc:  # noqa: BLE001 - the last line of defence
+        if os.environ.get("CMSIM_DEBUG"):
+            raise
+        detail = " ".join(str(exc).split())[:300]
+        return _fail(parser, args, f"internal error ({type(exc).__name__}: {detail}); please "
+                                   f"report it with the command line (CMSIM_DEBUG=1 shows the "
+                                   f"traceback)", 1)
+    if isinstance(res, dict) and args.warnings:
+        res = {**res, "warnings": list(args.warnings)}
+    if not args.json:
+        for text in args.warnings:
+            print(f"cmsim {args.command}: warning: {text}", file=sys.stderr)
+        print(args.text(res))
+    else:
+        print(json.dumps(finite(res)))
+    return 0
+
+
+def _fail(parser, args, message, status, option=None, extra=None):
+    message = " ".join(str(message).split())
+    prog = f"cmsim {args.command}" if getattr(args, "command", None) in subparsers(parser) \
+        else "cmsim"
+    print(f"{prog}: error: {message}", file=sys.stderr)
+    if getattr(args, "json", False):
+        out = {"error": message, "status": status, "option": option, **(extra or {})}
+        if getattr(args, "warnings", None):
+            out["warnings"] = list(args.warnings)
+        print(json.dumps(finite(out)))
+    return status

@@ -1,0 +1,226 @@
+"""Option groups several commands share, each declared once with its reader.
+
+The defaults come from the library (:data:`cmsim.rig.SAMPLING`, the rig's own values) and
+the ranges from :data:`cmsim.rig.RANGES`, so every command and the Python API give the same
+default and accept the same range for the same option.
+"""
+
+from __future__ import annotations
+
+import re
+
+from cmsim.cli.contract import CLIError, load_file, ranged
+from cmsim.errors import ParameterError
+from cmsim.rig import RANGES, SAMPLING, OperatingPoint, Rig
+from cmsim.rig.plausibility import load_warnings
+
+__all__ = ["number", "add_rig_options", "load_rig", "add_sampling_options", "add_mesh_options",
+           "mesh_argument", "prepare_tables", "add_fault_options", "faults_of", "add_losses_option",
+           "check_losses_options", "operating_point", "operating_warnings", "FAULT_NAMES"]
+
+#: The catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
+#: pulls in the mesh-stiffness stack; tests check the two agree).
+FAULT_NAMES = ("outer_race", "inner_race", "ball", "wear", "off_size_ball", "rolling_slip",
+               "eccentricity", "tooth_crack", "tooth_spall", "tooth_breakage", "profile_error",
+               "speed_fluctuation", "torque_ripple")
+
+
+def number(name):
+    """argparse type of the quantity ``name`` of :data:`cmsim.rig.RANGES`."""
+    return ranged(RANGES[name])
+
+
+# ---------------------------------------------------------------------- rig
+def add_rig_options(p, *, friction=True, many=False):
+    """Add ``--rig``, ``--clearance-m`` and (with ``friction``) ``--friction`` to the parser
+    ``p``; with ``many`` the last two take lists (a sweep varies them)."""
+    p.add_argument("--rig", metavar="FILE.toml",
+                   help="rig description (default: the paper's rig, Tables 1-3)")
+    nargs = "+" if many else None
+    p.add_argument("--clearance-m", type=number("clearance_m"), nargs=nargs, metavar="C",
+                   help="radial clearance of every bearing, m (negative = preload; default: "
+                        "the rig's)")
+    if friction:
+        p.add_argument("--friction", type=number("friction"), nargs=nargs, metavar="F",
+                       help="mesh friction coefficient (paper: 0, 0.03, 0.05; default: the "
+                            "rig's)")
+
+
+def load_rig(args, *, variants=True):
+    """The rig of ``args.rig`` (default the paper's), with ``--clearance-m`` and
+    ``--friction`` applied unless ``variants`` is False (a sweep varies them)."""
+    rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig \
+        else Rig.paper_2016()
+    if not variants:
+        return rig
+    if getattr(args, "clearance_m", None) is not None:
+        rig = rig.with_clearance(args.clearance_m)
+    if getattr(args, "friction", None) is not None:
+        if rig.gears is None:
+            raise CLIError("--friction needs a rig with gears", option="--friction")
+        rig = rig.with_friction(args.friction)
+    return rig
+
+
+def operating_warnings(args, rig, op):
+    """Warn through ``args.warn`` (:func:`cmsim.rig.plausibility.load_warnings`) about loads
+    of ``op`` that ``rig`` cannot carry; the warnings name the options."""
+    for text in load_warnings(rig, op):
+        args.warn(text)
+
+
+# ---------------------------------------------------------------------- sampling
+def add_sampling_options(p, *, seed_help="seed of every random draw of the run"):
+    """Add the one sampling group to the parser ``p``: --duration-s, --fs-hz, --warmup-s,
+    --substeps, --seed (its help ``seed_help``), with the library's defaults
+    (:data:`cmsim.rig.SAMPLING`)."""
+    s = SAMPLING
+    p.add_argument("--duration-s", type=number("duration_s"), default=s.duration_s,
+                   help=f"recorded duration, s (default {s.duration_s:g})")
+    p.add_argument("--fs-hz", type=number("fs_hz"), default=s.fs_hz,
+                   help=f"output sample rate, Hz (default {s.fs_hz:g}; any acquisition rate: "
+                        "the integration step follows the model, and the record is "
+                        "anti-alias filtered)")
+    p.add_argument("--warmup-s", type=number("warmup_s"), default=s.warmup_s,
+                   help=f"simulated start discarded before recording, s (default "
+                        f"{s.warmup_s:g})")
+    p.add_argument("--substeps", type=number("substeps"), default=s.substeps,
+                   help="integration steps per output sample (default: the fewest giving "
+                        ">= 4.7 steps per period of the highest mode; 1 at 75 kHz on the "
+                        "paper rig, 3 at 25.6 kHz)")
+    p.add_argument("--seed", type=number("seed"), default=s.seed,
+                   help=f"{seed_help} (default {s.seed}; recorded in the run)")
+
+
+# ---------------------------------------------------------------------- mesh
+def add_mesh_options(p):
+    """Add --mesh, --mesh-table and --table-torque-nm to the parser ``p`` (simulate, modes,
+    sweep, losses)."""
+    p.add_argument("--mesh", choices=("hybrid-tables", "potential-energy", "hybrid"),
+                   default="hybrid-tables",
+                   help="tooth contact: hybrid FE + Weber-Banaschek tables at the run's torque "
+                        "(default; paper model B, shipped for the paper's rig, built and "
+                        "cached on first use for other rigs), the load-independent "
+                        "potential-energy table, or the contact solved on-line from the FE "
+                        "influence coefficients (hybrid: paper model A, ~4x slower)")
+    p.add_argument("--mesh-table", metavar="FILE.npz",
+                   help="pair stiffness table(s) from cmsim mesh-table instead; the table at "
+                        "the run's torque is used (linear in torque between tables)")
+    p.add_argument("--table-torque-nm", type=number("torque_nm"), metavar="T",
+                   help="use the --mesh-table table of torque T instead (paper model C: "
+                        "tables at the wrong torque)")
+
+
+def mesh_argument(args, rig, torques_nm=()):
+    """The ``mesh`` value the options in ``args`` name: a string, or the MeshTableSet /
+    table of a file (a gear ``rig`` only).
+
+    A --mesh-table set of several torques is read between its tables only: a torque outside
+    its range (--table-torque-nm, or each of ``torques_nm`` without it) is refused, not
+    clamped.
+    """
+    from cmsim.mesh_stiffness.table_set import MeshTableSet
+
+    if args.table_torque_nm is not None and not args.mesh_table:
+        raise CLIError("--table-torque-nm selects a table of --mesh-table FILE; give "
+                       "--mesh-table too", option="--table-torque-nm")
+    if not args.mesh_table:
+        return args.mesh
+    if args.mesh != "hybrid-tables":
+        raise CLIError(f"--mesh {args.mesh} and --mesh-table exclude each other",
+                       option="--mesh")
+    if rig.gears is None:
+        raise CLIError("--mesh-table needs a rig with gears", option="--mesh-table")
+    tables = load_file("--mesh-table", args.mesh_table, MeshTableSet.load,
+                       "a mesh stiffness table file (cmsim mesh-table --out)")
+    known = [float(t.torque_nm) for t in tables.tables]
+    if len(known) > 1:
+        lo, hi = min(known), max(known)
+        asked = ([("--table-torque-nm", args.table_torque_nm)]
+                 if args.table_torque_nm is not None
+                 else [("--torque-nm", q) for q in torques_nm])
+        for option, q in asked:
+            if not lo - 1e-9 * hi <= q <= hi + 1e-9 * hi:
+                raise CLIError(f"{option} {q:g} is outside the torques of --mesh-table "
+                               f"{args.mesh_table}: allowed [{lo:g}, {hi:g}] N m (tables "
+                               f"at {', '.join(f'{x:g}' for x in known)})", option=option)
+    return tables if args.table_torque_nm is None else tables.at(args.table_torque_nm)
+
+
+def prepare_tables(args, rig, mesh):
+    """Build (or load) the hybrid mesh tables of ``rig`` once when ``mesh`` asks for them,
+    with a progress bar on stderr unless ``args.json``, before a run or the workers of a
+    sweep read them from the cache."""
+    if mesh == "hybrid-tables" and rig.gears is not None:
+        from cmsim.dynamics.mesh_choice import hybrid_table_set
+        hybrid_table_set(rig, progress=False if args.json else None)
+
+
+# ---------------------------------------------------------------------- faults
+def add_fault_options(p):
+    """Add --fault (repeatable) and --faults FILE to the parser ``p``."""
+    p.add_argument("--fault", action="append", metavar="TYPE:key=value,...",
+                   help="a fault of the catalogue, felt through the dynamics (repeatable), "
+                        "e.g. outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4 or "
+                        "tooth_crack:gear=1,depth_m=1e-3; types: " + ", ".join(FAULT_NAMES)
+                        + "; a rig file's [[faults]] list is applied too")
+    p.add_argument("--faults", metavar="FILE.toml",
+                   help="faults from a TOML file's [[faults]] list (type = \"...\", fields)")
+
+
+def faults_of(args, rig):
+    """The faults of the rig file's ``[[faults]]``, ``--faults FILE`` and each ``--fault``
+    of ``args`` (in that order), each checked against ``rig``; bad input names the option
+    that gave it."""
+    from cmsim.faults import load_faults, parse_fault
+
+    found = []                                    # (where, fault)
+    for option, path in (("--rig", getattr(args, "rig", None)),
+                         ("--faults", getattr(args, "faults", None))):
+        if path:
+            loaded = load_file(option, path, load_faults, "a TOML file with a [[faults]] list")
+            found += [(f"{option} {path}: faults[{i}] ({f.name})", f)
+                      for i, f in enumerate(loaded)]
+    for text in getattr(args, "fault", None) or ():
+        try:
+            found.append((f"--fault {text}", parse_fault(text)))
+        except ParameterError as exc:
+            raise CLIError(f"--fault {text}: {' '.join(str(exc).split())} (form: "
+                           f"TYPE:key=value,...)", option="--fault") from None
+        except TypeError as exc:                  # a required field left out
+            missing = re.findall(r"'(\w+)'", str(exc))
+            raise CLIError(f"--fault {text}: {', '.join(missing) or 'a parameter'} must be "
+                           f"given (form: TYPE:key=value,...)", option="--fault") from None
+    for where, fault in found:
+        try:
+            fault.validate(rig)
+        except ParameterError as exc:
+            raise CLIError(f"{where}: {' '.join(str(exc).split())}",
+                           option=where.split()[0]) from None
+    return tuple(f for _, f in found)
+
+
+# ---------------------------------------------------------------------- losses
+def add_losses_option(p):
+    """Add --losses to the parser ``p`` (simulate, sweep)."""
+    p.add_argument("--losses", action="store_true",
+                   help="every loss source in the run: windage, pumping and bearing friction "
+                        "torques resist the rotations, the tooth friction follows the "
+                        "mixed-lubrication film (paper 000, 004); the run's meta carries the "
+                        "breakdown by source and its power balance")
+
+
+def check_losses_options(args):
+    """--losses sets the tooth friction itself: refuse --friction beside it in ``args``."""
+    if getattr(args, "losses", False) and getattr(args, "friction", None) is not None:
+        raise CLIError("--losses sets the tooth friction from the lubricant film along the "
+                       "path; leave out --friction", option="--friction")
+
+
+def operating_point(args, rig):
+    """The OperatingPoint of --speed-rpm, --torque-nm, --radial-load-n in ``args``, with the
+    load warnings of :func:`operating_warnings` for ``rig``."""
+    op = OperatingPoint(speed_rpm=args.speed_rpm, torque_nm=getattr(args, "torque_nm", 0.0),
+                        radial_load_n=getattr(args, "radial_load_n", 0.0))
+    operating_warnings(args, rig, op)
+    return op

@@ -1,0 +1,84 @@
+"""``cmsim spectrum``: labelled amplitude, envelope or order spectrum of one signal of a run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from cmsim.cli.contract import load_file, ranged
+from cmsim.cli.output import save_figure
+from cmsim.rig import Range
+
+
+def register(sub):
+    """Add the ``spectrum`` parser."""
+    p = sub.add_parser("spectrum", help="labelled spectrum of one signal of a run",
+                       description="Amplitude, envelope or order spectrum of a run signal, "
+                                   "with its largest peaks named k·GMF ± m·BPF ± n·fr from "
+                                   "the run's own rig and operating point.")
+    p.add_argument("run", type=Path, metavar="RUN.npz", help="run written by cmsim simulate")
+    p.add_argument("--signal", default="F_1b1_loa", help="signal name (default F_1b1_loa)")
+    p.add_argument("--kind", default="amplitude", choices=("amplitude", "envelope", "order"),
+                   help="spectrum kind")
+    p.add_argument("--band-hz", type=ranged(Range(0.0, 1.0e7, unit="Hz")), nargs=2,
+                   metavar=("LO", "HI"),
+                   help="demodulation band for --kind envelope, Hz (default: kurtogram's)")
+    p.add_argument("--max-hz", type=ranged(Range(0.0, 1.0e7, lo_open=True, unit="Hz")),
+                   metavar="F", help="list peaks up to F Hz")
+    p.add_argument("--resolution-hz", type=ranged(Range(0.0, 1.0e6, lo_open=True, unit="Hz")),
+                   metavar="R", help="required bin spacing, Hz (error if the record is too short)")
+    p.add_argument("--bearing", help="bearing for the BPF family (default: from the signal)")
+    p.add_argument("--top", type=ranged(Range(1, 1000, integer=True)), default=20,
+                   help="number of largest peaks listed")
+    p.add_argument("--threshold-db", type=ranged(Range(0.0, 200.0, unit="dB")), default=15.0,
+                   help="least peak height above the noise floor, dB")
+    p.add_argument("--plot", type=Path, metavar="OUT.png", help="write the spectrum figure")
+    p.set_defaults(func=run, text=text)
+
+
+def run(args):
+    """The spectrum's labelled peaks (and its figure)."""
+    from cmsim.run import Run
+    from cmsim.spectra.run_spectrum import run_spectrum
+
+    def load(path):
+        run_ = Run.load(path)
+        run_.rig, run_.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
+        return run_
+
+    run_ = load_file("RUN.npz", args.run, load, "a cmsim run file (cmsim simulate --out)")
+    spec = run_spectrum(run_, args.signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
+                        resolution_hz=args.resolution_hz, bearing=args.bearing,
+                        max_peaks=args.top, threshold_db=args.threshold_db)
+    out = {"run": str(args.run), "signal": spec.signal, "kind": spec.kind, "unit": spec.unit,
+           "resolution_hz": spec.resolution_hz, "bearing": spec.bearing,
+           "families": spec.families, "band_hz": list(spec.band_hz) if spec.band_hz else None,
+           "max_hz": spec.max_hz, "n_peaks": len(spec.peaks), "peaks": spec.peak_records(),
+           "plot": None, **spec.extra}
+    if args.plot:
+        from cmsim.spectra.plots import plot_spectrum
+        fam = spec.families
+        fig = plot_spectrum(spec.freq_hz, spec.amplitude, spec.peaks, fam,
+                            amplitude_unit=spec.unit, max_freq=spec.max_hz,
+                            max_harmonic=max(1, int(spec.max_hz // fam.get("GMF", spec.max_hz))),
+                            title=f"{spec.signal}: {spec.kind} spectrum "
+                                  f"({spec.resolution_hz:.3g} Hz resolution)")
+        save_figure(fig, args.plot)
+        out["plot"] = str(args.plot)
+    return out
+
+
+def text(res):
+    """The peaks as a table."""
+    lines = [f"{res['kind']} spectrum of {res['signal']} [{res['unit']}], resolution "
+             f"{res['resolution_hz']:.4g} Hz, families of bearing {res['bearing']}: "
+             + ", ".join(f"{k} {v:.3f} Hz" for k, v in res["families"].items())]
+    if res["band_hz"]:
+        lines.append(f"demodulation band {res['band_hz'][0]:.0f}-{res['band_hz'][1]:.0f} Hz")
+    lines.append(f"{'frequency_hz':>13}  {'amplitude':>11}  {'dB re carrier':>13}  label")
+    for p in res["peaks"]:
+        db = "" if p["db_re_carrier"] is None else f"{p['db_re_carrier']:.1f}"
+        lines.append(f"{p['frequency_hz']:13.2f}  {p['amplitude']:11.4g}  {db:>13}  "
+                     f"{p['label']}")
+    if res["plot"]:
+        lines.append(f"wrote {res['plot']}")
+    return "\n".join(lines)
