@@ -8,6 +8,8 @@ rate). Plus input checks: every bad input is refused with a message naming the p
 
 import math
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -271,13 +273,20 @@ def test_cwru_frequencies(cwru):
 
 
 def test_gear_fault_frequencies(rig):
+    """A tooth fault's key frequencies come from its own gear: on a 28:37 pair the driven
+    gear turns at fr1·28/37 (a 28:28 pair could not tell the gears apart)."""
+    pair = replace(rig.gears, driven=replace(rig.gears.driven, n_teeth=37))
+    rig = replace(rig, gears=pair)
     op = OperatingPoint(speed_rpm=1000.0, torque_nm=10.0)
     key = fault_frequencies(rig, op, [ToothCrack(gear=2, depth_m=1e-3),
+                                      ToothCrack(gear=1, depth_m=1e-3),
                                       ToothCrack(gear=2, depth_m=1e-3)])
-    (a, b) = key.values()
-    assert a["gmf_hz"] == pytest.approx(466.6667, rel=1e-6)
-    assert a["shaft_hz"] == pytest.approx(1000 / 60 * 28 / 28)
-    assert len(key) == 2                                           # duplicate labels kept
+    driven, driving, again = key.values()
+    fr1 = 1000 / 60
+    assert driven["gmf_hz"] == driving["gmf_hz"] == pytest.approx(28 * fr1, rel=1e-12)
+    assert driven["shaft_hz"] == pytest.approx(fr1 * 28 / 37, rel=1e-12)
+    assert driving["shaft_hz"] == pytest.approx(fr1, rel=1e-12)
+    assert len(key) == 3 and again == driven                       # duplicate labels kept
 
 
 def test_rig_toml_with_faults(tmp_path, rig):
