@@ -459,7 +459,7 @@ def _add_spectrum(sub):
 
 # ---------------------------------------------------------------------- sweep
 def _cmd_sweep(args):
-    from cmsim.datasets import SweepSpec, run_sweep
+    from cmsim.datasets import DatasetSpec, Variation, generate_dataset
     from cmsim.rig import Rig
 
     rig = _load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig \
@@ -481,30 +481,38 @@ def _cmd_sweep(args):
         # build (or load) the rig's tables once, before the workers start
         from cmsim.dynamics.mesh_choice import hybrid_table_set
         hybrid_table_set(rig, progress=False if args.json else None)
-    spec = SweepSpec(speeds_rpm=args.speed_rpm, torques_nm=torques,
-                     radial_load_n=args.radial_load_n,
-                     duration_s=args.duration_s, frictions=args.friction or (None,),
-                     clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
-                     warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
-                     seed_policy=args.seed_policy, mesh=mesh, faults=_faults_of(args, rig),
-                     losses=args.losses or None)
+    axes = [("speed_rpm", args.speed_rpm), ("torque_nm", torques), ("friction", args.friction),
+            ("clearance_m", args.clearance_m)]
+    spec = DatasetSpec([Variation(n, v) for n, v in axes if v],
+                       fixed={"radial_load_n": args.radial_load_n} if args.radial_load_n
+                       else None, duration_s=args.duration_s, rig=rig, fs_hz=args.fs_hz,
+                       warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
+                       seed_policy=args.seed_policy, mesh=mesh, faults=_faults_of(args, rig),
+                       losses=args.losses or None)
     progress = not args.json and sys.stderr.isatty()
     try:
-        summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,
-                            progress=progress)
+        summary = generate_dataset(spec, args.out, workers=args.workers, force=args.force,
+                                   progress=progress, verify=True)
     except KeyboardInterrupt:
-        raise CLIError(f"interrupted; finished runs are kept in {args.out}/manifest.json, "
+        raise CLIError(f"interrupted; finished runs are kept in {args.out}/manifest.parquet, "
                        f"re-run the same command to resume", 130) from None
+    if summary.records_failed:
+        errors = "; ".join(f"{r}: {e}" for r, e in summary.failed)
+        exc = IntegrationDiverged(f"{summary.records_failed} of {summary.records_total} runs "
+                                  f"failed ({errors}); the other runs are saved in "
+                                  f"{args.out}/manifest.parquet")
+        exc.summary = summary
+        raise exc
     return summary.to_dict()
 
 
 def _text_sweep(res):
-    lines = [f"{res['n_runs']} runs in {res['dir']}: {res['completed']} simulated, "
-             f"{res['skipped']} already there ({res['adopted']} adopted), "
-             f"{len(res['failed'])} failed",
+    lines = [f"{res['records_total']} runs in {res['dir']}: {res['records_written']} "
+             f"simulated, {res['records_skipped']} already there ({res['records_adopted']} "
+             f"adopted), {res['records_failed']} failed",
              f"wall {res['wall_s']:.2f} s on {res['workers']} workers ({res['start_method']}); "
-             f"integration {res['integration_s']:.2f} s, compile {res['compile_s']:.2f} s, "
-             f"setup {res['setup_s']:.2f} s, spectra {res['spectra_s']:.2f} s, "
+             f"integration {res['integration_s']:.2f} s, warm-up {res['warmup_s']:.2f} s, "
+             f"setup {res['setup_s']:.2f} s, features {res['features_s']:.2f} s, "
              f"save {res['save_s']:.2f} s; utilisation {100 * res['utilisation']:.0f} %",
              f"manifest {res['manifest']}"]
     return "\n".join(lines)
@@ -513,9 +521,10 @@ def _text_sweep(res):
 def _add_sweep(sub):
     p = sub.add_parser("sweep", help="simulate a grid of operating points in parallel",
                        description="Simulate speeds × torques (× frictions × clearances) on "
-                                   "worker processes; each run is saved to DIR/runs/ and "
-                                   "recorded in DIR/manifest.json as it finishes. Re-running "
-                                   "the same command resumes: finished runs are skipped.")
+                                   "worker processes: a grid dataset spec whose records keep "
+                                   "every signal; each run is saved to DIR/records/ and listed "
+                                   "in DIR/manifest.parquet as it finishes. Re-running the "
+                                   "same command resumes: finished runs are skipped.")
     p.add_argument("--torque-nm", type=float, nargs="+",
                    help="output torques, N m (gear rigs; default 0: unloaded, the teeth may "
                         "separate)")
@@ -534,9 +543,11 @@ def _add_sweep(sub):
                         "rig's)")
     p.add_argument("--fs-hz", type=float, default=75_000.0, help="output sample rate, Hz")
     p.add_argument("--warmup-s", type=float, default=0.05, help="discarded start, s")
-    p.add_argument("--substeps", type=int, default=1, help="integration steps per sample")
+    p.add_argument("--substeps", type=int, default=None,
+                   help="integration steps per output sample (default: automatic, with "
+                        "anti-alias decimation, as simulate)")
     p.add_argument("--seed", type=int, default=0,
-                   help="base seed; run i gets a seed derived from (seed, i)")
+                   help="base seed; run i gets a seed drawn from SeedSequence([seed, i])")
     p.add_argument("--seed-policy", default="per_run", choices=("per_run", "shared"),
                    help="per_run: independent seed per run; shared: every run uses --seed")
     p.add_argument("--workers", type=int, default=None,
