@@ -87,7 +87,7 @@ def bench_throughput(records, workers, tmp):
 def bench_resume_100k(tmp, n=100_000):
     import pandas as pd
     from cmsim.datasets import DatasetSpec
-    from cmsim.datasets.generate import RECORDS_DIR, ROWS_DIR, _done_indices, _open
+    from cmsim.datasets.manifest import RECORDS_DIR, ROWS_DIR, done_indices, open_directory
     raw = tomllib.loads((ROOT / "datasets" / "ci.toml").read_text())
     raw["dataset"]["records"] = n
     spec = DatasetSpec.from_dict(raw)
@@ -103,9 +103,9 @@ def bench_resume_100k(tmp, n=100_000):
     for k in range(60):                     # a realistic width
         cols[f"col{k}"] = 1.0
     pd.DataFrame(cols).to_parquet(out / "manifest.parquet", index=False)
-    _open(spec, out, False)
+    open_directory(spec, out, False)
     t = time.perf_counter()
-    found, _ = _done_indices(spec, out, verify=False)
+    found, _ = done_indices(spec, out, verify=False)
     dt = time.perf_counter() - t
     assert len(found) == done
     return {"rows": done, "resume_scan_s": round(dt, 2),

@@ -1,7 +1,9 @@
 """HTML report of a sweep directory: waterfalls, orbits, DTE traces and labelled-peak tables.
 
-:func:`build_report` reads the run files of a sweep (``DIR/runs/*.npz``, listed by
-``DIR/manifest.json`` when there is one) and writes ``DIR/report.html`` with PNG figures
+:func:`build_report` reads the run files of a sweep (``DIR/records/*.npz``, listed by
+``DIR/manifest.parquet`` when there is one; a folder of runs saved by
+:meth:`Run.save <cmsim.run.Run.save>` under ``DIR/runs/`` too) and writes
+``DIR/report.html`` with PNG figures
 beside it (relative links, no external assets: the directory can be zipped and sent).
 Everything shown is computed from the run files alone — operating point, rig, clearance and
 friction are read from each run's metadata — so regenerating the report from the files
@@ -39,7 +41,8 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_bytes, atomic_write_text
-from cmsim.datasets import RUNS_DIR, read_manifest
+from cmsim.datasets import RECORDS_DIR, read_rows
+from cmsim.datasets.manifest import read_spec
 from cmsim.errors import ParameterError, check_range
 from cmsim.features import N_GMF_HARMONICS, gmf_levels
 from cmsim.frequencies import rig_frequencies
@@ -65,6 +68,8 @@ _UNITS = {"torque_nm": "N·m", "speed_rpm": "rpm", "friction": "friction", "clea
 _SIGNAL_TITLES = {"dte_um": "DTE along the line of action",
                   "dte": "DTE (angle)"}
 _DPI = 110
+#: Folder of runs saved by hand (``Run.save``) or by cmsim before sweeps wrote ``records/``.
+_RUNS_DIR = "runs"
 
 
 @dataclass(frozen=True)
@@ -107,19 +112,24 @@ class ReportResult:
 
 
 def sweep_run_files(sweep_dir):
-    """Run files of a sweep: the manifest's finished runs in index order, else ``runs/*.npz``."""
+    """Run files of a sweep: the manifest's ok records in index order, else
+    ``records/*.npz`` (or ``runs/*.npz``: runs saved by hand, or by an older cmsim)."""
     d = Path(sweep_dir)
     if not d.is_dir():
         raise ParameterError(f"sweep directory {d} does not exist (or is not a directory)")
-    manifest = read_manifest(d)
-    if manifest is not None:
-        entries = sorted(manifest.get("runs", {}).items(), key=lambda kv: kv[1].get("index", 0))
-        files = [d / e["file"] for _, e in entries if e.get("status") == "done"]
-        files = [f for f in files if f.is_file()]
+    rows = read_rows(d) if (d / RECORDS_DIR).is_dir() else None
+    if rows is not None:
+        channels = (read_spec(d) or {}).get("spec", {}).get("channels")
+        if channels is not None:
+            raise ParameterError(f"{d} is a dataset of sensor channels ({', '.join(channels)}); "
+                                 f"the report draws the full runs a sweep keeps (a spec "
+                                 f"without channels, e.g. cmsim sweep)")
+        rows = rows[rows["status"] == "ok"]
+        files = [f for f in (d / p for p in rows["path"]) if f.is_file()]
     else:
-        files = sorted((d / RUNS_DIR).glob("*.npz"))
+        files = sorted((d / RECORDS_DIR).glob("*.npz")) or sorted((d / _RUNS_DIR).glob("*.npz"))
     if not files:
-        raise ParameterError(f"{d} holds no finished runs (expected {d / RUNS_DIR}/*.npz)")
+        raise ParameterError(f"{d} holds no finished runs (expected {d / RECORDS_DIR}/*.npz)")
     return files
 
 
@@ -153,7 +163,8 @@ def _digest(path, signals, top_n, max_freq_hz, n_mesh_cycles):
     freqs = rig_frequencies(rig, op)
     bearings = rig.bearing_names
     fs = run.fs_hz
-    d = {"name": path.stem, "file": path.name, "rig_name": rig.name, "has_gears": rig.has_gears,
+    d = {"name": path.stem, "file": f"{path.parent.name}/{path.name}", "rig_name": rig.name,
+         "has_gears": rig.has_gears,
          "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
          "friction": rig.mesh_contact.friction_coefficient if rig.has_gears else None,
          "clearance_m": rig.bearings[0].clearance_m, "seed": meta.get("seed"),
@@ -334,8 +345,9 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
     Parameters
     ----------
     sweep_dir : str or path-like
-        Directory written by :func:`cmsim.datasets.run_sweep` (or any directory with
-        ``runs/*.npz`` written by :func:`cmsim.dynamics.simulate`).
+        Directory written by ``cmsim sweep`` (:func:`cmsim.datasets.generate_dataset` of a
+        spec without channels), or any directory with ``runs/*.npz`` saved from
+        :func:`cmsim.dynamics.simulate`.
     signals : sequence of str
         Signals drawn as waterfalls and tabulated (must exist in every run).
     top_n : int
@@ -402,7 +414,7 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
     runs = []
     for d in digests:
         k, a = _dominant(d, dom_signal)
-        runs.append({"name": d["name"], "file": f"runs/{d['file']}", "speed_rpm": d["speed_rpm"],
+        runs.append({"name": d["name"], "file": d["file"], "speed_rpm": d["speed_rpm"],
                      "torque_nm": d["torque_nm"], "friction": d["friction"],
                      "clearance_m": d["clearance_m"], "seed": d["seed"],
                      "dominant_gmf_harmonic": k, "dominant_gmf_amplitude": a,
@@ -529,7 +541,8 @@ def _html_page(out_dir, digests, runs, axis, signals, dom_signal, sections, top_
     values = sorted({d[axis] for d in digests})
     speeds = sorted({d["speed_rpm"] for d in digests})
     head = [("Rig", html.escape(d0["rig_name"])),
-            ("Runs", f"{len(digests)} (files in <code>runs/</code>)"),
+            ("Runs", f"{len(digests)} (files in <code>"
+                     f"{html.escape(d0['file'].split('/')[0])}/</code>)"),
             ("Sweep parameter", f"{html.escape(SWEEP_AXES[axis])}: "
                                 f"{', '.join(f'{v:g}' for v in values)}"),
             ("Speed", ", ".join(f"{s:g} rpm" for s in speeds)),

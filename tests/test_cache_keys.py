@@ -19,7 +19,7 @@ import shutil
 
 import pytest
 
-from cmsim.datasets import RUNS_DIR, SweepSpec, run_sweep
+from cmsim.datasets import RECORDS_DIR, DatasetSpec, generate_dataset
 from cmsim.dynamics.mesh_choice import tables_key
 from cmsim.mesh_stiffness import cache
 from cmsim.mesh_stiffness.influence import influence_table
@@ -122,8 +122,13 @@ def test_hybrid_tables_key_ignores_what_the_tables_do_not_depend_on():
 
 
 # ---------------------------------------------------------------------- resume
-BASE = dict(speeds_rpm=[1000.0], torques_nm=[20.0], duration_s=0.02, warmup_s=0.01,
-            mesh="potential-energy")
+BASE = dict(duration_s=0.02, warmup_s=0.01, mesh="potential-energy")
+GRID = [("speed_rpm", [1000.0]), ("torque_nm", [20.0])]
+
+
+def run_sweep(spec, out):
+    """The runner as ``cmsim sweep`` runs it: every finished file's SHA-256 checked."""
+    return generate_dataset(spec, out, workers=1, verify=True)
 
 
 @pytest.fixture(scope="module")
@@ -132,8 +137,8 @@ def sweeps(tmp_path_factory):
     out = {}
     for name, kw in (("a", dict(seed=7)), ("seed", dict(seed=8)),
                      ("duration", dict(seed=7, duration_s=0.03))):
-        spec = SweepSpec(**{**BASE, **kw})
-        run_sweep(spec, root / name, workers=1)
+        spec = DatasetSpec(GRID, **{**BASE, **kw})
+        run_sweep(spec, root / name)
         out[name] = (spec, root / name)
     return out
 
@@ -143,14 +148,13 @@ def test_resume_recomputes_a_swapped_run_file(sweeps, donor, tmp_path):
     spec, src = sweeps["a"]
     out = tmp_path / "a"
     shutil.copytree(src, out)
-    (victim,) = (out / RUNS_DIR).glob("*.npz")
-    (foreign,) = (sweeps[donor][1] / RUNS_DIR).glob("*.npz")
-    assert foreign.name == victim.name                 # the same case name
+    (victim,) = (out / RECORDS_DIR).glob("*.npz")
+    (foreign,) = (sweeps[donor][1] / RECORDS_DIR).glob("*.npz")
+    assert foreign.name == victim.name                 # the same record id
     shutil.copyfile(foreign, victim)
-    s = run_sweep(spec, out, workers=1)
-    assert (s.completed, s.skipped) == (1, 0)
+    s = run_sweep(spec, out)
+    assert (s.records_written, s.records_skipped) == (1, 0)
     run = Run.load(victim)
-    case = spec.cases()[0]
-    assert run.meta["seed"] == case.seed
+    assert run.meta["seed"] == spec.record(0).sim_seed
     assert run.meta["duration_s"] == pytest.approx(spec.duration_s, rel=1e-12)
     assert math.isclose(run.t[0], run.meta["warmup_s"], abs_tol=1e-12)

@@ -129,8 +129,8 @@ def test_bearing_rig_sweep_radial_load_and_report(capsys, tmp_path):
     status, res = run_json(capsys, ["sweep", "--speed-rpm", "1800", "--radial-load-n", "500",
                                     "--rig", str(tmp_path / "b.toml"), "--duration-s", "0.05",
                                     "--out", str(out), "--workers", "1"])
-    assert status == 0 and res["completed"] == 1
-    run = Run.load(next((out / "runs").glob("*.npz")))
+    assert status == 0 and res["records_written"] == 1
+    run = Run.load(next((out / "records").glob("*.npz")))
     assert run.meta["operating_point"]["radial_load_n"] == pytest.approx(500.0)
     status, res = run_json(capsys, ["report", str(out)])
     assert status == 0 and "dte_um" not in " ".join(res["figures"])

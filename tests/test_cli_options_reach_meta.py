@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from cmsim.cli import main
-from cmsim.datasets import RUNS_DIR
+from cmsim.datasets import RECORDS_DIR
 from cmsim.mesh_stiffness.table_set import MeshTableSet
 from cmsim.rig import Rig
 from cmsim.run import Run
@@ -139,8 +139,8 @@ def test_sweep_options_reach_the_runs(tmp_path, capsys):
             "--clearance-m", "-2e-6", "--seed", "11", "--seed-policy", "shared",
             "--mesh", "potential-energy", "--workers", "1", "--out", str(out), "--json"]
     assert main(argv) == 0
-    assert json.loads(capsys.readouterr().out)["completed"] == 1
-    (path,) = (out / RUNS_DIR).glob("*.npz")
+    assert json.loads(capsys.readouterr().out)["records_written"] == 1
+    (path,) = (out / RECORDS_DIR).glob("*.npz")
     m = Run.load(path).meta
     assert m["operating_point"]["torque_nm"] == 15.0
     assert m["operating_point"]["speed_rpm"] == 1200.0
@@ -150,5 +150,5 @@ def test_sweep_options_reach_the_runs(tmp_path, capsys):
     assert m["rig"]["mesh_contact"]["friction_coefficient"] == 0.07
     assert all(b["clearance_m"] == -2e-6 for b in _bearings(m))
     assert m["seed"] == 11                              # shared policy: the base seed itself
-    assert m["sweep_case"]["base_seed"] == 11
+    assert m["record"]["base_seed"] == 11 and m["record"]["seed_policy"] == "shared"
     assert m["mesh_table"]["method"] == "potential-energy"

@@ -20,7 +20,7 @@ import pytest
 
 from cmsim.cli import main
 from cmsim.datasets import DatasetSpec, generate_dataset, load
-from cmsim.datasets.generate import PARQUET_NAME, RECORDS_DIR, ROWS_DIR, consolidate
+from cmsim.datasets.manifest import PARQUET_NAME, RECORDS_DIR, ROWS_DIR, consolidate
 from cmsim.errors import ParameterError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -100,7 +100,7 @@ def test_ci_spec_generates_a_labelled_dataset(ci_dataset):
     assert size < 4 * 0.21 * 25_600 * 4 + 40_000          # + the meta (rig, answer key)
     assert not list((out / ROWS_DIR).glob("*.json"))      # consolidated into Parquet
     # each record regenerates on its own from (base seed, index)
-    from cmsim.datasets.generate import simulate_record
+    from cmsim.datasets.records import simulate_record
     alone, _ = simulate_record(spec, 5)
     np.testing.assert_array_equal(alone["accel_2b1_y"], ds.record(5).signals["accel_2b1_y"])
 
@@ -182,7 +182,7 @@ def test_killed_run_resumes_without_recomputing(small_one_worker, tmp_path):
 
 
 def test_failed_record_is_marked_and_the_rest_go_on(tmp_path, monkeypatch):
-    import cmsim.datasets.generate as gen
+    import cmsim.datasets.records as gen
     real = gen.simulate_record
 
     def flaky(spec, index):
@@ -249,10 +249,10 @@ def test_manifest_of_many_records_resumes_fast(tmp_path):
                   "status": "ok", "path": [f"records/{i:06d}.npz" for i in range(n_done)],
                   "bytes": 0, "spec_digest": spec.digest, "fault_label": "healthy"}
                  ).to_parquet(out / PARQUET_NAME, index=False)
-    from cmsim.datasets.generate import SPEC_NAME, _done_indices, _open
-    _open(spec, out, False)
+    from cmsim.datasets.manifest import SPEC_NAME, done_indices, open_directory
+    open_directory(spec, out, False)
     t = time.perf_counter()
-    done, adopted = _done_indices(spec, out, verify=False)
+    done, adopted = done_indices(spec, out, verify=False)
     assert time.perf_counter() - t < 10
     assert len(done) == n_done and adopted == 0
     (out / ROWS_DIR / "019998.json").write_text(json.dumps(

@@ -12,17 +12,18 @@ import numpy as np
 import pytest
 
 from cmsim.cli import main
-from cmsim.datasets import MANIFEST_NAME, SweepSpec, run_sweep
+from cmsim.datasets import PARQUET_NAME, RECORDS_DIR, DatasetSpec, generate_dataset
 from cmsim.errors import ParameterError
 from cmsim.report import build_report
 
-TINY = dict(speeds_rpm=[1000.0], torques_nm=[10.0, 100.0], duration_s=0.05, seed=7)
+TINY = DatasetSpec([("speed_rpm", [1000.0]), ("torque_nm", [10.0, 100.0])], duration_s=0.05,
+                   seed=7)
 
 
 @pytest.fixture(scope="module")
 def sweep_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("report") / "tiny"
-    run_sweep(SweepSpec(**TINY), out, workers=2)
+    generate_dataset(TINY, out, workers=2)
     return out
 
 
@@ -70,7 +71,7 @@ def test_header_tables_and_dominant_harmonic(report, sweep_dir):
 def test_regenerating_from_the_run_files_alone_reproduces_the_report(report, sweep_dir,
                                                                        tmp_path):
     bare = tmp_path / "bare"
-    shutil.copytree(sweep_dir / "runs", bare / "runs")    # no manifest, no report
+    shutil.copytree(sweep_dir / RECORDS_DIR, bare / RECORDS_DIR)    # no manifest, no report
     again = build_report(bare)
     assert again.figures == report.figures
     assert [r["dominant_gmf_harmonic"] for r in again.runs] == \
@@ -102,7 +103,7 @@ def test_cli_report_json(sweep_dir, capsys):
     assert "waterfall_F_1b1_loa.png" in res["figures"]
     assert "waterfall_dte_um.png" not in res["figures"]
     assert [r["dominant_gmf_harmonic"] for r in res["runs"]] == [2, 5]
-    assert main(["report", str(sweep_dir / MANIFEST_NAME), "--json"]) == 2
+    assert main(["report", str(sweep_dir / PARQUET_NAME), "--json"]) == 2
 
 
 def test_loss_breakdown_of_a_sweep_whose_runs_carry_it(tmp_path, capsys):
@@ -126,6 +127,15 @@ def test_loss_breakdown_of_a_sweep_whose_runs_carry_it(tmp_path, capsys):
         assert 95.0 < efficiency < 100.0 and closure < 1.0
     img = _pixels(out / "losses.png")
     assert img.shape[0] > 200 and np.std(img) > 0.05
+
+
+def test_a_dataset_of_sensor_channels_is_refused_by_name(tmp_path):
+    """The report draws full runs; a dataset that kept sensor channels only says so."""
+    spec = DatasetSpec([("speed_rpm", [1000.0])], channels=["accel_1b1_y"], fs_hz=25_600.0,
+                       duration_s=0.02)
+    generate_dataset(spec, tmp_path / "ds", workers=1)
+    with pytest.raises(ParameterError, match="sensor channels"):
+        build_report(tmp_path / "ds")
 
 
 def test_no_loss_section_without_losses(report, sweep_dir):

@@ -18,8 +18,7 @@ import pandas as pd
 import pytest
 
 from cmsim.cli import main
-from cmsim.datasets import generate_dataset, load
-from cmsim.datasets.dataset_spec import DatasetSpec
+from cmsim.datasets import DatasetSpec, generate_dataset, load
 from cmsim.datasets.export import to_bearing_datasets
 from cmsim.diagnostics.measured import data_root
 from cmsim.diagnostics.syn2real import (WindowSet, check_disjoint, envelope_features,

@@ -109,8 +109,8 @@ MUTANTS = (
            '"tip_radius_coef", "bore_radius_m", "youngs_modulus_pa"',
            '"tip_radius_coef", "youngs_modulus_pa"', ("tests/test_cache_keys.py",)),
     Mutant("resume-seed-unchecked", "caches", "cmsim/datasets/manifest.py",
-           'sc.get("name") == case.name and meta.get("seed") == case.seed',
-           'sc.get("name") == case.name', ("tests/test_cache_keys.py",)),
+           'if row.get("spec_digest") != spec.digest or f"{row[\'record_id\']}.npz" != path.name:',
+           'if f"{row[\'record_id\']}.npz" != path.name:', ("tests/test_cache_keys.py",)),
     # --- time bases
     Mutant("time-off-by-one", "time", "cmsim/dynamics/simulate.py",
            "t = (n_warm + np.arange(n_rec)) * dt", "t = (n_warm + 1 + np.arange(n_rec)) * dt",

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, ranged
+from cmsim.errors import IntegrationDiverged
 from cmsim.cli.options import (add_fault_options, add_losses_option, add_mesh_options,
                                add_rig_options, add_sampling_options, check_losses_options,
                                faults_of, load_rig, mesh_argument, number, operating_warnings,
@@ -17,9 +18,10 @@ def register(sub):
     """Add the ``sweep`` parser."""
     p = sub.add_parser("sweep", help="simulate a grid of operating points in parallel",
                        description="Simulate speeds × torques (× frictions × clearances) on "
-                                   "worker processes; each run is saved to DIR/runs/ and "
-                                   "recorded in DIR/manifest.json as it finishes. Re-running "
-                                   "the same command resumes: finished runs are skipped.")
+                                   "worker processes: a grid dataset spec whose records keep "
+                                   "every signal; each run is saved to DIR/records/ and listed "
+                                   "in DIR/manifest.parquet as it finishes. Re-running the "
+                                   "same command resumes: finished runs are skipped.")
     p.add_argument("--torque-nm", type=number("torque_nm"), nargs="+",
                    help="output torques, N m (gear rigs; default 0: unloaded, the teeth may "
                         "separate)")
@@ -29,7 +31,8 @@ def register(sub):
                    help="input shaft speeds, rpm")
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="sweep directory")
     add_rig_options(p, many=True)
-    add_sampling_options(p, seed_help="base seed; run i gets a seed derived from (seed, i)")
+    add_sampling_options(p, seed_help="base seed; run i gets a seed drawn from "
+                                       "SeedSequence([seed, i])")
     p.add_argument("--seed-policy", default="per_run", choices=("per_run", "shared"),
                    help="per_run: independent seed per run; shared: every run uses --seed")
     p.add_argument("--workers", type=ranged(Range(1, 1024, integer=True)), default=None,
@@ -43,8 +46,9 @@ def register(sub):
 
 
 def run(args):
-    """Build the sweep's spec from the options and run it."""
-    from cmsim.datasets import SweepSpec, run_sweep
+    """Build the sweep's spec (a grid dataset spec whose records keep every signal) from
+    the options and run it; runs that failed make the command exit 3."""
+    from cmsim.datasets import DatasetSpec, Variation, generate_dataset
 
     rig = load_rig(args, variants=False)
     torques = args.torque_nm if args.torque_nm is not None else (
@@ -60,32 +64,40 @@ def run(args):
     mesh = mesh_argument(args, rig, torques or ())
     check_losses_options(args)
     prepare_tables(args, rig, mesh)                 # once, before the workers start
-    spec = SweepSpec(speeds_rpm=args.speed_rpm, torques_nm=torques,
-                     radial_load_n=args.radial_load_n,
-                     duration_s=args.duration_s, frictions=args.friction or (None,),
-                     clearances_m=args.clearance_m or (None,), rig=rig, fs_hz=args.fs_hz,
-                     warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
-                     seed_policy=args.seed_policy, mesh=mesh, faults=faults_of(args, rig),
-                     losses=args.losses or None)
+    axes = [("speed_rpm", args.speed_rpm), ("torque_nm", torques), ("friction", args.friction),
+            ("clearance_m", args.clearance_m)]
+    spec = DatasetSpec([Variation(n, v) for n, v in axes if v],
+                       fixed={"radial_load_n": args.radial_load_n} if args.radial_load_n
+                       else None, duration_s=args.duration_s, rig=rig, fs_hz=args.fs_hz,
+                       warmup_s=args.warmup_s, substeps=args.substeps, seed=args.seed,
+                       seed_policy=args.seed_policy, mesh=mesh, faults=faults_of(args, rig),
+                       losses=args.losses or None)
     args.notice_compile()
     progress = not args.json and sys.stderr.isatty()
     try:
-        summary = run_sweep(spec, args.out, workers=args.workers, force=args.force,
-                            progress=progress)
+        summary = generate_dataset(spec, args.out, workers=args.workers, force=args.force,
+                                   progress=progress, verify=True)
     except KeyboardInterrupt:
-        raise CLIError(f"interrupted; finished runs are kept in {args.out}/manifest.json, "
+        raise CLIError(f"interrupted; finished runs are kept in {args.out}/manifest.parquet, "
                        f"re-run the same command to resume", 130) from None
+    if summary.records_failed:
+        errors = "; ".join(f"{r}: {e}" for r, e in summary.failed)
+        exc = IntegrationDiverged(f"{summary.records_failed} of {summary.records_total} runs "
+                                  f"failed ({errors}); the other runs are saved in "
+                                  f"{args.out}/manifest.parquet")
+        exc.summary = summary
+        raise exc
     return summary.to_dict()
 
 
 def text(res):
     """Runs done, time spent, where the manifest is."""
-    lines = [f"{res['n_runs']} runs in {res['dir']}: {res['completed']} simulated, "
-             f"{res['skipped']} already there ({res['adopted']} adopted), "
-             f"{len(res['failed'])} failed",
+    lines = [f"{res['records_total']} runs in {res['dir']}: {res['records_written']} "
+             f"simulated, {res['records_skipped']} already there ({res['records_adopted']} "
+             f"adopted), {res['records_failed']} failed",
              f"wall {res['wall_s']:.2f} s on {res['workers']} workers ({res['start_method']}); "
-             f"integration {res['integration_s']:.2f} s, compile {res['compile_s']:.2f} s, "
-             f"setup {res['setup_s']:.2f} s, spectra {res['spectra_s']:.2f} s, "
+             f"integration {res['integration_s']:.2f} s, warm-up {res['warmup_s']:.2f} s, "
+             f"setup {res['setup_s']:.2f} s, features {res['features_s']:.2f} s, "
              f"save {res['save_s']:.2f} s; utilisation {100 * res['utilisation']:.0f} %",
              f"manifest {res['manifest']}"]
     return "\n".join(lines)

@@ -19,12 +19,12 @@ from pathlib import Path
 
 import numpy as np
 
-from cmsim.datasets.generate import PARQUET_NAME, SPEC_NAME, read_rows
+from cmsim.datasets.manifest import PARQUET_NAME, SPEC_NAME, read_rows
 from cmsim.errors import ParameterError
 from cmsim.frequencies import RigFrequencies
 from cmsim.rig import OperatingPoint, Rig
 
-__all__ = ["load", "Dataset", "Record"]
+__all__ = ["load", "Dataset", "DatasetRecord"]
 
 
 class _LazySignals(Mapping):
@@ -46,8 +46,9 @@ class _LazySignals(Mapping):
         return len(self._names)
 
 
-class Record:
-    """One record of a dataset.
+class DatasetRecord:
+    """One record of a generated dataset, as loaded (what its spec drew for it is a
+    :class:`~cmsim.datasets.plan.RecordPlan`).
 
     Attributes
     ----------
@@ -69,7 +70,7 @@ class Record:
         self._meta = None
 
     def __repr__(self):
-        return f"Record({self.record_id!r}, {self.row.get('fault_label')!r})"
+        return f"DatasetRecord({self.record_id!r}, {self.row.get('fault_label')!r})"
 
     @property
     def meta(self):
@@ -112,6 +113,7 @@ class Dataset:
     manifest : pandas.DataFrame
         One row per record (failed ones included, ``status == "failed"``).
     channels : tuple of str
+        The spec's channels (a sweep's records: every signal of its runs).
     fs_hz : float
     spec : dict
         The resolved spec (``dataset.json``).
@@ -130,9 +132,15 @@ class Dataset:
             raise ParameterError(f"{self.directory} has no records yet ({PARQUET_NAME})",
                                  param="dir")
         self.manifest = df
-        self.channels = tuple(self.spec["channels"])
         self.fs_hz = float(self.spec["fs_hz"])
         self._ok = df.index[df["status"] == "ok"].to_numpy()
+        if self.spec.get("channels") is not None:
+            self.channels = tuple(self.spec["channels"])
+        elif len(self._ok):                # full runs (a sweep): the first record's signals
+            with np.load(self.directory / df["path"].iloc[self._ok[0]]) as z:
+                self.channels = tuple(k for k in z.files if k not in ("t", "meta", "source"))
+        else:
+            self.channels = ()
 
     def __len__(self):
         """Number of ok records."""
@@ -145,7 +153,7 @@ class Dataset:
     def _record_at(self, pos):
         row = {k: (None if isinstance(v, float) and math.isnan(v) else v)
                for k, v in self.manifest.iloc[int(pos)].to_dict().items()}
-        return Record(self.directory, row, self.channels, row.get("fs_hz") or self.fs_hz)
+        return DatasetRecord(self.directory, row, self.channels, row.get("fs_hz") or self.fs_hz)
 
     def record(self, key):
         """A record by ``record_id`` (str) or record index (int).
@@ -157,7 +165,7 @@ class Dataset:
 
         Returns
         -------
-        Record
+        DatasetRecord
         """
         col = "record_id" if isinstance(key, str) else "index"
         hits = np.flatnonzero(self.manifest[col].to_numpy() == key)

@@ -1,8 +1,8 @@
-"""What a sweep can vary: named settings of the operating point or of the rig, and their values.
+"""What a spec can vary: named settings of the operating point or of the rig, and their values.
 
-A :class:`Variation` names one *setting* and lists its values; a sweep's cases are the
-Cartesian product of its variations (:class:`~cmsim.datasets.spec.SweepSpec`). A setting is
-one of
+A *setting* is what a :class:`~cmsim.datasets.spec.DatasetSpec` draws or lays on a grid for
+each record; a :class:`Variation` names one setting and lists its values (one axis of a grid:
+a sweep's records are the Cartesian product of its variations). A setting is one of
 
 operating-point fields
     ``speed_rpm``, ``torque_nm``, ``radial_load_n``, ``radial_load_angle_rad``
@@ -19,7 +19,8 @@ any rig field, by its dotted path
 
 A new kind of axis (a fault, a sensor setting) is one more entry in :data:`RIG_TRANSFORMS`
 (or a dotted path), never a new loop. A value ``None`` means "leave the base setting" (the
-case name then leaves the setting out).
+record id then leaves the setting out). Operating-point fields and the named transformations
+are checked against :data:`cmsim.rig.RANGES`; a dotted field is checked by its component.
 """
 
 from __future__ import annotations
@@ -30,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
-from cmsim.rig import OperatingPoint, Rig
+from cmsim.errors import ParameterError
+from cmsim.rig import RANGES, OperatingPoint, Rig
 
 __all__ = ["Variation", "RigTransform", "OPERATING_POINT_FIELDS", "RIG_TRANSFORMS", "setting_kind",
            "apply_rig_setting", "value_token", "allowed_settings"]
@@ -42,14 +43,14 @@ OPERATING_POINT_FIELDS = tuple(f.name for f in dataclasses.fields(OperatingPoint
 
 @dataclass(frozen=True)
 class RigTransform:
-    """A named change of the rig, ``apply(rig, value) -> Rig``, and its token in case names.
+    """A named change of the rig, ``apply(rig, value) -> Rig``, and its token in record ids.
 
     Attributes
     ----------
     apply : callable
         ``apply(rig, value)`` returns the changed rig.
     token : callable
-        ``token(value)`` returns the part of a case name, e.g. ``"c15um"``.
+        ``token(value)`` returns the part of a record id, e.g. ``"c15um"``.
     check : callable
         ``check(label, value)`` returns the checked value or raises ``ParameterError``.
     needs_gears : bool
@@ -66,14 +67,13 @@ class RigTransform:
 RIG_TRANSFORMS = {
     "clearance_m": RigTransform(apply=Rig.with_clearance,
                                 token=lambda v: f"c{v * 1e6:g}um",
-                                check=lambda label, v: check_range(label, v, -1e-3, 1e-3,
-                                                                   unit="m")),
+                                check=RANGES["clearance_m"].check),
     "friction": RigTransform(apply=Rig.with_friction, token=lambda v: f"f{v:g}",
-                             check=lambda label, v: check_range(label, v, 0.0, 1.0),
+                             check=RANGES["friction"].check,
                              needs_gears=True),
 }
 
-#: Case-name tokens of the operating-point fields.
+#: Record-id tokens of the operating-point fields.
 _OP_TOKENS = {"speed_rpm": lambda v: f"n{v:g}rpm", "torque_nm": lambda v: f"T{v:g}Nm",
               "radial_load_n": lambda v: f"Fr{v:g}N",
               "radial_load_angle_rad": lambda v: f"phi{v:g}rad"}
@@ -164,7 +164,7 @@ def apply_rig_setting(rig, name, value):
 
 
 def value_token(name, value):
-    """Part of a case name for ``name = value`` ("" for None), e.g. ``"T10Nm"``, ``"f0.03"``,
+    """Part of a record id for ``name = value`` ("" for None), e.g. ``"T10Nm"``, ``"f0.03"``,
     ``"lubricant-dynamic_viscosity_pa_s0.004"``."""
     if value is None:
         return ""
@@ -195,7 +195,7 @@ def _check_value(label, name, value):
 
 @dataclass(frozen=True)
 class Variation:
-    """One axis of a sweep: a setting and the values it takes.
+    """One axis of a grid: a setting and the values it takes.
 
     Attributes
     ----------

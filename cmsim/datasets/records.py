@@ -1,0 +1,270 @@
+"""One record of a spec: simulate it, write its file, make its manifest row.
+
+A record's file ``DIR/records/<record_id>.npz`` holds its signals and ``meta`` (JSON: the
+manifest row, rig, operating point, faults, the answer key, timing):
+
+* a spec with ``channels`` keeps those channels only, float32 at the sensor rate
+  (accelerometers and tacho through the rig's housing path, with the drawn sensor noise);
+* a spec without (a sweep) keeps the simulated run in full — ``t``, every signal at full
+  precision and the run's own meta — so the file is a :class:`~cmsim.run.Run`
+  (:meth:`Run.load <cmsim.run.Run.load>` reads it; ``cmsim report`` draws it), and its
+  manifest row also carries the features of :data:`FEATURE_SIGNALS`.
+
+:func:`run_record` is the task a worker runs: it writes the record file atomically, then
+its row as a sidecar (``DIR/rows/<record_id>.json``), also for a failed record (with its
+error); the runner folds the sidecars into the Parquet manifest
+(:mod:`cmsim.datasets.manifest`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+
+from cmsim._io import atomic_savez
+from cmsim.datasets.manifest import RECORDS_DIR, file_sha256, write_row
+from cmsim.datasets.spec import mesh_key
+from cmsim.dynamics import simulate
+from cmsim.dynamics.profiles import SpeedProfile
+from cmsim.faults import fault_frequencies
+from cmsim.features import N_GMF_HARMONICS, run_features
+from cmsim.frequencies import RigFrequencies
+from cmsim.run import Run
+from cmsim.sensors import add_sensors
+
+__all__ = ["simulate_record", "run_record", "base_row", "manifest_features", "FEATURE_SIGNALS",
+           "FORMAT"]
+
+#: Signals of a full-run record whose features go into its manifest row (those it has).
+FEATURE_SIGNALS = ("F_1b1_loa", "F_1b1_oloa", "dte_um")
+
+#: ``meta["format"]`` of a record file.
+FORMAT = "cmsim-dataset"
+
+
+def _frequency_columns(rig, op):
+    fr = RigFrequencies.of(rig, op)
+    out = {"shaft_hz": fr.fr1_hz, "gmf_hz": math.nan if fr.gmf_hz is None else fr.gmf_hz}
+    for name in fr.bearing_names:
+        b = fr.bearing(name)
+        for key in ("bpfo", "bpfi", "bsf", "ftf"):
+            out[f"{key}_hz_{name}"] = float(getattr(b, f"{key}_hz"))
+    return out
+
+
+def _column(v):
+    """A manifest cell: bools and None stay, numbers become floats."""
+    return v if v is None or isinstance(v, (bool, np.bool_)) else float(v)
+
+
+def base_row(spec, plan):
+    """The manifest row of a record before it is simulated (parameters and answer key).
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+    plan : RecordPlan
+        One of its records (:meth:`DatasetSpec.record`).
+
+    Returns
+    -------
+    dict
+    """
+    f = plan.fault
+    row = {"record_id": plan.record_id, "index": plan.index, "seed": plan.sim_seed,
+           "status": "pending", "error": None,
+           "path": f"{RECORDS_DIR}/{plan.record_id}.npz", "wall_s": math.nan,
+           "rig_name": spec.rig.name, "spec_digest": spec.digest, "repeat": plan.repeat,
+           **{k: _column(v) for k, v in plan.params.items()},
+           "fault_label": plan.fault_label, "fault_component": plan.fault_component,
+           "fault_severity": plan.fault_severity}
+    row.setdefault("torque_nm", 0.0)
+    row.setdefault("radial_load_n", 0.0)
+    if f is not None:
+        for k, v in f.to_dict().items():
+            if k not in ("type", "bearing", "gear") and isinstance(v, (int, float)) \
+                    and not isinstance(v, bool):
+                row[f"fault_{k}"] = float(v)
+    row.update(_frequency_columns(spec.record_rig(plan), spec.record_operating_point(plan)))
+    return row
+
+
+def _simulated_channels(channels):
+    """The simulated signals a record's channels are made from: an accelerometer needs both
+    force components of its bearing, the tacho the input shaft's rotation."""
+    out = set()
+    for c in channels:
+        if c.startswith("accel_"):
+            b = c.split("_")[1]
+            out |= {f"F_{b}_x", f"F_{b}_y"}
+        elif c == "tacho":
+            out.add("theta_1b1")
+        else:
+            out.add(c)
+    return sorted(out)
+
+
+def simulate_record(spec, index):
+    """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
+    docstring). Raises what :func:`cmsim.dynamics.simulate` raises (e.g.
+    :class:`~cmsim.errors.IntegrationDiverged`).
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+    index : int
+        Record number.
+
+    Returns
+    -------
+    arrays : dict of str to ndarray
+        The channels (float32), or ``t``, ``source`` and every signal of the full run.
+    meta : dict
+        JSON-ready meta of the record.
+    """
+    plan = spec.record(index)
+    rig = spec.record_rig(plan)
+    op = spec.record_operating_point(plan)
+    profile = None
+    if plan.params["runup"]:
+        profile = SpeedProfile.ramp(op.speed_rpm, plan.params["end_speed_rpm"],
+                                    spec.duration_s, start_s=spec.warmup_s)
+    channels = spec.channels
+    sensed = [c for c in channels or () if c.startswith("accel_") or c == "tacho"]
+    t0 = time.perf_counter()
+    run = simulate(rig, op, spec.duration_s, mesh=spec.mesh, fs_hz=spec.fs_hz,
+                   substeps=spec.substeps, seed=plan.sim_seed, warmup_s=spec.warmup_s,
+                   faults=plan.faults, profile=profile, losses=spec.losses,
+                   record=None if channels is None else _simulated_channels(channels))
+    t1 = time.perf_counter()
+    if sensed:
+        accel = [c.split("_") for c in sensed if c.startswith("accel_")]
+        bearings = sorted({a[1] for a in accel}) or None
+        directions = sorted({a[2] for a in accel}) or ("x", "y")
+        run = add_sensors(run, path=rig.housing, noise_rms=plan.params["sensor_noise_m_s2"],
+                          seed=plan.sim_seed, bearings=bearings, directions=directions)
+    t2 = time.perf_counter()
+    key = fault_frequencies(rig, op, [plan.fault]) if plan.fault is not None else {}
+    integration = float(run.meta["wall_s"])
+    record = {"format": FORMAT,
+              "labels": {"fault_label": plan.fault_label, "fault_component": plan.fault_component,
+                         "fault_severity": plan.fault_severity,
+                         "faults": [plan.fault.to_dict()] if plan.fault is not None else [],
+                         "fault_frequencies": key},
+              "record": {"index": plan.index, "record_id": plan.record_id, "seed": plan.sim_seed,
+                         "base_seed": spec.seed, "seed_policy": spec.seed_policy,
+                         "repeat": plan.repeat, "mesh": mesh_key(spec.mesh),
+                         "values": {n: plan.params[n] for n, _ in spec.settings}},
+              "timing_s": {"integration": integration, "setup": t1 - t0 - integration,
+                           "sensors": t2 - t1}}
+    if channels is None:
+        return {"t": run.t, "source": np.asarray(run.source), **run.signals}, \
+            {**run.meta, **record}
+    meta = {"fs_hz": run.fs_hz, "t0_s": float(run.t[0]), "n_samples": int(run.t.size),
+            "rig": rig.to_dict(), "operating_point": run.meta["operating_point"],
+            "profile": None if profile is None else {"times_s": list(profile.times_s),
+                                                     "speeds_rpm": list(profile.speeds_rpm)},
+            "faults": [f.to_dict() for f in plan.faults], "substeps": run.meta.get("substeps"),
+            "sim_wall_s": integration, **record}
+    return {c: np.asarray(run[c], dtype=np.float32) for c in channels}, meta
+
+
+def manifest_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS, top_n=5):
+    """Features of a full run as flat manifest columns ``<signal>.<feature>``.
+
+    Parameters
+    ----------
+    run : cmsim.run.Run
+        Simulated run.
+    signals : sequence of str
+        Signals to summarise (those absent from the run are left out).
+    n_harmonics : int
+        GMF harmonics measured (default :data:`cmsim.features.N_GMF_HARMONICS`).
+    top_n : int
+        Largest labelled peaks kept per signal.
+
+    Returns
+    -------
+    dict
+        Per signal, the columns of :meth:`cmsim.features.FeatureRow.to_dict` (``gmf1_amp``
+        ..., ``rms``, ``peak1_hz`` ...) and ``dominant_gmf_harmonic`` (NaN without gears),
+        each named ``"<signal>.<column>"``.
+    """
+    out = {}
+    for name in signals:
+        if name not in run.signals:
+            continue
+        row = run_features(run, name, n_gmf_harmonics=n_harmonics, top_n=top_n)
+        dominant = row.dominant_gmf_harmonic
+        out[f"{name}.dominant_gmf_harmonic"] = math.nan if dominant is None else float(dominant)
+        out.update({f"{name}.{k}": v for k, v in row.to_dict().items()})
+    return out
+
+
+def run_record(spec, index, out_dir):
+    """Worker task: simulate record ``index``, write its file then its sidecar row; return
+    the row (status ``"ok"``, or ``"failed"`` with the error: a failed record does not stop
+    the others).
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+    index : int
+        Record number.
+    out_dir : str or Path
+        The dataset directory.
+
+    Returns
+    -------
+    dict
+    """
+    start = time.perf_counter()
+    out = Path(out_dir)
+    plan = spec.record(index)
+    row = base_row(spec, plan)
+    row["record_key"] = spec.record_key(plan)
+    row["pid"] = os.getpid()
+    path = out / row["path"]
+    try:
+        arrays, meta = simulate_record(spec, index)
+    except Exception as exc:               # noqa: BLE001 - a failed record, the rest go on
+        row.update(status="failed", error=" ".join(f"{type(exc).__name__}: {exc}".split()),
+                   wall_s=time.perf_counter() - start)
+        if os.environ.get("CMSIM_DEBUG"):
+            traceback.print_exc()
+        write_row(out, row)
+        return row
+    t_features = time.perf_counter()
+    if spec.channels is None:
+        signals = {k: v for k, v in arrays.items() if k not in ("t", "source")}
+        row.update(manifest_features(Run(arrays["t"], signals, meta)))
+    timing = meta["timing_s"]
+    t_save = time.perf_counter()
+    row.update(status="ok", n_samples=int(next(iter(arrays.values())).size
+                                          if spec.channels else arrays["t"].size),
+               fs_hz=meta["fs_hz"], integration_s=timing["integration"],
+               setup_s=timing["setup"], sensors_s=timing["sensors"],
+               features_s=t_save - t_features)
+    meta["row"] = row
+    atomic_savez(path, meta=json.dumps(meta, default=_json_default), **arrays)
+    row["bytes"] = path.stat().st_size
+    row["sha256"] = file_sha256(path)
+    row["save_s"] = time.perf_counter() - t_save
+    row["wall_s"] = time.perf_counter() - start
+    write_row(out, row)
+    return row
+
+
+def _json_default(obj):
+    if isinstance(obj, (np.floating, np.integer, np.bool_)):
+        return obj.item()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
