@@ -8,6 +8,12 @@ The file also holds the owner's pid, for the error message only.
 The file is removed on release while still locked; a process that locked a file which was
 removed meanwhile (it opened the path before the removal) sees that the path no longer
 names its file and tries again, so two owners can never hold two different files.
+
+A forked process (a worker of the local pool) does not hold the lock: an ``flock`` belongs
+to the open file, which a fork shares, so every lock this process holds is closed in the
+child right after the fork (without unlocking it, which would release the parent's lock).
+A run killed with SIGKILL therefore frees its directory when its own process ends, whatever
+its workers are still doing.
 """
 
 from __future__ import annotations
@@ -22,6 +28,22 @@ __all__ = ["DirectoryLock", "LOCK_NAME"]
 
 #: Name of the lock file inside a sweep directory.
 LOCK_NAME = ".sweep.lock"
+
+#: File descriptors of the locks this process holds.
+_HELD = set()
+
+
+def _forget_held_locks():
+    """In a forked child: close the inherited lock files (the parent keeps its locks)."""
+    for fd in tuple(_HELD):
+        try:
+            os.close(fd)
+        except OSError:                            # pragma: no cover - already closed
+            pass
+    _HELD.clear()
+
+
+os.register_at_fork(after_in_child=_forget_held_locks)
 
 
 class DirectoryLock:
@@ -63,13 +85,15 @@ class DirectoryLock:
             os.ftruncate(fd, 0)
             os.write(fd, str(os.getpid()).encode())
             self._fd = fd
+            _HELD.add(fd)
             return self
         raise ParameterError(f"could not lock {self.path}")   # pragma: no cover
 
     def __exit__(self, *exc):
         if self._fd is not None:
             self.path.unlink(missing_ok=True)      # while locked: see the module docstring
-            fcntl.flock(self._fd, fcntl.LOCK_UN)   # also if a forked worker still has the fd
+            _HELD.discard(self._fd)
+            fcntl.flock(self._fd, fcntl.LOCK_UN)
             os.close(self._fd)
             self._fd = None
         return False

@@ -20,6 +20,7 @@ Processes
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import os
 import signal
@@ -70,6 +71,10 @@ def check_start_method(start_method):
     return method
 
 
+#: prctl option: signal to send this process when its parent dies (linux/prctl.h).
+_PR_SET_PDEATHSIG = 1
+
+
 def _watch_parent(parent_pid, period_s=0.5):
     """Exit this worker as soon as its parent is gone (killed run: no orphans left)."""
     while True:
@@ -78,10 +83,27 @@ def _watch_parent(parent_pid, period_s=0.5):
             os._exit(1)
 
 
+def _die_with_parent():
+    """Ask the kernel to kill this process when its parent dies (Linux ``PR_SET_PDEATHSIG``);
+    False where that is not available."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):              # pragma: no cover - no prctl
+        return False
+
+
 def _worker_init(parent_pid):
-    """Pool initializer: only the parent reacts to Ctrl-C/SIGTERM; watch the parent."""
+    """Pool initializer: only the parent reacts to Ctrl-C/SIGTERM; the worker dies with the
+    parent (SIGKILL from the kernel on Linux, else a thread that watches it)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if _die_with_parent():
+        if os.getppid() != parent_pid:             # the parent died before the request
+            os._exit(1)
+        return
     threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True,
                      name="cmsim-parent-watch").start()
 
