@@ -172,7 +172,7 @@ def bearing_frequencies(shaft_hz, n_balls, ball_diameter_m, pitch_diameter_m,
 class RigFrequencies:
     """Characteristic frequencies of a rig at one operating point, Hz.
 
-    Build it with :meth:`of` from a rig and an operating point, or directly for a measured
+    Build it with :func:`rig_frequencies` from a rig and an operating point, or directly for a measured
     record (e.g. ``RigFrequencies(fr1_hz=29.95, bearings={"DE": bearing_frequencies(...)})``).
 
     Attributes
@@ -198,47 +198,6 @@ class RigFrequencies:
             if not isinstance(bf, BearingFrequencies):
                 raise ParameterError(f"bearings[{name!r}] must be a BearingFrequencies, got "
                                      f"{type(bf).__name__}")
-
-    @classmethod
-    def of(cls, rig, op):
-        """Frequencies of ``rig`` at ``op`` (each bearing's effective contact angle and
-        ``outer_ring_speed_ratio``).
-
-        Parameters
-        ----------
-        rig : cmsim.rig.Rig
-            Gear rig or bearing rig.
-        op : cmsim.rig.OperatingPoint
-            Input shaft speed (``op.speed_rpm``).
-
-        Returns
-        -------
-        RigFrequencies
-
-        Examples
-        --------
-        >>> from cmsim.rig import Rig, OperatingPoint
-        >>> f = RigFrequencies.of(Rig.paper_2016(), OperatingPoint(speed_rpm=1000.0))
-        >>> round(f.gmf_hz, 2), round(f.bearing("1b1").bpf_hz / f.fr1_hz, 4)
-        (466.67, 3.6339)
-        """
-        f1 = float(op.shaft_hz)
-        rates = [f1]
-        f2 = gmf = None
-        if rig.has_gears:
-            z1, z2 = rig.gears.driving.n_teeth, rig.gears.driven.n_teeth
-            f2 = f1 * z1 / z2
-            gmf = z1 * f1
-            rates.append(f2)
-        shaft_of = [i for i, s in enumerate(rig.shafts) for _ in s.bearings]
-        bearings = {}
-        for name, brg, i_shaft in zip(rig.bearing_names, rig.bearings, shaft_of):
-            fs_hz = rates[i_shaft]
-            bearings[name] = bearing_frequencies(
-                fs_hz, brg.n_balls, brg.ball_diameter_m, brg.pitch_diameter_m,
-                brg.effective_contact_angle_rad,
-                outer_ring_hz=brg.outer_ring_speed_ratio * fs_hz)
-        return cls(fr1_hz=f1, fr2_hz=f2, gmf_hz=gmf, bearings=bearings)
 
     @property
     def has_gears(self):
@@ -339,7 +298,19 @@ class RigFrequencies:
 
 
 def rig_frequencies(rig, op):
-    """Characteristic frequencies of a rig at an operating point: :meth:`RigFrequencies.of`.
+    """Characteristic frequencies of ``rig`` at ``op`` (each bearing's effective contact angle
+    and ``outer_ring_speed_ratio``).
+
+    Parameters
+    ----------
+    rig : cmsim.rig.Rig
+        Gear rig or bearing rig.
+    op : cmsim.rig.OperatingPoint
+        Input shaft speed (``op.speed_rpm``).
+
+    Returns
+    -------
+    RigFrequencies
 
     Examples
     --------
@@ -348,7 +319,23 @@ def rig_frequencies(rig, op):
     >>> round(f.gmf_hz, 2), round(f.bearing("1b1").bpf_hz / f.fr1_hz, 4)
     (466.67, 3.6339)
     """
-    return RigFrequencies.of(rig, op)
+    f1 = float(op.shaft_hz)
+    rates = [f1]
+    f2 = gmf = None
+    if rig.has_gears:
+        z1, z2 = rig.gears.driving.n_teeth, rig.gears.driven.n_teeth
+        f2 = f1 * z1 / z2
+        gmf = z1 * f1
+        rates.append(f2)
+    shaft_of = [i for i, s in enumerate(rig.shafts) for _ in s.bearings]
+    bearings = {}
+    for name, brg, i_shaft in zip(rig.bearing_names, rig.bearings, shaft_of):
+        fs_hz = rates[i_shaft]
+        bearings[name] = bearing_frequencies(
+            fs_hz, brg.n_balls, brg.ball_diameter_m, brg.pitch_diameter_m,
+            brg.effective_contact_angle_rad,
+            outer_ring_hz=brg.outer_ring_speed_ratio * fs_hz)
+    return RigFrequencies(fr1_hz=f1, fr2_hz=f2, gmf_hz=gmf, bearings=bearings)
 
 
 def peak_families(freqs, bearing=None):

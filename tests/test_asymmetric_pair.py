@@ -26,7 +26,7 @@ import cmsim
 from cmsim.dynamics import simulate
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_state
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.rig import GearPair
 
@@ -57,7 +57,7 @@ def test_the_pair_is_valid_and_unequal():
 
 
 def test_output_shaft_rate_and_gmf(run):
-    f = RigFrequencies.of(RIG, OP)
+    f = rig_frequencies(RIG, OP)
     assert f.fr1_hz == pytest.approx(20.0, rel=1e-12)
     assert f.fr2_hz == pytest.approx(20.0 * Z1 / Z2, rel=1e-12)
     assert f.gmf_hz == pytest.approx(Z1 * 20.0, rel=1e-12)

@@ -78,7 +78,6 @@ UNDOCUMENTED = frozenset({
     "cmsim.faults.operating.SpeedFluctuation.lines",
     "cmsim.frequencies.RigFrequencies.from_dict",
     "cmsim.frequencies.peak_families",
-    "cmsim.frequencies.rig_frequencies",
     "cmsim.mesh_stiffness.cache.load_entry",
     "cmsim.mesh_stiffness.contact.potential_slots",
     "cmsim.mesh_stiffness.contact.table_range_m",

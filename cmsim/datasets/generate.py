@@ -45,7 +45,7 @@ from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import file_sha256
 from cmsim.datasets.pool import check_start_method, check_workers, run_tasks
 from cmsim.errors import ParameterError
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 
 __all__ = ["generate_dataset", "DatasetSummary", "PARQUET_NAME", "RECORDS_DIR", "ROWS_DIR",
            "SPEC_NAME", "consolidate", "read_rows", "simulate_record"]
@@ -109,7 +109,7 @@ class DatasetSummary:
 
 # ---------------------------------------------------------------------- one record
 def _frequency_columns(rig, op):
-    fr = RigFrequencies.of(rig, op)
+    fr = rig_frequencies(rig, op)
     out = {"shaft_hz": fr.fr1_hz, "gmf_hz": math.nan if fr.gmf_hz is None else fr.gmf_hz}
     for name in fr.bearing_names:
         b = fr.bearing(name)

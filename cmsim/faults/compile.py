@@ -29,7 +29,7 @@ from cmsim.faults.crack import crack_stiffness_factor
 from cmsim.faults.gear import (BREAKAGE_SEPARATION_M, Eccentricity, ProfileError, ToothBreakage,
                                ToothCrack, ToothSpall, roll_length_m)
 from cmsim.faults.operating import SpeedFluctuation, TorqueRipple
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 from cmsim.mesh_stiffness.contact import table_range_m
 from cmsim.mesh_stiffness.geometry import ToothProfile
 from cmsim.mesh_stiffness.potential_energy import _path_length
@@ -367,7 +367,7 @@ def fault_frequencies(rig, op, faults):
         ``{label: {"type": name, <key>_hz: value, ...}}`` in fault order (JSON-ready).
     """
     faults = check_faults(rig, faults)
-    fr = RigFrequencies.of(rig_with_faults(rig, faults), op)
+    fr = rig_frequencies(rig_with_faults(rig, faults), op)
     rates = {1: fr.fr1_hz}
     if fr.fr2_hz is not None:
         rates[2] = fr.fr2_hz
