@@ -28,7 +28,8 @@ from cmsim.faults.bearing import (BallDefect, BearingWear, InnerRaceDefect, OffS
 from cmsim.faults.crack import crack_stiffness_factor
 from cmsim.faults.gear import (BREAKAGE_SEPARATION_M, Eccentricity, ProfileError, ToothBreakage,
                                ToothCrack, ToothSpall, roll_length_m)
-from cmsim.faults.operating import SpeedFluctuation, TorqueRipple
+from cmsim.faults.operating import (MAX_TOTAL_RELATIVE_AMPLITUDE, SpeedFluctuation,
+                                    TorqueRipple)
 from cmsim.frequencies import rig_frequencies
 from cmsim.mesh_stiffness.contact import table_range_m
 from cmsim.mesh_stiffness.geometry import ToothProfile
@@ -336,9 +337,10 @@ def operating_modulation(faults, op=None, rig=None):
             return None
         lines = np.array([ln for f in items for ln in f.lines(rates)], dtype=float)
         total = float(lines[:, 1].sum())
-        if total > 0.5:
-            raise ParameterError(f"relative_amplitude must sum to at most 0.5 over all "
-                                 f"modulation faults, got {total:g}",
+        if total > MAX_TOTAL_RELATIVE_AMPLITUDE:
+            raise ParameterError(f"relative_amplitude must sum to at most "
+                                 f"{MAX_TOTAL_RELATIVE_AMPLITUDE:g} over all modulation faults, "
+                                 f"got {total:g}",
                                  param="relative_amplitude")
         freq, amp, ph = (np.ascontiguousarray(lines[:, k]) for k in range(3))
 
