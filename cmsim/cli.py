@@ -56,7 +56,8 @@ def _add_rig_options(p, *, friction=True):
 
 # ---------------------------------------------------------------------- simulate
 def _cmd_simulate(args):
-    from cmsim.dynamics import SlipModel, simulate
+    from cmsim.dynamics import simulate
+    from cmsim.faults import RollingSlip
     from cmsim.frequencies import rig_frequencies
 
     rig = _load_rig(args)
@@ -73,8 +74,8 @@ def _cmd_simulate(args):
     def progress(done_s, total_s):
         bar.update(round(done_s, 3) - bar.n)
 
-    slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
-                     correlation_s=args.slip_correlation_s)
+    slip = RollingSlip(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
+                       correlation_s=args.slip_correlation_s)
     _check_losses_options(args)
     try:
         run = simulate(rig, op, args.duration_s, fs_hz=args.fs_hz, substeps=args.substeps,

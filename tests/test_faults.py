@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from cmsim.errors import ParameterError
-from cmsim.faults import (FAULT_TYPES, BallDefect, OuterRaceDefect, ToothCrack,
+from cmsim.faults import (FAULT_TYPES, BallDefect, OuterRaceDefect, RollingSlip, ToothCrack,
                           compile_faults, fault_frequencies, fault_from_dict, load_faults,
                           operating_modulation, parse_fault, rig_with_faults, slip_from_faults)
 from cmsim.faults.bearing import ball_drop_m, defect_profile, track_share, wandering_offset
@@ -242,8 +242,8 @@ def test_off_size_ball_and_wear(rig):
 
 def test_slip_and_modulation(rig):
     fs = [parse_fault(t) for t in ALL]
-    assert slip_from_faults(fs) == {"cage_speed_rms": 0.01, "ball_rms_rad": 0.0,
-                                    "correlation_s": 5e-3}
+    assert slip_from_faults(fs) == RollingSlip(cage_speed_rms=0.01, ball_rms_rad=0.0,
+                                               correlation_s=5e-3)
     assert slip_from_faults(fs[:3]) is None
     op = OperatingPoint(speed_rpm=1200.0, torque_nm=20.0)
     speed, torque = operating_modulation(fs, op, rig)

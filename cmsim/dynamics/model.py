@@ -37,50 +37,13 @@ from cmsim.dynamics import _kernels as K
 from cmsim.dynamics.mesh_choice import resolve_mesh
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, compile_faults, rig_with_faults
-from cmsim.faults.bearing import track_share, wandering_offset
+from cmsim.faults.bearing import NO_SLIP, track_share, wandering_offset
 from cmsim.mesh_stiffness._kernels import GEO_SIZE
 from cmsim.mesh_stiffness.contact import (contact_geometry, corner_zone_m, potential_slots,
                                           reference_phases, table_range_m)
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
-__all__ = ["DynamicModel", "RigModel", "SlipModel", "build_model", "rig_model"]
-
-
-@dataclass(frozen=True)
-class SlipModel:
-    """Random rolling slip (paper 001 §5, last assumption, and §6.2.1).
-
-    Two independent effects, both Ornstein-Uhlenbeck processes with correlation time
-    ``correlation_s``, drawn from the run's seed:
-
-    * the cage speed fluctuates by a fraction ``cage_speed_rms`` of its nominal value, so the
-      cage angle wanders like a random walk and the ball-pass lines spread over a band;
-    * each ball leads or lags its nominal place in the cage by a small angle of standard
-      deviation ``ball_rms_rad`` (cage-pocket play).
-
-    Attributes
-    ----------
-    cage_speed_rms : float
-        Standard deviation of the relative cage-speed fluctuation (0.01 = 1 %).
-    ball_rms_rad : float
-        Standard deviation of each ball's angular deviation, rad (<= 0.05).
-    correlation_s : float
-        Correlation time of both processes, s.
-    """
-
-    cage_speed_rms: float = 0.0
-    ball_rms_rad: float = 0.0
-    correlation_s: float = 5e-3
-
-    def __post_init__(self):
-        check_range("cage_speed_rms", self.cage_speed_rms, 0.0, 0.2)
-        check_range("ball_rms_rad", self.ball_rms_rad, 0.0, 0.05, unit="rad")
-        check_range("correlation_s", self.correlation_s, 1e-5, 10.0, unit="s")
-
-    @property
-    def active(self):
-        """True when any slip is requested."""
-        return self.cage_speed_rms > 0.0 or self.ball_rms_rad > 0.0
+__all__ = ["DynamicModel", "RigModel", "build_model", "rig_model"]
 
 
 @dataclass(frozen=True)
@@ -221,7 +184,8 @@ class DynamicModel:
         Named kernel arrays ``P`` (:class:`cmsim.dynamics._kernels.KernelParams`).
     diag_names : tuple of str
         Names of the output forces the kernel writes (bearing housing forces, pair forces).
-    slip : SlipModel
+    slip : RollingSlip
+        The run's rolling slip (:data:`cmsim.faults.NO_SLIP` without).
     mesh_model : HybridMeshModel or None
         On-line hybrid contact model (model A), or ``None`` for the table.
     cage_phases_rad : ndarray, shape (n_bearings,)
@@ -237,7 +201,7 @@ class DynamicModel:
     omega: np.ndarray
     packed: K.KernelParams = field(repr=False)
     diag_names: tuple = ()
-    slip: SlipModel = SlipModel()
+    slip: object = NO_SLIP
     mesh_model: object = None
     cage_phases_rad: np.ndarray = field(default=None, repr=False)
     faults: tuple = ()
@@ -295,8 +259,8 @@ class DynamicModel:
         cage_phases_rad : sequence of float, optional
             Initial cage angle θ0 of each bearing (eq. 7), one per bearing in
             ``rig.bearing_names`` order; default all zero.
-        slip : SlipModel, optional
-            Random rolling slip (default none).
+        slip : RollingSlip, optional
+            Random rolling slip (:class:`cmsim.faults.RollingSlip`; default none).
         duration_s : float
             Span over which the slip and a wandering spin axis are generated, s.
         seed : int, optional
@@ -304,7 +268,7 @@ class DynamicModel:
         """
         rig = self.rig
         nb = len(rig.bearings)
-        slip = SlipModel() if slip is None else slip
+        slip = NO_SLIP if slip is None else slip
         phases = np.zeros(nb) if cage_phases_rad is None else np.asarray(cage_phases_rad, float)
         if phases.shape != (nb,) or not np.all(np.isfinite(phases)):
             raise ParameterError(f"cage_phases_rad needs {nb} finite values (one per bearing "
@@ -535,7 +499,7 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
                             *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab, c_tab,
                             np.ones((fields[0].shape[0], 1)))
     model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
-                         SlipModel(), mesh_model, np.zeros(nb), faults)
+                         NO_SLIP, mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
                          seed=seed)
 

@@ -14,12 +14,12 @@ from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
 from cmsim.dynamics.mesh_choice import resolve_mesh
-from cmsim.dynamics.model import SlipModel, build_model
+from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
-from cmsim.faults import (check_faults, fault_frequencies, operating_modulation,
-                          slip_from_faults)
+from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
+                          operating_modulation, slip_from_faults)
 from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
@@ -284,8 +284,9 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         004's load-independent table); ``"hybrid"`` = solved on-line from the FE influence
         coefficients (model A, about 3-4 times slower); or an explicit table, a table set
         (read at the run's torque) or a ``HybridMeshModel``.
-    slip : SlipModel, optional
-        Random ball-position jitter; uses ``seed``.
+    slip : RollingSlip, optional
+        Random rolling slip (:class:`cmsim.faults.RollingSlip`: cage-speed fluctuation and
+        ball jitter); uses ``seed``. A ``rolling_slip`` among ``faults`` takes its place.
     seed : int, optional
         Seed for the jitter and the cage phases; drawn at random and recorded when omitted.
     warmup_s : float
@@ -339,7 +340,10 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         raise ParameterError(f"substeps must be an integer in [1, 1000], got {substeps!r}")
     if seed is None:
         seed = int(np.random.SeedSequence().entropy % (2 ** 31))
-    slip = SlipModel() if slip is None else slip
+    slip = NO_SLIP if slip is None else slip
+    if not isinstance(slip, RollingSlip):
+        raise ParameterError(f"slip must be a RollingSlip (cmsim.faults), got "
+                             f"{type(slip).__name__}", param="slip")
     rng = np.random.default_rng(seed)
     if isinstance(cage_phases_rad, str):
         if cage_phases_rad != "random":
@@ -348,9 +352,7 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         cage_phases_rad = rng.uniform(0.0, 2.0 * math.pi, len(rig.bearings))
     _check_memory(duration_s, fs_hz, rig.n_dof, 4 * len(rig.bearings) + 8)
     faults = check_faults(rig, faults)
-    fault_slip = slip_from_faults(faults)
-    if fault_slip is not None:
-        slip = SlipModel(**fault_slip)
+    slip = slip_from_faults(faults) or slip
     speed_factor, torque_factor = operating_modulation(faults, op, rig)
     kprof = None
     if profile is not None or speed_factor is not None or torque_factor is not None:

@@ -3,7 +3,7 @@
 The contract with the dynamics kernel (:mod:`cmsim.dynamics._kernels` reads these arrays):
 :func:`compile_faults` turns a tuple of faults into one :class:`FaultArrays` (float64 arrays,
 all present, neutral when unused); :func:`rig_with_faults` applies the faults that are plain
-rig changes (bearing wear); :func:`slip_from_faults` gives the rolling-slip parameters,
+rig changes (bearing wear); :func:`slip_from_faults` picks the run's rolling slip,
 :func:`operating_modulation` the speed and torque factors, :func:`fault_frequencies` the
 answer key for a run's meta.
 
@@ -288,12 +288,11 @@ def rig_with_faults(rig, faults):
 
 
 def slip_from_faults(faults):
-    """Keyword arguments of the dynamics' ``SlipModel`` from a ``rolling_slip`` fault.
+    """The ``rolling_slip`` fault among ``faults`` (the run's slip), or ``None``.
 
     Returns
     -------
-    dict or None
-        ``{"cage_speed_rms", "ball_rms_rad", "correlation_s"}`` (``SlipModel(**d)``), or
+    RollingSlip or None
         ``None`` without a ``rolling_slip`` fault. Two of them are refused.
     """
     slips = [f for f in (faults or ()) if isinstance(f, RollingSlip)]
@@ -301,9 +300,7 @@ def slip_from_faults(faults):
         return None
     if len(slips) > 1:
         raise ParameterError("faults may hold at most one rolling_slip", param="rolling_slip")
-    f = slips[0]
-    return {"cage_speed_rms": f.cage_speed_rms, "ball_rms_rad": f.ball_rms_rad,
-            "correlation_s": f.correlation_s}
+    return slips[0]
 
 
 def operating_modulation(faults, op=None, rig=None):
