@@ -28,6 +28,7 @@ from cmsim.dynamics import _kernels as K
 from cmsim.dynamics import build_model, quasi_static_state
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.simulate import integrate
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit
 
 FS = 75_000.0
@@ -151,7 +152,8 @@ def numpy_rhs_factory(model):
 def main():
     rig = cmsim.Rig.paper_2016()
     op = cmsim.OperatingPoint(1000.0, 100.0)
-    model = build_model(rig, op, cage_phases_rad=[0.3, 1.1, 2.0, 4.4])
+    model = build_model(rig, op, resolve_mesh(rig, None, op.torque_nm),
+                        cage_phases_rad=[0.3, 1.1, 2.0, 4.4])
     print(f"mesh: {model.mesh_table.method} table at {model.mesh_table.torque_nm} N m")
     n = model.n_dof
     y0 = np.concatenate([quasi_static_state(model, 0.0), np.zeros(n)])

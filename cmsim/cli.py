@@ -211,7 +211,7 @@ def _mesh_argument(args, torques_nm=()):
 
 def _resolve_mesh_options(args, rig, torque_nm):
     """(mesh_table, mesh_model) of the mesh options at ``torque_nm`` (resolve_mesh)."""
-    from cmsim.dynamics.mesh_choice import resolve_mesh
+    from cmsim.dynamics.tooth_contact import resolve_mesh
     mesh = _mesh_argument(args, [torque_nm])
     if rig.gears is None and args.mesh_table:
         raise CLIError("--mesh-table needs a rig with gears", option="--mesh-table")
@@ -480,7 +480,7 @@ def _cmd_sweep(args):
     _check_losses_options(args)
     if mesh == "hybrid-tables" and rig.gears is not None:
         # build (or load) the rig's tables once, before the workers start
-        from cmsim.dynamics.mesh_choice import hybrid_table_set
+        from cmsim.dynamics.tooth_contact import hybrid_table_set
         hybrid_table_set(rig, progress=False if args.json else None)
     spec = SweepSpec(speeds_rpm=args.speed_rpm, torques_nm=torques,
                      radial_load_n=args.radial_load_n,

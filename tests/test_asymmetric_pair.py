@@ -99,7 +99,7 @@ def test_mesh_force_and_coupling_torques_balance_the_load(run):
 @pytest.mark.parametrize("t", [0.0, 1.3e-4, 7e-4])
 def test_quasi_static_mesh_compression_from_the_states(t):
     k = 3e8
-    model = build_model(RIG, OP, MeshStiffnessTable.constant(PAIR, k))
+    model = build_model(RIG, OP, (MeshStiffnessTable.constant(PAIR, k), None))
     q = quasi_static_state(model, t)
     _, diag = model.rhs(t, np.concatenate([q, np.zeros(model.n_dof)]), want_diag=True)
     forces = np.array([d for d, name in zip(diag, model.diag_names) if name.startswith("Fmesh")])

@@ -52,8 +52,6 @@ UNDOCUMENTED = frozenset({
     "cmsim.datasets.spec.SweepSpec.from_dict",
     "cmsim.datasets.variation.Variation.coerce",
     "cmsim.datasets.variation.allowed_settings",
-    "cmsim.dynamics.mesh_choice.build_paper_tables",
-    "cmsim.dynamics.mesh_choice.hybrid_mesh_table",
     "cmsim.dynamics.model.DynamicModel.rhs",
     "cmsim.dynamics.model.DynamicModel.static_residual",
     "cmsim.dynamics.quasistatic.initial_state",

@@ -138,7 +138,7 @@ def test_rigid_mesh_static_transmission_error():
     k_pair = 2.0e8
     for torque in (10.0, 100.0):
         op = cmsim.OperatingPoint(1000.0, torque)
-        model = build_model(rig, op, MeshStiffnessTable.constant(rig.gears, k_pair))
+        model = build_model(rig, op, (MeshStiffnessTable.constant(rig.gears, k_pair), None))
         q = quasi_static_state(model, 0.0)
         rb = rig.gears.driving.base_radius_m
         dte = q[model.index("theta_1G1")] - q[model.index("theta_2G1")]

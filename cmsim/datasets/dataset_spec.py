@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from cmsim.datasets.variation import RIG_TRANSFORMS
-from cmsim.dynamics.mesh_choice import MESH_CHOICES
+from cmsim.dynamics.tooth_contact import MESH_CHOICES
 from cmsim.errors import ParameterError
 from cmsim.faults import FAULT_TYPES, RollingSlip, SpeedFluctuation, check_faults
 from cmsim.rig import OperatingPoint, RollingBearing, Rig, Rotor

@@ -37,7 +37,7 @@ import numpy as np
 
 from cmsim.datasets.variation import (OPERATING_POINT_FIELDS, Variation, _check_value,
                                       apply_rig_setting, setting_kind, value_token)
-from cmsim.dynamics.mesh_choice import MESH_CHOICES
+from cmsim.dynamics.tooth_contact import MESH_CHOICES
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, fault_from_dict
 from cmsim.losses import LossSettings

@@ -26,6 +26,7 @@ from cmsim.bearings.kinematics import ball_pass_cycles_per_rev
 from cmsim.dynamics import _kernels as K
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_orbit
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.errors import ParameterError
 
 __all__ = ["ModalResult", "modal_analysis", "MODE_TYPES"]
@@ -144,7 +145,7 @@ def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     """
     if not isinstance(n_positions, (int, np.integer)) or n_positions < 4:
         raise ParameterError(f"n_positions must be an integer >= 4, got {n_positions!r}")
-    model = build_model(rig, op, mesh)
+    model = build_model(rig, op, resolve_mesh(rig, mesh, op.torque_nm))
     times = _bearing_cycle_times(model, n_positions)
     states = quasi_static_orbit(model, times)
     k_brg = _averaged_bearing_stiffness(model, states, times)

@@ -34,13 +34,13 @@ from cmsim.bearings.forces import ball_offsets
 from cmsim.bearings.hertz import bearing_contact_stiffness
 from cmsim.bearings.kinematics import cage_ratios, slip_jitter
 from cmsim.dynamics import _kernels as K
-from cmsim.dynamics.mesh_choice import resolve_mesh
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, compile_faults, rig_with_faults
 from cmsim.faults.bearing import NO_SLIP, track_share, wandering_offset
 from cmsim.mesh_stiffness._kernels import GEO_SIZE
 from cmsim.mesh_stiffness.contact import (contact_geometry, corner_zone_m, potential_slots,
                                           reference_phases, table_range_m)
+from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
 __all__ = ["DynamicModel", "RigModel", "build_model", "rig_model"]
@@ -352,7 +352,7 @@ def _dof_names(rig):
     return tuple(names)
 
 
-def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
+def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=None,
                 cage_phases_rad=None, faults=(), profile=None, loads=None, friction_table=None,
                 damping_table=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
@@ -361,11 +361,12 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     ----------
     rig : Rig
     op : OperatingPoint
-    mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
-        Tooth contact model (:func:`cmsim.dynamics.mesh_choice.resolve_mesh`): ``None`` =
-        the rig's hybrid FE + Weber–Banaschek tables at the operating torque (paper 001
-        §6.1, model B); ``"potential-energy"``; ``"hybrid"`` = on-line contact solve
-        (model A); or an explicit table, table set or hybrid model.
+    mesh : tuple of (MeshStiffnessTable or None, HybridMeshModel or None)
+        The tooth contact, already resolved at ``op.torque_nm`` for the rig with its faults'
+        changes (:func:`cmsim.dynamics.tooth_contact.resolve_mesh`, which turns the user's
+        ``mesh`` choice into this pair): the pair stiffness table and, for the on-line
+        contact solve (paper 001 §6.1, model A), the hybrid model. ``(None, None)`` (the
+        default) for a rig without gears.
     slip, duration_s, seed, cage_phases_rad
         Per-run values, as in :meth:`DynamicModel.for_run`.
     faults : sequence of Fault
@@ -404,7 +405,7 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     rig = rig_with_faults(rig, faults)
     rm = rig_model(rig)
     n = rm.n_dof
-    mesh_table, mesh_model = resolve_mesh(rig, mesh, op.torque_nm)
+    mesh_table, mesh_model = _checked_mesh(rig, mesh)
     fault_arrays = compile_faults(rig, faults, mesh_table, op=op) if faults else None
     omega = np.zeros(n)
     ratio = rig.gears.driving.n_teeth / rig.gears.driven.n_teeth if rig.gears else 0.0
@@ -502,6 +503,30 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
                          NO_SLIP, mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
                          seed=seed)
+
+
+def _checked_mesh(rig, mesh):
+    """``(table, on-line model)`` of a resolved ``mesh`` (:func:`build_model`), checked
+    against ``rig``."""
+    if not (isinstance(mesh, tuple) and len(mesh) == 2):
+        raise ParameterError(f"mesh must be the (table, on-line model) pair that "
+                             f"cmsim.dynamics.tooth_contact.resolve_mesh returns, got "
+                             f"{type(mesh).__name__}", param="mesh")
+    table, online = mesh
+    if rig.gears is None:
+        if table is not None or online is not None:
+            raise ParameterError("mesh given for a rig without gears (allowed: (None, None))",
+                                 param="mesh")
+        return None, None
+    if not isinstance(table, MeshStiffnessTable):
+        raise ParameterError(f"mesh: a rig with gears needs a MeshStiffnessTable first (from "
+                             f"resolve_mesh), got {type(table).__name__}", param="mesh")
+    if online is not None:
+        if not isinstance(online, HybridMeshModel):
+            raise ParameterError(f"mesh: the on-line model must be a HybridMeshModel or None, "
+                                 f"got {type(online).__name__}", param="mesh")
+        online.check_pair(rig.gears)
+    return table, online
 
 
 def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):

@@ -13,13 +13,13 @@ from cmsim.dynamics import _kernels as K
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
-from cmsim.dynamics.mesh_choice import resolve_mesh
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
 from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
-                          operating_modulation, slip_from_faults)
+                          operating_modulation, rig_with_faults, slip_from_faults)
 from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
@@ -234,7 +234,7 @@ def _compile_seconds():
         start = time.perf_counter()
         rig = cmsim.Rig.paper_2016()
         model = build_model(rig, cmsim.OperatingPoint(1000.0, 10.0),
-                            MeshStiffnessTable.constant(rig.gears, 1e8))
+                            (MeshStiffnessTable.constant(rig.gears, 1e8), None))
         y0 = np.zeros(2 * model.n_dof)
         tab = SCHEMES["ode3"]
         K.integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.packed,
@@ -371,12 +371,15 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         if loads is not None or friction_table is not None:
             raise ParameterError("losses sets the run's loads and friction table; give either "
                                  "losses or loads/friction_table", param="losses")
-        table, mesh_model = resolve_mesh(rig, mesh, op.torque_nm)
-        mesh = mesh_model if mesh_model is not None else table
-        loss_inputs = run_losses(rig, op, table, LossSettings() if losses is True else losses)
+        # the losses read the tables of the rig as given (not worn by faults)
+        contact = resolve_mesh(rig, mesh, op.torque_nm)
+        loss_inputs = run_losses(rig, op, contact[0],
+                                 LossSettings() if losses is True else losses)
         loads, friction_table = loss_inputs.loads, loss_inputs.friction_table
+    else:
+        contact = resolve_mesh(rig_with_faults(rig, faults), mesh, op.torque_nm)
     compile_s = _compile_seconds()
-    model = build_model(rig, op, mesh, slip=slip, duration_s=warmup_s + duration_s,
+    model = build_model(rig, op, contact, slip=slip, duration_s=warmup_s + duration_s,
                         seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad,
                         profile=kprof, faults=faults, loads=loads,
                         friction_table=friction_table, damping_table=damping_table)
