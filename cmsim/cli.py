@@ -153,9 +153,9 @@ LONG_RUN_S = 2.0
 
 def _fits(args, rig):
     """False when simulate will refuse the run for its memory (then say nothing before)."""
-    from cmsim.dynamics import simulate as sim
+    from cmsim.dynamics.simulate import check_memory
     try:
-        sim._check_memory(args.duration_s, args.fs_hz, rig.n_dof, 4 * len(rig.bearings) + 8)
+        check_memory(args.duration_s, args.fs_hz, rig)
     except (ParameterError, AttributeError, TypeError):
         return False
     return True

@@ -18,7 +18,8 @@ from cmsim.bearings import bearing_contact_stiffness, bearing_strain_energy
 from cmsim.dynamics import _kernels as K
 from cmsim.dynamics import build_model, quasi_static_state
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.simulate import integrate
+from cmsim.dynamics.simulate import check_memory, integrate
+from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
 M, KS, C, F0, X0 = 2.0, 8.0e6, 40.0, 300.0, 1e-4
@@ -183,3 +184,12 @@ def test_mean_bearing_reactions_balance_mesh_force():
         oloa = run[f"F_{shaft}b1_oloa"].mean() + run[f"F_{shaft}b2_oloa"].mean()
         assert loa == pytest.approx(mesh, rel=0.01)
         assert abs(oloa) < 0.01 * mesh
+
+
+def test_check_memory_refuses_a_run_that_does_not_fit():
+    """A run whose outputs exceed MAX_OUTPUT_BYTES is refused before any work, naming the
+    duration that fits; the paper's 75 kHz second fits."""
+    rig = cmsim.Rig.paper_2016()
+    check_memory(1.0, 75_000.0, rig)
+    with pytest.raises(ParameterError, match=r"duration_s = 600 s .* duration_s <= \d+ s"):
+        check_memory(600.0, 1e7, rig)

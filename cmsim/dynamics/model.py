@@ -402,11 +402,11 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
     torque) and does not double in double contact.
     """
     faults = check_faults(rig, faults)
-    rig = rig_with_faults(rig, faults)
+    given, rig = rig, rig_with_faults(rig, faults)
     rm = rig_model(rig)
     n = rm.n_dof
     mesh_table, mesh_model = _checked_mesh(rig, mesh)
-    fault_arrays = compile_faults(rig, faults, mesh_table, op=op) if faults else None
+    fault_arrays = compile_faults(given, faults, mesh_table, op=op) if faults else None
     omega = np.zeros(n)
     ratio = rig.gears.driving.n_teeth / rig.gears.driven.n_teeth if rig.gears else 0.0
     speeds = (op.omega_rad_s, op.omega_rad_s * ratio)

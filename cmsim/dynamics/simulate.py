@@ -24,8 +24,8 @@ from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
 
-__all__ = ["simulate", "integrate", "MAX_ROTATION_DEVIATION_RAD", "STEPS_PER_PERIOD",
-           "MAX_OUTPUT_BYTES"]
+__all__ = ["simulate", "integrate", "check_memory", "MAX_ROTATION_DEVIATION_RAD",
+           "STEPS_PER_PERIOD", "MAX_OUTPUT_BYTES"]
 
 #: Integration steps per period of the highest natural frequency when the step is chosen
 #: automatically: ω_max·h <= 2π/4.7 = 1.34, 77 % of ode3's stability limit √3 on the
@@ -153,8 +153,25 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     return states, diag, runner.wall
 
 
-def _check_memory(duration_s, fs_hz, n_dof, n_diag):
-    """Refuse a run whose outputs would not fit in :data:`MAX_OUTPUT_BYTES`, before any work."""
+def check_memory(duration_s, fs_hz, rig):
+    """Refuse a run whose outputs would not fit in :data:`MAX_OUTPUT_BYTES`, before any work.
+
+    Parameters
+    ----------
+    duration_s : float
+        Recorded duration, s.
+    fs_hz : float
+        Output sample rate, Hz.
+    rig : Rig
+        The rig (its DOFs and bearings set the number of signals).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``duration_s`` and the longest duration that fits at ``fs_hz``.
+    """
+    n_dof = rig.n_dof
+    n_diag = 4 * len(rig.bearings) + 8      # bounds the bearing and pair forces
     # states (2n), forces, then the named signals (DOFs, forces, LOA/OLOA pairs, DTE)
     per_second = 8.0 * fs_hz * (2 * n_dof + 3 * n_diag + n_dof + 8)
     if duration_s * per_second > MAX_OUTPUT_BYTES:
@@ -350,7 +367,7 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
             raise ParameterError(f"cage_phases_rad must be 'random', None or one angle per "
                                  f"bearing, got {cage_phases_rad!r}")
         cage_phases_rad = rng.uniform(0.0, 2.0 * math.pi, len(rig.bearings))
-    _check_memory(duration_s, fs_hz, rig.n_dof, 4 * len(rig.bearings) + 8)
+    check_memory(duration_s, fs_hz, rig)
     faults = check_faults(rig, faults)
     slip = slip_from_faults(faults) or slip
     speed_factor, torque_factor = operating_modulation(faults, op, rig)

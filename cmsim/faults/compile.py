@@ -35,8 +35,8 @@ from cmsim.mesh_stiffness.contact import table_range_m
 from cmsim.mesh_stiffness.geometry import ToothProfile
 from cmsim.mesh_stiffness.potential_energy import _path_length
 
-__all__ = ["FaultArrays", "compile_faults", "rig_with_faults", "slip_from_faults",
-           "operating_modulation", "fault_frequencies", "check_faults",
+__all__ = ["FaultArrays", "CheckedFaults", "compile_faults", "rig_with_faults",
+           "slip_from_faults", "operating_modulation", "fault_frequencies", "check_faults",
            "DEFECT_COLUMNS", "DEFAULT_GRID_POINTS"]
 
 #: Columns of ``FaultArrays.bearing_defects``.
@@ -102,8 +102,32 @@ class FaultArrays(NamedTuple):
         return self.has_bearing_defects or self.has_tooth_faults or self.has_eccentricity
 
 
+class CheckedFaults(tuple):
+    """A tuple of faults :func:`check_faults` validated against one rig (attribute ``rig``).
+
+    The functions of this module validate the faults they are given; handed a
+    ``CheckedFaults`` of the same rig (the same object), they trust it instead of validating
+    again, so a run validates its faults once however many steps read them.
+    """
+
+
 def check_faults(rig, faults):
-    """Validate ``faults`` (a Fault or an iterable of them) against ``rig``; return a tuple."""
+    """Validate ``faults`` (a Fault or an iterable of them) against ``rig``.
+
+    Parameters
+    ----------
+    rig : Rig
+        The rig as given (before the faults' own changes, e.g. wear).
+    faults : Fault or iterable of Fault
+        Catalogue entries; a :class:`CheckedFaults` of this rig is returned as is.
+
+    Returns
+    -------
+    CheckedFaults
+        The faults as a tuple that remembers the rig it was checked on.
+    """
+    if isinstance(faults, CheckedFaults) and faults.rig is rig:
+        return faults
     if isinstance(faults, Fault):
         faults = (faults,)
     faults = tuple(faults or ())
@@ -112,7 +136,9 @@ def check_faults(rig, faults):
             raise ParameterError(f"faults[{i}] must be a Fault (see cmsim.faults), got "
                                  f"{type(f).__name__}", param="faults")
         f.validate(rig)
-    return faults
+    checked = CheckedFaults(faults)
+    checked.rig = rig
+    return checked
 
 
 def _load_zone_angle(rig, bearing_index, op):
@@ -177,6 +203,8 @@ def compile_faults(rig, faults, mesh_table=None, *, op=None):
     Parameters
     ----------
     rig : Rig
+        The rig the faults are checked on (:func:`check_faults`); the arrays do not depend
+        on the clearances that wear changes.
     faults : iterable of Fault
         Any catalogue entries; those that are not kernel arrays (wear, slip, speed and torque
         modulations) are ignored here (see :func:`rig_with_faults`, :func:`slip_from_faults`,
