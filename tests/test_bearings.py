@@ -147,7 +147,7 @@ def test_contact_angle_follows_the_operating_clearance(b209):
     bottoms (α = 0: 9/2·(1 − d/D) = 3.6207 cycles), and the model's cage turns at that rate."""
     from dataclasses import replace
 
-    from cmsim.dynamics.model import rig_model
+    from cmsim.dynamics.rig_model import rig_model
     from cmsim.dynamics import _kernels as K
     assert b209.operating_contact_angle_rad == pytest.approx(b209.free_contact_angle_rad,
                                                              rel=1e-9)
@@ -181,7 +181,7 @@ def test_cage_speed_with_both_rings_rotating(b209, ratio):
     from dataclasses import replace
     from cmsim.bearings.kinematics import ball_angles, cage_angle
     from cmsim.dynamics import _kernels as kern
-    from cmsim.dynamics.model import rig_model
+    from cmsim.dynamics.rig_model import rig_model
     brg = replace(b209, outer_ring_speed_ratio=ratio)
     d, pd = brg.ball_diameter_m, brg.pitch_diameter_m
     cos_a = math.cos(brg.effective_contact_angle_rad)

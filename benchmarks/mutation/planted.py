@@ -74,7 +74,7 @@ MUTANTS = (
     Mutant("rollers-tangent", "rollers", "cmsim/bearings/_kernels.py",
            "g = k * p * d ** (p - 1.0)", "g = k * 1.5 * math.sqrt(d)",
            ("tests/test_rollers.py",)),
-    Mutant("rollers-model-exponent", "rollers", "cmsim/dynamics/model.py",
+    Mutant("rollers-model-exponent", "rollers", "cmsim/dynamics/rig_model.py",
            "b_par[ib, K.BP_P] = brg.load_exponent", "b_par[ib, K.BP_P] = 1.5",
            ("tests/test_rollers.py",)),
     Mutant("table-separation-ignored", "separation", "cmsim/dynamics/_kernels.py",
@@ -116,8 +116,8 @@ MUTANTS = (
            "t = (n_warm + np.arange(n_rec)) * dt", "t = (n_warm + 1 + np.arange(n_rec)) * dt",
            ("tests/test_time_base.py",)),
     Mutant("time-warmup-samples", "time", "cmsim/dynamics/simulate.py",
-           "n_warm = int(round(warmup_s * fs_hz))\n        states",
-           "n_warm = int(warmup_s * fs_hz) + 1\n        states",
+           "n_warm = int(round(warmup_s * fs_hz))\n        report",
+           "n_warm = int(warmup_s * fs_hz) + 1\n        report",
            ("tests/test_time_base.py",)),
     # --- scheme data
     Mutant("tableau-ode3-node", "schemes", "cmsim/dynamics/integrator.py",
@@ -127,7 +127,7 @@ MUTANTS = (
            "np.array([1.0, 2.0, 2.0, 1.0]) / 6.0", "np.array([1.0, 2.5, 1.5, 1.0]) / 6.0",
            ("tests/test_tableaus.py",)),
     # --- tests that asserted little (strengthened)
-    Mutant("cage-model-outer-sign", "weak", "cmsim/dynamics/model.py",
+    Mutant("cage-model-outer-sign", "weak", "cmsim/dynamics/rig_model.py",
            "b_par[ib, K.BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio",
            "b_par[ib, K.BP_CAGE] = k_in - k_out * brg.outer_ring_speed_ratio",
            ("tests/test_bearings.py",)),
