@@ -80,7 +80,7 @@ def dense_linear_ode3(y0, h, n_steps, minv, kmat, cmat, fext, out):
 
 def numpy_rhs_factory(model):
     """The same equations as the kernel, written with NumPy (what a user would write)."""
-    P = model.packed
+    P = model.kernel_params
     n = model.n_dof
     minv, fext, omega = P.minv, P.fext, P.omega
     kmat, cmat = model.stiffness, model.damping
@@ -169,16 +169,16 @@ def main():
 
     # 2a. bare dense linear ode3
     out = np.empty((n_steps, 2 * n))
-    args = (model.packed.minv, model.stiffness, model.damping, model.force, out)
+    args = (model.kernel_params.minv, model.stiffness, model.damping, model.force, out)
     dense_linear_ode3(y0, h, 10, *args)
     dense = best_of(lambda: dense_linear_ode3(y0, h, n_steps, *args)) / n_steps
     print(f"per-step cost / bare dense-linear numba ode3: {ours_per_step / dense:.2f} "
           f"(baseline {dense * 1e9:.0f} ns per step)   [target <= 3]")
     # 2b. our own integrator on the linear part only (no bearings, no mesh)
-    P = model.packed._replace(b_int=np.zeros((0, K.BI_SIZE), dtype=np.int64),
+    P = model.kernel_params._replace(b_int=np.zeros((0, K.BI_SIZE), dtype=np.int64),
                               m_int=np.zeros(K.MI_SIZE, dtype=np.int64))
     tab = SCHEMES["ode3"]
-    diag = np.empty((n_steps, len(model.diag_names)))
+    diag = np.empty((n_steps, len(model.output_force_names)))
 
     def linear_only():
         # without the mesh, the load torque spins shaft 2 up: lift the divergence limits

@@ -102,7 +102,8 @@ def test_quasi_static_mesh_compression_from_the_states(t):
     model = build_model(RIG, OP, (MeshStiffnessTable.constant(PAIR, k), None))
     q = quasi_static_state(model, t)
     _, diag = model.rhs(t, np.concatenate([q, np.zeros(model.n_dof)]), want_diag=True)
-    forces = np.array([d for d, name in zip(diag, model.diag_names) if name.startswith("Fmesh")])
+    forces = np.array([d for d, name in zip(diag, model.output_force_names)
+                       if name.startswith("Fmesh")])
     assert forces.sum() == pytest.approx(TORQUE / PAIR.driven.base_radius_m, rel=1e-6)
     alpha = PAIR.working_pressure_angle_rad
     n = np.array([-math.cos(alpha), math.sin(alpha)])        # force of gear 1 on gear 2

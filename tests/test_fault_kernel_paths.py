@@ -45,9 +45,9 @@ def test_defect_correction_equals_ball_by_ball(case):
     bearings = sorted({f.bearing for f in faults})
     exact = build_model(rig, op, seed=1, faults=faults + tuple(
         OffSizeBall(b, diameter_excess_m=1e-30) for b in bearings))
-    modes = [int(fast.packed.b_int[i, K.BI_FAULTY]) for i in range(len(rig.bearings))]
+    modes = [int(fast.kernel_params.b_int[i, K.BI_FAULTY]) for i in range(len(rig.bearings))]
     assert modes[rig.bearing_names.index("1b1")] == 1
-    assert all(int(exact.packed.b_int[rig.bearing_names.index(b), K.BI_FAULTY]) == 2
+    assert all(int(exact.kernel_params.b_int[rig.bearing_names.index(b), K.BI_FAULTY]) == 2
                for b in bearings)
     rng = np.random.default_rng(4)
     n = fast.n_dof

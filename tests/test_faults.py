@@ -16,7 +16,8 @@ from cmsim.errors import ParameterError
 from cmsim.faults import (FAULT_TYPES, BallDefect, OuterRaceDefect, RollingSlip, ToothCrack,
                           compile_faults, fault_frequencies, fault_from_dict, load_faults,
                           operating_modulation, parse_fault, rig_with_faults, slip_from_faults)
-from cmsim.faults.bearing import BearingWear, ball_drop_m, defect_profile, track_share, wandering_offset
+from cmsim.faults.bearing import (BearingWear, ball_drop_m, defect_profile, track_share,
+                                  wandering_offset)
 from cmsim.faults.compile import DEFECT_COLUMNS, check_faults
 from cmsim.faults.gear import BREAKAGE_SEPARATION_M, roll_length_m
 from cmsim.mesh_stiffness.table import MeshStiffnessTable

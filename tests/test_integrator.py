@@ -98,8 +98,8 @@ def _energy(model, states, t):
     load = -q @ model.force
     balls = 0.0
     for ib, brg in enumerate(model.rig.bearings):
-        ix, iy, it = (int(v) for v in model.packed.b_int[ib, :3])
-        b_par = model.packed.b_par
+        ix, iy, it = (int(v) for v in model.kernel_params.b_int[ib, :3])
+        b_par = model.kernel_params.b_par
         cage = (b_par[ib, K.BP_CAGE] * b_par[ib, K.BP_SENSE] * (model.omega[it] * t + q[:, it])
                 + b_par[ib, K.BP_PHASE])
         balls = balls + bearing_strain_energy(brg, q[:, ix], q[:, iy], cage)

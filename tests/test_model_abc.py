@@ -65,8 +65,9 @@ def test_online_forces_equal_independent_hybrid_solve(rig, mesh_model, t):
     q = quasi_static_state(model, t)
     # nominal rotation at rest relative to it: velocities of the nominal motion only
     _, diag = model.rhs(t, np.concatenate([q, np.zeros(model.n_dof)]), want_diag=True)
-    pair_forces = np.array([diag[model.diag_names.index(f"Fmesh_{j}")]
-                            for j in range(sum(d.startswith("Fmesh") for d in model.diag_names))])
+    pair_forces = np.array([diag[model.output_force_names.index(f"Fmesh_{j}")]
+                            for j in range(sum(d.startswith("Fmesh")
+                                               for d in model.output_force_names))])
     ix1, ix2 = model.index("x_1G1"), model.index("x_2G1")
     th1 = model.omega[ix1 + 2] * t + q[ix1 + 2]
     th2 = model.omega[ix2 + 2] * t + q[ix2 + 2]
@@ -92,8 +93,9 @@ def test_table_forces_equal_online_forces_at_a_corner_contact(rig, mesh_model, t
     model_b = build_model(undamped, op, (tables.at(100.0), None))
     t = phase / (24.0 * 1000.0 / 60.0 * rig.gears.driving.n_teeth)
     y = np.concatenate([quasi_static_state(model_a, t), np.zeros(model_a.n_dof)])
-    names = [n for n in model_a.diag_names if n.startswith("Fmesh")]
-    fa, fb = (np.array([m.rhs(t, y, want_diag=True)[1][m.diag_names.index(n)] for n in names])
+    names = [n for n in model_a.output_force_names if n.startswith("Fmesh")]
+    fa, fb = (np.array([m.rhs(t, y, want_diag=True)[1][m.output_force_names.index(n)]
+                        for n in names])
               for m in (model_a, model_b))
     ix1, ix2 = model_a.index("x_1G1"), model_a.index("x_2G1")
     c = slot_contacts(rig.gears, model_a.omega[ix1 + 2] * t + y[ix1 + 2],

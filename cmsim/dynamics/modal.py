@@ -88,7 +88,7 @@ def _bearing_cycle_times(model, n_positions):
 
 def _averaged_bearing_stiffness(model, states, times):
     """Tangent stiffness of each bearing averaged over the given states, (nb, 2, 2)."""
-    P = model.packed
+    P = model.kernel_params
     b_int, b_par, b_cos, b_sin = P.b_int, P.b_par, P.b_cos, P.b_sin
     nb = b_int.shape[0]
     out = np.zeros((nb, 2, 2))
@@ -115,7 +115,7 @@ def highest_frequency_hz(model, q, t=0.0):
     k_brg = _averaged_bearing_stiffness(model, [np.asarray(q, float)], [t])
     kmat = model.stiffness.copy()
     for ib in range(k_brg.shape[0]):
-        ix = int(model.packed.b_int[ib, K.BI_X])
+        ix = int(model.kernel_params.b_int[ib, K.BI_X])
         kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
     if model.rig.gears is not None:
         k_peak = float(np.max(model.mesh_table.mesh_stiffness(model.rig.gears)[1]))
@@ -151,7 +151,7 @@ def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     k_brg = _averaged_bearing_stiffness(model, states, times)
     kmat = model.stiffness.copy()
     for ib in range(k_brg.shape[0]):
-        ix = int(model.packed.b_int[ib, K.BI_X])
+        ix = int(model.kernel_params.b_int[ib, K.BI_X])
         kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
     k_mean = 0.0
     if rig.gears is not None:

@@ -57,10 +57,11 @@ class DynamicModel:
         Constant external load (output torque, radial load).
     omega : ndarray, shape (n,)
         Nominal rotation speed of each DOF, rad/s (0 for translations).
-    packed : KernelParams
+    kernel_params : KernelParams
         Named kernel arrays ``P`` (:class:`cmsim.dynamics._kernels.KernelParams`).
-    diag_names : tuple of str
-        Names of the output forces the kernel writes (bearing housing forces, pair forces).
+    output_force_names : tuple of str
+        Names of the forces the kernel writes at each output instant, in its order:
+        ``F_<bearing>_x``, ``F_<bearing>_y`` (housing forces), then ``Fmesh_<slot>``.
     slip : RollingSlip
         The run's rolling slip (:data:`cmsim.faults.NO_SLIP` without).
     mesh_model : HybridMeshModel or None
@@ -76,8 +77,8 @@ class DynamicModel:
     mesh_table: MeshStiffnessTable | None
     force: np.ndarray
     omega: np.ndarray
-    packed: K.KernelParams = field(repr=False)
-    diag_names: tuple = ()
+    kernel_params: K.KernelParams = field(repr=False)
+    output_force_names: tuple = ()
     slip: object = NO_SLIP
     mesh_model: object = None
     cage_phases_rad: np.ndarray = field(default=None, repr=False)
@@ -86,7 +87,7 @@ class DynamicModel:
     def __post_init__(self):
         # one array-flag signature for the kernels, whatever built the model (numba
         # recompiles the integrator for each mix of read-only and writeable arrays)
-        object.__setattr__(self, "packed", self.packed.frozen())
+        object.__setattr__(self, "kernel_params", self.kernel_params.frozen())
 
     @property
     def rig(self):
@@ -150,25 +151,26 @@ class DynamicModel:
         if phases.shape != (nb,) or not np.all(np.isfinite(phases)):
             raise ParameterError(f"cage_phases_rad needs {nb} finite values (one per bearing "
                                  f"{rig.bearing_names}), got {cage_phases_rad!r}")
-        b_par = self.rig_model.b_par.copy()
+        b_par = self.rig_model.bearing_params.copy()
         b_par[:, K.BP_PHASE] = phases
-        cage_rates = [abs(b_par[ib, K.BP_CAGE] * self.omega[self.rig_model.b_int[ib, K.BI_T]])
-                      for ib in range(nb)]
-        jitter, jdt = _jitter(rig.bearings, self.rig_model.b_cos.shape[1], cage_rates, slip,
+        shaft_dof = self.rig_model.bearing_index[:, K.BI_T]
+        cage_rates = [abs(b_par[ib, K.BP_CAGE] * self.omega[shaft_dof[ib]]) for ib in range(nb)]
+        jitter, jdt = _jitter(rig.bearings, self.rig_model.ball_cos.shape[1], cage_rates, slip,
                               duration_s, seed)
-        track, tdt = _track(self.packed.b_def, duration_s, seed)
-        m_par = self.packed.m_par.copy()
+        track, tdt = _track(self.kernel_params.b_def, duration_s, seed)
+        m_par = self.kernel_params.m_par.copy()
         m_par[K.MP_JDT] = jdt
         m_par[K.MP_TDT] = tdt
-        packed = self.packed._replace(b_par=b_par, jitter=jitter, m_par=m_par, track=track)
-        return replace(self, packed=packed, slip=slip, cage_phases_rad=phases)
+        kernel_params = self.kernel_params._replace(b_par=b_par, jitter=jitter, m_par=m_par,
+                                                    track=track)
+        return replace(self, kernel_params=kernel_params, slip=slip, cage_phases_rad=phases)
 
     def rhs(self, t, y, want_diag=False):
         """Evaluate the kernel right-hand side; returns ``dydt`` (and ``diag``)."""
         dydt = np.empty((1, 2 * self.n_dof))
-        diag = np.zeros(len(self.diag_names))
-        K.rhs_jit(float(t), np.ascontiguousarray(y, dtype=float), dydt, 0, self.packed, diag,
-                  bool(want_diag), K.make_work(self.packed))
+        diag = np.zeros(len(self.output_force_names))
+        K.rhs_jit(float(t), np.ascontiguousarray(y, dtype=float), dydt, 0, self.kernel_params, diag,
+                  bool(want_diag), K.make_work(self.kernel_params))
         return (dydt[0], diag) if want_diag else dydt[0]
 
     def static_residual(self, t, q):
@@ -284,7 +286,7 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
     m_par = np.zeros(K.MP_SIZE)
     m_par[K.MP_JDT] = 1.0
     m_par[K.MP_DIAGB] = 2 * nb
-    diag_names = [f"F_{b}_{d}" for b in rig.bearing_names for d in ("x", "y")]
+    output_force_names = [f"F_{b}_{d}" for b in rig.bearing_names for d in ("x", "y")]
     if rig.gears is not None:
         pair, geom = rig.gears, rm.mesh
         mode = K.MODE_TABLE if mesh_model is None else K.MODE_HYBRID
@@ -312,7 +314,7 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
         m_par[K.MP_SINT0] = math.sin(geom["phi_t0"])
         tab_k = np.ascontiguousarray(mesh_table.stiffness_n_per_m)
         tab_e = np.ascontiguousarray(mesh_table.separation_m)
-        diag_names += [f"Fmesh_{j}" for j in range(geom["n_slots"])]
+        output_force_names += [f"Fmesh_{j}" for j in range(geom["n_slots"])]
         geo, teeth1, teeth2 = geom["geo"], geom["teeth1"], geom["teeth2"]
     else:
         geo = np.zeros(GEO_SIZE)
@@ -350,12 +352,12 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
             raise ParameterError(f"damping_table needs {len(tab_k)} finite values >= 0 N s/m "
                                  f"(one per point of the mesh table grid)")
         m_int[K.MI_CTAB] = 1
-    packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, b_int, rm.b_par,
-                            rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
-                            m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
-                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab, c_tab,
-                            np.ones((fields[0].shape[0], 1)))
-    model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
+    kernel_params = K.KernelParams(
+        1.0 / rm.mass, rm.springs, force, omega, b_int, rm.bearing_params, rm.ball_cos,
+        rm.ball_sin, np.zeros((nb, rm.ball_cos.shape[1] + 1, 1)), m_int, m_par, geo, tab_k,
+        tab_e, teeth1, teeth2, rm.spring_ends, *hybrid, fields[0], rm.ball_angles_rad,
+        *fields[1:], prof, mu_tab, c_tab, np.ones((fields[0].shape[0], 1)))
+    model = DynamicModel(rm, op, mesh_table, force, omega, kernel_params, tuple(output_force_names),
                          NO_SLIP, mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
                          seed=seed)
@@ -387,9 +389,9 @@ def _checked_mesh(rig, mesh):
 
 def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
     """``(b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc))`` for the kernel from FaultArrays."""
-    nb, max_balls = rm.b_cos.shape
+    nb, max_balls = rm.ball_cos.shape
     if fa is None or not fa.active:
-        return rm.b_int, K.no_faults(nb, max_balls)
+        return rm.bearing_index, K.no_faults(nb, max_balls)
     b_def = np.ascontiguousarray(fa.bearing_defects, dtype=float).reshape(-1, K.DF_SIZE)
     b_off = np.ascontiguousarray(fa.ball_offset_m, dtype=float)
     if b_off.shape != (nb, max_balls):
@@ -397,7 +399,7 @@ def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
                              f"got {b_off.shape}")
     order = np.argsort(b_def[:, K.DF_BRG], kind="stable")
     b_def = np.ascontiguousarray(b_def[order])
-    b_int = rm.b_int.copy()
+    b_int = rm.bearing_index.copy()
     for ib in range(nb):
         rows = np.flatnonzero(b_def[:, K.DF_BRG] == ib)
         b_int[ib, K.BI_DEF0] = rows[0] if rows.size else 0

@@ -48,14 +48,16 @@ class RigModel:
         Spring-damper (k, c) of each element in kernel order.
     spring_ends : ndarray of int64, shape (e, 3)
         DOF indices of each element (:func:`cmsim.dynamics._kernels.linear_accel_jit`).
-    b_int : ndarray of int64, shape (nb, BI_SIZE)
-        Bearing DOF indices and ball counts.
-    b_par : ndarray, shape (nb, BP_SIZE)
-        Bearing parameters; the phase column is set per run.
-    b_cos, b_sin : ndarray, shape (nb, max_balls)
-        cos and sin of the ball offsets in each cage.
-    b_ang : ndarray, shape (nb, max_balls)
-        The ball offsets in each cage, rad.
+    bearing_index : ndarray of int64, shape (nb, BI_SIZE)
+        Per bearing: its node's DOF indices and its number of balls (columns ``BI_*`` of
+        :mod:`cmsim.dynamics._kernels`; the defect columns are filled per model).
+    bearing_params : ndarray, shape (nb, BP_SIZE)
+        Per bearing: Hertz constant, exponent, clearance, cage rate, sense, damping, spin
+        ratio (columns ``BP_*``); the cage phase column is set per run.
+    ball_cos, ball_sin : ndarray, shape (nb, max_balls)
+        cos and sin of each ball's nominal angle in its cage.
+    ball_angles_rad : ndarray, shape (nb, max_balls)
+        Each ball's nominal angle in its cage, rad.
     mesh : dict
         Tooth geometry of the kernels (``geo``, ``teeth1``, ``teeth2``, slots, phases, zone
         limits); empty without gears.
@@ -68,11 +70,11 @@ class RigModel:
     damping: np.ndarray = field(repr=False)
     springs: np.ndarray = field(repr=False)
     spring_ends: np.ndarray = field(repr=False)
-    b_int: np.ndarray = field(repr=False)
-    b_par: np.ndarray = field(repr=False)
-    b_cos: np.ndarray = field(repr=False)
-    b_sin: np.ndarray = field(repr=False)
-    b_ang: np.ndarray = field(repr=False, default=None)
+    bearing_index: np.ndarray = field(repr=False)
+    bearing_params: np.ndarray = field(repr=False)
+    ball_cos: np.ndarray = field(repr=False)
+    ball_sin: np.ndarray = field(repr=False)
+    ball_angles_rad: np.ndarray = field(repr=False, default=None)
     mesh: dict = field(repr=False, default_factory=dict)
 
     @property

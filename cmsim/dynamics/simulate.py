@@ -68,14 +68,14 @@ class _Integrator:
 
     def chunks(self, y0, t0, h, n_out, substeps):
         model, tab = self.model, self.tab
-        n_diag = len(model.diag_names)
+        n_diag = len(model.output_force_names)
         buffers = K.make_integrator_buffers(tab.b, y0.size, n_diag)
         # compile (or load from cache) outside the timed region, then start from fresh scratch
-        K.integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.packed,
-                        K.make_work(model.packed), buffers, np.empty((1, y0.size)),
+        K.integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
+                        K.make_work(model.kernel_params), buffers, np.empty((1, y0.size)),
                         np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
                         self.mask)
-        self.work = K.make_work(model.packed)
+        self.work = K.make_work(model.kernel_params)
         y, m0 = y0, 0
         while m0 < n_out:
             # one sample of overlap: a block's last state starts the next block
@@ -85,7 +85,7 @@ class _Integrator:
             first = m0 - 1 if m0 else 0
             start = time.perf_counter()
             status = K.integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
-                                     model.packed, self.work, buffers, states, diag,
+                                     model.kernel_params, self.work, buffers, states, diag,
                                      self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
             self.wall += time.perf_counter() - start
             if status >= 0:
@@ -143,7 +143,7 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     """
     runner = _Integrator(model, scheme, progress)
     states = np.empty((n_out, y0.size))
-    diag = np.empty((n_out, len(model.diag_names)))
+    diag = np.empty((n_out, len(model.output_force_names)))
     for m0, st, dg in runner.chunks(np.asarray(y0, dtype=float), t0, dt_out / substeps, n_out,
                                     substeps):
         states[m0:m0 + len(st)] = st
@@ -188,7 +188,7 @@ def _recorded(model, record):
     if isinstance(record, str):
         record = (record,)
     dofs = {name: i for i, name in enumerate(model.dof_names)}
-    diag = {name: j for j, name in enumerate(model.diag_names)}
+    diag = {name: j for j, name in enumerate(model.output_force_names)}
     q_cols, d_cols = set(), set()
     for name in record:
         if name in dofs:
@@ -220,10 +220,11 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     n = model.n_dof
     first = n_warm * k - hl                       # first fast sample the filter reads
     last = (n_warm + n_rec - 1) * k + hl          # last one
+    n_forces = len(model.output_force_names)
     q_out = np.full((n_rec, n), np.nan)
-    d_out = np.full((n_rec, len(model.diag_names)), np.nan)
+    d_out = np.full((n_rec, n_forces), np.nan)
     qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
-    dc = np.arange(len(model.diag_names)) if d_cols is None else np.asarray(d_cols, dtype=int)
+    dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
     runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
     tail = None                                   # fast samples not yet consumed
@@ -254,11 +255,11 @@ def _compile_seconds():
                             (MeshStiffnessTable.constant(rig.gears, 1e8), None))
         y0 = np.zeros(2 * model.n_dof)
         tab = SCHEMES["ode3"]
-        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.packed,
-                        K.make_work(model.packed),
-                        K.make_integrator_buffers(tab.b, y0.size, len(model.diag_names)),
+        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
+                        K.make_work(model.kernel_params),
+                        K.make_integrator_buffers(tab.b, y0.size, len(model.output_force_names)),
                         np.empty((2, y0.size)),
-                        np.empty((2, len(model.diag_names))), 1.0, 1.0,
+                        np.empty((2, len(model.output_force_names))), 1.0, 1.0,
                         model.translational_mask)
         _compile_seconds.value = time.perf_counter() - start
     return _compile_seconds.value
@@ -487,7 +488,7 @@ def _signals(model, t, states, diag, kprof=None):
         if name.startswith("theta"):
             value = value + model.omega[i] * tau
         sig[name] = value
-    for j, name in enumerate(model.diag_names):
+    for j, name in enumerate(model.output_force_names):
         sig[name] = diag[:, j].copy()
     for bname in rig.bearing_names:
         e = model.loa_direction(0 if bname.startswith("1") else 1)
@@ -499,6 +500,6 @@ def _signals(model, t, states, diag, kprof=None):
         dte = states[:, model.index("theta_1G1")] - ratio * states[:, model.index("theta_2G1")]
         sig["dte"] = dte
         sig["dte_um"] = dte * rig.gears.driving.base_radius_m * 1e6
-        slots = [k for k in model.diag_names if k.startswith("Fmesh_")]
+        slots = [k for k in model.output_force_names if k.startswith("Fmesh_")]
         sig["Fmesh_total"] = np.sum([sig[k] for k in slots], axis=0)
     return sig
