@@ -1274,13 +1274,13 @@ def _numba_cache_cold():
 
     try:
         import cmsim.dynamics as dyn
-        src = Path(dyn.__file__).parent / "_kernels.py"
+        src = Path(dyn.__file__).parent / "_rhs_kernels.py"
         places = [src.parent / "__pycache__"]
         if os.environ.get("NUMBA_CACHE_DIR"):
             places.append(Path(os.environ["NUMBA_CACHE_DIR"]))
         mtime = src.stat().st_mtime
         for place in places:
-            for idx in place.rglob("_kernels.integrate_jit*.nbi") if place.is_dir() else ():
+            for idx in place.rglob("_rhs_kernels.integrate_jit*.nbi") if place.is_dir() else ():
                 if idx.stat().st_mtime >= mtime:
                     return False
         return True

@@ -29,7 +29,17 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from cmsim.bearings.kinematics import slip_jitter
-from cmsim.dynamics import _kernels as K
+from cmsim.dynamics._bearing_kernels import (BI_DEF0, BI_FAULTY, BI_NDEF, BI_T, BP_CAGE, BP_PHASE,
+                                             DEF_BALL, DF_AXIS, DF_BRG, DF_HALF, DF_KIND, DF_SIZE,
+                                             DF_TRACK, DF_WANDER)
+from cmsim.dynamics._mesh_kernels import (MI_CTAB, MI_ECC, MI_FAULTY_BALLS, MI_MUTAB, MI_PROFILE,
+                                          MI_SIZE, MI_TDOF, MI_TEETH, MODE_HYBRID, MODE_TABLE,
+                                          MP_A0, MP_BETA, MP_COST0, MP_DIAGB, MP_DTHR, MP_JDT,
+                                          MP_KOSTER, MP_MU, MP_OM1, MP_OM2, MP_OMREF, MP_PB,
+                                          MP_PDT, MP_PHIT0, MP_PSI10, MP_PSI20, MP_PT0, MP_SINT0,
+                                          MP_SIZE, MP_SLO, MP_TAB0, MP_TABD, MP_TDT, MP_V0,
+                                          MP_ZAFTER, MP_ZBEFORE, no_hybrid)
+from cmsim.dynamics._rhs_kernels import KernelParams, make_work, no_faults, no_profile, rhs_jit
 from cmsim.dynamics.rig_model import RigModel, rig_model
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, compile_faults, rig_with_faults
@@ -58,7 +68,7 @@ class DynamicModel:
     omega : ndarray, shape (n,)
         Nominal rotation speed of each DOF, rad/s (0 for translations).
     kernel_params : KernelParams
-        Named kernel arrays ``P`` (:class:`cmsim.dynamics._kernels.KernelParams`).
+        Named kernel arrays ``P`` (:class:`cmsim.dynamics._rhs_kernels.KernelParams`).
     output_force_names : tuple of str
         Names of the forces the kernel writes at each output instant, in its order:
         ``F_<bearing>_x``, ``F_<bearing>_y`` (housing forces), then ``Fmesh_<slot>``.
@@ -77,7 +87,7 @@ class DynamicModel:
     mesh_table: MeshStiffnessTable | None
     force: np.ndarray
     omega: np.ndarray
-    kernel_params: K.KernelParams = field(repr=False)
+    kernel_params: KernelParams = field(repr=False)
     output_force_names: tuple = ()
     slip: object = NO_SLIP
     mesh_model: object = None
@@ -152,15 +162,15 @@ class DynamicModel:
             raise ParameterError(f"cage_phases_rad needs {nb} finite values (one per bearing "
                                  f"{rig.bearing_names}), got {cage_phases_rad!r}")
         b_par = self.rig_model.bearing_params.copy()
-        b_par[:, K.BP_PHASE] = phases
-        shaft_dof = self.rig_model.bearing_index[:, K.BI_T]
-        cage_rates = [abs(b_par[ib, K.BP_CAGE] * self.omega[shaft_dof[ib]]) for ib in range(nb)]
+        b_par[:, BP_PHASE] = phases
+        shaft_dof = self.rig_model.bearing_index[:, BI_T]
+        cage_rates = [abs(b_par[ib, BP_CAGE] * self.omega[shaft_dof[ib]]) for ib in range(nb)]
         jitter, jdt = _jitter(rig.bearings, self.rig_model.ball_cos.shape[1], cage_rates, slip,
                               duration_s, seed)
         track, tdt = _track(self.kernel_params.b_def, duration_s, seed)
         m_par = self.kernel_params.m_par.copy()
-        m_par[K.MP_JDT] = jdt
-        m_par[K.MP_TDT] = tdt
+        m_par[MP_JDT] = jdt
+        m_par[MP_TDT] = tdt
         kernel_params = self.kernel_params._replace(b_par=b_par, jitter=jitter, m_par=m_par,
                                                     track=track)
         return replace(self, kernel_params=kernel_params, slip=slip, cage_phases_rad=phases)
@@ -169,8 +179,8 @@ class DynamicModel:
         """Evaluate the kernel right-hand side; returns ``dydt`` (and ``diag``)."""
         dydt = np.empty((1, 2 * self.n_dof))
         diag = np.zeros(len(self.output_force_names))
-        K.rhs_jit(float(t), np.ascontiguousarray(y, dtype=float), dydt, 0, self.kernel_params, diag,
-                  bool(want_diag), K.make_work(self.kernel_params))
+        rhs_jit(float(t), np.ascontiguousarray(y, dtype=float), dydt, 0, self.kernel_params, diag,
+                  bool(want_diag), make_work(self.kernel_params))
         return (dydt[0], diag) if want_diag else dydt[0]
 
     def static_residual(self, t, q):
@@ -281,37 +291,37 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
         force[rm.index(name)] += check_range(f"loads[{name!r}]", value, unit="N or N m")
 
     nb = len(rig.bearings)
-    m_int = np.zeros(K.MI_SIZE, dtype=np.int64)
-    m_int[K.MI_TDOF] = -1
-    m_par = np.zeros(K.MP_SIZE)
-    m_par[K.MP_JDT] = 1.0
-    m_par[K.MP_DIAGB] = 2 * nb
+    m_int = np.zeros(MI_SIZE, dtype=np.int64)
+    m_int[MI_TDOF] = -1
+    m_par = np.zeros(MP_SIZE)
+    m_par[MP_JDT] = 1.0
+    m_par[MP_DIAGB] = 2 * nb
     output_force_names = [f"F_{b}_{d}" for b in rig.bearing_names for d in ("x", "y")]
     if rig.gears is not None:
         pair, geom = rig.gears, rm.mesh
-        mode = K.MODE_TABLE if mesh_model is None else K.MODE_HYBRID
-        m_int[:K.MI_TEETH] = (geom["g1"], geom["g2"], geom["n_slots"], 1, mode)
+        mode = MODE_TABLE if mesh_model is None else MODE_HYBRID
+        m_int[:MI_TEETH] = (geom["g1"], geom["g2"], geom["n_slots"], 1, mode)
         mc = rig.mesh_contact
         k_mean = mesh_table.mean_mesh_stiffness(pair)
-        m_par[K.MP_A0] = pair.working_centre_distance_m
-        m_par[K.MP_PSI10] = geom["psi10"]
-        m_par[K.MP_PSI20] = geom["psi20"]
-        m_par[K.MP_PB] = pair.driving.base_pitch_m
-        m_par[K.MP_SLO] = geom["slo"]
-        m_par[K.MP_OM1] = speeds[0]
-        m_par[K.MP_OM2] = speeds[1]
-        m_par[K.MP_MU] = mc.friction_coefficient
-        m_par[K.MP_V0] = mc.friction_smoothing_m_s
-        m_par[K.MP_BETA] = 2 * mc.damping_ratio * math.sqrt(pair.mesh_stiffness_mass_kg / k_mean)
-        m_par[K.MP_KOSTER] = geom["koster"]
-        m_par[K.MP_DTHR] = mc.squeeze_gap_threshold_m
-        m_par[K.MP_TAB0] = mesh_table.position_m[0]
-        m_par[K.MP_TABD] = mesh_table.spacing_m
-        m_par[K.MP_ZBEFORE] = geom["before"]
-        m_par[K.MP_ZAFTER] = geom["after"]
-        m_par[K.MP_PHIT0] = geom["phi_t0"]
-        m_par[K.MP_COST0] = math.cos(geom["phi_t0"])
-        m_par[K.MP_SINT0] = math.sin(geom["phi_t0"])
+        m_par[MP_A0] = pair.working_centre_distance_m
+        m_par[MP_PSI10] = geom["psi10"]
+        m_par[MP_PSI20] = geom["psi20"]
+        m_par[MP_PB] = pair.driving.base_pitch_m
+        m_par[MP_SLO] = geom["slo"]
+        m_par[MP_OM1] = speeds[0]
+        m_par[MP_OM2] = speeds[1]
+        m_par[MP_MU] = mc.friction_coefficient
+        m_par[MP_V0] = mc.friction_smoothing_m_s
+        m_par[MP_BETA] = 2 * mc.damping_ratio * math.sqrt(pair.mesh_stiffness_mass_kg / k_mean)
+        m_par[MP_KOSTER] = geom["koster"]
+        m_par[MP_DTHR] = mc.squeeze_gap_threshold_m
+        m_par[MP_TAB0] = mesh_table.position_m[0]
+        m_par[MP_TABD] = mesh_table.spacing_m
+        m_par[MP_ZBEFORE] = geom["before"]
+        m_par[MP_ZAFTER] = geom["after"]
+        m_par[MP_PHIT0] = geom["phi_t0"]
+        m_par[MP_COST0] = math.cos(geom["phi_t0"])
+        m_par[MP_SINT0] = math.sin(geom["phi_t0"])
         tab_k = np.ascontiguousarray(mesh_table.stiffness_n_per_m)
         tab_e = np.ascontiguousarray(mesh_table.separation_m)
         output_force_names += [f"Fmesh_{j}" for j in range(geom["n_slots"])]
@@ -319,22 +329,22 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
     else:
         geo = np.zeros(GEO_SIZE)
         teeth1 = teeth2 = np.zeros((1, 2))
-        m_par[K.MP_TABD] = 1.0
+        m_par[MP_TABD] = 1.0
         tab_k = np.zeros(2)
         tab_e = np.zeros(2)
     if mesh_model is not None:
         hybrid = tuple(np.ascontiguousarray(a, dtype=float) for a in mesh_model.kernel_args())
     else:
-        hybrid = K.no_hybrid()
+        hybrid = no_hybrid()
     b_int, fields = _fault_fields(rm, m_int, fault_arrays,
-                                  (m_par[K.MP_TAB0], m_par[K.MP_TABD]))
-    prof = K.no_profile()
+                                  (m_par[MP_TAB0], m_par[MP_TABD]))
+    prof = no_profile()
     if profile is not None:
-        m_int[K.MI_PROFILE] = 1
-        m_int[K.MI_TDOF] = n - 1 if rig.gears is not None else -1
-        m_par[K.MP_PT0] = profile.t0_s
-        m_par[K.MP_PDT] = profile.dt_s
-        m_par[K.MP_OMREF] = op.omega_rad_s
+        m_int[MI_PROFILE] = 1
+        m_int[MI_TDOF] = n - 1 if rig.gears is not None else -1
+        m_par[MP_PT0] = profile.t0_s
+        m_par[MP_PDT] = profile.dt_s
+        m_par[MP_OMREF] = op.omega_rad_s
         prof = np.ascontiguousarray(profile.table, dtype=float)
     mu_tab = np.zeros(1)
     if friction_table is not None:
@@ -343,7 +353,7 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
                 or np.any(mu_tab < 0) or np.any(mu_tab > 1):
             raise ParameterError(f"friction_table needs {len(tab_k)} values in [0, 1] (one "
                                  f"per point of the mesh table grid)")
-        m_int[K.MI_MUTAB] = 1
+        m_int[MI_MUTAB] = 1
     c_tab = np.zeros(1)
     if damping_table is not None:
         c_tab = np.ascontiguousarray(damping_table, dtype=float)
@@ -351,8 +361,8 @@ def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=N
                 or np.any(c_tab < 0):
             raise ParameterError(f"damping_table needs {len(tab_k)} finite values >= 0 N s/m "
                                  f"(one per point of the mesh table grid)")
-        m_int[K.MI_CTAB] = 1
-    kernel_params = K.KernelParams(
+        m_int[MI_CTAB] = 1
+    kernel_params = KernelParams(
         1.0 / rm.mass, rm.springs, force, omega, b_int, rm.bearing_params, rm.ball_cos,
         rm.ball_sin, np.zeros((nb, rm.ball_cos.shape[1] + 1, 1)), m_int, m_par, geo, tab_k,
         tab_e, teeth1, teeth2, rm.spring_ends, *hybrid, fields[0], rm.ball_angles_rad,
@@ -391,24 +401,24 @@ def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
     """``(b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc))`` for the kernel from FaultArrays."""
     nb, max_balls = rm.ball_cos.shape
     if fa is None or not fa.active:
-        return rm.bearing_index, K.no_faults(nb, max_balls)
-    b_def = np.ascontiguousarray(fa.bearing_defects, dtype=float).reshape(-1, K.DF_SIZE)
+        return rm.bearing_index, no_faults(nb, max_balls)
+    b_def = np.ascontiguousarray(fa.bearing_defects, dtype=float).reshape(-1, DF_SIZE)
     b_off = np.ascontiguousarray(fa.ball_offset_m, dtype=float)
     if b_off.shape != (nb, max_balls):
         raise ParameterError(f"ball_offset_m must have shape {(nb, max_balls)}, "
                              f"got {b_off.shape}")
-    order = np.argsort(b_def[:, K.DF_BRG], kind="stable")
+    order = np.argsort(b_def[:, DF_BRG], kind="stable")
     b_def = np.ascontiguousarray(b_def[order])
     b_int = rm.bearing_index.copy()
     for ib in range(nb):
-        rows = np.flatnonzero(b_def[:, K.DF_BRG] == ib)
-        b_int[ib, K.BI_DEF0] = rows[0] if rows.size else 0
-        b_int[ib, K.BI_NDEF] = rows.size
+        rows = np.flatnonzero(b_def[:, DF_BRG] == ib)
+        b_int[ib, BI_DEF0] = rows[0] if rows.size else 0
+        b_int[ib, BI_NDEF] = rows.size
         # 2: an off-size ball, every ball ball by ball; 1: defects only, healthy law plus
-        # the change of the balls in a defect (the kernels' _faulty_bearing_forces)
-        b_int[ib, K.BI_FAULTY] = 2 if np.any(b_off[ib] != 0.0) else int(rows.size > 0)
+        # the change of the balls in a defect (the kernels' faulty_bearing_forces_jit)
+        b_int[ib, BI_FAULTY] = 2 if np.any(b_off[ib] != 0.0) else int(rows.size > 0)
     if np.any(b_off != 0.0):
-        m_int[K.MI_FAULTY_BALLS] = 1
+        m_int[MI_FAULTY_BALLS] = 1
     rig = rm.rig
     tk1, tk2, te1, te2 = (np.ascontiguousarray(a, dtype=float) for a in
                           (fa.tooth_factor1, fa.tooth_factor2, fa.tooth_sep1, fa.tooth_sep2))
@@ -423,14 +433,14 @@ def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
                 or te2.shape[0] != z2:
             raise ParameterError(f"per-tooth tables need {z1} rows for gear 1 and {z2} for "
                                  f"gear 2")
-        m_int[K.MI_TEETH] = 1
+        m_int[MI_TEETH] = 1
     else:
         tk1 = tk2 = np.ones((1, 1))
         te1 = te2 = np.zeros((1, 1))
     ecc_in = np.asarray(fa.eccentricity, dtype=float).reshape(2, 2)
     ecc = np.zeros((2, 3))
     if rig.gears is not None and np.any(ecc_in[:, 0] != 0.0):
-        m_int[K.MI_ECC] = 1
+        m_int[MI_ECC] = 1
         # the kernel turns the offset with the gear's involute origin ψ = θ + ψ0
         refs = (rm.mesh["psi10"], rm.mesh["psi20"])
         for gear in range(2):
@@ -449,22 +459,22 @@ def _track(b_def, duration_s, seed):
     ``seed``). Returns ((m, n_grid), dt); n_grid = 1 when nothing varies.
     """
     m = b_def.shape[0]
-    ball = b_def[:, K.DF_KIND] == K.DEF_BALL
-    wander = ball & (b_def[:, K.DF_WANDER] > 0.0)
+    ball = b_def[:, DF_KIND] == DEF_BALL
+    wander = ball & (b_def[:, DF_WANDER] > 0.0)
     if not np.any(wander):
         out = np.ones((m, 1))
         for r in np.flatnonzero(ball):
-            out[r] = track_share(b_def[r, K.DF_AXIS], b_def[r, K.DF_TRACK], b_def[r, K.DF_HALF])
+            out[r] = track_share(b_def[r, DF_AXIS], b_def[r, DF_TRACK], b_def[r, DF_HALF])
         return out, 1.0
-    dt = float(np.min(b_def[wander, K.DF_WANDER])) / 20.0
+    dt = float(np.min(b_def[wander, DF_WANDER])) / 20.0
     n_grid = int(math.ceil(duration_s / dt)) + 2
     rng = np.random.default_rng(None if seed is None else [int(seed), _TRACK_STREAM])
     out = np.ones((m, n_grid))
     for r in np.flatnonzero(ball):
-        z = b_def[r, K.DF_AXIS]
+        z = b_def[r, DF_AXIS]
         if wander[r]:
-            z = wandering_offset(z, b_def[r, K.DF_WANDER], n_grid, dt, rng)
-        out[r] = track_share(z, b_def[r, K.DF_TRACK], b_def[r, K.DF_HALF])
+            z = wandering_offset(z, b_def[r, DF_WANDER], n_grid, dt, rng)
+        out[r] = track_share(z, b_def[r, DF_TRACK], b_def[r, DF_HALF])
     return out, dt
 
 

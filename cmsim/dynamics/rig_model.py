@@ -24,7 +24,8 @@ import numpy as np
 from cmsim.bearings.forces import ball_offsets
 from cmsim.bearings.hertz import bearing_contact_stiffness
 from cmsim.bearings.kinematics import cage_ratios
-from cmsim.dynamics import _kernels as K
+from cmsim.dynamics._bearing_kernels import (BI_DEF0, BI_SIZE, BP_C, BP_CAGE, BP_DAMP, BP_K, BP_P,
+                                             BP_SENSE, BP_SIZE, BP_SPIN)
 from cmsim.mesh_stiffness.contact import (contact_geometry, corner_zone_m, potential_slots,
                                           reference_phases, table_range_m)
 
@@ -47,10 +48,10 @@ class RigModel:
     springs : ndarray, shape (e, 2)
         Spring-damper (k, c) of each element in kernel order.
     spring_ends : ndarray of int64, shape (e, 3)
-        DOF indices of each element (:func:`cmsim.dynamics._kernels.linear_accel_jit`).
+        DOF indices of each element (:func:`cmsim.dynamics._rhs_kernels.linear_accel_jit`).
     bearing_index : ndarray of int64, shape (nb, BI_SIZE)
         Per bearing: its node's DOF indices and its number of balls (columns ``BI_*`` of
-        :mod:`cmsim.dynamics._kernels`; the defect columns are filled per model).
+        :mod:`cmsim.dynamics._bearing_kernels`; the defect columns are filled per model).
     bearing_params : ndarray, shape (nb, BP_SIZE)
         Per bearing: Hertz constant, exponent, clearance, cage rate, sense, damping, spin
         ratio (columns ``BP_*``); the cage phase column is set per run.
@@ -106,8 +107,8 @@ def rig_model(rig):
     bearings = rig.bearings
     nb = len(bearings)
     max_balls = max(b.n_balls for b in bearings)
-    b_int = np.zeros((nb, K.BI_SIZE), dtype=np.int64)
-    b_par = np.zeros((nb, K.BP_SIZE))
+    b_int = np.zeros((nb, BI_SIZE), dtype=np.int64)
+    b_par = np.zeros((nb, BP_SIZE))
     b_cos = np.zeros((nb, max_balls))
     b_sin = np.zeros((nb, max_balls))
     b_ang = np.zeros((nb, max_balls))
@@ -115,14 +116,14 @@ def rig_model(rig):
     for ib, (bname, brg) in enumerate(zip(rig.bearing_names, bearings)):
         node = node_of[bname]
         k_in, k_out = cage_ratios(brg)
-        b_int[ib, :K.BI_DEF0] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls)
-        b_par[ib, K.BP_K] = bearing_contact_stiffness(brg)
-        b_par[ib, K.BP_P] = brg.load_exponent
-        b_par[ib, K.BP_C] = brg.clearance_m
-        b_par[ib, K.BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio
-        b_par[ib, K.BP_SENSE] = 1.0 if bname.startswith("1") else -1.0
-        b_par[ib, K.BP_DAMP] = brg.damping_n_s_per_m
-        b_par[ib, K.BP_SPIN] = (brg.pitch_diameter_m - brg.ball_diameter_m
+        b_int[ib, :BI_DEF0] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls)
+        b_par[ib, BP_K] = bearing_contact_stiffness(brg)
+        b_par[ib, BP_P] = brg.load_exponent
+        b_par[ib, BP_C] = brg.clearance_m
+        b_par[ib, BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio
+        b_par[ib, BP_SENSE] = 1.0 if bname.startswith("1") else -1.0
+        b_par[ib, BP_DAMP] = brg.damping_n_s_per_m
+        b_par[ib, BP_SPIN] = (brg.pitch_diameter_m - brg.ball_diameter_m
                                 * math.cos(brg.effective_contact_angle_rad)) / brg.ball_diameter_m
         co, so = ball_offsets(brg)
         b_cos[ib, :brg.n_balls] = co

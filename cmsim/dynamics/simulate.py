@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 import cmsim
-from cmsim.dynamics import _kernels as K
+from cmsim.dynamics._rhs_kernels import PR_THETA, integrate_jit, make_integrator_buffers, make_work
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
@@ -69,13 +69,13 @@ class _Integrator:
     def chunks(self, y0, t0, h, n_out, substeps):
         model, tab = self.model, self.tab
         n_diag = len(model.output_force_names)
-        buffers = K.make_integrator_buffers(tab.b, y0.size, n_diag)
+        buffers = make_integrator_buffers(tab.b, y0.size, n_diag)
         # compile (or load from cache) outside the timed region, then start from fresh scratch
-        K.integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
-                        K.make_work(model.kernel_params), buffers, np.empty((1, y0.size)),
+        integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
+                        make_work(model.kernel_params), buffers, np.empty((1, y0.size)),
                         np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
                         self.mask)
-        self.work = K.make_work(model.kernel_params)
+        self.work = make_work(model.kernel_params)
         y, m0 = y0, 0
         while m0 < n_out:
             # one sample of overlap: a block's last state starts the next block
@@ -84,7 +84,7 @@ class _Integrator:
             diag = np.empty((count, n_diag))
             first = m0 - 1 if m0 else 0
             start = time.perf_counter()
-            status = K.integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
+            status = integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
                                      model.kernel_params, self.work, buffers, states, diag,
                                      self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
             self.wall += time.perf_counter() - start
@@ -255,9 +255,9 @@ def _compile_seconds():
                             (MeshStiffnessTable.constant(rig.gears, 1e8), None))
         y0 = np.zeros(2 * model.n_dof)
         tab = SCHEMES["ode3"]
-        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
-                        K.make_work(model.kernel_params),
-                        K.make_integrator_buffers(tab.b, y0.size, len(model.output_force_names)),
+        integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
+                        make_work(model.kernel_params),
+                        make_integrator_buffers(tab.b, y0.size, len(model.output_force_names)),
                         np.empty((2, y0.size)),
                         np.empty((2, len(model.output_force_names))), 1.0, 1.0,
                         model.translational_mask)
@@ -482,7 +482,7 @@ def _signals(model, t, states, diag, kprof=None):
     if kprof is not None:
         # equivalent time of the nominal rotation, Θ(t)/Ω_ref (as the kernels use it)
         grid = kprof.t0_s + kprof.dt_s * np.arange(kprof.table.shape[0])
-        tau = np.interp(t, grid, kprof.table[:, K.PR_THETA]) / model.op.omega_rad_s
+        tau = np.interp(t, grid, kprof.table[:, PR_THETA]) / model.op.omega_rad_s
     for i, name in enumerate(model.dof_names):
         value = states[:, i]
         if name.startswith("theta"):

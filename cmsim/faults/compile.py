@@ -1,6 +1,7 @@
 """Faults → what the model consumes: :class:`FaultArrays`, a changed rig, slip, modulations.
 
-The contract with the dynamics kernel (:mod:`cmsim.dynamics._kernels` reads these arrays):
+The contract with the dynamics kernels (:mod:`cmsim.dynamics._bearing_kernels` and
+:mod:`cmsim.dynamics._mesh_kernels` read these arrays):
 :func:`compile_faults` turns a tuple of faults into one :class:`FaultArrays` (float64 arrays,
 all present, neutral when unused); :func:`rig_with_faults` applies the faults that are plain
 rig changes (bearing wear); :func:`slip_from_faults` picks the run's rolling slip,
