@@ -103,25 +103,16 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
     (``MI_ECC``: the contact geometry uses each gear's geometric centre, turning about its
     shaft; moments and contact velocities use the shaft centre).
 
-    Pass 1 stores each slot's geometry in ``S`` (columns ``SG_*``); in hybrid mode the
-    interferences of all slots are then solved together (out-of-zone slots enter with a
-    large negative interference, so they stay unloaded); pass 2 applies the forces.
+    Pass 1 (:func:`_slot_geometry`) stores each slot's geometry in ``W.slots`` (columns
+    ``SG_*``); in hybrid mode the interferences of all slots are then solved together
+    (:func:`_hybrid_slot_forces`; out-of-zone slots enter with a large negative interference,
+    so they stay unloaded); pass 2 (:func:`_apply_pair_forces`) applies the forces.
     Inlined into the integrator, so taking the arrays out of ``P`` and ``W`` costs nothing."""
-    m_int, mp, geo, tab_k, tab_e = P.m_int, P.m_par, P.geo, P.tab_k, P.tab_e
-    teeth1, teeth2, hp, hd1, hc1, hd2, hc2 = P.teeth1, P.teeth2, P.hp, P.hd1, P.hc1, P.hd2, P.hc2
-    tk1, tk2, te1, te2, ecc = P.tk1, P.tk2, P.te1, P.te2, P.ecc
-    S, hw, hdelta, hrho1, hrho2 = W.slots, W.hwork, W.hdelta, W.hrho1, W.hrho2
-    hchi1, hchi2, hout, hstat, psi_anchor = W.hchi1, W.hchi2, W.hout, W.hstat, W.psi
-    hext = W.hext
-    z1 = teeth1.shape[0]
-    z2 = teeth2.shape[0]
+    m_int, mp, geo = P.m_int, P.m_par, P.geo
     i1 = m_int[MI_G1]
     i2 = m_int[MI_G2]
-    n_slots = m_int[MI_SLOTS]
-    hybrid = m_int[MI_MODE] == MODE_HYBRID
     rb1 = geo[0]
     rb2 = geo[1]
-    pb = mp[MP_PB]
     c1x = y[i1]
     c1y = y[i1 + 1]
     c2x = y[i2]
@@ -137,30 +128,57 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
     gx2 = c2x
     gy2 = c2y
     if m_int[MI_ECC] != 0:
-        cp1, sp1 = anchored_cos_sin_jit(psi_anchor, 0, psi1)
-        cp2, sp2 = anchored_cos_sin_jit(psi_anchor, 1, psi2)
+        ecc = P.ecc
+        cp1, sp1 = anchored_cos_sin_jit(W.psi, 0, psi1)
+        cp2, sp2 = anchored_cos_sin_jit(W.psi, 1, psi2)
         trig_done = True
         gx1 += ecc[0, 0] * (cp1 * ecc[0, 1] - sp1 * ecc[0, 2])
         gy1 += ecc[0, 0] * (sp1 * ecc[0, 1] + cp1 * ecc[0, 2])
         gx2 += ecc[1, 0] * (cp2 * ecc[1, 1] - sp2 * ecc[1, 2])
         gy2 += ecc[1, 0] * (sp2 * ecc[1, 1] + cp2 * ecc[1, 2])
     phi_t1, length, cos_t1, sin_t1 = _mesh_frame(gx1, gy1, gx2, gy2, rb1, rb2, mp)
-    teeth_on = m_int[MI_TEETH] != 0
     # interference: nominal rolling cancels exactly (rb1·Ω1 = rb2·Ω2)
     delta_inv = (rb1 * (y[i1 + 2] + mp[MP_PSI10] - phi_t1)
                  + rb2 * (mp[MP_PSI20] - y[i2 + 2] - (phi_t1 + math.pi))
                  - length)
     s_ref = rb1 * (psi1 - phi_t1)
-    m0f = math.floor((s_ref - mp[MP_SLO]) / pb)
-    m0 = int(m0f)
+    _slot_geometry(P, W, s_ref, delta_inv, psi1, psi2, trig_done, cp1, sp1, cp2, sp2, gx1, gy1,
+                   gx2, gy2, cos_t1, sin_t1, length)
+    if m_int[MI_MODE] == MODE_HYBRID:
+        _hybrid_slot_forces(P, W)
     w1 = mp[MP_OM1] * sr + y[n + i1 + 2]
     w2 = -(mp[MP_OM2] * sr + y[n + i2 + 2])
+    _apply_pair_forces(y, n, g, P, W, diag, want_diag, c1x, c1y, c2x, c2y, w1, w2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _slot_geometry(P, W, s_ref, delta_inv, psi1, psi2, trig_done, cp1, sp1, cp2, sp2, gx1, gy1,
+                   gx2, gy2, cos_t1, sin_t1, length):
+    """Pass 1 of :func:`mesh_forces_jit`: the contact geometry of every slot in ``W.slots``,
+    with the elastic force in table mode or the hybrid solve's inputs in hybrid mode.
+
+    Slot ``j`` holds the pair ``m0 − j`` (one tooth earlier on both gears per slot), at
+    ``s = s_ref − pair·p_b`` on the line of action; the gears' involute origins (``cp1`` …
+    ``sp2``, unless ``trig_done``) are turned only when a corner (rounded-tip) contact needs
+    them."""
+    m_int, mp, geo, tab_k, tab_e = P.m_int, P.m_par, P.geo, P.tab_k, P.tab_e
+    teeth1, teeth2, hp = P.teeth1, P.teeth2, P.hp
+    tk1, tk2, te1, te2 = P.tk1, P.tk2, P.te1, P.te2
+    S, hdelta, hrho1, hrho2 = W.slots, W.hdelta, W.hrho1, W.hrho2
+    hchi1, hchi2, hext, psi_anchor = W.hchi1, W.hchi2, W.hext, W.psi
+    z1 = teeth1.shape[0]
+    z2 = teeth2.shape[0]
+    n_slots = m_int[MI_SLOTS]
+    hybrid = m_int[MI_MODE] == MODE_HYBRID
+    teeth_on = m_int[MI_TEETH] != 0
+    pb = mp[MP_PB]
+    m0f = math.floor((s_ref - mp[MP_SLO]) / pb)
+    m0 = int(m0f)
     lo = length - geo[3] - mp[MP_ZBEFORE]
     hi = geo[2] + mp[MP_ZAFTER]
     # tooth numbers of the first slot's pair, m0 mod Z (float floor: integer % is slow)
     k1 = int(m0f - z1 * math.floor(m0f / z1))
     k2 = int(m0f - z2 * math.floor(m0f / z2))
-    # ---- pass 1: geometry, and the elastic force in table mode
     for j in range(n_slots):
         if j > 0:
             # next slot: one tooth earlier on both gears
@@ -224,29 +242,46 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
             S[j, SG_ELASTIC] = k_pair * overlap if overlap > 0.0 else 0.0
             S[j, SG_GAP] = -overlap
             S[j, SG_KPAIR] = k_pair
-    if hybrid:
-        it = hybrid_forces_jit(hdelta, hrho1, hrho2, hchi1, hchi2, hp, hd1, hc1, hd2, hc2, hext,
-                               hw, hout)
-        hstat[0] += 1.0
-        if it < 0:
-            hstat[1] += 1.0
-        loaded = False
-        for j in range(n_slots):
-            if hout[j] > 0.0:
-                loaded = True
-        for j in range(n_slots):
-            S[j, SG_ELASTIC] = hout[j]
-            # secant stiffness of a loaded pair, F/δ, for its share of the mesh damping
-            S[j, SG_KPAIR] = hout[j] / hdelta[j] if hout[j] > 0.0 and hdelta[j] > 0.0 else 0.0
-            # gap of an unloaded pair under the other pairs' loads, Σ_k C_jk F_k − δ_j (the
-            # solver leaves the coupling matrix C in the first n² entries of its work)
-            gap = -hdelta[j]
-            if loaded and hout[j] == 0.0:
-                for k in range(n_slots):
-                    gap += hw[j * n_slots + k] * hout[k]
-            S[j, SG_GAP] = gap
-    # ---- pass 2: damping, friction, forces and moments
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _hybrid_slot_forces(P, W):
+    """The on-line hybrid contact solve of all slots together (paper 001 eq. 2, model A):
+    each slot's elastic force, secant stiffness F/δ (its share of the mesh damping) and the
+    gap of an unloaded pair under the other pairs' loads, into ``W.slots``."""
+    S, hw, hdelta, hout, hstat = W.slots, W.hwork, W.hdelta, W.hout, W.hstat
+    n_slots = P.m_int[MI_SLOTS]
+    it = hybrid_forces_jit(hdelta, W.hrho1, W.hrho2, W.hchi1, W.hchi2, P.hp, P.hd1, P.hc1,
+                           P.hd2, P.hc2, W.hext, hw, hout)
+    hstat[0] += 1.0
+    if it < 0:
+        hstat[1] += 1.0
+    loaded = False
     for j in range(n_slots):
+        if hout[j] > 0.0:
+            loaded = True
+    for j in range(n_slots):
+        S[j, SG_ELASTIC] = hout[j]
+        # secant stiffness of a loaded pair, F/δ, for its share of the mesh damping
+        S[j, SG_KPAIR] = hout[j] / hdelta[j] if hout[j] > 0.0 and hdelta[j] > 0.0 else 0.0
+        # gap of an unloaded pair under the other pairs' loads, Σ_k C_jk F_k − δ_j (the
+        # solver leaves the coupling matrix C in the first n² entries of its work)
+        gap = -hdelta[j]
+        if loaded and hout[j] == 0.0:
+            for k in range(n_slots):
+                gap += hw[j * n_slots + k] * hout[k]
+        S[j, SG_GAP] = gap
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _apply_pair_forces(y, n, g, P, W, diag, want_diag, c1x, c1y, c2x, c2y, w1, w2):
+    """Pass 2 of :func:`mesh_forces_jit`: each loaded (or squeezing) slot's normal force with
+    its damping, its smoothed Coulomb friction, and their forces and moments on both gears
+    (``w1``, ``w2``: the gears' angular speeds, counter-clockwise positive)."""
+    m_int, mp, S = P.m_int, P.m_par, W.slots
+    i1 = m_int[MI_G1]
+    i2 = m_int[MI_G2]
+    for j in range(m_int[MI_SLOTS]):
         if S[j, SG_ON] == 0.0:
             if want_diag:
                 diag[int(mp[MP_DIAGB]) + j] = 0.0
