@@ -168,6 +168,45 @@ def unit_cycles():
     return cycles
 
 
+def module_cycles():
+    """Every group of modules that import each other round a circle, as ``"a, b (circle)"``.
+
+    Finer than :func:`unit_cycles`: it sees circles inside a package too. Imports of a
+    package's ``__init__`` are left out (a module importing its own package's facade is not
+    a circle of the code), as the before-stop hook does; known exceptions are left out.
+    """
+    graph = {m: sorted({t for t, _, _ in imports(m)
+                        if t in MODULES and t != m and MODULES[t].name != "__init__.py"
+                        and f"{m} -> {t}" not in KNOWN_EXCEPTIONS}) for m in MODULES}
+    index, low, stack, on_stack, groups = {}, {}, [], set(), []
+
+    def connect(v):                                # Tarjan's strongly connected components
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph[v]:
+            if w not in index:
+                connect(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                group.append(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                groups.append(", ".join(sorted(group)) + " (circle)")
+
+    for v in sorted(graph):
+        if v not in index:
+            connect(v)
+    return groups
+
+
 def _local():
     """``(exception key, message)`` for every function-local import the rules do not allow."""
     for module in MODULES:
@@ -204,6 +243,22 @@ def test_no_import_of_a_higher_layer():
 def test_no_two_units_import_each_other():
     found = unit_cycles()
     assert not found, "import cycles between parts of cmsim:\n" + "\n".join(found)
+
+
+def test_no_two_modules_import_each_other():
+    found = module_cycles()
+    assert not found, "import circles between modules of cmsim:\n" + "\n".join(found)
+
+
+def test_the_checker_sees_a_circle_inside_a_package(tmp_path, monkeypatch):
+    """Two probe modules of one package that import each other make a circle; a module that
+    imports its own package's __init__ does not."""
+    a, b = tmp_path / "a.py", tmp_path / "b.py"
+    a.write_text("from cmsim.dynamics import probe_b\nimport cmsim.dynamics\n")
+    b.write_text("def f():\n    from cmsim.dynamics.probe_a import g\n")
+    monkeypatch.setitem(MODULES, "cmsim.dynamics.probe_a", a)
+    monkeypatch.setitem(MODULES, "cmsim.dynamics.probe_b", b)
+    assert "cmsim.dynamics.probe_a, cmsim.dynamics.probe_b (circle)" in module_cycles()
 
 
 def test_no_needless_function_local_imports():
@@ -247,6 +302,6 @@ def test_the_checker_sees_local_imports_and_cycles(tmp_path, monkeypatch):
 
 
 if __name__ == "__main__":
-    problems = upward_imports() + unit_cycles() + local_imports()
+    problems = upward_imports() + unit_cycles() + module_cycles() + local_imports()
     print("\n".join(problems) or "no layering problems")
     sys.exit(bool(problems))
