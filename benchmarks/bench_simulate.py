@@ -187,8 +187,8 @@ def main():
     def linear_only():
         # without the mesh, the load torque spins shaft 2 up: lift the divergence limits
         status = integrate_jit(y0, 0.0, h, n_steps, 1, 0, tab.a, tab.b, tab.c, P,
-                                 make_work(P), make_integrator_buffers(tab.b, 2 * n, diag.shape[1]),
-                                 out, diag, math.inf, math.inf, model.translational_mask)
+                               make_work(P), make_integrator_buffers(tab.b, 2 * n, diag.shape[1]),
+                               out, diag, math.inf, math.inf, model.translational_mask)
         assert status == -1
     linear_only()
     lin = best_of(linear_only) / n_steps

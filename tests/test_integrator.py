@@ -56,8 +56,8 @@ def run_sdof(scheme, h, t_end=2e-3):
     n_out = int(round(t_end / h)) + 1
     out = np.empty((n_out, 2))
     status = integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, 0, tab.a, tab.b, tab.c, P,
-                             make_work(P), make_integrator_buffers(tab.b, 2, 0), out,
-                             np.empty((n_out, 0)), 1.0, 1.0, np.array([True]))
+                           make_work(P), make_integrator_buffers(tab.b, 2, 0), out,
+                           np.empty((n_out, 0)), 1.0, 1.0, np.array([True]))
     assert status == -1
     t = h * np.arange(n_out)
     return t, out[:, 0]

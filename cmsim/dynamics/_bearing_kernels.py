@@ -226,7 +226,7 @@ def _defect_ball(r, b_def, ang0, pitch, n_balls, cage_angle, shaft_angle):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def faulty_bearing_forces_jit(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor,
-                           cage_slip, diag, want_diag, b_ang, b_off, b_def, gain):
+                              cage_slip, diag, want_diag, b_ang, b_off, b_def, gain):
     """Forces of the bearings with defects or off-size balls (``BI_FAULTY``).
 
     ``BI_FAULTY`` = 1 (race or ball defects only): :func:`bearing_forces_jit` has applied the
@@ -283,7 +283,7 @@ def faulty_bearing_forces_jit(t, y, n, g, omega, b_int, b_par, ball_cos, ball_si
 
 @njit(cache=True, fastmath=True, error_model="numpy", _nrt=False)
 def bearing_forces_jit(t, y, n, g, omega, b_int, b_par, ball_cos, ball_sin, anchor, cage_slip,
-                    diag, want_diag):
+                       diag, want_diag):
     """Fukata forces of all bearings with balls at offsets ``ball_cos/sin`` from the cage
     and cages shifted by the slip angles ``cage_slip`` (zeros without slip); ``t`` is the
     equivalent time τ of the nominal rotation (``KernelParams``).

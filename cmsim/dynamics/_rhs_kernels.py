@@ -258,7 +258,7 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
             g[P.m_int[MI_TDOF]] = -torque
     if P.jitter.shape[2] > 1:
         slip_offsets_jit(t, P.b_int, P.b_cos, P.b_sin, P.jitter, P.m_par[MP_JDT], W.slip_cos,
-                      W.slip_sin, W.cage_slip)
+                         W.slip_sin, W.cage_slip)
         ball_cos = W.slip_cos
         ball_sin = W.slip_sin
     else:
@@ -266,13 +266,13 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
         ball_sin = P.b_sin
     if P.b_int.shape[0] > 0:
         bearing_forces_jit(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
-                        W.cage_slip, diag, want_diag)
+                           W.cage_slip, diag, want_diag)
         if P.b_def.shape[0] > 0 or P.m_int[MI_FAULTY_BALLS] != 0:
             if P.track.shape[1] > 1:
                 track_gains_jit(P.track, P.m_par[MP_TDT], t, W.def_gain)
             faulty_bearing_forces_jit(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos,
-                                   ball_sin, W.cage, W.cage_slip, diag, want_diag, P.b_ang,
-                                   P.b_off, P.b_def, W.def_gain)
+                                      ball_sin, W.cage, W.cage_slip, diag, want_diag, P.b_ang,
+                                      P.b_off, P.b_def, W.def_gain)
     if P.m_int[MI_ON] != 0:
         mesh_forces_jit(tau, sr, y, n, g, P, W, diag, want_diag)
     linear_accel_jit(y, g, minv, P.springs, P.spring_ends, dydt, row)

@@ -180,7 +180,7 @@ class DynamicModel:
         dydt = np.empty((1, 2 * self.n_dof))
         diag = np.zeros(len(self.output_force_names))
         rhs_jit(float(t), np.ascontiguousarray(y, dtype=float), dydt, 0, self.kernel_params, diag,
-                  bool(want_diag), make_work(self.kernel_params))
+                bool(want_diag), make_work(self.kernel_params))
         return (dydt[0], diag) if want_diag else dydt[0]
 
     def static_residual(self, t, q):

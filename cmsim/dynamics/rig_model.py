@@ -124,7 +124,7 @@ def rig_model(rig):
         b_par[ib, BP_SENSE] = 1.0 if bname.startswith("1") else -1.0
         b_par[ib, BP_DAMP] = brg.damping_n_s_per_m
         b_par[ib, BP_SPIN] = (brg.pitch_diameter_m - brg.ball_diameter_m
-                                * math.cos(brg.effective_contact_angle_rad)) / brg.ball_diameter_m
+                              * math.cos(brg.effective_contact_angle_rad)) / brg.ball_diameter_m
         co, so = ball_offsets(brg)
         b_cos[ib, :brg.n_balls] = co
         b_sin[ib, :brg.n_balls] = so

@@ -72,9 +72,9 @@ class _Integrator:
         buffers = make_integrator_buffers(tab.b, y0.size, n_diag)
         # compile (or load from cache) outside the timed region, then start from fresh scratch
         integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
-                        make_work(model.kernel_params), buffers, np.empty((1, y0.size)),
-                        np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
-                        self.mask)
+                      make_work(model.kernel_params), buffers, np.empty((1, y0.size)),
+                      np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
+                      self.mask)
         self.work = make_work(model.kernel_params)
         y, m0 = y0, 0
         while m0 < n_out:
@@ -85,8 +85,8 @@ class _Integrator:
             first = m0 - 1 if m0 else 0
             start = time.perf_counter()
             status = integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
-                                     model.kernel_params, self.work, buffers, states, diag,
-                                     self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
+                                   model.kernel_params, self.work, buffers, states, diag,
+                                   self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
             self.wall += time.perf_counter() - start
             if status >= 0:
                 raise IntegrationDiverged(
@@ -256,11 +256,11 @@ def _compile_seconds():
         y0 = np.zeros(2 * model.n_dof)
         tab = SCHEMES["ode3"]
         integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
-                        make_work(model.kernel_params),
-                        make_integrator_buffers(tab.b, y0.size, len(model.output_force_names)),
-                        np.empty((2, y0.size)),
-                        np.empty((2, len(model.output_force_names))), 1.0, 1.0,
-                        model.translational_mask)
+                      make_work(model.kernel_params),
+                      make_integrator_buffers(tab.b, y0.size, len(model.output_force_names)),
+                      np.empty((2, y0.size)),
+                      np.empty((2, len(model.output_force_names))), 1.0, 1.0,
+                      model.translational_mask)
         _compile_seconds.value = time.perf_counter() - start
     return _compile_seconds.value
 
