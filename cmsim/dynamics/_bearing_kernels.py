@@ -9,14 +9,9 @@ cages' slip at time t (:func:`slip_offsets_jit`) and the share of each defect th
 are defined here. The cage angle's cos and sin come from its anchor
 (:mod:`cmsim.dynamics._rotation_kernels`).
 
-This is one of the kernel modules of :mod:`cmsim.dynamics` (rotation anchors, bearing forces,
-mesh forces, right-hand side and integrator): they share the numba convention —
-``@njit(cache=True)``, float64/int64 arrays and scalars only, no Python objects, no random
-numbers; hot-path code never slices arrays and never takes arrays out of tuples inside loops
-(numba takes an atomic reference count for each); the force and integrator kernels are compiled
-without numba's reference-counting runtime (``_nrt=False``: they allocate nothing, the caller
-passes every buffer); small kernels are inlined at numba-IR level (``inline="always"``: a call
-with array arguments costs about 25 ns).
+The numba rule of every kernel module of :mod:`cmsim.dynamics` (in full in
+:mod:`cmsim.dynamics._rhs_kernels`): ``@njit(cache=True)``, float64/int64 arrays and
+scalars only, no Python objects, no random numbers, no allocation in the hot path.
 
 References
 ----------

@@ -10,14 +10,9 @@ spacings) of :class:`~cmsim.dynamics._rhs_kernels.KernelParams`, and of the per-
 (:mod:`cmsim.dynamics._rotation_kernels`); the line of action's angle is a short ``atan``
 series about its nominal value.
 
-This is one of the kernel modules of :mod:`cmsim.dynamics` (rotation anchors, bearing forces,
-mesh forces, right-hand side and integrator): they share the numba convention —
-``@njit(cache=True)``, float64/int64 arrays and scalars only, no Python objects, no random
-numbers; hot-path code never slices arrays and never takes arrays out of tuples inside loops
-(numba takes an atomic reference count for each); the force and integrator kernels are compiled
-without numba's reference-counting runtime (``_nrt=False``: they allocate nothing, the caller
-passes every buffer); small kernels are inlined at numba-IR level (``inline="always"``: a call
-with array arguments costs about 25 ns).
+The numba rule of every kernel module of :mod:`cmsim.dynamics` (in full in
+:mod:`cmsim.dynamics._rhs_kernels`): ``@njit(cache=True)``, float64/int64 arrays and
+scalars only, no Python objects, no random numbers, no allocation in the hot path.
 
 References
 ----------
