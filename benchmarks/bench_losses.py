@@ -12,7 +12,7 @@ import json
 import time
 
 from cmsim.dynamics import simulate
-from cmsim.dynamics.model import build_model
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.losses import friction_table_for, operating_losses, power_balance
 from cmsim.rig import OperatingPoint, Rig
 
@@ -24,7 +24,7 @@ def main(argv=None):
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
     rig, op = Rig.paper_2016(), OperatingPoint(3000.0, 50.0)
-    tab = build_model(rig, op).mesh_table
+    tab = resolve_mesh(rig, None, op.torque_nm)[0]
     start = time.perf_counter()
     losses = operating_losses(rig, op, mesh_table=tab)
     mu = friction_table_for(rig, op, tab, rig.lubricant.surface_roughness_m,

@@ -55,7 +55,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # run from a chec
 import cmsim  # noqa: E402
 from cmsim.faults.crack import max_crack_depth_m  # noqa: E402
 from cmsim.mesh_stiffness import fe_mesh  # noqa: E402
-from cmsim.mesh_stiffness.fe_mesh import MeshSpec, RootCrack, gear_mesh  # noqa: E402
+from cmsim.mesh_stiffness.fe_mesh import MeshSpec, gear_mesh  # noqa: E402
+from cmsim.mesh_stiffness.root_crack import RootCrack  # noqa: E402
 from cmsim.mesh_stiffness.geometry import ToothProfile  # noqa: E402
 
 REPEATS = 3

@@ -24,10 +24,15 @@ from numba import njit
 from scipy.integrate import solve_ivp
 
 import cmsim
-from cmsim.dynamics import _kernels as K
 from cmsim.dynamics import build_model, quasi_static_state
+from cmsim.dynamics._bearing_kernels import BI_SIZE, BP_C, BP_CAGE, BP_K, BP_P, BP_PHASE, BP_SENSE
+from cmsim.dynamics._mesh_kernels import (MI_SIZE, MP_A0, MP_BETA, MP_DTHR, MP_KOSTER, MP_MU,
+                                          MP_OM1, MP_OM2, MP_PB, MP_PSI10, MP_PSI20, MP_SLO,
+                                          MP_TAB0, MP_TABD, MP_V0, MP_ZAFTER, MP_ZBEFORE)
+from cmsim.dynamics._rhs_kernels import integrate_jit, make_integrator_buffers, make_work
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.simulate import integrate
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit
 
 FS = 75_000.0
@@ -79,7 +84,7 @@ def dense_linear_ode3(y0, h, n_steps, minv, kmat, cmat, fext, out):
 
 def numpy_rhs_factory(model):
     """The same equations as the kernel, written with NumPy (what a user would write)."""
-    P = model.packed
+    P = model.kernel_params
     n = model.n_dof
     minv, fext, omega = P.minv, P.fext, P.omega
     kmat, cmat = model.stiffness, model.damping
@@ -89,34 +94,34 @@ def numpy_rhs_factory(model):
     rb1, rb2 = geo[0], geo[1]
     offsets = np.arctan2(b_sin, b_cos)
     z1, z2 = P.teeth1.shape[0], P.teeth2.shape[0]
-    s_tab = mp[K.MP_TAB0] + mp[K.MP_TABD] * np.arange(tab_k.size)
+    s_tab = mp[MP_TAB0] + mp[MP_TABD] * np.arange(tab_k.size)
 
     def rhs(t, y):
         q, v = y[:n], y[n:]
         g = fext.copy()
         # bearings, vectorised over balls
-        rate = b_par[:, K.BP_CAGE] * b_par[:, K.BP_SENSE]
-        cage = rate * (omega[b_int[:, 2]] * t + q[b_int[:, 2]]) + b_par[:, K.BP_PHASE]
+        rate = b_par[:, BP_CAGE] * b_par[:, BP_SENSE]
+        cage = rate * (omega[b_int[:, 2]] * t + q[b_int[:, 2]]) + b_par[:, BP_PHASE]
         theta = cage[:, None] + offsets
         x, yy = q[b_int[:, 0]], q[b_int[:, 1]]
-        d = x[:, None] * np.cos(theta) + yy[:, None] * np.sin(theta) - b_par[:, K.BP_C][:, None]
-        f = b_par[:, K.BP_K][:, None] * np.clip(d, 0.0, None) ** b_par[:, K.BP_P][:, None]
+        d = x[:, None] * np.cos(theta) + yy[:, None] * np.sin(theta) - b_par[:, BP_C][:, None]
+        f = b_par[:, BP_K][:, None] * np.clip(d, 0.0, None) ** b_par[:, BP_P][:, None]
         np.subtract.at(g, b_int[:, 0], np.sum(f * np.cos(theta), axis=1))
         np.subtract.at(g, b_int[:, 1], np.sum(f * np.sin(theta), axis=1))
         # mesh: exact pair geometry per potential pair
-        c1x, c1y, c2x, c2y = q[i1], q[i1 + 1], q[i2], mp[K.MP_A0] + q[i2 + 1]
+        c1x, c1y, c2x, c2y = q[i1], q[i1 + 1], q[i2], mp[MP_A0] + q[i2 + 1]
         phi_t1, length, cos_t1, sin_t1 = mesh_frame_jit.py_func(c1x, c1y, c2x, c2y, rb1, rb2)
-        psi1 = mp[K.MP_OM1] * t + q[i1 + 2] + mp[K.MP_PSI10]
-        psi2 = mp[K.MP_PSI20] - (mp[K.MP_OM2] * t + q[i2 + 2])
-        delta_inv = (rb1 * (q[i1 + 2] + mp[K.MP_PSI10] - phi_t1)
-                     + rb2 * (mp[K.MP_PSI20] - q[i2 + 2] - phi_t1 - math.pi) - length)
+        psi1 = mp[MP_OM1] * t + q[i1 + 2] + mp[MP_PSI10]
+        psi2 = mp[MP_PSI20] - (mp[MP_OM2] * t + q[i2 + 2])
+        delta_inv = (rb1 * (q[i1 + 2] + mp[MP_PSI10] - phi_t1)
+                     + rb2 * (mp[MP_PSI20] - q[i2 + 2] - phi_t1 - math.pi) - length)
         s_ref = rb1 * (psi1 - phi_t1)
-        m0 = math.floor((s_ref - mp[K.MP_SLO]) / mp[K.MP_PB])
-        w1, w2 = mp[K.MP_OM1] + v[i1 + 2], -(mp[K.MP_OM2] + v[i2 + 2])
+        m0 = math.floor((s_ref - mp[MP_SLO]) / mp[MP_PB])
+        w1, w2 = mp[MP_OM1] + v[i1 + 2], -(mp[MP_OM2] + v[i2 + 2])
         for j in range(n_slots):
             pair = m0 - j
-            s = s_ref - pair * mp[K.MP_PB]
-            if s < length - geo[3] - mp[K.MP_ZBEFORE] or s > geo[2] + mp[K.MP_ZAFTER]:
+            s = s_ref - pair * mp[MP_PB]
+            if s < length - geo[3] - mp[MP_ZBEFORE] or s > geo[2] + mp[MP_ZAFTER]:
                 continue
             p1 = psi1 - 2 * math.pi * (pair % z1) / z1
             p2 = psi2 + 2 * math.pi * (pair % z2) / z2
@@ -129,15 +134,15 @@ def numpy_rhs_factory(model):
             overlap = delta - np.interp(s, s_tab, tab_e)
             if overlap > 0:
                 k_pair = np.interp(s, s_tab, tab_k)
-                fn = max(k_pair * (overlap + mp[K.MP_BETA] * approach), 0.0)
+                fn = max(k_pair * (overlap + mp[MP_BETA] * approach), 0.0)
             elif approach > 0:
-                gap = max(-overlap, mp[K.MP_DTHR])
+                gap = max(-overlap, mp[MP_DTHR])
                 req = chi1 * chi2 / (chi1 + chi2) if chi1 > 0 and chi2 > 0 else 0.0
-                fn = mp[K.MP_KOSTER] * (req / (2 * gap)) ** 1.5 * approach
+                fn = mp[MP_KOSTER] * (req / (2 * gap)) ** 1.5 * approach
             else:
                 continue
             slide = dvx * ny - dvy * nx
-            ff = mp[K.MP_MU] * fn * slide / math.sqrt(slide ** 2 + mp[K.MP_V0] ** 2)
+            ff = mp[MP_MU] * fn * slide / math.sqrt(slide ** 2 + mp[MP_V0] ** 2)
             f2 = np.array([fn * nx + ff * ny, fn * ny - ff * nx])
             g[i2:i2 + 2] += f2
             g[i1:i1 + 2] -= f2
@@ -151,7 +156,8 @@ def numpy_rhs_factory(model):
 def main():
     rig = cmsim.Rig.paper_2016()
     op = cmsim.OperatingPoint(1000.0, 100.0)
-    model = build_model(rig, op, cage_phases_rad=[0.3, 1.1, 2.0, 4.4])
+    model = build_model(rig, op, resolve_mesh(rig, None, op.torque_nm),
+                        cage_phases_rad=[0.3, 1.1, 2.0, 4.4])
     print(f"mesh: {model.mesh_table.method} table at {model.mesh_table.torque_nm} N m")
     n = model.n_dof
     y0 = np.concatenate([quasi_static_state(model, 0.0), np.zeros(n)])
@@ -167,22 +173,22 @@ def main():
 
     # 2a. bare dense linear ode3
     out = np.empty((n_steps, 2 * n))
-    args = (model.packed.minv, model.stiffness, model.damping, model.force, out)
+    args = (model.kernel_params.minv, model.stiffness, model.damping, model.force, out)
     dense_linear_ode3(y0, h, 10, *args)
     dense = best_of(lambda: dense_linear_ode3(y0, h, n_steps, *args)) / n_steps
     print(f"per-step cost / bare dense-linear numba ode3: {ours_per_step / dense:.2f} "
           f"(baseline {dense * 1e9:.0f} ns per step)   [target <= 3]")
     # 2b. our own integrator on the linear part only (no bearings, no mesh)
-    P = model.packed._replace(b_int=np.zeros((0, K.BI_SIZE), dtype=np.int64),
-                              m_int=np.zeros(K.MI_SIZE, dtype=np.int64))
+    P = model.kernel_params._replace(b_int=np.zeros((0, BI_SIZE), dtype=np.int64),
+                              m_int=np.zeros(MI_SIZE, dtype=np.int64))
     tab = SCHEMES["ode3"]
-    diag = np.empty((n_steps, len(model.diag_names)))
+    diag = np.empty((n_steps, len(model.output_force_names)))
 
     def linear_only():
         # without the mesh, the load torque spins shaft 2 up: lift the divergence limits
-        status = K.integrate_jit(y0, 0.0, h, n_steps, 1, 0, tab.a, tab.b, tab.c, P,
-                                 K.make_work(P), K.make_integrator_buffers(tab.b, 2 * n, diag.shape[1]),
-                                 out, diag, math.inf, math.inf, model.translational_mask)
+        status = integrate_jit(y0, 0.0, h, n_steps, 1, 0, tab.a, tab.b, tab.c, P,
+                               make_work(P), make_integrator_buffers(tab.b, 2 * n, diag.shape[1]),
+                               out, diag, math.inf, math.inf, model.translational_mask)
         assert status == -1
     linear_only()
     lin = best_of(linear_only) / n_steps

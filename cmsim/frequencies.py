@@ -2,7 +2,8 @@
 
 These are rig kinematics (no signal processing): :class:`RigFrequencies` holds the shaft
 rates, the gear mesh frequency and, per bearing, a :class:`BearingFrequencies`. The cage
-formula is written once, in :func:`cmsim.bearings.kinematics.cage_speed_ratios`
+formula is written once, here, in :func:`cage_speed_ratios` (the model's ball angles in
+:mod:`cmsim.bearings.kinematics` take it from here too)
 (f_c = K_in·f_i + K_out·f_o, K_in = (1 − γ)/2, K_out = (1 + γ)/2, γ = (d/D)·cos α); with the
 inner ring rate f_i and outer ring rate f_o (Hz, signed, same sense positive):
 
@@ -17,8 +18,8 @@ With a fixed outer ring BPF = BPFO. The paper rig's ratio BPF/f_shaft = 3.6342 (
 cycles per gear turn", ref. [1] §5) needs a contact angle near 10°: the free contact angle of
 its 209 bearing (9.93°, D = 64.9985 mm) gives 3.6339, within 0.01 % (α = 0 gives 3.6207).
 
-Layering: this module imports only :mod:`cmsim.errors` and :mod:`cmsim.bearings`; the
-spectra, features and datasets layers import it.
+Layering: this module imports only :mod:`cmsim.errors` (it sits below
+:mod:`cmsim.bearings`); the bearings, faults, spectra, features and datasets layers import it.
 
 References
 ----------
@@ -35,14 +36,39 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from cmsim.bearings.kinematics import cage_speed_ratios
 from cmsim.errors import ParameterError, check_range
 
 __all__ = ["BearingFrequencies", "RigFrequencies", "bearing_frequencies", "rig_frequencies",
-           "peak_families", "FAMILY_KEYS"]
+           "peak_families", "cage_speed_ratios", "FAMILY_KEYS"]
 
 #: Keys of a families dict (see :meth:`RigFrequencies.families` and :mod:`cmsim.spectra.labels`).
 FAMILY_KEYS = ("GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF")
+
+
+def cage_speed_ratios(ball_diameter_m, pitch_diameter_m, contact_angle_rad=0.0):
+    """(K_in, K_out) = ((1 − γ)/2, (1 + γ)/2), γ = (d/D)·cos α: the one cage formula.
+
+    The cage turns at f_c = K_in·f_in + K_out·f_out (rolling without slip); every cage,
+    defect and ball-pass rate in cmsim (this module's, the model's ball angles through
+    :func:`cmsim.bearings.kinematics.cage_ratios`) derives from these two ratios.
+
+    Parameters
+    ----------
+    ball_diameter_m : float
+        Ball diameter d, m.
+    pitch_diameter_m : float
+        Pitch diameter D, m.
+    contact_angle_rad : float
+        Contact angle α, rad.
+
+    Examples
+    --------
+    >>> k_in, k_out = cage_speed_ratios(7.94e-3, 39.04e-3)      # CWRU 6205
+    >>> round(k_in, 6), round(k_out, 6)
+    (0.398309, 0.601691)
+    """
+    gamma = ball_diameter_m / pitch_diameter_m * math.cos(contact_angle_rad)
+    return 0.5 * (1.0 - gamma), 0.5 * (1.0 + gamma)
 
 
 @dataclass(frozen=True)
@@ -146,7 +172,7 @@ def bearing_frequencies(shaft_hz, n_balls, ball_diameter_m, pitch_diameter_m,
 class RigFrequencies:
     """Characteristic frequencies of a rig at one operating point, Hz.
 
-    Build it with :meth:`of` from a rig and an operating point, or directly for a measured
+    Build it with :func:`rig_frequencies` from a rig and an operating point, or directly for a measured
     record (e.g. ``RigFrequencies(fr1_hz=29.95, bearings={"DE": bearing_frequencies(...)})``).
 
     Attributes
@@ -172,47 +198,6 @@ class RigFrequencies:
             if not isinstance(bf, BearingFrequencies):
                 raise ParameterError(f"bearings[{name!r}] must be a BearingFrequencies, got "
                                      f"{type(bf).__name__}")
-
-    @classmethod
-    def of(cls, rig, op):
-        """Frequencies of ``rig`` at ``op`` (each bearing's effective contact angle and
-        ``outer_ring_speed_ratio``).
-
-        Parameters
-        ----------
-        rig : cmsim.rig.Rig
-            Gear rig or bearing rig.
-        op : cmsim.rig.OperatingPoint
-            Input shaft speed (``op.speed_rpm``).
-
-        Returns
-        -------
-        RigFrequencies
-
-        Examples
-        --------
-        >>> from cmsim.rig import Rig, OperatingPoint
-        >>> f = RigFrequencies.of(Rig.paper_2016(), OperatingPoint(speed_rpm=1000.0))
-        >>> round(f.gmf_hz, 2), round(f.bearing("1b1").bpf_hz / f.fr1_hz, 4)
-        (466.67, 3.6339)
-        """
-        f1 = float(op.shaft_hz)
-        rates = [f1]
-        f2 = gmf = None
-        if rig.has_gears:
-            z1, z2 = rig.gears.driving.n_teeth, rig.gears.driven.n_teeth
-            f2 = f1 * z1 / z2
-            gmf = z1 * f1
-            rates.append(f2)
-        shaft_of = [i for i, s in enumerate(rig.shafts) for _ in s.bearings]
-        bearings = {}
-        for name, brg, i_shaft in zip(rig.bearing_names, rig.bearings, shaft_of):
-            fs_hz = rates[i_shaft]
-            bearings[name] = bearing_frequencies(
-                fs_hz, brg.n_balls, brg.ball_diameter_m, brg.pitch_diameter_m,
-                brg.effective_contact_angle_rad,
-                outer_ring_hz=brg.outer_ring_speed_ratio * fs_hz)
-        return cls(fr1_hz=f1, fr2_hz=f2, gmf_hz=gmf, bearings=bearings)
 
     @property
     def has_gears(self):
@@ -313,7 +298,19 @@ class RigFrequencies:
 
 
 def rig_frequencies(rig, op):
-    """Characteristic frequencies of a rig at an operating point: :meth:`RigFrequencies.of`.
+    """Characteristic frequencies of ``rig`` at ``op`` (each bearing's effective contact angle
+    and ``outer_ring_speed_ratio``).
+
+    Parameters
+    ----------
+    rig : cmsim.rig.Rig
+        Gear rig or bearing rig.
+    op : cmsim.rig.OperatingPoint
+        Input shaft speed (``op.speed_rpm``).
+
+    Returns
+    -------
+    RigFrequencies
 
     Examples
     --------
@@ -322,7 +319,23 @@ def rig_frequencies(rig, op):
     >>> round(f.gmf_hz, 2), round(f.bearing("1b1").bpf_hz / f.fr1_hz, 4)
     (466.67, 3.6339)
     """
-    return RigFrequencies.of(rig, op)
+    f1 = float(op.shaft_hz)
+    rates = [f1]
+    f2 = gmf = None
+    if rig.has_gears:
+        z1, z2 = rig.gears.driving.n_teeth, rig.gears.driven.n_teeth
+        f2 = f1 * z1 / z2
+        gmf = z1 * f1
+        rates.append(f2)
+    shaft_of = [i for i, s in enumerate(rig.shafts) for _ in s.bearings]
+    bearings = {}
+    for name, brg, i_shaft in zip(rig.bearing_names, rig.bearings, shaft_of):
+        fs_hz = rates[i_shaft]
+        bearings[name] = bearing_frequencies(
+            fs_hz, brg.n_balls, brg.ball_diameter_m, brg.pitch_diameter_m,
+            brg.effective_contact_angle_rad,
+            outer_ring_hz=brg.outer_ring_speed_ratio * fs_hz)
+    return RigFrequencies(fr1_hz=f1, fr2_hz=f2, gmf_hz=gmf, bearings=bearings)
 
 
 def peak_families(freqs, bearing=None):

@@ -26,7 +26,7 @@ import cmsim
 from cmsim.dynamics import simulate
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_state
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.rig import GearPair
 
@@ -57,7 +57,7 @@ def test_the_pair_is_valid_and_unequal():
 
 
 def test_output_shaft_rate_and_gmf(run):
-    f = RigFrequencies.of(RIG, OP)
+    f = rig_frequencies(RIG, OP)
     assert f.fr1_hz == pytest.approx(20.0, rel=1e-12)
     assert f.fr2_hz == pytest.approx(20.0 * Z1 / Z2, rel=1e-12)
     assert f.gmf_hz == pytest.approx(Z1 * 20.0, rel=1e-12)
@@ -99,10 +99,11 @@ def test_mesh_force_and_coupling_torques_balance_the_load(run):
 @pytest.mark.parametrize("t", [0.0, 1.3e-4, 7e-4])
 def test_quasi_static_mesh_compression_from_the_states(t):
     k = 3e8
-    model = build_model(RIG, OP, MeshStiffnessTable.constant(PAIR, k))
+    model = build_model(RIG, OP, (MeshStiffnessTable.constant(PAIR, k), None))
     q = quasi_static_state(model, t)
     _, diag = model.rhs(t, np.concatenate([q, np.zeros(model.n_dof)]), want_diag=True)
-    forces = np.array([d for d, name in zip(diag, model.diag_names) if name.startswith("Fmesh")])
+    forces = np.array([d for d, name in zip(diag, model.output_force_names)
+                       if name.startswith("Fmesh")])
     assert forces.sum() == pytest.approx(TORQUE / PAIR.driven.base_radius_m, rel=1e-6)
     alpha = PAIR.working_pressure_angle_rad
     n = np.array([-math.cos(alpha), math.sin(alpha)])        # force of gear 1 on gear 2

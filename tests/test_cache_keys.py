@@ -7,7 +7,7 @@ seed or length silently mixes records. Checked:
 * the FE influence-coefficient cache key (read from :func:`influence_table` without building
   anything) changes with every :class:`~cmsim.rig.SpurGear` field except the lumped mass and
   inertia, and with the FE settings; it does not change when nothing changes;
-* the hybrid-table key :func:`~cmsim.dynamics.mesh_choice.tables_key` changes with each gear
+* the hybrid-table key :func:`~cmsim.dynamics.tooth_contact.tables_key` changes with each gear
   (either one), bearing, shaft, coupling and friction parameter;
 * a resumed sweep recomputes a run file swapped for a valid file of the same case name from
   another seed or another duration.
@@ -20,7 +20,7 @@ import shutil
 import pytest
 
 from cmsim.datasets import RECORDS_DIR, DatasetSpec, generate_dataset
-from cmsim.dynamics.mesh_choice import tables_key
+from cmsim.dynamics.tooth_contact import tables_key
 from cmsim.mesh_stiffness import cache
 from cmsim.mesh_stiffness.influence import influence_table
 from cmsim.rig import Coupling, Rig, SpurGear

@@ -24,7 +24,7 @@ from cmsim.cli import main
 from cmsim.diagnostics import BASELINES, data_root, evaluate, load_measured
 from cmsim.dynamics import simulate
 from cmsim.faults import parse_fault
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
 from cmsim.sensors import add_sensors
 
@@ -57,7 +57,7 @@ def _records(rig, cases, *, duration_s, fs_hz, sensor_fs_hz, noise, channels):
         out.append(SimpleNamespace(
             record_id=f"r{i:02d}_{label}", fs_hz=run.fs_hz, operating_point=op,
             signals={k: np.asarray(run[k], dtype=np.float32) for k in channels},
-            frequencies=RigFrequencies.of(rig, op),
+            frequencies=rig_frequencies(rig, op),
             labels={"fault_label": label, "fault_severity": severity}))
     return out
 

@@ -12,6 +12,7 @@ import pytest
 import cmsim
 from cmsim.dynamics import simulate
 from cmsim.errors import IntegrationDiverged, ParameterError
+from cmsim.faults import RollingSlip
 from cmsim.spectra import amplitude_spectrum, label_peaks, peak_families, rig_frequencies
 
 RIG = cmsim.Rig.paper_2016()
@@ -134,7 +135,7 @@ def test_slip_spreads_the_ball_pass_line(runs, bpf):
     """Paper §6.2.1: slip makes the cage frequency fluctuate and spreads the BPF energy over
     its neighbourhood, while the GMF lines stay sharp. (The BPF *peak* height is not a
     measure: the four bearings' ball-pass excitations interfere in each force.)"""
-    slip = cmsim.dynamics.SlipModel(cage_speed_rms=0.05, correlation_s=0.02)
+    slip = RollingSlip(cage_speed_rms=0.05, correlation_s=0.02)
     slipping = simulate(RIG, _op(10), 1.0, seed=SEED, slip=slip)
     for name in ("dte", "F_1b1_loa"):
         assert _line_concentration(runs["10"], name, bpf) > 0.95

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from cmsim.dynamics import _kernels as K
+from cmsim.dynamics._bearing_kernels import BI_FAULTY
 from cmsim.dynamics.model import build_model
 from cmsim.faults import BallDefect, InnerRaceDefect, OffSizeBall, OuterRaceDefect
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
@@ -45,9 +45,9 @@ def test_defect_correction_equals_ball_by_ball(case):
     bearings = sorted({f.bearing for f in faults})
     exact = build_model(rig, op, seed=1, faults=faults + tuple(
         OffSizeBall(b, diameter_excess_m=1e-30) for b in bearings))
-    modes = [int(fast.packed.b_int[i, K.BI_FAULTY]) for i in range(len(rig.bearings))]
+    modes = [int(fast.kernel_params.b_int[i, BI_FAULTY]) for i in range(len(rig.bearings))]
     assert modes[rig.bearing_names.index("1b1")] == 1
-    assert all(int(exact.packed.b_int[rig.bearing_names.index(b), K.BI_FAULTY]) == 2
+    assert all(int(exact.kernel_params.b_int[rig.bearing_names.index(b), BI_FAULTY]) == 2
                for b in bearings)
     rng = np.random.default_rng(4)
     n = fast.n_dof

@@ -13,12 +13,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from cmsim.dynamics.model import build_model
 from cmsim.errors import ParameterError
-from cmsim.faults import (FAULT_TYPES, BallDefect, OuterRaceDefect, ToothCrack,
+from cmsim.faults import (FAULT_TYPES, BallDefect, OuterRaceDefect, RollingSlip, ToothCrack,
                           compile_faults, fault_frequencies, fault_from_dict, load_faults,
                           operating_modulation, parse_fault, rig_with_faults, slip_from_faults)
-from cmsim.faults.bearing import ball_drop_m, defect_profile, track_share, wandering_offset
-from cmsim.faults.compile import DEFECT_COLUMNS
+from cmsim.faults.bearing import (BearingWear, ball_drop_m, defect_profile, track_share,
+                                  wandering_offset)
+from cmsim.faults.compile import DEFECT_COLUMNS, check_faults
 from cmsim.faults.gear import BREAKAGE_SEPARATION_M, roll_length_m
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
@@ -244,8 +246,8 @@ def test_off_size_ball_and_wear(rig):
 
 def test_slip_and_modulation(rig):
     fs = [parse_fault(t) for t in ALL]
-    assert slip_from_faults(fs) == {"cage_speed_rms": 0.01, "ball_rms_rad": 0.0,
-                                    "correlation_s": 5e-3}
+    assert slip_from_faults(fs) == RollingSlip(cage_speed_rms=0.01, ball_rms_rad=0.0,
+                                               correlation_s=5e-3)
     assert slip_from_faults(fs[:3]) is None
     op = OperatingPoint(speed_rpm=1200.0, torque_nm=20.0)
     speed, torque = operating_modulation(fs, op, rig)
@@ -344,3 +346,26 @@ def test_ball_defect_on_the_track_keeps_its_full_depth(cwru, size_m, load_n):
     row = BallDefect("1b1", size_m, 2e-4).defect_row(cwru, load_n)
     cols = dict(zip(DEFECT_COLUMNS, row))
     assert track_share(0.0, cols["track_rad"], cols["half_width_rad"]) == 1.0
+
+
+def test_faults_are_validated_once_against_the_rig_as_given(rig, table, monkeypatch):
+    """check_faults returns a tuple that remembers the rig it was checked on: what reads it
+    later for that rig (wear, kernel arrays, answer key) does not validate it again. Wear is
+    checked on the rig as given; applied first, a growth above half its allowed margin was
+    refused (the worn rig's own margin is smaller)."""
+    brg = rig.bearings[0]
+    margin = 0.05 * brg.ball_diameter_m - brg.clearance_m
+    faults = (OuterRaceDefect("1b1", 1e-3, 5e-5), BearingWear("1b1", 0.8 * margin))
+    checked = check_faults(rig, faults)
+    assert checked == faults and check_faults(rig, checked) is checked
+    op = OperatingPoint(speed_rpm=1000.0, torque_nm=10.0)
+    model = build_model(rig, op, (table, None), faults=checked)
+    assert model.rig.bearings[0].clearance_m == pytest.approx(brg.clearance_m + 0.8 * margin)
+    calls = []
+    monkeypatch.setattr(BearingWear, "validate", lambda self, r: calls.append(r) or self)
+    worn = rig_with_faults(rig, checked)
+    compile_faults(rig, checked, table, op=op)
+    fault_frequencies(rig, op, checked)
+    assert calls == []
+    check_faults(worn, checked)                   # another rig: validated again
+    assert calls == [worn]

@@ -77,10 +77,10 @@ def test_weakest_near_the_tip(pair):
 
 
 def test_fe_crack_has_the_pe_geometry(pair):
-    """The FE crack (mesh_stiffness.fe_mesh.RootCrack) starts where the PE crack starts and
+    """The FE crack (mesh_stiffness.root_crack.RootCrack) starts where the PE crack starts and
     its tip sits at the PE tip offset h_q = h_c - q sin(nu) from the centreline."""
     from cmsim.faults.crack import crack_tip_offset_m
-    from cmsim.mesh_stiffness.fe_mesh import RootCrack
+    from cmsim.mesh_stiffness.root_crack import RootCrack
 
     prof = ToothProfile.from_gear(pair.driving, n_points=800)     # the FE mesh's sampling
     q = 0.6 * max_crack_depth_m(pair.driving, NU)

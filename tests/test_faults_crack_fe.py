@@ -23,7 +23,7 @@ import pytest
 from cmsim.errors import ParameterError
 from cmsim.faults.crack import (crack_stiffness_factor, fe_pair_compliance,
                                 max_crack_depth_m, mesh_stiffness_loss)
-from cmsim.mesh_stiffness.fe_mesh import RootCrack
+from cmsim.mesh_stiffness.root_crack import RootCrack
 from cmsim.mesh_stiffness.fe_model import GearBodyModel
 from cmsim.mesh_stiffness.influence import flank_points, influence_table, roll_range_m
 from cmsim.mesh_stiffness.potential_energy import _involute_domain

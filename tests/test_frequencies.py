@@ -86,7 +86,7 @@ def test_rig_frequencies_follow_gear_ratio_and_outer_ring_speed():
     sh2 = rig.shafts[1]
     sh2 = replace(sh2, bearing_1=replace(sh2.bearing_1, outer_ring_speed_ratio=-1.0))
     rig2 = replace(rig, gears=replace(rig.gears, driven=wheel), shafts=(rig.shafts[0], sh2))
-    f = RigFrequencies.of(rig2, OperatingPoint(speed_rpm=1200.0))
+    f = rig_frequencies(rig2, OperatingPoint(speed_rpm=1200.0))
     assert f.fr2_hz == pytest.approx(20.0 * 28 / 42)
     assert f.gmf_hz == pytest.approx(28 * 20.0)
     assert f.bearing("2b2").shaft_hz == pytest.approx(20.0 * 28 / 42)

@@ -86,7 +86,7 @@ def test_bearing_frequencies_mapping_access():
 
 def test_rig_frequencies_mapping_and_round_trip():
     rig = Rig.paper_2016()
-    f = RigFrequencies.of(rig, OperatingPoint(1200.0))
+    f = rig_frequencies(rig, OperatingPoint(1200.0))
     d = f.to_dict()
     assert list(d) == ["shaft_hz", "output_shaft_hz", "gmf_hz", *rig.bearing_names]
     assert d["shaft_hz"] == pytest.approx(20.0) and d["gmf_hz"] == pytest.approx(560.0)
@@ -134,7 +134,7 @@ def test_bearing_rig_and_slow_shafts():
     brg = Rig.paper_2016().bearings[0]
     from cmsim.rig import Rotor
     rig = Rig.rotor_on_bearings(brg, Rotor(mass_kg=5.0, inertia_kg_m2=0.01))
-    f = RigFrequencies.of(rig, OperatingPoint(30.0))
+    f = rig_frequencies(rig, OperatingPoint(30.0))
     assert f.fr2_hz is None and f.gmf_hz is None and not f.has_gears
     assert f.fr1_hz == pytest.approx(0.5, rel=1e-12)
     fam = f.families()

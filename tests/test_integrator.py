@@ -15,25 +15,29 @@ from scipy.optimize import brentq
 
 import cmsim
 from cmsim.bearings import bearing_contact_stiffness, bearing_strain_energy
-from cmsim.dynamics import _kernels as K
 from cmsim.dynamics import build_model, quasi_static_state
+from cmsim.dynamics._bearing_kernels import BI_SIZE, BP_CAGE, BP_PHASE, BP_SENSE, BP_SIZE, DF_SIZE
+from cmsim.dynamics._mesh_kernels import MI_SIZE, MP_SIZE, no_hybrid
+from cmsim.dynamics._rhs_kernels import (KernelParams, integrate_jit, make_integrator_buffers,
+                                         make_work, no_profile)
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.simulate import integrate
+from cmsim.dynamics.simulate import check_memory, integrate
+from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
 M, KS, C, F0, X0 = 2.0, 8.0e6, 40.0, 300.0, 1e-4
 
 
 def sdof_packed():
-    """Kernel arrays of m x'' + c x' + k x = F0 (layout documented in dynamics._kernels)."""
-    return K.KernelParams(np.array([1.0 / M]), np.array([[KS, C]]), np.array([F0]), np.zeros(1),
-            np.zeros((0, K.BI_SIZE), dtype=np.int64), np.zeros((0, K.BP_SIZE)),
+    """Kernel arrays of m x'' + c x' + k x = F0 (layout documented in dynamics._rhs_kernels)."""
+    return KernelParams(np.array([1.0 / M]), np.array([[KS, C]]), np.array([F0]), np.zeros(1),
+            np.zeros((0, BI_SIZE), dtype=np.int64), np.zeros((0, BP_SIZE)),
             np.zeros((0, 1)), np.zeros((0, 1)), np.zeros((0, 1, 1)),
-            np.zeros(K.MI_SIZE, dtype=np.int64), np.zeros(K.MP_SIZE), np.zeros(14),
+            np.zeros(MI_SIZE, dtype=np.int64), np.zeros(MP_SIZE), np.zeros(14),
             np.zeros(2), np.zeros(2), np.zeros((1, 2)), np.zeros((1, 2)),
-            np.array([[0, 0, 1]], dtype=np.int64), *K.no_hybrid(), np.zeros((0, K.DF_SIZE)),
+            np.array([[0, 0, 1]], dtype=np.int64), *no_hybrid(), np.zeros((0, DF_SIZE)),
             np.zeros((0, 1)), np.zeros((0, 1)), np.ones((1, 1)), np.ones((1, 1)),
-            np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 3)), K.no_profile(),
+            np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 3)), no_profile(),
             np.zeros(1), np.zeros(1), np.ones((0, 1)))
 
 
@@ -51,9 +55,9 @@ def run_sdof(scheme, h, t_end=2e-3):
     P = sdof_packed()
     n_out = int(round(t_end / h)) + 1
     out = np.empty((n_out, 2))
-    status = K.integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, 0, tab.a, tab.b, tab.c, P,
-                             K.make_work(P), K.make_integrator_buffers(tab.b, 2, 0), out,
-                             np.empty((n_out, 0)), 1.0, 1.0, np.array([True]))
+    status = integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, 0, tab.a, tab.b, tab.c, P,
+                           make_work(P), make_integrator_buffers(tab.b, 2, 0), out,
+                           np.empty((n_out, 0)), 1.0, 1.0, np.array([True]))
     assert status == -1
     t = h * np.arange(n_out)
     return t, out[:, 0]
@@ -97,10 +101,10 @@ def _energy(model, states, t):
     load = -q @ model.force
     balls = 0.0
     for ib, brg in enumerate(model.rig.bearings):
-        ix, iy, it = (int(v) for v in model.packed.b_int[ib, :3])
-        b_par = model.packed.b_par
-        cage = (b_par[ib, K.BP_CAGE] * b_par[ib, K.BP_SENSE] * (model.omega[it] * t + q[:, it])
-                + b_par[ib, K.BP_PHASE])
+        ix, iy, it = (int(v) for v in model.kernel_params.b_int[ib, :3])
+        b_par = model.kernel_params.b_par
+        cage = (b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE] * (model.omega[it] * t + q[:, it])
+                + b_par[ib, BP_PHASE])
         balls = balls + bearing_strain_energy(brg, q[:, ix], q[:, iy], cage)
     return kinetic + springs + load + balls
 
@@ -138,7 +142,7 @@ def test_rigid_mesh_static_transmission_error():
     k_pair = 2.0e8
     for torque in (10.0, 100.0):
         op = cmsim.OperatingPoint(1000.0, torque)
-        model = build_model(rig, op, MeshStiffnessTable.constant(rig.gears, k_pair))
+        model = build_model(rig, op, (MeshStiffnessTable.constant(rig.gears, k_pair), None))
         q = quasi_static_state(model, 0.0)
         rb = rig.gears.driving.base_radius_m
         dte = q[model.index("theta_1G1")] - q[model.index("theta_2G1")]
@@ -183,3 +187,12 @@ def test_mean_bearing_reactions_balance_mesh_force():
         oloa = run[f"F_{shaft}b1_oloa"].mean() + run[f"F_{shaft}b2_oloa"].mean()
         assert loa == pytest.approx(mesh, rel=0.01)
         assert abs(oloa) < 0.01 * mesh
+
+
+def test_check_memory_refuses_a_run_that_does_not_fit():
+    """A run whose outputs exceed MAX_OUTPUT_BYTES is refused before any work, naming the
+    duration that fits; the paper's 75 kHz second fits."""
+    rig = cmsim.Rig.paper_2016()
+    check_memory(1.0, 75_000.0, rig)
+    with pytest.raises(ParameterError, match=r"duration_s = 600 s .* duration_s <= \d+ s"):
+        check_memory(600.0, 1e7, rig)

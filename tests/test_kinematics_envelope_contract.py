@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from cmsim.bearings.kinematics import (ball_angles, ball_pass_cycles_per_rev, cage_angle,
-                                       cage_speed_ratios, slip_jitter)
+                                       slip_jitter)
 from cmsim.errors import ParameterError
+from cmsim.frequencies import cage_speed_ratios
 from cmsim.rig import Rig
 from cmsim.spectra.envelope import bandpass, envelope, envelope_spectrum
 

@@ -60,13 +60,9 @@ LAZY_UNITS = {"cli"}
 #: Known exceptions to the layer and local-import rules, "module -> imported module", each
 #: with its reason (their edges are also left out of the cycle check). Shrink to empty.
 #: (Done: mesh_stiffness/torque_tables.py, which imported dynamics and spectra, moved to
-#: cmsim/dynamics/torque_tables.py; cmsim/dynamics lost its function-local imports.)
-KNOWN_EXCEPTIONS = {
-    # In progress (frequencies/features agent): RigFrequencies takes the cage formula from
-    # bearings.kinematics, but DESIGN.md puts frequencies below bearings. The formula should
-    # live in cmsim/frequencies.py (or rig.py), with bearings/kinematics.py importing it.
-    "cmsim.frequencies -> cmsim.bearings.kinematics",
-}
+#: cmsim/dynamics/torque_tables.py; cmsim/dynamics lost its function-local imports; the one
+#: cage formula moved from bearings.kinematics into cmsim/frequencies.py, below bearings.)
+KNOWN_EXCEPTIONS = set()
 
 
 def module_name(path):

@@ -11,12 +11,14 @@ import pytest
 import cmsim
 from cmsim.dynamics import build_model, simulate
 from cmsim.dynamics.quasistatic import initial_state
+from cmsim.dynamics.tooth_contact import resolve_mesh
 
 RIG = cmsim.Rig.paper_2016()
 
 
 def test_no_load_starts_from_nominal_geometry():
-    model = build_model(RIG, cmsim.OperatingPoint(1000.0), "potential-energy")
+    model = build_model(RIG, cmsim.OperatingPoint(1000.0),
+                        resolve_mesh(RIG, "potential-energy", 0.0))
     q, method = initial_state(model)
     assert method == "nominal geometry"
     assert np.all(q == 0.0)

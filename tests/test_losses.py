@@ -214,11 +214,12 @@ def test_mixed_lubrication_mesh_drives_the_dynamics():
     pair damping along the path: rougher surfaces give a softer, less damped mesh, and the
     run's GMF response changes accordingly."""
     import cmsim
-    from cmsim.dynamics import build_model, simulate
+    from cmsim.dynamics import simulate
+    from cmsim.dynamics.tooth_contact import resolve_mesh
     from cmsim.losses.contact_mixed import mixed_lubrication_mesh
     rig = cmsim.Rig.paper_2016()
     op = cmsim.OperatingPoint(500.0, 50.0)
-    dry = build_model(rig, op).mesh_table
+    dry = resolve_mesh(rig, None, op.torque_nm)[0]
     smooth, c_smooth = mixed_lubrication_mesh(rig, op, dry, 0.356e-6)
     rough, c_rough = mixed_lubrication_mesh(rig, op, dry, 0.929e-6)
     loaded = c_smooth != c_rough

@@ -10,7 +10,7 @@ import pytest
 
 from cmsim.dynamics import simulate
 from cmsim.errors import ParameterError
-from cmsim.dynamics.model import build_model
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.losses import friction_table_for, operating_losses, power_balance
 from cmsim.rig import OperatingPoint, Rig
 
@@ -19,7 +19,7 @@ from cmsim.rig import OperatingPoint, Rig
 def setup():
     rig = Rig.paper_2016()
     op = OperatingPoint(3000.0, 50.0)
-    tab = build_model(rig, op).mesh_table
+    tab = resolve_mesh(rig, None, op.torque_nm)[0]
     losses = operating_losses(rig, op, mesh_table=tab)
     mu = friction_table_for(rig, op, tab, rig.lubricant.surface_roughness_m,
                             rig.lubricant.dynamic_viscosity_pa_s)

@@ -17,9 +17,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cmsim.dynamics import mesh_choice
-from cmsim.dynamics.mesh_choice import (MESH_CHOICES, TORQUE_GRID_NM, hybrid_table_set,
-                                        resolve_mesh, tables_key)
+from cmsim.dynamics import tooth_contact
+from cmsim.dynamics.tooth_contact import (MESH_CHOICES, TORQUE_GRID_NM, hybrid_table_set,
+                                          resolve_mesh, tables_key)
 from cmsim.dynamics.torque_tables import torque_tables
 from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness import influence
@@ -38,8 +38,8 @@ def _no_fe(*args, **kwargs):
 @pytest.fixture
 def fresh(monkeypatch, tmp_path):
     """Empty in-memory memo and an empty on-disk cache."""
-    monkeypatch.setattr(mesh_choice, "_SETS", {})
-    monkeypatch.setattr(mesh_choice, "_ABOVE", {})
+    monkeypatch.setattr(tooth_contact, "_SETS", {})
+    monkeypatch.setattr(tooth_contact, "_ABOVE", {})
     monkeypatch.setenv("CMSIM_CACHE_DIR", str(tmp_path / "cache"))
     return tmp_path / "cache"
 
@@ -63,9 +63,9 @@ def test_built_tables_mean_stiffness_is_the_mesh_cycle_figure():
 
 
 def test_shipped_tables_match_the_paper_rig_and_their_mesh_cycle():
-    tables = mesh_choice._shipped_set(tables_key(RIG))
+    tables = tooth_contact._shipped_set(tables_key(RIG))
     assert tables is not None, ("the shipped tables do not match Rig.paper_2016(): rebuild "
-                                "them with python -m cmsim.dynamics.mesh_choice")
+                                "them with python -m cmsim.dynamics.tooth_contact")
     assert np.allclose(tables.torques_nm, TORQUE_GRID_NM, rtol=0, atol=1e-12)
     rows = {row["torque_nm"]: row for row in tables.summary}
     for q in (10.0, 50.0, 100.0):
@@ -77,7 +77,7 @@ def test_shipped_tables_match_the_paper_rig_and_their_mesh_cycle():
 
 
 def test_default_mesh_on_the_paper_rig_needs_no_fe_build(fresh, no_fe, monkeypatch):
-    monkeypatch.setattr(mesh_choice.table_builder, "torque_tables", _no_fe)
+    monkeypatch.setattr(tooth_contact.table_builder, "torque_tables", _no_fe)
     table, model = resolve_mesh(RIG, None, 100.0)
     assert model is None and table.method == "hybrid" and table.torque_nm == 100.0
     same, _ = resolve_mesh(RIG, "hybrid-tables", 100.0)
@@ -104,7 +104,7 @@ def test_other_rigs_build_the_table_their_torque_needs_once(fresh, monkeypatch):
         RIG.mesh_contact, friction_coefficient=0.03))) == tables_key(RIG)
     rig = RIG.with_clearance(5e-6)
     assert tables_key(rig) != tables_key(RIG)
-    shipped = mesh_choice._shipped_set(tables_key(RIG))
+    shipped = tooth_contact._shipped_set(tables_key(RIG))
     calls = []
 
     def fake_builder(rig_, torques, **kwargs):
@@ -115,13 +115,13 @@ def test_other_rigs_build_the_table_their_torque_needs_once(fresh, monkeypatch):
             return MeshTableSet((replace(shipped.tables[-1], torque_nm=torques[0]),))
         return MeshTableSet(shipped.tables, shipped.summary, {"method": "hybrid"})
 
-    monkeypatch.setattr(mesh_choice.table_builder, "torque_tables", fake_builder)
+    monkeypatch.setattr(tooth_contact.table_builder, "torque_tables", fake_builder)
     monkeypatch.setattr(HybridMeshModel, "from_pair", classmethod(lambda cls, pair: None))
     seen = []
     table, _ = resolve_mesh(rig, None, 50.0, progress=lambda i, n, row: seen.append(i))
     assert calls == [[50.0]] and seen and table.torque_nm == 50.0
     assert any(fresh.glob("hybrid-table-*.npz"))
-    monkeypatch.setattr(mesh_choice, "_ABOVE", {})
+    monkeypatch.setattr(tooth_contact, "_ABOVE", {})
     again, _ = resolve_mesh(rig, None, 50.0, progress=False)
     assert len(calls) == 1                                  # from the disk cache
     assert np.array_equal(again.stiffness_n_per_m, table.stiffness_n_per_m)
@@ -132,7 +132,7 @@ def test_other_rigs_build_the_table_their_torque_needs_once(fresh, monkeypatch):
     # a whole set, built and cached, then serves the grid's torques without new builds
     hybrid_table_set(rig, progress=False)
     assert calls[-1] == list(TORQUE_GRID_NM)
-    monkeypatch.setattr(mesh_choice, "_SETS", {})
+    monkeypatch.setattr(tooth_contact, "_SETS", {})
     n = len(calls)
     resolve_mesh(rig, None, 77.0, progress=False)
     assert len(calls) == n

@@ -24,6 +24,7 @@ import pytest
 
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_state
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.dynamics.torque_tables import torque_tables
 from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness.contact import active_path_m
@@ -60,12 +61,13 @@ def test_online_forces_equal_independent_hybrid_solve(rig, mesh_model, t):
     # no mesh damping: a corner contact has a normal approach velocity even in the nominal
     # motion, and the hysteretic term would add to the elastic force compared here
     undamped = replace(rig, mesh_contact=replace(rig.mesh_contact, damping_ratio=0.0))
-    model = build_model(undamped, op, mesh_model)
+    model = build_model(undamped, op, resolve_mesh(undamped, mesh_model, op.torque_nm))
     q = quasi_static_state(model, t)
     # nominal rotation at rest relative to it: velocities of the nominal motion only
     _, diag = model.rhs(t, np.concatenate([q, np.zeros(model.n_dof)]), want_diag=True)
-    pair_forces = np.array([diag[model.diag_names.index(f"Fmesh_{j}")]
-                            for j in range(sum(d.startswith("Fmesh") for d in model.diag_names))])
+    pair_forces = np.array([diag[model.output_force_names.index(f"Fmesh_{j}")]
+                            for j in range(sum(d.startswith("Fmesh")
+                                               for d in model.output_force_names))])
     ix1, ix2 = model.index("x_1G1"), model.index("x_2G1")
     th1 = model.omega[ix1 + 2] * t + q[ix1 + 2]
     th2 = model.omega[ix2 + 2] * t + q[ix2 + 2]
@@ -87,12 +89,13 @@ def test_table_forces_equal_online_forces_at_a_corner_contact(rig, mesh_model, t
     # (s = 6.98 and 7.37 mm, involute path from 7.70 mm) and carries 190 and 760 N
     op = OperatingPoint(1000.0, 100.0)
     undamped = replace(rig, mesh_contact=replace(rig.mesh_contact, damping_ratio=0.0))
-    model_a = build_model(undamped, op, mesh_model)
-    model_b = build_model(undamped, op, tables.at(100.0))
+    model_a = build_model(undamped, op, resolve_mesh(undamped, mesh_model, op.torque_nm))
+    model_b = build_model(undamped, op, (tables.at(100.0), None))
     t = phase / (24.0 * 1000.0 / 60.0 * rig.gears.driving.n_teeth)
     y = np.concatenate([quasi_static_state(model_a, t), np.zeros(model_a.n_dof)])
-    names = [n for n in model_a.diag_names if n.startswith("Fmesh")]
-    fa, fb = (np.array([m.rhs(t, y, want_diag=True)[1][m.diag_names.index(n)] for n in names])
+    names = [n for n in model_a.output_force_names if n.startswith("Fmesh")]
+    fa, fb = (np.array([m.rhs(t, y, want_diag=True)[1][m.output_force_names.index(n)]
+                        for n in names])
               for m in (model_a, model_b))
     ix1, ix2 = model_a.index("x_1G1"), model_a.index("x_2G1")
     c = slot_contacts(rig.gears, model_a.omega[ix1 + 2] * t + y[ix1 + 2],
@@ -108,12 +111,30 @@ def test_mesh_model_must_match_the_rig(rig, mesh_model):
     rotor_rig = Rig.rotor_on_bearings(rig.shafts[0].bearing_1,
                                       Rotor(mass_kg=4.0, inertia_kg_m2=0.01))
     with pytest.raises(ParameterError, match="without gears"):
-        build_model(rotor_rig, OperatingPoint(1000.0, 0.0, radial_load_n=100.0), mesh_model)
+        resolve_mesh(rotor_rig, mesh_model, 0.0)
     wider = replace(rig, gears=replace(rig.gears, centre_distance_m=0.0891))
     with pytest.raises(ParameterError, match="different gear pair"):
-        build_model(wider, OperatingPoint(1000.0, 10.0), mesh_model)
+        resolve_mesh(wider, mesh_model, 10.0)
     with pytest.raises(ParameterError, match="HybridMeshModel"):
-        build_model(rig, OperatingPoint(1000.0, 10.0), "no-such-mesh")
+        resolve_mesh(rig, "no-such-mesh", 10.0)
+
+
+def test_build_model_takes_a_resolved_mesh(rig, mesh_model):
+    """build_model takes the (table, on-line model) pair of resolve_mesh and checks it."""
+    op = OperatingPoint(1000.0, 10.0)
+    table = resolve_mesh(rig, "potential-energy", 10.0)[0]
+    with pytest.raises(ParameterError, match="resolve_mesh"):
+        build_model(rig, op, "potential-energy")
+    with pytest.raises(ParameterError, match="MeshStiffnessTable"):
+        build_model(rig, op)
+    rotor_rig = Rig.rotor_on_bearings(rig.shafts[0].bearing_1,
+                                      Rotor(mass_kg=4.0, inertia_kg_m2=0.01))
+    with pytest.raises(ParameterError, match="without gears"):
+        build_model(rotor_rig, OperatingPoint(1000.0, 0.0, radial_load_n=100.0), (table, None))
+    wider = replace(rig, gears=replace(rig.gears, centre_distance_m=0.0891))
+    with pytest.raises(ParameterError, match="different gear pair"):
+        build_model(wider, op, (table, mesh_model))
+    assert build_model(rig, op, (table, None)).mesh_table is table
 
 
 def test_torque_tables_follow_the_paper(tables):

@@ -102,5 +102,5 @@ def test_dynamics_kernel_uses_the_roller_law(brg, k):
     _, diag = model.rhs(0.0, np.concatenate([q, np.zeros(model.n_dof)]), want_diag=True)
     for (name, (x, y)), phase, b in zip(offsets.items(), phases, rig.bearings):
         want = _hand_force(b, k, x, y, phase)
-        got = [diag[model.diag_names.index(f"F_{name}_{d}")] for d in "xy"]
+        got = [diag[model.output_force_names.index(f"F_{name}_{d}")] for d in "xy"]
         np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-6 * np.linalg.norm(want))

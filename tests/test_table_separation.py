@@ -36,7 +36,7 @@ def _static_dte_um(rig, separation_m, t):
     table = MeshStiffnessTable.constant(rig.gears, K_PAIR)
     table = dataclasses.replace(table, separation_m=np.full_like(table.separation_m,
                                                                  separation_m))
-    model = build_model(rig, OP, table)
+    model = build_model(rig, OP, (table, None))
     q = quasi_static_state(model, t)
     z1, z2 = rig.gears.driving.n_teeth, rig.gears.driven.n_teeth
     dte = q[model.index("theta_1G1")] - z2 / z1 * q[model.index("theta_2G1")]

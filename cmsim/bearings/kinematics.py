@@ -17,38 +17,15 @@ import math
 import numpy as np
 from scipy.signal import lfilter
 
-__all__ = ["cage_speed_ratios", "cage_ratios", "cage_angle", "ball_angles", "ball_pass_cycles_per_rev",
+from cmsim.frequencies import cage_speed_ratios
+
+__all__ = ["cage_ratios", "cage_angle", "ball_angles", "ball_pass_cycles_per_rev",
            "slip_jitter"]
 
 
-def cage_speed_ratios(ball_diameter_m, pitch_diameter_m, contact_angle_rad=0.0):
-    """(K_in, K_out) = ((1 − γ)/2, (1 + γ)/2), γ = (d/D)·cos α: the one cage formula.
-
-    The cage turns at f_c = K_in·f_in + K_out·f_out (rolling without slip); every cage,
-    defect and ball-pass rate in cmsim (:mod:`cmsim.frequencies`, the model's ball angles)
-    derives from these two ratios.
-
-    Parameters
-    ----------
-    ball_diameter_m : float
-        Ball diameter d, m.
-    pitch_diameter_m : float
-        Pitch diameter D, m.
-    contact_angle_rad : float
-        Contact angle α, rad.
-
-    Examples
-    --------
-    >>> k_in, k_out = cage_speed_ratios(7.94e-3, 39.04e-3)      # CWRU 6205
-    >>> round(k_in, 6), round(k_out, 6)
-    (0.398309, 0.601691)
-    """
-    gamma = ball_diameter_m / pitch_diameter_m * math.cos(contact_angle_rad)
-    return 0.5 * (1.0 - gamma), 0.5 * (1.0 + gamma)
-
-
 def cage_ratios(bearing):
-    """(K_in, K_out) with θ_cage = K_in·θ_in + K_out·θ_out (:func:`cage_speed_ratios`).
+    """(K_in, K_out) with θ_cage = K_in·θ_in + K_out·θ_out
+    (:func:`cmsim.frequencies.cage_speed_ratios`, the one cage formula).
 
     Examples
     --------

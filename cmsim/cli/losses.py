@@ -42,7 +42,7 @@ def register(sub):
 
 def run(args):
     """The loss breakdown (and its figure against speed)."""
-    from cmsim.dynamics.mesh_choice import resolve_mesh
+    from cmsim.dynamics.tooth_contact import resolve_mesh
     from cmsim.losses import LossSettings, operating_losses
 
     rig = load_rig(args)

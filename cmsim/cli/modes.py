@@ -26,7 +26,7 @@ def register(sub):
 
 def run(args):
     """Modal analysis at the operating point."""
-    from cmsim.dynamics.mesh_choice import resolve_mesh
+    from cmsim.dynamics.tooth_contact import resolve_mesh
     from cmsim.dynamics.modal import modal_analysis
 
     rig = load_rig(args)

@@ -152,7 +152,7 @@ def prepare_tables(args, rig, mesh):
     with a progress bar on stderr unless ``args.json``, before a run or the workers of a
     sweep read them from the cache."""
     if mesh == "hybrid-tables" and rig.gears is not None:
-        from cmsim.dynamics.mesh_choice import hybrid_table_set
+        from cmsim.dynamics.tooth_contact import hybrid_table_set
         hybrid_table_set(rig, progress=False if args.json else None)
 
 

@@ -75,7 +75,8 @@ def _speed_profile(args):
 
 def run(args):
     """Simulate, optionally add the sensors, write the run; the summary as a dict."""
-    from cmsim.dynamics import SlipModel, simulate
+    from cmsim.dynamics import simulate
+    from cmsim.faults import RollingSlip
     from cmsim.frequencies import rig_frequencies
 
     rig = load_rig(args)
@@ -88,8 +89,8 @@ def run(args):
     if args.sensor_fs_hz is not None and args.sensor_fs_hz > args.fs_hz:
         raise CLIError(f"--sensor-fs-hz {args.sensor_fs_hz:g} must be <= --fs-hz "
                        f"{args.fs_hz:g}", option="--sensor-fs-hz")
-    slip = SlipModel(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
-                     correlation_s=args.slip_correlation_s)
+    slip = RollingSlip(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
+                       correlation_s=args.slip_correlation_s)
     bar = None
 
     def started(total_s):

@@ -21,7 +21,7 @@ import numpy as np
 
 from cmsim.datasets.manifest import PARQUET_NAME, SPEC_NAME, read_rows
 from cmsim.errors import ParameterError
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 from cmsim.rig import OperatingPoint, Rig
 
 __all__ = ["load", "Dataset", "DatasetRecord"]
@@ -96,7 +96,7 @@ class DatasetRecord:
     @property
     def frequencies(self):
         """:class:`~cmsim.frequencies.RigFrequencies` of the rig at the operating point."""
-        return RigFrequencies.of(self.rig, self.operating_point)
+        return rig_frequencies(self.rig, self.operating_point)
 
     @property
     def labels(self):

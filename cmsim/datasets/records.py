@@ -34,7 +34,7 @@ from cmsim.dynamics import simulate
 from cmsim.dynamics.profiles import SpeedProfile
 from cmsim.faults import fault_frequencies
 from cmsim.features import N_GMF_HARMONICS, run_features
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
@@ -49,7 +49,7 @@ FORMAT = "cmsim-dataset"
 
 
 def _frequency_columns(rig, op):
-    fr = RigFrequencies.of(rig, op)
+    fr = rig_frequencies(rig, op)
     out = {"shaft_hz": fr.fr1_hz, "gmf_hz": math.nan if fr.gmf_hz is None else fr.gmf_hz}
     for name in fr.bearing_names:
         b = fr.bearing(name)

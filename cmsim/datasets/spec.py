@@ -51,7 +51,7 @@ from cmsim.datasets.spec_toml import (check_channels, read_toml, setting_range, 
                                       toml_keywords)
 from cmsim.datasets.variation import (OPERATING_POINT_FIELDS, Variation, _check_value,
                                       apply_rig_setting, setting_kind, value_token)
-from cmsim.dynamics.mesh_choice import MESH_CHOICES
+from cmsim.dynamics.tooth_contact import MESH_CHOICES
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import FAULT_TYPES, check_faults
 from cmsim.losses import LossSettings

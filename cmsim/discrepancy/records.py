@@ -33,7 +33,7 @@ import numpy as np
 from scipy.io import wavfile
 
 from cmsim.errors import ParameterError
-from cmsim.frequencies import RigFrequencies
+from cmsim.frequencies import rig_frequencies
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
 from cmsim.run import Run
 
@@ -107,7 +107,7 @@ class MeasuredRecord:
     def frequencies(self, speed_rpm=None):
         """:class:`~cmsim.frequencies.RigFrequencies` of the model rig at the record's speed."""
         op = self.op if speed_rpm is None else replace(self.op, speed_rpm=speed_rpm)
-        return RigFrequencies.of(self.rig, op)
+        return rig_frequencies(self.rig, op)
 
 
 # ---------------------------------------------------------------------- files

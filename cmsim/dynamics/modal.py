@@ -23,9 +23,10 @@ import scipy.linalg
 
 from cmsim.bearings._kernels import ball_tangent_stiffness_jit
 from cmsim.bearings.kinematics import ball_pass_cycles_per_rev
-from cmsim.dynamics import _kernels as K
+from cmsim.dynamics._bearing_kernels import BI_X, BP_C, BP_CAGE, BP_K, BP_P, BP_PHASE, BP_SENSE
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_orbit
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.errors import ParameterError
 
 __all__ = ["ModalResult", "modal_analysis", "MODE_TYPES"]
@@ -87,18 +88,18 @@ def _bearing_cycle_times(model, n_positions):
 
 def _averaged_bearing_stiffness(model, states, times):
     """Tangent stiffness of each bearing averaged over the given states, (nb, 2, 2)."""
-    P = model.packed
+    P = model.kernel_params
     b_int, b_par, b_cos, b_sin = P.b_int, P.b_par, P.b_cos, P.b_sin
     nb = b_int.shape[0]
     out = np.zeros((nb, 2, 2))
     for q, t in zip(states, times):
         for ib in range(nb):
             ix, iy, it, n_balls = (int(v) for v in b_int[ib, :4])
-            rate = b_par[ib, K.BP_CAGE] * b_par[ib, K.BP_SENSE]
-            cage = rate * (model.omega[it] * t + q[it]) + b_par[ib, K.BP_PHASE]
+            rate = b_par[ib, BP_CAGE] * b_par[ib, BP_SENSE]
+            cage = rate * (model.omega[it] * t + q[it]) + b_par[ib, BP_PHASE]
             kxx, kxy, kyy = ball_tangent_stiffness_jit(
                 q[ix], q[iy], math.cos(cage), math.sin(cage), b_cos[ib, :n_balls],
-                b_sin[ib, :n_balls], b_par[ib, K.BP_K], b_par[ib, K.BP_P], b_par[ib, K.BP_C])
+                b_sin[ib, :n_balls], b_par[ib, BP_K], b_par[ib, BP_P], b_par[ib, BP_C])
             out[ib] += np.array([[kxx, kxy], [kxy, kyy]])
     return out / len(states)
 
@@ -114,7 +115,7 @@ def highest_frequency_hz(model, q, t=0.0):
     k_brg = _averaged_bearing_stiffness(model, [np.asarray(q, float)], [t])
     kmat = model.stiffness.copy()
     for ib in range(k_brg.shape[0]):
-        ix = int(model.packed.b_int[ib, K.BI_X])
+        ix = int(model.kernel_params.b_int[ib, BI_X])
         kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
     if model.rig.gears is not None:
         k_peak = float(np.max(model.mesh_table.mesh_stiffness(model.rig.gears)[1]))
@@ -144,13 +145,13 @@ def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     """
     if not isinstance(n_positions, (int, np.integer)) or n_positions < 4:
         raise ParameterError(f"n_positions must be an integer >= 4, got {n_positions!r}")
-    model = build_model(rig, op, mesh)
+    model = build_model(rig, op, resolve_mesh(rig, mesh, op.torque_nm))
     times = _bearing_cycle_times(model, n_positions)
     states = quasi_static_orbit(model, times)
     k_brg = _averaged_bearing_stiffness(model, states, times)
     kmat = model.stiffness.copy()
     for ib in range(k_brg.shape[0]):
-        ix = int(model.packed.b_int[ib, K.BI_X])
+        ix = int(model.kernel_params.b_int[ib, BI_X])
         kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
     k_mean = 0.0
     if rig.gears is not None:

@@ -3,8 +3,9 @@
 The model is built in three parts by lifetime, so that a dataset or a calibration that runs
 one rig many times rebuilds only what changes:
 
-* :class:`RigModel` — per rig: masses, shaft and coupling springs, bearing and tooth
-  geometry (:func:`rig_model`, memoised per rig);
+* :class:`~cmsim.dynamics.rig_model.RigModel` — per rig: masses, shaft and coupling
+  springs, bearing and tooth geometry (:func:`~cmsim.dynamics.rig_model.rig_model`,
+  memoised per rig);
 * :class:`DynamicModel` — per operating point: speeds, loads, the mesh stiffness at the
   torque (:func:`build_model`);
 * per run: cage phases, slip and a ball defect's spin-axis walk, by
@@ -23,182 +24,31 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from dataclasses import replace
-from functools import lru_cache
-
-from cmsim.bearings.forces import ball_offsets
-from cmsim.bearings.hertz import bearing_contact_stiffness
-from cmsim.bearings.kinematics import cage_ratios, slip_jitter
-from cmsim.dynamics import _kernels as K
-from cmsim.dynamics.mesh_choice import resolve_mesh
+from cmsim.bearings.kinematics import slip_jitter
+from cmsim.dynamics._bearing_kernels import (BI_DEF0, BI_FAULTY, BI_NDEF, BI_T, BP_CAGE, BP_PHASE,
+                                             DEF_BALL, DF_AXIS, DF_BRG, DF_HALF, DF_KIND, DF_SIZE,
+                                             DF_TRACK, DF_WANDER)
+from cmsim.dynamics._mesh_kernels import (MI_CTAB, MI_ECC, MI_FAULTY_BALLS, MI_MUTAB, MI_PROFILE,
+                                          MI_SIZE, MI_TDOF, MI_TEETH, MODE_HYBRID, MODE_TABLE,
+                                          MP_A0, MP_BETA, MP_COST0, MP_DIAGB, MP_DTHR, MP_JDT,
+                                          MP_KOSTER, MP_MU, MP_OM1, MP_OM2, MP_OMREF, MP_PB,
+                                          MP_PDT, MP_PHIT0, MP_PSI10, MP_PSI20, MP_PT0, MP_SINT0,
+                                          MP_SIZE, MP_SLO, MP_TAB0, MP_TABD, MP_TDT, MP_V0,
+                                          MP_ZAFTER, MP_ZBEFORE, no_hybrid)
+from cmsim.dynamics._rhs_kernels import KernelParams, make_work, no_faults, no_profile, rhs_jit
+from cmsim.dynamics.rig_model import RigModel, rig_model
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, compile_faults, rig_with_faults
-from cmsim.faults.bearing import track_share, wandering_offset
+from cmsim.faults.bearing import NO_SLIP, track_share, wandering_offset
 from cmsim.mesh_stiffness._kernels import GEO_SIZE
-from cmsim.mesh_stiffness.contact import (contact_geometry, corner_zone_m, potential_slots,
-                                          reference_phases, table_range_m)
+from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
-__all__ = ["DynamicModel", "RigModel", "SlipModel", "build_model", "rig_model"]
-
-
-@dataclass(frozen=True)
-class SlipModel:
-    """Random rolling slip (paper 001 §5, last assumption, and §6.2.1).
-
-    Two independent effects, both Ornstein-Uhlenbeck processes with correlation time
-    ``correlation_s``, drawn from the run's seed:
-
-    * the cage speed fluctuates by a fraction ``cage_speed_rms`` of its nominal value, so the
-      cage angle wanders like a random walk and the ball-pass lines spread over a band;
-    * each ball leads or lags its nominal place in the cage by a small angle of standard
-      deviation ``ball_rms_rad`` (cage-pocket play).
-
-    Attributes
-    ----------
-    cage_speed_rms : float
-        Standard deviation of the relative cage-speed fluctuation (0.01 = 1 %).
-    ball_rms_rad : float
-        Standard deviation of each ball's angular deviation, rad (<= 0.05).
-    correlation_s : float
-        Correlation time of both processes, s.
-    """
-
-    cage_speed_rms: float = 0.0
-    ball_rms_rad: float = 0.0
-    correlation_s: float = 5e-3
-
-    def __post_init__(self):
-        check_range("cage_speed_rms", self.cage_speed_rms, 0.0, 0.2)
-        check_range("ball_rms_rad", self.ball_rms_rad, 0.0, 0.05, unit="rad")
-        check_range("correlation_s", self.correlation_s, 1e-5, 10.0, unit="s")
-
-    @property
-    def active(self):
-        """True when any slip is requested."""
-        return self.cage_speed_rms > 0.0 or self.ball_rms_rad > 0.0
-
-
-@dataclass(frozen=True)
-class RigModel:
-    """The parts of eq. 1 that depend on the rig alone (built once per rig).
-
-    Attributes
-    ----------
-    rig : Rig
-    dof_names : tuple of str
-        ``x_1b1, y_1b1, theta_1b1, ...``.
-    mass : ndarray, shape (n,)
-        Diagonal of M (kg or kg·m²).
-    stiffness, damping : ndarray, shape (n, n)
-        Linear K and C of the shafts, couplings and bearing dampers.
-    springs : ndarray, shape (e, 2)
-        Spring-damper (k, c) of each element in kernel order.
-    spring_ends : ndarray of int64, shape (e, 3)
-        DOF indices of each element (:func:`cmsim.dynamics._kernels.linear_accel_jit`).
-    b_int : ndarray of int64, shape (nb, BI_SIZE)
-        Bearing DOF indices and ball counts.
-    b_par : ndarray, shape (nb, BP_SIZE)
-        Bearing parameters; the phase column is set per run.
-    b_cos, b_sin : ndarray, shape (nb, max_balls)
-        cos and sin of the ball offsets in each cage.
-    b_ang : ndarray, shape (nb, max_balls)
-        The ball offsets in each cage, rad.
-    mesh : dict
-        Tooth geometry of the kernels (``geo``, ``teeth1``, ``teeth2``, slots, phases, zone
-        limits); empty without gears.
-    """
-
-    rig: object
-    dof_names: tuple
-    mass: np.ndarray = field(repr=False)
-    stiffness: np.ndarray = field(repr=False)
-    damping: np.ndarray = field(repr=False)
-    springs: np.ndarray = field(repr=False)
-    spring_ends: np.ndarray = field(repr=False)
-    b_int: np.ndarray = field(repr=False)
-    b_par: np.ndarray = field(repr=False)
-    b_cos: np.ndarray = field(repr=False)
-    b_sin: np.ndarray = field(repr=False)
-    b_ang: np.ndarray = field(repr=False, default=None)
-    mesh: dict = field(repr=False, default_factory=dict)
-
-    @property
-    def n_dof(self):
-        """Number of DOFs."""
-        return self.mass.size
-
-    def index(self, name):
-        """Position of DOF ``name`` (e.g. ``"theta_1G1"``)."""
-        try:
-            return self.dof_names.index(name)
-        except ValueError:
-            raise KeyError(f"no DOF {name!r}; DOFs are {self.dof_names}") from None
-
-
-@lru_cache(maxsize=16)
-def rig_model(rig):
-    """The :class:`RigModel` of ``rig`` (memoised: rigs are frozen values)."""
-    n = rig.n_dof
-    mass = rig.dof_masses
-    elements = rig.spring_elements()
-    kmat, cmat = _linear_matrices(elements, n)
-    names = _dof_names(rig)
-    # kernel layout: two-node springs first, then ground springs (b = a), count in [0, 2]
-    ordered = sorted(elements, key=lambda e: e[1] < 0)
-    springs = np.array([(k, c) for _, _, k, c in ordered])
-    spring_ends = np.array([(a, a if b < 0 else b, 0) for a, b, _, _ in ordered], dtype=np.int64)
-    spring_ends[0, 2] = sum(1 for e in ordered if e[1] < 0)
-    bearings = rig.bearings
-    nb = len(bearings)
-    max_balls = max(b.n_balls for b in bearings)
-    b_int = np.zeros((nb, K.BI_SIZE), dtype=np.int64)
-    b_par = np.zeros((nb, K.BP_SIZE))
-    b_cos = np.zeros((nb, max_balls))
-    b_sin = np.zeros((nb, max_balls))
-    b_ang = np.zeros((nb, max_balls))
-    node_of = {name: k for k, name in enumerate(rig.node_names)}
-    for ib, (bname, brg) in enumerate(zip(rig.bearing_names, bearings)):
-        node = node_of[bname]
-        k_in, k_out = cage_ratios(brg)
-        b_int[ib, :K.BI_DEF0] = (3 * node, 3 * node + 1, 3 * node + 2, brg.n_balls)
-        b_par[ib, K.BP_K] = bearing_contact_stiffness(brg)
-        b_par[ib, K.BP_P] = brg.load_exponent
-        b_par[ib, K.BP_C] = brg.clearance_m
-        b_par[ib, K.BP_CAGE] = k_in + k_out * brg.outer_ring_speed_ratio
-        b_par[ib, K.BP_SENSE] = 1.0 if bname.startswith("1") else -1.0
-        b_par[ib, K.BP_DAMP] = brg.damping_n_s_per_m
-        b_par[ib, K.BP_SPIN] = (brg.pitch_diameter_m - brg.ball_diameter_m
-                                * math.cos(brg.effective_contact_angle_rad)) / brg.ball_diameter_m
-        co, so = ball_offsets(brg)
-        b_cos[ib, :brg.n_balls] = co
-        b_sin[ib, :brg.n_balls] = so
-        b_ang[ib, :brg.n_balls] = np.arctan2(so, co)
-    mesh = {}
-    if rig.gears is not None:
-        pair = rig.gears
-        lo, _ = table_range_m(pair)
-        before, after = corner_zone_m(pair)
-        psi10, psi20 = reference_phases(pair)
-        alpha = pair.working_pressure_angle_rad
-        lub = rig.lubricant
-        mesh = {"geo": contact_geometry(pair), "n_slots": potential_slots(pair),
-                "psi10": psi10, "psi20": psi20, "slo": lo, "before": before, "after": after,
-                "teeth1": _pitch_multiples(pair.driving.n_teeth),
-                "teeth2": _pitch_multiples(pair.driven.n_teeth),
-                "g1": 3 * node_of["1G1"], "g2": 3 * node_of["2G1"],
-                # nominal line of action: tangent point T1 at polar angle π/2 − α_w
-                "phi_t0": 0.5 * math.pi - alpha,
-                "koster": 12 * math.pi * lub.dynamic_viscosity_pa_s * min(
-                    pair.driving.face_width_m, pair.driven.face_width_m)}
-    for arr in (mass, kmat, cmat, springs, spring_ends, b_int, b_par, b_cos, b_sin, b_ang):
-        arr.setflags(write=False)
-    return RigModel(rig, names, mass, kmat, cmat, springs, spring_ends, b_int, b_par, b_cos,
-                    b_sin, b_ang, mesh)
+__all__ = ["DynamicModel", "build_model"]
 
 
 @dataclass(frozen=True)
@@ -217,11 +67,13 @@ class DynamicModel:
         Constant external load (output torque, radial load).
     omega : ndarray, shape (n,)
         Nominal rotation speed of each DOF, rad/s (0 for translations).
-    packed : KernelParams
-        Named kernel arrays ``P`` (:class:`cmsim.dynamics._kernels.KernelParams`).
-    diag_names : tuple of str
-        Names of the output forces the kernel writes (bearing housing forces, pair forces).
-    slip : SlipModel
+    kernel_params : KernelParams
+        Named kernel arrays ``P`` (:class:`cmsim.dynamics._rhs_kernels.KernelParams`).
+    output_force_names : tuple of str
+        Names of the forces the kernel writes at each output instant, in its order:
+        ``F_<bearing>_x``, ``F_<bearing>_y`` (housing forces), then ``Fmesh_<slot>``.
+    slip : RollingSlip
+        The run's rolling slip (:data:`cmsim.faults.NO_SLIP` without).
     mesh_model : HybridMeshModel or None
         On-line hybrid contact model (model A), or ``None`` for the table.
     cage_phases_rad : ndarray, shape (n_bearings,)
@@ -235,9 +87,9 @@ class DynamicModel:
     mesh_table: MeshStiffnessTable | None
     force: np.ndarray
     omega: np.ndarray
-    packed: K.KernelParams = field(repr=False)
-    diag_names: tuple = ()
-    slip: SlipModel = SlipModel()
+    kernel_params: KernelParams = field(repr=False)
+    output_force_names: tuple = ()
+    slip: object = NO_SLIP
     mesh_model: object = None
     cage_phases_rad: np.ndarray = field(default=None, repr=False)
     faults: tuple = ()
@@ -245,7 +97,7 @@ class DynamicModel:
     def __post_init__(self):
         # one array-flag signature for the kernels, whatever built the model (numba
         # recompiles the integrator for each mix of read-only and writeable arrays)
-        object.__setattr__(self, "packed", self.packed.frozen())
+        object.__setattr__(self, "kernel_params", self.kernel_params.frozen())
 
     @property
     def rig(self):
@@ -295,8 +147,8 @@ class DynamicModel:
         cage_phases_rad : sequence of float, optional
             Initial cage angle θ0 of each bearing (eq. 7), one per bearing in
             ``rig.bearing_names`` order; default all zero.
-        slip : SlipModel, optional
-            Random rolling slip (default none).
+        slip : RollingSlip, optional
+            Random rolling slip (:class:`cmsim.faults.RollingSlip`; default none).
         duration_s : float
             Span over which the slip and a wandering spin axis are generated, s.
         seed : int, optional
@@ -304,30 +156,31 @@ class DynamicModel:
         """
         rig = self.rig
         nb = len(rig.bearings)
-        slip = SlipModel() if slip is None else slip
+        slip = NO_SLIP if slip is None else slip
         phases = np.zeros(nb) if cage_phases_rad is None else np.asarray(cage_phases_rad, float)
         if phases.shape != (nb,) or not np.all(np.isfinite(phases)):
             raise ParameterError(f"cage_phases_rad needs {nb} finite values (one per bearing "
                                  f"{rig.bearing_names}), got {cage_phases_rad!r}")
-        b_par = self.rig_model.b_par.copy()
-        b_par[:, K.BP_PHASE] = phases
-        cage_rates = [abs(b_par[ib, K.BP_CAGE] * self.omega[self.rig_model.b_int[ib, K.BI_T]])
-                      for ib in range(nb)]
-        jitter, jdt = _jitter(rig.bearings, self.rig_model.b_cos.shape[1], cage_rates, slip,
+        b_par = self.rig_model.bearing_params.copy()
+        b_par[:, BP_PHASE] = phases
+        shaft_dof = self.rig_model.bearing_index[:, BI_T]
+        cage_rates = [abs(b_par[ib, BP_CAGE] * self.omega[shaft_dof[ib]]) for ib in range(nb)]
+        jitter, jdt = _jitter(rig.bearings, self.rig_model.ball_cos.shape[1], cage_rates, slip,
                               duration_s, seed)
-        track, tdt = _track(self.packed.b_def, duration_s, seed)
-        m_par = self.packed.m_par.copy()
-        m_par[K.MP_JDT] = jdt
-        m_par[K.MP_TDT] = tdt
-        packed = self.packed._replace(b_par=b_par, jitter=jitter, m_par=m_par, track=track)
-        return replace(self, packed=packed, slip=slip, cage_phases_rad=phases)
+        track, tdt = _track(self.kernel_params.b_def, duration_s, seed)
+        m_par = self.kernel_params.m_par.copy()
+        m_par[MP_JDT] = jdt
+        m_par[MP_TDT] = tdt
+        kernel_params = self.kernel_params._replace(b_par=b_par, jitter=jitter, m_par=m_par,
+                                                    track=track)
+        return replace(self, kernel_params=kernel_params, slip=slip, cage_phases_rad=phases)
 
     def rhs(self, t, y, want_diag=False):
         """Evaluate the kernel right-hand side; returns ``dydt`` (and ``diag``)."""
         dydt = np.empty((1, 2 * self.n_dof))
-        diag = np.zeros(len(self.diag_names))
-        K.rhs_jit(float(t), np.ascontiguousarray(y, dtype=float), dydt, 0, self.packed, diag,
-                  bool(want_diag), K.make_work(self.packed))
+        diag = np.zeros(len(self.output_force_names))
+        rhs_jit(float(t), np.ascontiguousarray(y, dtype=float), dydt, 0, self.kernel_params, diag,
+                bool(want_diag), make_work(self.kernel_params))
         return (dydt[0], diag) if want_diag else dydt[0]
 
     def static_residual(self, t, q):
@@ -367,28 +220,7 @@ class DynamicModel:
         return g
 
 
-def _linear_matrices(elements, n):
-    """Assemble K and C (n, n) from spring elements."""
-    kmat = np.zeros((n, n))
-    cmat = np.zeros((n, n))
-    for a, b, k, c in elements:
-        for mat, value in ((kmat, k), (cmat, c)):
-            mat[a, a] += value
-            if b >= 0:
-                mat[b, b] += value
-                mat[a, b] -= value
-                mat[b, a] -= value
-    return kmat, cmat
-
-
-def _dof_names(rig):
-    names = [f"{d}_{node}" for node in rig.node_names for d in ("x", "y", "theta")]
-    if rig.gears is not None:
-        names.append("theta_2J2")
-    return tuple(names)
-
-
-def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
+def build_model(rig, op, mesh=(None, None), *, slip=None, duration_s=1.0, seed=None,
                 cage_phases_rad=None, faults=(), profile=None, loads=None, friction_table=None,
                 damping_table=None):
     """Assemble the :class:`DynamicModel` of ``rig`` at ``op``.
@@ -397,11 +229,12 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     ----------
     rig : Rig
     op : OperatingPoint
-    mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
-        Tooth contact model (:func:`cmsim.dynamics.mesh_choice.resolve_mesh`): ``None`` =
-        the rig's hybrid FE + Weber–Banaschek tables at the operating torque (paper 001
-        §6.1, model B); ``"potential-energy"``; ``"hybrid"`` = on-line contact solve
-        (model A); or an explicit table, table set or hybrid model.
+    mesh : tuple of (MeshStiffnessTable or None, HybridMeshModel or None)
+        The tooth contact, already resolved at ``op.torque_nm`` for the rig with its faults'
+        changes (:func:`cmsim.dynamics.tooth_contact.resolve_mesh`, which turns the user's
+        ``mesh`` choice into this pair): the pair stiffness table and, for the on-line
+        contact solve (paper 001 §6.1, model A), the hybrid model. ``(None, None)`` (the
+        default) for a rig without gears.
     slip, duration_s, seed, cage_phases_rad
         Per-run values, as in :meth:`DynamicModel.for_run`.
     faults : sequence of Fault
@@ -437,11 +270,11 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
     torque) and does not double in double contact.
     """
     faults = check_faults(rig, faults)
-    rig = rig_with_faults(rig, faults)
+    given, rig = rig, rig_with_faults(rig, faults)
     rm = rig_model(rig)
     n = rm.n_dof
-    mesh_table, mesh_model = resolve_mesh(rig, mesh, op.torque_nm)
-    fault_arrays = compile_faults(rig, faults, mesh_table, op=op) if faults else None
+    mesh_table, mesh_model = _checked_mesh(rig, mesh)
+    fault_arrays = compile_faults(given, faults, mesh_table, op=op) if faults else None
     omega = np.zeros(n)
     ratio = rig.gears.driving.n_teeth / rig.gears.driven.n_teeth if rig.gears else 0.0
     speeds = (op.omega_rad_s, op.omega_rad_s * ratio)
@@ -458,60 +291,60 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
         force[rm.index(name)] += check_range(f"loads[{name!r}]", value, unit="N or N m")
 
     nb = len(rig.bearings)
-    m_int = np.zeros(K.MI_SIZE, dtype=np.int64)
-    m_int[K.MI_TDOF] = -1
-    m_par = np.zeros(K.MP_SIZE)
-    m_par[K.MP_JDT] = 1.0
-    m_par[K.MP_DIAGB] = 2 * nb
-    diag_names = [f"F_{b}_{d}" for b in rig.bearing_names for d in ("x", "y")]
+    m_int = np.zeros(MI_SIZE, dtype=np.int64)
+    m_int[MI_TDOF] = -1
+    m_par = np.zeros(MP_SIZE)
+    m_par[MP_JDT] = 1.0
+    m_par[MP_DIAGB] = 2 * nb
+    output_force_names = [f"F_{b}_{d}" for b in rig.bearing_names for d in ("x", "y")]
     if rig.gears is not None:
         pair, geom = rig.gears, rm.mesh
-        mode = K.MODE_TABLE if mesh_model is None else K.MODE_HYBRID
-        m_int[:K.MI_TEETH] = (geom["g1"], geom["g2"], geom["n_slots"], 1, mode)
+        mode = MODE_TABLE if mesh_model is None else MODE_HYBRID
+        m_int[:MI_TEETH] = (geom["g1"], geom["g2"], geom["n_slots"], 1, mode)
         mc = rig.mesh_contact
         k_mean = mesh_table.mean_mesh_stiffness(pair)
-        m_par[K.MP_A0] = pair.working_centre_distance_m
-        m_par[K.MP_PSI10] = geom["psi10"]
-        m_par[K.MP_PSI20] = geom["psi20"]
-        m_par[K.MP_PB] = pair.driving.base_pitch_m
-        m_par[K.MP_SLO] = geom["slo"]
-        m_par[K.MP_OM1] = speeds[0]
-        m_par[K.MP_OM2] = speeds[1]
-        m_par[K.MP_MU] = mc.friction_coefficient
-        m_par[K.MP_V0] = mc.friction_smoothing_m_s
-        m_par[K.MP_BETA] = 2 * mc.damping_ratio * math.sqrt(pair.mesh_stiffness_mass_kg / k_mean)
-        m_par[K.MP_KOSTER] = geom["koster"]
-        m_par[K.MP_DTHR] = mc.squeeze_gap_threshold_m
-        m_par[K.MP_TAB0] = mesh_table.position_m[0]
-        m_par[K.MP_TABD] = mesh_table.spacing_m
-        m_par[K.MP_ZBEFORE] = geom["before"]
-        m_par[K.MP_ZAFTER] = geom["after"]
-        m_par[K.MP_PHIT0] = geom["phi_t0"]
-        m_par[K.MP_COST0] = math.cos(geom["phi_t0"])
-        m_par[K.MP_SINT0] = math.sin(geom["phi_t0"])
+        m_par[MP_A0] = pair.working_centre_distance_m
+        m_par[MP_PSI10] = geom["psi10"]
+        m_par[MP_PSI20] = geom["psi20"]
+        m_par[MP_PB] = pair.driving.base_pitch_m
+        m_par[MP_SLO] = geom["slo"]
+        m_par[MP_OM1] = speeds[0]
+        m_par[MP_OM2] = speeds[1]
+        m_par[MP_MU] = mc.friction_coefficient
+        m_par[MP_V0] = mc.friction_smoothing_m_s
+        m_par[MP_BETA] = 2 * mc.damping_ratio * math.sqrt(pair.mesh_stiffness_mass_kg / k_mean)
+        m_par[MP_KOSTER] = geom["koster"]
+        m_par[MP_DTHR] = mc.squeeze_gap_threshold_m
+        m_par[MP_TAB0] = mesh_table.position_m[0]
+        m_par[MP_TABD] = mesh_table.spacing_m
+        m_par[MP_ZBEFORE] = geom["before"]
+        m_par[MP_ZAFTER] = geom["after"]
+        m_par[MP_PHIT0] = geom["phi_t0"]
+        m_par[MP_COST0] = math.cos(geom["phi_t0"])
+        m_par[MP_SINT0] = math.sin(geom["phi_t0"])
         tab_k = np.ascontiguousarray(mesh_table.stiffness_n_per_m)
         tab_e = np.ascontiguousarray(mesh_table.separation_m)
-        diag_names += [f"Fmesh_{j}" for j in range(geom["n_slots"])]
+        output_force_names += [f"Fmesh_{j}" for j in range(geom["n_slots"])]
         geo, teeth1, teeth2 = geom["geo"], geom["teeth1"], geom["teeth2"]
     else:
         geo = np.zeros(GEO_SIZE)
         teeth1 = teeth2 = np.zeros((1, 2))
-        m_par[K.MP_TABD] = 1.0
+        m_par[MP_TABD] = 1.0
         tab_k = np.zeros(2)
         tab_e = np.zeros(2)
     if mesh_model is not None:
         hybrid = tuple(np.ascontiguousarray(a, dtype=float) for a in mesh_model.kernel_args())
     else:
-        hybrid = K.no_hybrid()
+        hybrid = no_hybrid()
     b_int, fields = _fault_fields(rm, m_int, fault_arrays,
-                                  (m_par[K.MP_TAB0], m_par[K.MP_TABD]))
-    prof = K.no_profile()
+                                  (m_par[MP_TAB0], m_par[MP_TABD]))
+    prof = no_profile()
     if profile is not None:
-        m_int[K.MI_PROFILE] = 1
-        m_int[K.MI_TDOF] = n - 1 if rig.gears is not None else -1
-        m_par[K.MP_PT0] = profile.t0_s
-        m_par[K.MP_PDT] = profile.dt_s
-        m_par[K.MP_OMREF] = op.omega_rad_s
+        m_int[MI_PROFILE] = 1
+        m_int[MI_TDOF] = n - 1 if rig.gears is not None else -1
+        m_par[MP_PT0] = profile.t0_s
+        m_par[MP_PDT] = profile.dt_s
+        m_par[MP_OMREF] = op.omega_rad_s
         prof = np.ascontiguousarray(profile.table, dtype=float)
     mu_tab = np.zeros(1)
     if friction_table is not None:
@@ -520,7 +353,7 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
                 or np.any(mu_tab < 0) or np.any(mu_tab > 1):
             raise ParameterError(f"friction_table needs {len(tab_k)} values in [0, 1] (one "
                                  f"per point of the mesh table grid)")
-        m_int[K.MI_MUTAB] = 1
+        m_int[MI_MUTAB] = 1
     c_tab = np.zeros(1)
     if damping_table is not None:
         c_tab = np.ascontiguousarray(damping_table, dtype=float)
@@ -528,40 +361,64 @@ def build_model(rig, op, mesh=None, *, slip=None, duration_s=1.0, seed=None,
                 or np.any(c_tab < 0):
             raise ParameterError(f"damping_table needs {len(tab_k)} finite values >= 0 N s/m "
                                  f"(one per point of the mesh table grid)")
-        m_int[K.MI_CTAB] = 1
-    packed = K.KernelParams(1.0 / rm.mass, rm.springs, force, omega, b_int, rm.b_par,
-                            rm.b_cos, rm.b_sin, np.zeros((nb, rm.b_cos.shape[1] + 1, 1)),
-                            m_int, m_par, geo, tab_k, tab_e, teeth1, teeth2, rm.spring_ends,
-                            *hybrid, fields[0], rm.b_ang, *fields[1:], prof, mu_tab, c_tab,
-                            np.ones((fields[0].shape[0], 1)))
-    model = DynamicModel(rm, op, mesh_table, force, omega, packed, tuple(diag_names),
-                         SlipModel(), mesh_model, np.zeros(nb), faults)
+        m_int[MI_CTAB] = 1
+    kernel_params = KernelParams(
+        1.0 / rm.mass, rm.springs, force, omega, b_int, rm.bearing_params, rm.ball_cos,
+        rm.ball_sin, np.zeros((nb, rm.ball_cos.shape[1] + 1, 1)), m_int, m_par, geo, tab_k,
+        tab_e, teeth1, teeth2, rm.spring_ends, *hybrid, fields[0], rm.ball_angles_rad,
+        *fields[1:], prof, mu_tab, c_tab, np.ones((fields[0].shape[0], 1)))
+    model = DynamicModel(rm, op, mesh_table, force, omega, kernel_params, tuple(output_force_names),
+                         NO_SLIP, mesh_model, np.zeros(nb), faults)
     return model.for_run(cage_phases_rad=cage_phases_rad, slip=slip, duration_s=duration_s,
                          seed=seed)
 
 
+def _checked_mesh(rig, mesh):
+    """``(table, on-line model)`` of a resolved ``mesh`` (:func:`build_model`), checked
+    against ``rig``."""
+    if not (isinstance(mesh, tuple) and len(mesh) == 2):
+        raise ParameterError(f"mesh must be the (table, on-line model) pair that "
+                             f"cmsim.dynamics.tooth_contact.resolve_mesh returns, got "
+                             f"{type(mesh).__name__}", param="mesh")
+    table, online = mesh
+    if rig.gears is None:
+        if table is not None or online is not None:
+            raise ParameterError("mesh given for a rig without gears (allowed: (None, None))",
+                                 param="mesh")
+        return None, None
+    if not isinstance(table, MeshStiffnessTable):
+        raise ParameterError(f"mesh: a rig with gears needs a MeshStiffnessTable first (from "
+                             f"resolve_mesh), got {type(table).__name__}", param="mesh")
+    if online is not None:
+        if not isinstance(online, HybridMeshModel):
+            raise ParameterError(f"mesh: the on-line model must be a HybridMeshModel or None, "
+                                 f"got {type(online).__name__}", param="mesh")
+        online.check_pair(rig.gears)
+    return table, online
+
+
 def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
     """``(b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc))`` for the kernel from FaultArrays."""
-    nb, max_balls = rm.b_cos.shape
+    nb, max_balls = rm.ball_cos.shape
     if fa is None or not fa.active:
-        return rm.b_int, K.no_faults(nb, max_balls)
-    b_def = np.ascontiguousarray(fa.bearing_defects, dtype=float).reshape(-1, K.DF_SIZE)
+        return rm.bearing_index, no_faults(nb, max_balls)
+    b_def = np.ascontiguousarray(fa.bearing_defects, dtype=float).reshape(-1, DF_SIZE)
     b_off = np.ascontiguousarray(fa.ball_offset_m, dtype=float)
     if b_off.shape != (nb, max_balls):
         raise ParameterError(f"ball_offset_m must have shape {(nb, max_balls)}, "
                              f"got {b_off.shape}")
-    order = np.argsort(b_def[:, K.DF_BRG], kind="stable")
+    order = np.argsort(b_def[:, DF_BRG], kind="stable")
     b_def = np.ascontiguousarray(b_def[order])
-    b_int = rm.b_int.copy()
+    b_int = rm.bearing_index.copy()
     for ib in range(nb):
-        rows = np.flatnonzero(b_def[:, K.DF_BRG] == ib)
-        b_int[ib, K.BI_DEF0] = rows[0] if rows.size else 0
-        b_int[ib, K.BI_NDEF] = rows.size
+        rows = np.flatnonzero(b_def[:, DF_BRG] == ib)
+        b_int[ib, BI_DEF0] = rows[0] if rows.size else 0
+        b_int[ib, BI_NDEF] = rows.size
         # 2: an off-size ball, every ball ball by ball; 1: defects only, healthy law plus
-        # the change of the balls in a defect (the kernels' _faulty_bearing_forces)
-        b_int[ib, K.BI_FAULTY] = 2 if np.any(b_off[ib] != 0.0) else int(rows.size > 0)
+        # the change of the balls in a defect (the kernels' faulty_bearing_forces_jit)
+        b_int[ib, BI_FAULTY] = 2 if np.any(b_off[ib] != 0.0) else int(rows.size > 0)
     if np.any(b_off != 0.0):
-        m_int[K.MI_FAULTY_BALLS] = 1
+        m_int[MI_FAULTY_BALLS] = 1
     rig = rm.rig
     tk1, tk2, te1, te2 = (np.ascontiguousarray(a, dtype=float) for a in
                           (fa.tooth_factor1, fa.tooth_factor2, fa.tooth_sep1, fa.tooth_sep2))
@@ -576,26 +433,20 @@ def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
                 or te2.shape[0] != z2:
             raise ParameterError(f"per-tooth tables need {z1} rows for gear 1 and {z2} for "
                                  f"gear 2")
-        m_int[K.MI_TEETH] = 1
+        m_int[MI_TEETH] = 1
     else:
         tk1 = tk2 = np.ones((1, 1))
         te1 = te2 = np.zeros((1, 1))
     ecc_in = np.asarray(fa.eccentricity, dtype=float).reshape(2, 2)
     ecc = np.zeros((2, 3))
     if rig.gears is not None and np.any(ecc_in[:, 0] != 0.0):
-        m_int[K.MI_ECC] = 1
+        m_int[MI_ECC] = 1
         # the kernel turns the offset with the gear's involute origin ψ = θ + ψ0
         refs = (rm.mesh["psi10"], rm.mesh["psi20"])
         for gear in range(2):
             ecc[gear] = (ecc_in[gear, 0], math.cos(ecc_in[gear, 1] - refs[gear]),
                          math.sin(ecc_in[gear, 1] - refs[gear]))
     return b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc)
-
-
-def _pitch_multiples(n_teeth):
-    """cos and sin of k·2π/Z for k = 0..Z−1, shape (Z, 2)."""
-    a = 2.0 * math.pi * np.arange(n_teeth) / n_teeth
-    return np.ascontiguousarray(np.column_stack([np.cos(a), np.sin(a)]))
 
 
 def _track(b_def, duration_s, seed):
@@ -608,22 +459,22 @@ def _track(b_def, duration_s, seed):
     ``seed``). Returns ((m, n_grid), dt); n_grid = 1 when nothing varies.
     """
     m = b_def.shape[0]
-    ball = b_def[:, K.DF_KIND] == K.DEF_BALL
-    wander = ball & (b_def[:, K.DF_WANDER] > 0.0)
+    ball = b_def[:, DF_KIND] == DEF_BALL
+    wander = ball & (b_def[:, DF_WANDER] > 0.0)
     if not np.any(wander):
         out = np.ones((m, 1))
         for r in np.flatnonzero(ball):
-            out[r] = track_share(b_def[r, K.DF_AXIS], b_def[r, K.DF_TRACK], b_def[r, K.DF_HALF])
+            out[r] = track_share(b_def[r, DF_AXIS], b_def[r, DF_TRACK], b_def[r, DF_HALF])
         return out, 1.0
-    dt = float(np.min(b_def[wander, K.DF_WANDER])) / 20.0
+    dt = float(np.min(b_def[wander, DF_WANDER])) / 20.0
     n_grid = int(math.ceil(duration_s / dt)) + 2
     rng = np.random.default_rng(None if seed is None else [int(seed), _TRACK_STREAM])
     out = np.ones((m, n_grid))
     for r in np.flatnonzero(ball):
-        z = b_def[r, K.DF_AXIS]
+        z = b_def[r, DF_AXIS]
         if wander[r]:
-            z = wandering_offset(z, b_def[r, K.DF_WANDER], n_grid, dt, rng)
-        out[r] = track_share(z, b_def[r, K.DF_TRACK], b_def[r, K.DF_HALF])
+            z = wandering_offset(z, b_def[r, DF_WANDER], n_grid, dt, rng)
+        out[r] = track_share(z, b_def[r, DF_TRACK], b_def[r, DF_HALF])
     return out, dt
 
 

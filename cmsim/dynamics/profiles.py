@@ -18,7 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from cmsim.dynamics import _kernels as K
+from cmsim.dynamics._rhs_kernels import PR_ALPHA, PR_OMEGA, PR_SIZE, PR_THETA, PR_TORQUE
 from cmsim.errors import ParameterError, check_range
 
 __all__ = ["SpeedProfile", "KernelProfile", "kernel_profile"]
@@ -98,7 +98,7 @@ class SpeedProfile:
 
 
 class KernelProfile(NamedTuple):
-    """Profile table for the kernels (:data:`cmsim.dynamics._kernels.PR_SIZE` columns)."""
+    """Profile table for the kernels (:data:`cmsim.dynamics._rhs_kernels.PR_SIZE` columns)."""
 
     t0_s: float
     dt_s: float
@@ -147,9 +147,9 @@ def kernel_profile(profile, torque_nm, end_s, dt_s, *, speed_factor=None, torque
         torque = np.full(n, float(torque_nm))
     if torque_factor is not None:
         torque = torque * np.asarray(torque_factor(t), dtype=float)
-    table = np.empty((n, K.PR_SIZE))
-    table[:, K.PR_THETA] = theta
-    table[:, K.PR_OMEGA] = omega
-    table[:, K.PR_ALPHA] = alpha
-    table[:, K.PR_TORQUE] = torque
+    table = np.empty((n, PR_SIZE))
+    table[:, PR_THETA] = theta
+    table[:, PR_OMEGA] = omega
+    table[:, PR_ALPHA] = alpha
+    table[:, PR_TORQUE] = torque
     return KernelProfile(0.0, float(dt_s), np.ascontiguousarray(table))

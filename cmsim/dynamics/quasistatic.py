@@ -48,7 +48,7 @@ def _linear_guess(model, f_ref):
         k_re = bearing_contact_stiffness(brg)
         deflection = (load / k_re) ** (1.0 / brg.load_exponent)
         k_lin = 1.5 * load / deflection
-        ix = int(model.packed.b_int[ib, 0])
+        ix = int(model.kernel_params.b_int[ib, 0])
         kmat[ix, ix] += k_lin
         kmat[ix + 1, ix + 1] += k_lin
         offsets[ix:ix + 2] = max(brg.clearance_m, 0.0)
@@ -63,7 +63,7 @@ def _linear_guess(model, f_ref):
     q = np.linalg.solve(kmat, rhs)
     # push each bearing across its clearance in the direction it moves
     for ib in range(nb):
-        ix = int(model.packed.b_int[ib, 0])
+        ix = int(model.kernel_params.b_int[ib, 0])
         r = math.hypot(q[ix], q[ix + 1])
         if r > 0:
             q[ix:ix + 2] += offsets[ix:ix + 2] * q[ix:ix + 2] / r
@@ -123,7 +123,7 @@ def quasi_static_orbit(model, times_s):
 def _with_load_scaled(model, factor):
     """The same model with its external loads multiplied by ``factor``."""
     force = model.force * factor
-    return replace(model, force=force, packed=model.packed._replace(fext=force),
+    return replace(model, force=force, kernel_params=model.kernel_params._replace(fext=force),
                    op=replace(model.op, torque_nm=model.op.torque_nm * factor,
                               radial_load_n=model.op.radial_load_n * factor))
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -11,23 +12,23 @@ from pathlib import Path
 import numpy as np
 
 import cmsim
-from cmsim.dynamics import _kernels as K
+from cmsim.dynamics._rhs_kernels import PR_THETA, integrate_jit, make_integrator_buffers, make_work
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
-from cmsim.dynamics.mesh_choice import resolve_mesh
-from cmsim.dynamics.model import SlipModel, build_model
+from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
+from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
-from cmsim.faults import (check_faults, fault_frequencies, operating_modulation,
-                          slip_from_faults)
+from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
+                          operating_modulation, rig_with_faults, slip_from_faults)
 from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.run import Run
 
-__all__ = ["simulate", "integrate", "kernels_cached", "MAX_ROTATION_DEVIATION_RAD",
-           "STEPS_PER_PERIOD", "MAX_OUTPUT_BYTES"]
+__all__ = ["simulate", "integrate", "check_memory", "kernels_cached",
+           "MAX_ROTATION_DEVIATION_RAD",           "STEPS_PER_PERIOD", "MAX_OUTPUT_BYTES"]
 
 #: Integration steps per period of the highest natural frequency when the step is chosen
 #: automatically: ω_max·h <= 2π/4.7 = 1.34, 77 % of ode3's stability limit √3 on the
@@ -70,14 +71,14 @@ class _Integrator:
 
     def chunks(self, y0, t0, h, n_out, substeps):
         model, tab = self.model, self.tab
-        n_diag = len(model.diag_names)
-        buffers = K.make_integrator_buffers(tab.b, y0.size, n_diag)
+        n_diag = len(model.output_force_names)
+        buffers = make_integrator_buffers(tab.b, y0.size, n_diag)
         # compile (or load from cache) outside the timed region, then start from fresh scratch
-        K.integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.packed,
-                        K.make_work(model.packed), buffers, np.empty((1, y0.size)),
-                        np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
-                        self.mask)
-        self.work = K.make_work(model.packed)
+        integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
+                      make_work(model.kernel_params), buffers, np.empty((1, y0.size)),
+                      np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
+                      self.mask)
+        self.work = make_work(model.kernel_params)
         y, m0 = y0, 0
         while m0 < n_out:
             # one sample of overlap: a block's last state starts the next block
@@ -86,9 +87,9 @@ class _Integrator:
             diag = np.empty((count, n_diag))
             first = m0 - 1 if m0 else 0
             start = time.perf_counter()
-            status = K.integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
-                                     model.packed, self.work, buffers, states, diag,
-                                     self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
+            status = integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
+                                   model.kernel_params, self.work, buffers, states, diag,
+                                   self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
             self.wall += time.perf_counter() - start
             if status >= 0:
                 raise IntegrationDiverged(
@@ -145,7 +146,7 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     """
     runner = _Integrator(model, scheme, progress)
     states = np.empty((n_out, y0.size))
-    diag = np.empty((n_out, len(model.diag_names)))
+    diag = np.empty((n_out, len(model.output_force_names)))
     for m0, st, dg in runner.chunks(np.asarray(y0, dtype=float), t0, dt_out / substeps, n_out,
                                     substeps):
         states[m0:m0 + len(st)] = st
@@ -155,8 +156,25 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     return states, diag, runner.wall
 
 
-def _check_memory(duration_s, fs_hz, n_dof, n_diag):
-    """Refuse a run whose outputs would not fit in :data:`MAX_OUTPUT_BYTES`, before any work."""
+def check_memory(duration_s, fs_hz, rig):
+    """Refuse a run whose outputs would not fit in :data:`MAX_OUTPUT_BYTES`, before any work.
+
+    Parameters
+    ----------
+    duration_s : float
+        Recorded duration, s.
+    fs_hz : float
+        Output sample rate, Hz.
+    rig : Rig
+        The rig (its DOFs and bearings set the number of signals).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``duration_s`` and the longest duration that fits at ``fs_hz``.
+    """
+    n_dof = rig.n_dof
+    n_diag = 4 * len(rig.bearings) + 8      # bounds the bearing and pair forces
     # states (2n), forces, then the named signals (DOFs, forces, LOA/OLOA pairs, DTE)
     per_second = 8.0 * fs_hz * (2 * n_dof + 3 * n_diag + n_dof + 8)
     if duration_s * per_second > MAX_OUTPUT_BYTES:
@@ -173,7 +191,7 @@ def _recorded(model, record):
     if isinstance(record, str):
         record = (record,)
     dofs = {name: i for i, name in enumerate(model.dof_names)}
-    diag = {name: j for j, name in enumerate(model.diag_names)}
+    diag = {name: j for j, name in enumerate(model.output_force_names)}
     q_cols, d_cols = set(), set()
     for name in record:
         if name in dofs:
@@ -205,10 +223,11 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     n = model.n_dof
     first = n_warm * k - hl                       # first fast sample the filter reads
     last = (n_warm + n_rec - 1) * k + hl          # last one
+    n_forces = len(model.output_force_names)
     q_out = np.full((n_rec, n), np.nan)
-    d_out = np.full((n_rec, len(model.diag_names)), np.nan)
+    d_out = np.full((n_rec, n_forces), np.nan)
     qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
-    dc = np.arange(len(model.diag_names)) if d_cols is None else np.asarray(d_cols, dtype=int)
+    dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
     runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
     tail = None                                   # fast samples not yet consumed
@@ -233,13 +252,13 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
 def kernels_cached():
     """True when the integration kernel has an up-to-date numba cache (the first run of a
     fresh install compiles it, about 30 s); False when it will compile or cannot tell."""
-    source = Path(K.__file__)
+    source = Path(sys.modules[integrate_jit.__module__].__file__)
     # numba writes its cache to $NUMBA_CACHE_DIR when set, else beside the source
     places = [Path(os.environ["NUMBA_CACHE_DIR"]) if os.environ.get("NUMBA_CACHE_DIR")
               else source.parent / "__pycache__"]
     try:
         mtime = source.stat().st_mtime
-        pattern = f"{source.stem}.{K.integrate_jit.__name__}*.nbi"
+        pattern = f"{source.stem}.{integrate_jit.__name__}*.nbi"
         return any(index.stat().st_mtime >= mtime for place in places if place.is_dir()
                    for index in place.rglob(pattern))
     except OSError:
@@ -252,15 +271,15 @@ def _compile_seconds():
         start = time.perf_counter()
         rig = cmsim.Rig.paper_2016()
         model = build_model(rig, cmsim.OperatingPoint(1000.0, 10.0),
-                            MeshStiffnessTable.constant(rig.gears, 1e8))
+                            (MeshStiffnessTable.constant(rig.gears, 1e8), None))
         y0 = np.zeros(2 * model.n_dof)
         tab = SCHEMES["ode3"]
-        K.integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.packed,
-                        K.make_work(model.packed),
-                        K.make_integrator_buffers(tab.b, y0.size, len(model.diag_names)),
-                        np.empty((2, y0.size)),
-                        np.empty((2, len(model.diag_names))), 1.0, 1.0,
-                        model.translational_mask)
+        integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
+                      make_work(model.kernel_params),
+                      make_integrator_buffers(tab.b, y0.size, len(model.output_force_names)),
+                      np.empty((2, y0.size)),
+                      np.empty((2, len(model.output_force_names))), 1.0, 1.0,
+                      model.translational_mask)
         _compile_seconds.value = time.perf_counter() - start
     return _compile_seconds.value
 
@@ -302,8 +321,9 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         004's load-independent table); ``"hybrid"`` = solved on-line from the FE influence
         coefficients (model A, about 3-4 times slower); or an explicit table, a table set
         (read at the run's torque) or a ``HybridMeshModel``.
-    slip : SlipModel, optional
-        Random ball-position jitter; uses ``seed``.
+    slip : RollingSlip, optional
+        Random rolling slip (:class:`cmsim.faults.RollingSlip`: cage-speed fluctuation and
+        ball jitter); uses ``seed``. A ``rolling_slip`` among ``faults`` takes its place.
     seed : int, optional
         Seed for the jitter and the cage phases; drawn at random and recorded when omitted.
     warmup_s : float
@@ -361,18 +381,19 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         raise ParameterError(f"substeps must be an integer in [1, 1000], got {substeps!r}")
     if seed is None:
         seed = int(np.random.SeedSequence().entropy % (2 ** 31))
-    slip = SlipModel() if slip is None else slip
+    slip = NO_SLIP if slip is None else slip
+    if not isinstance(slip, RollingSlip):
+        raise ParameterError(f"slip must be a RollingSlip (cmsim.faults), got "
+                             f"{type(slip).__name__}", param="slip")
     rng = np.random.default_rng(seed)
     if isinstance(cage_phases_rad, str):
         if cage_phases_rad != "random":
             raise ParameterError(f"cage_phases_rad must be 'random', None or one angle per "
                                  f"bearing, got {cage_phases_rad!r}")
         cage_phases_rad = rng.uniform(0.0, 2.0 * math.pi, len(rig.bearings))
-    _check_memory(duration_s, fs_hz, rig.n_dof, 4 * len(rig.bearings) + 8)
+    check_memory(duration_s, fs_hz, rig)
     faults = check_faults(rig, faults)
-    fault_slip = slip_from_faults(faults)
-    if fault_slip is not None:
-        slip = SlipModel(**fault_slip)
+    slip = slip_from_faults(faults) or slip
     speed_factor, torque_factor = operating_modulation(faults, op, rig)
     kprof = None
     if profile is not None or speed_factor is not None or torque_factor is not None:
@@ -391,12 +412,15 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
         if loads is not None or friction_table is not None:
             raise ParameterError("losses sets the run's loads and friction table; give either "
                                  "losses or loads/friction_table", param="losses")
-        table, mesh_model = resolve_mesh(rig, mesh, op.torque_nm)
-        mesh = mesh_model if mesh_model is not None else table
-        loss_inputs = run_losses(rig, op, table, LossSettings() if losses is True else losses)
+        # the losses read the tables of the rig as given (not worn by faults)
+        contact = resolve_mesh(rig, mesh, op.torque_nm)
+        loss_inputs = run_losses(rig, op, contact[0],
+                                 LossSettings() if losses is True else losses)
         loads, friction_table = loss_inputs.loads, loss_inputs.friction_table
+    else:
+        contact = resolve_mesh(rig_with_faults(rig, faults), mesh, op.torque_nm)
     compile_s = _compile_seconds()
-    model = build_model(rig, op, mesh, slip=slip, duration_s=warmup_s + duration_s,
+    model = build_model(rig, op, contact, slip=slip, duration_s=warmup_s + duration_s,
                         seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad,
                         profile=kprof, faults=faults, loads=loads,
                         friction_table=friction_table, damping_table=damping_table)
@@ -483,13 +507,13 @@ def _signals(model, t, states, diag, kprof=None):
     if kprof is not None:
         # equivalent time of the nominal rotation, Θ(t)/Ω_ref (as the kernels use it)
         grid = kprof.t0_s + kprof.dt_s * np.arange(kprof.table.shape[0])
-        tau = np.interp(t, grid, kprof.table[:, K.PR_THETA]) / model.op.omega_rad_s
+        tau = np.interp(t, grid, kprof.table[:, PR_THETA]) / model.op.omega_rad_s
     for i, name in enumerate(model.dof_names):
         value = states[:, i]
         if name.startswith("theta"):
             value = value + model.omega[i] * tau
         sig[name] = value
-    for j, name in enumerate(model.diag_names):
+    for j, name in enumerate(model.output_force_names):
         sig[name] = diag[:, j].copy()
     for bname in rig.bearing_names:
         e = model.loa_direction(0 if bname.startswith("1") else 1)
@@ -501,6 +525,6 @@ def _signals(model, t, states, diag, kprof=None):
         dte = states[:, model.index("theta_1G1")] - ratio * states[:, model.index("theta_2G1")]
         sig["dte"] = dte
         sig["dte_um"] = dte * rig.gears.driving.base_radius_m * 1e6
-        slots = [k for k in model.diag_names if k.startswith("Fmesh_")]
+        slots = [k for k in model.output_force_names if k.startswith("Fmesh_")]
         sig["Fmesh_total"] = np.sum([sig[k] for k in slots], axis=0)
     return sig

@@ -33,11 +33,11 @@ from dataclasses import replace
 import numpy as np
 
 from cmsim.bearings.kinematics import ball_pass_cycles_per_rev
-from cmsim.dynamics import model as dynamic_model   # module: model imports mesh_choice
+from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_orbit, quasi_static_state
 from cmsim.errors import IntegrationDiverged, ParameterError, check_range
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
-from cmsim.mesh_stiffness.mesh_cycle import mesh_cycle
+from cmsim.mesh_stiffness.mesh_cycle import hybrid_mesh_table, mesh_cycle
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
 from cmsim.rig import OperatingPoint
@@ -156,7 +156,7 @@ def _orbit_centroids(rig, torque_nm, speed_rpm, mesh_model, n_orbit):
     and the largest distance of an orbit point from its centroid, µm.
     """
     op = OperatingPoint(speed_rpm, torque_nm)
-    model = dynamic_model.build_model(rig, op, mesh_model)
+    model = build_model(rig, op, (hybrid_mesh_table(mesh_model, torque_nm), mesh_model))
     bpf = op.omega_rad_s * ball_pass_cycles_per_rev(rig.bearings[0]) / (2.0 * math.pi)
     # instants over one ball pass; the mesh phase then sweeps several mesh cycles
     times = np.arange(n_orbit) / (n_orbit * bpf)
@@ -186,7 +186,7 @@ def _guided_orbit(rig, op, model, times):
     centroid to far below a micrometre), and an instant that still fails is left out of the
     centroid; at least half of them must succeed.
     """
-    guide = dynamic_model.build_model(rig, op, model.mesh_table)
+    guide = build_model(rig, op, (model.mesh_table, None))
     orbit = []
     g = None
     for t in times:

@@ -62,9 +62,8 @@ from cmsim.errors import ParameterError, check_range
 from cmsim.faults.base import Fault, check_bearing, check_int, mm, register
 
 __all__ = ["OuterRaceDefect", "InnerRaceDefect", "BallDefect", "BearingWear", "OffSizeBall",
-           "RollingSlip", "ball_drop_m", "defect_profile", "track_share", "wandering_offset",
-           "EXIT_RAMP_FRACTION",
-           "KIND_OUTER", "KIND_INNER", "KIND_BALL"]
+           "RollingSlip", "NO_SLIP", "ball_drop_m", "defect_profile", "track_share",
+           "wandering_offset", "EXIT_RAMP_FRACTION", "KIND_OUTER", "KIND_INNER", "KIND_BALL"]
 
 #: Kind codes of the ``bearing_defects`` rows.
 KIND_OUTER, KIND_INNER, KIND_BALL = 1.0, 2.0, 3.0
@@ -460,15 +459,21 @@ class OffSizeBall(Fault):
 @register
 @dataclass(frozen=True)
 class RollingSlip(Fault):
-    """Random rolling slip of all bearings (paper 001 §5, §6.2.1) as a catalogue entry.
+    """Random rolling slip of all bearings (paper 001 §5, last assumption, and §6.2.1).
 
-    The same fields as the dynamics' ``SlipModel`` (handed over by
-    :func:`~cmsim.faults.compile.slip_from_faults`).
+    The one slip value: a catalogue entry (``rolling_slip``) and the ``slip`` argument of
+    :func:`cmsim.dynamics.simulate` alike. Two independent effects, both Ornstein-Uhlenbeck
+    processes with correlation time ``correlation_s``, drawn from the run's seed:
+
+    * the cage speed fluctuates by a fraction ``cage_speed_rms`` of its nominal value, so the
+      cage angle wanders like a random walk and the ball-pass lines spread over a band;
+    * each ball leads or lags its nominal place in the cage by a small angle of standard
+      deviation ``ball_rms_rad`` (cage-pocket play).
 
     Attributes
     ----------
     cage_speed_rms : float
-        Standard deviation of the relative cage-speed fluctuation, in [0, 0.2].
+        Standard deviation of the relative cage-speed fluctuation (0.01 = 1 %), in [0, 0.2].
     ball_rms_rad : float
         Standard deviation of each ball's angular deviation, rad, in [0, 0.05].
     correlation_s : float
@@ -487,6 +492,15 @@ class RollingSlip(Fault):
         check_range("correlation_s", self.correlation_s, 1e-5, 10.0, unit="s")
 
     @property
+    def active(self):
+        """True when any slip is requested."""
+        return self.cage_speed_rms > 0.0 or self.ball_rms_rad > 0.0
+
+    @property
     def label(self):
         return (f"rolling_slip cage={100 * self.cage_speed_rms:.3g}% "
                 f"ball={1e3 * self.ball_rms_rad:.3g}mrad")
+
+
+#: Rolling without slip (the paper's runs but §6.2.1): what a run without ``slip`` uses.
+NO_SLIP = RollingSlip(cage_speed_rms=0.0)

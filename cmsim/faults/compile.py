@@ -1,9 +1,10 @@
 """Faults → what the model consumes: :class:`FaultArrays`, a changed rig, slip, modulations.
 
-The contract with the dynamics kernel (:mod:`cmsim.dynamics._kernels` reads these arrays):
+The contract with the dynamics kernels (:mod:`cmsim.dynamics._bearing_kernels` and
+:mod:`cmsim.dynamics._mesh_kernels` read these arrays):
 :func:`compile_faults` turns a tuple of faults into one :class:`FaultArrays` (float64 arrays,
 all present, neutral when unused); :func:`rig_with_faults` applies the faults that are plain
-rig changes (bearing wear); :func:`slip_from_faults` gives the rolling-slip parameters,
+rig changes (bearing wear); :func:`slip_from_faults` picks the run's rolling slip,
 :func:`operating_modulation` the speed and torque factors, :func:`fault_frequencies` the
 answer key for a run's meta.
 
@@ -28,14 +29,15 @@ from cmsim.faults.bearing import (BallDefect, BearingWear, InnerRaceDefect, OffS
 from cmsim.faults.crack import crack_stiffness_factor
 from cmsim.faults.gear import (BREAKAGE_SEPARATION_M, Eccentricity, ProfileError, ToothBreakage,
                                ToothCrack, ToothSpall, roll_length_m)
-from cmsim.faults.operating import SpeedFluctuation, TorqueRipple
-from cmsim.frequencies import RigFrequencies
+from cmsim.faults.operating import (MAX_TOTAL_RELATIVE_AMPLITUDE, SpeedFluctuation,
+                                    TorqueRipple)
+from cmsim.frequencies import rig_frequencies
 from cmsim.mesh_stiffness.contact import table_range_m
 from cmsim.mesh_stiffness.geometry import ToothProfile
 from cmsim.mesh_stiffness.potential_energy import _path_length
 
-__all__ = ["FaultArrays", "compile_faults", "rig_with_faults", "slip_from_faults",
-           "operating_modulation", "fault_frequencies", "check_faults",
+__all__ = ["FaultArrays", "CheckedFaults", "compile_faults", "rig_with_faults",
+           "slip_from_faults", "operating_modulation", "fault_frequencies", "check_faults",
            "DEFECT_COLUMNS", "DEFAULT_GRID_POINTS"]
 
 #: Columns of ``FaultArrays.bearing_defects``.
@@ -101,8 +103,32 @@ class FaultArrays(NamedTuple):
         return self.has_bearing_defects or self.has_tooth_faults or self.has_eccentricity
 
 
+class CheckedFaults(tuple):
+    """A tuple of faults :func:`check_faults` validated against one rig (attribute ``rig``).
+
+    The functions of this module validate the faults they are given; handed a
+    ``CheckedFaults`` of the same rig (the same object), they trust it instead of validating
+    again, so a run validates its faults once however many steps read them.
+    """
+
+
 def check_faults(rig, faults):
-    """Validate ``faults`` (a Fault or an iterable of them) against ``rig``; return a tuple."""
+    """Validate ``faults`` (a Fault or an iterable of them) against ``rig``.
+
+    Parameters
+    ----------
+    rig : Rig
+        The rig as given (before the faults' own changes, e.g. wear).
+    faults : Fault or iterable of Fault
+        Catalogue entries; a :class:`CheckedFaults` of this rig is returned as is.
+
+    Returns
+    -------
+    CheckedFaults
+        The faults as a tuple that remembers the rig it was checked on.
+    """
+    if isinstance(faults, CheckedFaults) and faults.rig is rig:
+        return faults
     if isinstance(faults, Fault):
         faults = (faults,)
     faults = tuple(faults or ())
@@ -111,7 +137,9 @@ def check_faults(rig, faults):
             raise ParameterError(f"faults[{i}] must be a Fault (see cmsim.faults), got "
                                  f"{type(f).__name__}", param="faults")
         f.validate(rig)
-    return faults
+    checked = CheckedFaults(faults)
+    checked.rig = rig
+    return checked
 
 
 def _load_zone_angle(rig, bearing_index, op):
@@ -176,6 +204,8 @@ def compile_faults(rig, faults, mesh_table=None, *, op=None):
     Parameters
     ----------
     rig : Rig
+        The rig the faults are checked on (:func:`check_faults`); the arrays do not depend
+        on the clearances that wear changes.
     faults : iterable of Fault
         Any catalogue entries; those that are not kernel arrays (wear, slip, speed and torque
         modulations) are ignored here (see :func:`rig_with_faults`, :func:`slip_from_faults`,
@@ -287,12 +317,11 @@ def rig_with_faults(rig, faults):
 
 
 def slip_from_faults(faults):
-    """Keyword arguments of the dynamics' ``SlipModel`` from a ``rolling_slip`` fault.
+    """The ``rolling_slip`` fault among ``faults`` (the run's slip), or ``None``.
 
     Returns
     -------
-    dict or None
-        ``{"cage_speed_rms", "ball_rms_rad", "correlation_s"}`` (``SlipModel(**d)``), or
+    RollingSlip or None
         ``None`` without a ``rolling_slip`` fault. Two of them are refused.
     """
     slips = [f for f in (faults or ()) if isinstance(f, RollingSlip)]
@@ -300,9 +329,7 @@ def slip_from_faults(faults):
         return None
     if len(slips) > 1:
         raise ParameterError("faults may hold at most one rolling_slip", param="rolling_slip")
-    f = slips[0]
-    return {"cage_speed_rms": f.cage_speed_rms, "ball_rms_rad": f.ball_rms_rad,
-            "correlation_s": f.correlation_s}
+    return slips[0]
 
 
 def operating_modulation(faults, op=None, rig=None):
@@ -336,9 +363,10 @@ def operating_modulation(faults, op=None, rig=None):
             return None
         lines = np.array([ln for f in items for ln in f.lines(rates)], dtype=float)
         total = float(lines[:, 1].sum())
-        if total > 0.5:
-            raise ParameterError(f"relative_amplitude must sum to at most 0.5 over all "
-                                 f"modulation faults, got {total:g}",
+        if total > MAX_TOTAL_RELATIVE_AMPLITUDE:
+            raise ParameterError(f"relative_amplitude must sum to at most "
+                                 f"{MAX_TOTAL_RELATIVE_AMPLITUDE:g} over all modulation faults, "
+                                 f"got {total:g}",
                                  param="relative_amplitude")
         freq, amp, ph = (np.ascontiguousarray(lines[:, k]) for k in range(3))
 
@@ -367,7 +395,7 @@ def fault_frequencies(rig, op, faults):
         ``{label: {"type": name, <key>_hz: value, ...}}`` in fault order (JSON-ready).
     """
     faults = check_faults(rig, faults)
-    fr = RigFrequencies.of(rig_with_faults(rig, faults), op)
+    fr = rig_frequencies(rig_with_faults(rig, faults), op)
     rates = {1: fr.fr1_hz}
     if fr.fr2_hz is not None:
         rates[2] = fr.fr2_hz

@@ -25,7 +25,7 @@ run's own table (hybrid or potential energy) for that tooth only.
 Finite-element variant (``method="fe"``)
 -----------------------------------------
 The crack is cut into the in-house FE mesh of the whole gear body
-(:class:`~cmsim.mesh_stiffness.fe_mesh.RootCrack`: same start, angle and depth; nodes
+(:class:`~cmsim.mesh_stiffness.root_crack.RootCrack`: same start, angle and depth; nodes
 duplicated along the faces, which are traction-free — the faces' contact when the crack
 closes is ignored, which matters only for loads on the other flank). The cracked tooth's
 influence coefficients λ(d; ρ_a, ρ_b) come from the same solve as the healthy ones
@@ -88,7 +88,7 @@ import math
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.mesh_stiffness.fe_mesh import MeshSpec, RootCrack, crack_start_point
+from cmsim.mesh_stiffness.fe_mesh import MeshSpec
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
 from cmsim.mesh_stiffness.influence import influence_table
 from cmsim.mesh_stiffness.local_deflection import (contact_modulus, hertz_half_width,
@@ -96,6 +96,7 @@ from cmsim.mesh_stiffness.local_deflection import (contact_modulus, hertz_half_w
 from cmsim.mesh_stiffness.potential_energy import (
     ToothCompliance, _involute_domain, _path_length, cantilever_compliance,
     fillet_foundation_compliance, pair_compliance_potential_energy)
+from cmsim.mesh_stiffness.root_crack import RootCrack, crack_start_point
 
 __all__ = ["crack_start", "crack_tip_offset_m", "max_crack_depth_m", "cracked_tooth_compliance",
            "crack_stiffness_factor", "fe_pair_compliance", "mesh_stiffness_loss",
@@ -112,7 +113,7 @@ def crack_start(profile):
 
     The point of the loaded-side fillet where the tangent makes 30° with the tooth centreline
     (ISO 6336-3 critical section), found on the tooth outline by finite differences
-    (:func:`cmsim.mesh_stiffness.fe_mesh.crack_start_point`, shared with the FE crack).
+    (:func:`cmsim.mesh_stiffness.root_crack.crack_start_point`, shared with the FE crack).
     """
     return crack_start_point(profile)
 
@@ -278,7 +279,7 @@ def fe_pair_compliance(pair, position_m, load_n=DEFAULT_FE_LOAD_N, use_cache=Tru
     the whole gear body clamped at its bore) and u_L the Hertz/Weber-Banaschek local
     approach (:func:`~cmsim.mesh_stiffness.local_deflection.local_approach`) at the force F.
     With a crack, the cracked gear's λ(0) comes from its mesh with the crack cut in
-    (:class:`~cmsim.mesh_stiffness.fe_mesh.RootCrack`, traction-free faces, cached on disk
+    (:class:`~cmsim.mesh_stiffness.root_crack.RootCrack`, traction-free faces, cached on disk
     keyed by geometry and crack). The coupling of the pair to the other pairs in contact
     (λ(d ≠ 0)) is left out, as in the potential-energy method; it changes little with the
     crack (module docstring).

@@ -52,15 +52,37 @@ def _check_spectrum(spectrum):
 
 @dataclass(frozen=True)
 class _Modulation(Fault):
-    """Common checks and evaluation of a relative sinusoidal modulation."""
+    """Common checks and evaluation of a relative sinusoidal modulation.
 
-    def _check_total(self, lines):
-        total = sum(a for _, a, _ in lines)
+    Subclasses hold ``relative_amplitude``, ``phase_rad`` and ``spectrum`` and say how their
+    single line's frequency is given (:meth:`_check_line`) and what else they check
+    (:meth:`_check_fields`).
+    """
+
+    def __post_init__(self):
+        check_range("relative_amplitude", self.relative_amplitude, 0.0,
+                    MAX_TOTAL_RELATIVE_AMPLITUDE)
+        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+        object.__setattr__(self, "spectrum", _check_spectrum(self.spectrum))
+        self._check_fields()
+        if self.relative_amplitude > 0:
+            self._check_line()
+        elif not self.spectrum:
+            raise ParameterError("relative_amplitude must be > 0 (or give a spectrum)",
+                                 param="relative_amplitude", allowed="in (0, 0.5]")
+        total = sum([self.relative_amplitude] + [a for _, a, _ in self.spectrum])
         if total > MAX_TOTAL_RELATIVE_AMPLITUDE:
             raise ParameterError(
                 f"relative_amplitude must sum to at most {MAX_TOTAL_RELATIVE_AMPLITUDE:g} "
                 f"over all lines, got {total:g}", param="relative_amplitude",
                 allowed=f"a total in [0, {MAX_TOTAL_RELATIVE_AMPLITUDE:g}]")
+
+    def _check_fields(self):
+        """Checks of the subclass's own fields (none by default)."""
+
+    def _check_line(self):
+        """Check how the single line's frequency is given (``relative_amplitude > 0``)."""
+        raise NotImplementedError
 
     def factor(self, t, shaft_hz=None):
         """1 + Σ ε_k sin(2π f_k t + φ_k) at times ``t`` (s), same shape as ``t``."""
@@ -95,21 +117,11 @@ class SpeedFluctuation(_Modulation):
     phase_rad: float = 0.0
     spectrum: tuple = ()
 
-    def __post_init__(self):
-        check_range("relative_amplitude", self.relative_amplitude, 0.0,
-                    MAX_TOTAL_RELATIVE_AMPLITUDE)
-        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
-        object.__setattr__(self, "spectrum", _check_spectrum(self.spectrum))
-        if self.relative_amplitude > 0:
-            if self.frequency_hz is None:
-                raise ParameterError("frequency_hz must be given with relative_amplitude "
-                                     "(a number > 0 Hz)", param="frequency_hz",
-                                     allowed="> 0 Hz")
-            check_range("frequency_hz", self.frequency_hz, 0.0, 1e5, lo_open=True, unit="Hz")
-        elif not self.spectrum:
-            raise ParameterError("relative_amplitude must be > 0 (or give a spectrum)",
-                                 param="relative_amplitude", allowed="in (0, 0.5]")
-        self._check_total(self.lines())
+    def _check_line(self):
+        if self.frequency_hz is None:
+            raise ParameterError("frequency_hz must be given with relative_amplitude "
+                                 "(a number > 0 Hz)", param="frequency_hz", allowed="> 0 Hz")
+        check_range("frequency_hz", self.frequency_hz, 0.0, 1e5, lo_open=True, unit="Hz")
 
     def lines(self, shaft_hz=None):
         """All lines as (frequency Hz, relative amplitude, phase rad)."""
@@ -153,28 +165,20 @@ class TorqueRipple(_Modulation):
     phase_rad: float = 0.0
     spectrum: tuple = ()
 
-    def __post_init__(self):
-        check_range("relative_amplitude", self.relative_amplitude, 0.0,
-                    MAX_TOTAL_RELATIVE_AMPLITUDE)
-        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
-        object.__setattr__(self, "spectrum", _check_spectrum(self.spectrum))
+    def _check_fields(self):
         if self.shaft not in (1, 2) or isinstance(self.shaft, bool):
             raise ParameterError(f"shaft must be 1 or 2, got {self.shaft!r}", param="shaft",
                                  allowed="1 or 2")
-        if self.relative_amplitude > 0:
-            if (self.frequency_hz is None) == (self.order is None):
-                raise ParameterError("give exactly one of frequency_hz and order with "
-                                     "relative_amplitude", param="frequency_hz",
-                                     allowed="frequency_hz > 0 Hz or order > 0")
-            if self.frequency_hz is not None:
-                check_range("frequency_hz", self.frequency_hz, 0.0, 1e5, lo_open=True,
-                            unit="Hz")
-            else:
-                check_range("order", self.order, 0.0, 1e3, lo_open=True)
-        elif not self.spectrum:
-            raise ParameterError("relative_amplitude must be > 0 (or give a spectrum)",
-                                 param="relative_amplitude", allowed="in (0, 0.5]")
-        self._check_total([(0.0, self.relative_amplitude, 0.0)] + list(self.spectrum))
+
+    def _check_line(self):
+        if (self.frequency_hz is None) == (self.order is None):
+            raise ParameterError("give exactly one of frequency_hz and order with "
+                                 "relative_amplitude", param="frequency_hz",
+                                 allowed="frequency_hz > 0 Hz or order > 0")
+        if self.frequency_hz is not None:
+            check_range("frequency_hz", self.frequency_hz, 0.0, 1e5, lo_open=True, unit="Hz")
+        else:
+            check_range("order", self.order, 0.0, 1e3, lo_open=True)
 
     def lines(self, shaft_hz=None):
         """All lines as (frequency Hz, relative amplitude, phase rad).

@@ -34,8 +34,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from cmsim.bearings.kinematics import cage_speed_ratios
 from cmsim.errors import check_range
+from cmsim.frequencies import cage_speed_ratios
 
 __all__ = ["BearingFriction", "RingKinematics", "ring_kinematics", "bearing_friction_torque",
            "static_load_rating_n", "ISO76_FACTOR_N_PER_M2"]

@@ -167,7 +167,8 @@ def friction_table_for(rig, op, mesh_table, roughness_m, viscosity_pa_s, *,
     op : OperatingPoint
         Speed and torque (the film and the pressure follow them).
     mesh_table : MeshStiffnessTable
-        The run's table (``build_model(rig, op, mesh).mesh_table``): its grid and load sharing.
+        The run's table (``resolve_mesh(rig, mesh, op.torque_nm)[0]``): its grid and load
+        sharing.
     roughness_m : float
         Composite RMS roughness σ, m (0 < σ <= 50 µm).
     viscosity_pa_s : float

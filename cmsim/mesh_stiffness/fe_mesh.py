@@ -11,7 +11,8 @@ Mesh generator
 No mesh generator ships with scikit-fem, and the maintained constrained-Delaunay packages
 (Triangle, via ``triangle``/``meshpy``; Gmsh) carry licences (non-commercial, GPL) that do not
 sit with an MIT package, so the mesh is made here with the force-equilibrium smoothing of
-Persson & Strang [1] ("DistMesh") on top of :func:`scipy.spatial.Delaunay`:
+Persson & Strang [1] ("DistMesh", :mod:`cmsim.mesh_stiffness.distmesh`) on top of
+:func:`scipy.spatial.Delaunay`:
 
 * the boundary (gear outline and bore circle) is sampled at the local target size ``h(x)``
   and these points are fixed, so every boundary node lies exactly on the true curve;
@@ -33,15 +34,16 @@ triangles, smallest angle ≈ 22°) takes ≈ 8 s.
 
 Root crack
 ----------
-:class:`RootCrack` cuts a straight root crack into tooth 0 (mouth at the loaded fillet's 30°
-tangent point, angle ν, length q, as :mod:`cmsim.faults.crack`): its nodes (spacing
-``h_crack``, mesh refined to ``h_crack`` along it and half of it at the tip) are fixed points
-of the DistMesh smoothing, the mouth replaces the nearest outline node, free points inside
-the diametral circle of a crack segment are dropped (so every segment is a Delaunay edge),
-and after triangulation every crack node but the tip is duplicated and the triangles on the
-tooth-tip side of the crack are renumbered to the duplicates (traction-free faces; contact
-of the faces when the crack closes is not modelled). The crack is checked: every segment
-is an edge, both faces are chains of boundary facets, no triangle touches both faces.
+:class:`~cmsim.mesh_stiffness.root_crack.RootCrack` cuts a straight root crack into tooth 0
+(mouth at the loaded fillet's 30° tangent point, angle ν, length q, as
+:mod:`cmsim.faults.crack`): its nodes (spacing ``h_crack``, mesh refined to ``h_crack``
+along it and half of it at the tip) are fixed points of the DistMesh smoothing, the mouth
+replaces the nearest outline node, free points inside the diametral circle of a crack
+segment are dropped (so every segment is a Delaunay edge), and after triangulation every
+crack node but the tip is duplicated and the triangles on the tooth-tip side of the crack
+are renumbered to the duplicates (traction-free faces; contact of the faces when the crack
+closes is not modelled). The crack is checked: every segment is an edge, both faces are
+chains of boundary facets, no triangle touches both faces.
 
 gmsh
 ----
@@ -85,24 +87,16 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.spatial import Delaunay, cKDTree
+from scipy.spatial import cKDTree
 
 from cmsim.errors import ParameterError, check_range
+from cmsim.mesh_stiffness.distmesh import (check_boundary_loops, distmesh_smooth, hex_lattice,
+                                           orient, thin_points, triangulate)
 from cmsim.mesh_stiffness.geometry import ToothProfile
+from cmsim.mesh_stiffness.root_crack import RootCrack
 from cmsim.rig import SpurGear
 
-__all__ = ["MeshSpec", "GearMesh", "RootCrack", "gear_mesh", "tooth_rotation_rad",
-           "crack_start_point", "CRITICAL_TANGENT_RAD"]
-
-#: Tangent angle to the centreline at the critical section (ISO 6336-3), rad: a root
-#: crack starts where the loaded fillet's tangent makes this angle with the centreline.
-CRITICAL_TANGENT_RAD = math.radians(30.0)
-
-#: DistMesh constants [1]: internal pressure factor, pseudo time step, stop tolerance.
-_FSCALE, _DELTAT, _DPTOL = 1.2, 0.2, 2e-3
-#: Re-triangulate when a point moved more than this fraction of its local size.
-_TTOL = 0.1
-
+__all__ = ["MeshSpec", "GearMesh", "gear_mesh", "tooth_rotation_rad"]
 
 @dataclass(frozen=True)
 class MeshSpec:
@@ -223,116 +217,6 @@ class GearMesh:
                        np.ascontiguousarray(self.triangles.T))
         return mesh.with_boundaries(
             {"bore": lambda x: np.hypot(x[0], x[1]) < r_bore + tol})
-
-
-_START_CACHE = {}
-
-
-def crack_start_point(profile):
-    """(y_s, h_c): height from the gear centre and half-thickness of a root crack's start, m.
-
-    The point of the loaded-side (right) fillet where the tangent makes
-    :data:`CRITICAL_TANGENT_RAD` (30°) with the tooth centreline (ISO 6336-3 critical
-    section), found by finite differences on the outline of the default resolution (so
-    the answer does not depend on how finely ``profile`` was sampled).
-
-    Parameters
-    ----------
-    profile : ToothProfile
-
-    Returns
-    -------
-    (float, float)
-    """
-    key = profile.gear
-    if key not in _START_CACHE:
-        profile = ToothProfile.from_gear(key)
-        y = np.linspace(profile.root_chord_y_m, profile.tip_radius_m, 4001)
-        h = profile.half_thickness_at(y)
-        slope = np.abs(np.gradient(h, y))
-        below = np.nonzero(slope <= math.tan(CRITICAL_TANGENT_RAD))[0]
-        i = int(below[0]) if below.size else 0
-        _START_CACHE[key] = (float(y[i]), float(h[i]))
-    return _START_CACHE[key]
-
-
-@dataclass(frozen=True)
-class RootCrack:
-    """A straight root crack in the loaded fillet of tooth 0, cut into the mesh.
-
-    The crack starts (its *mouth*) at the 30° tangent point of the right (loaded, tension
-    side) fillet, (h_c, y_s) of :func:`crack_start_point`, and runs a length q towards the
-    centreline and the gear centre at the angle ν to the centreline, direction
-    (−sin ν, −cos ν); its tip is at h_c − q sin ν from the centreline (Chaari et al. 2009,
-    as :mod:`cmsim.faults.crack`). Its faces are traction-free: contact of the faces when
-    the crack closes (under compression, e.g. load on the other flank) is not modelled.
-
-    Attributes
-    ----------
-    depth_m : float
-        Crack length q, m (> 0, tip at most on the centreline: q sin ν <= h_c).
-    angle_rad : float
-        ν, rad, in (0, π/2].
-    h_crack : float
-        Element size along the crack faces, in modules (0.03); the tip gets half of it.
-    """
-
-    depth_m: float
-    angle_rad: float = math.pi / 4
-    h_crack: float = 0.03
-
-    def __post_init__(self):
-        check_range("depth_m", self.depth_m, 0.0, 0.05, lo_open=True, unit="m")
-        check_range("angle_rad", self.angle_rad, 0.0, 0.5 * math.pi, lo_open=True, unit="rad")
-        check_range("h_crack", self.h_crack, 1e-3, 0.5, unit="modules")
-
-    def as_dict(self):
-        """Plain dict of the fields (for cache keys and provenance)."""
-        return {k: getattr(self, k) for k in self.__dataclass_fields__}
-
-    def path_m(self, profile):
-        """Mouth, direction (unit) and tip of the crack in the frame of tooth 0, m.
-
-        Parameters
-        ----------
-        profile : ToothProfile
-            The tooth (its gear sets the crack start, :func:`crack_start_point`).
-
-        Returns
-        -------
-        (ndarray, ndarray, ndarray)
-            Mouth (2,), m; unit direction (2,); tip (2,), m.
-
-        Raises
-        ------
-        ParameterError
-            If the tip would pass the tooth centreline (q sin ν > h_c).
-        """
-        y_s, h_c = crack_start_point(profile)
-        qmax = h_c / math.sin(self.angle_rad)
-        check_range("depth_m", self.depth_m, 0.0, qmax, lo_open=True,
-                    unit=f"m (crack tip at most on the tooth centreline: {qmax * 1e3:.4g} mm)")
-        mouth = np.array([h_c, y_s])
-        direction = np.array([-math.sin(self.angle_rad), -math.cos(self.angle_rad)])
-        return mouth, direction, mouth + self.depth_m * direction
-
-    def nodes_m(self, profile):
-        """Points along the crack from the mouth to the tip, spaced <= h_crack, m.
-
-        Parameters
-        ----------
-        profile : ToothProfile
-
-        Returns
-        -------
-        ndarray, shape (n + 1, 2)
-            Mouth first, tip last (n >= 2 segments).
-        """
-        mouth, direction, _ = self.path_m(profile)
-        h = self.h_crack * profile.gear.module_m
-        n = max(2, int(math.ceil(self.depth_m / h)))
-        t = self.depth_m * np.arange(n + 1) / n
-        return mouth + t[:, None] * direction
 
 
 def tooth_rotation_rad(gear, offset):
@@ -460,18 +344,6 @@ class _Geometry:
         return h
 
 
-def _hex_lattice(lo, hi, h):
-    dy = h * math.sqrt(3.0) / 2.0
-    ny = int(math.ceil((hi[1] - lo[1]) / dy)) + 1
-    nx = int(math.ceil((hi[0] - lo[0]) / h)) + 1
-    if nx * ny > 5_000_000:
-        raise ParameterError("mesh too fine for the lattice initialisation (> 5e6 candidates)")
-    j, i = np.meshgrid(np.arange(ny), np.arange(nx), indexing="ij")
-    x = lo[0] + h * (i + 0.5 * (j % 2))
-    y = lo[1] + dy * j
-    return np.column_stack([x.ravel(), y.ravel()])
-
-
 def _sample_by_size(curve, h_mid, closed, phase=0.0):
     """Parameters (cumulative index positions) of points spaced h along a polyline."""
     seg = np.hypot(*np.diff(curve, axis=0).T)
@@ -511,27 +383,6 @@ def _boundary_points(gear, profile, geo):
     return outline, bore
 
 
-def _thin(candidates, h, accepted_tree, factor=0.75):
-    """Keep candidates at least ``factor·h`` from accepted points and from each other."""
-    if candidates.shape[0] == 0:
-        return candidates
-    d = accepted_tree.query(candidates, workers=-1)[0]
-    ok = d >= factor * h
-    candidates, h = candidates[ok], h[ok]
-    # greedy among themselves, in order
-    pairs = cKDTree(candidates).query_pairs(factor * float(np.max(h)) if h.size else 0.0,
-                                            output_type="ndarray")
-    if pairs.size:
-        dist = np.hypot(*(candidates[pairs[:, 0]] - candidates[pairs[:, 1]]).T)
-        close = dist < factor * np.minimum(h[pairs[:, 0]], h[pairs[:, 1]])
-        keep = np.ones(candidates.shape[0], dtype=bool)
-        for a, b in pairs[close][np.argsort(pairs[close][:, 0], kind="stable")]:
-            if keep[a] and keep[b]:
-                keep[b] = False
-        candidates = candidates[keep]
-    return candidates
-
-
 def _interior_points(gear, profile, geo, fixed):
     """Initial interior points: layers parallel to the outline, then a lattice in the web.
 
@@ -561,92 +412,17 @@ def _interior_points(gear, profile, geo, fixed):
                             phase=0.5 * (layer % 2))
         idx = np.minimum(np.round(u).astype(np.int64), loop.shape[0] - 1)
         cand = _at(closed, u)[active[idx]]
-        cand = _thin(cand, geo.size(cand), tree)
+        cand = thin_points(cand, geo.size(cand), tree)
         if cand.size:
             accepted.append(cand)
             tree = cKDTree(np.concatenate(accepted))
     r = gear.tip_radius_m
-    lattice = _hex_lattice(np.array([-r, -r]), np.array([r, r]), geo.h_body)
+    lattice = hex_lattice(np.array([-r, -r]), np.array([r, r]), geo.h_body)
     h_l = geo.size(lattice)
     ok = geo.distance(lattice) < -0.5 * h_l
-    lattice = _thin(lattice[ok], h_l[ok], tree)
+    lattice = thin_points(lattice[ok], h_l[ok], tree)
     accepted.append(lattice)
     return np.concatenate(accepted[1:])
-
-
-def _triangulate(p, geo):
-    tri = Delaunay(p).simplices
-    centroids = p[tri].mean(axis=1)
-    return tri[geo.distance(centroids) < 0.0]
-
-
-def _distmesh(fixed, interior, geo, max_iterations):
-    """Persson-Strang smoothing of the interior points with the boundary points fixed."""
-    nf = fixed.shape[0]
-    p = np.vstack([fixed, interior])
-    p_old = np.full_like(p, np.inf)
-    tri, h_pt = None, None
-    for _ in range(max_iterations):
-        if tri is None or np.max(np.hypot(*(p - p_old).T) / h_pt) > _TTOL:
-            p_old = p.copy()
-            tri = _triangulate(p, geo)
-            bars = np.vstack([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
-            bars = np.unique(np.sort(bars, axis=1), axis=0)
-            h_pt = geo.size(p)
-            d_pt = geo.distance(p)
-            hbars = 0.5 * (h_pt[bars[:, 0]] + h_pt[bars[:, 1]])
-            near = np.nonzero(d_pt[nf:] > -3.0 * h_pt[nf:])[0] + nf
-        vec = p[bars[:, 0]] - p[bars[:, 1]]
-        length = np.hypot(vec[:, 0], vec[:, 1])
-        l0 = hbars * _FSCALE * math.sqrt(np.sum(length ** 2) / np.sum(hbars ** 2))
-        force = np.maximum(l0 - length, 0.0)
-        fvec = (force / length)[:, None] * vec
-        ftot = np.zeros_like(p)
-        np.add.at(ftot, bars[:, 0], fvec)
-        np.add.at(ftot, bars[:, 1], -fvec)
-        ftot[:nf] = 0.0
-        step = _DELTAT * ftot
-        p = p + step
-        # interior points pushed out of the body (or onto the boundary) are dropped
-        bad = near[geo.distance(p[near]) > -0.1 * h_pt[near]]
-        if bad.size:
-            keep = np.ones(p.shape[0], dtype=bool)
-            keep[bad] = False
-            p = p[keep]
-            tri = None
-            continue
-        if np.max(np.hypot(*step[nf:].T) / h_pt[nf:]) < _DPTOL:
-            break
-    return p, _triangulate(p, geo)
-
-
-def _orient(p, tri):
-    a, b, c = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
-    area2 = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-    tri = tri.copy()
-    neg = area2 < 0
-    tri[neg] = tri[neg][:, [0, 2, 1]]
-    return tri, np.abs(area2)
-
-
-def _check_boundary(tri, n_outline, n_bore, n_points):
-    """Raise unless the boundary facets form the two expected closed loops."""
-    edges = np.sort(np.vstack([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
-    uniq, count = np.unique(edges, axis=0, return_counts=True)
-    bnd = uniq[count == 1]
-    expected = set()
-    for start, n in ((0, n_outline), (n_outline, n_bore)):
-        idx = start + np.arange(n)
-        nxt = start + (np.arange(n) + 1) % n
-        expected |= {(min(a, b), max(a, b)) for a, b in zip(idx, nxt)}
-    found = {tuple(e) for e in bnd}
-    if found != expected:
-        raise ParameterError(
-            f"gear mesh generation failed: {len(found ^ expected)} boundary facets do not "
-            "follow the outline (try a finer MeshSpec)")
-    used = np.zeros(n_points, dtype=bool)
-    used[tri.ravel()] = True
-    return used
 
 
 def _clear_crack(p, nf, nodes, geo):
@@ -662,7 +438,7 @@ def _clear_crack(p, nf, nodes, geo):
     keep = np.ones(p.shape[0], dtype=bool)
     keep[nf:] = d > 1.15 * rad[i]
     p = p[keep]
-    return p, _triangulate(p, geo)
+    return p, triangulate(p, geo)
 
 
 def _cut_crack(p, tri, nodes, direction):
@@ -756,15 +532,15 @@ def gear_mesh(gear, spec=MeshSpec(), crack=None):
         outline[i_mouth] = cnodes[0]
     fixed = np.vstack([outline, bore, cnodes[1:]])
     interior = _interior_points(gear, profile, geo, fixed)
-    p, tri = _distmesh(fixed, interior, geo, spec.max_iterations)
+    p, tri = distmesh_smooth(fixed, interior, geo, spec.max_iterations)
     crack_idx = np.concatenate([[i_mouth], outline.shape[0] + bore.shape[0]
                                 + np.arange(cnodes.shape[0] - 1)]).astype(np.int64)
     if crack is not None:
         p, tri = _clear_crack(p, fixed.shape[0], cnodes, geo)
-    tri, area2 = _orient(p, tri)
+    tri, area2 = orient(p, tri)
     if np.any(area2 <= 1e-12 * geo.h_body ** 2):
         tri = tri[area2 > 1e-12 * geo.h_body ** 2]
-    used = _check_boundary(tri, outline.shape[0], bore.shape[0], p.shape[0])
+    used = check_boundary_loops(tri, outline.shape[0], bore.shape[0], p.shape[0])
     # renumber without unused interior points
     new = -np.ones(p.shape[0], dtype=np.int64)
     new[used] = np.arange(np.count_nonzero(used))

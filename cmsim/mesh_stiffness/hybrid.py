@@ -126,6 +126,23 @@ class HybridMeshModel:
         t2 = t1 if pair.driven == pair.driving else influence_table(pair.driven, **kw)
         return cls.from_tables(pair, t1, t2)
 
+    def check_pair(self, pair):
+        """Refuse a gear ``pair`` other than the one this model was built for.
+
+        Parameters
+        ----------
+        pair : GearPair
+            The rig's gears.
+
+        Raises
+        ------
+        ParameterError
+            Naming ``mesh`` (the argument that carries a model into a run).
+        """
+        if self.pair != pair:
+            raise ParameterError("mesh: the hybrid model was built for a different gear pair "
+                                 "than the rig's")
+
     @classmethod
     def from_tables(cls, pair, driving, driven):
         """Model from given influence tables (no FE)."""

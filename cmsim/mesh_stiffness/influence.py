@@ -52,9 +52,10 @@ import numpy as np
 
 from cmsim.errors import ParameterError, check_range
 from cmsim.mesh_stiffness import cache
-from cmsim.mesh_stiffness.fe_mesh import MeshSpec, RootCrack, tooth_rotation_rad
+from cmsim.mesh_stiffness.fe_mesh import MeshSpec, tooth_rotation_rad
 from cmsim.mesh_stiffness.fe_model import PLANE_MODES, GearBodyModel
 from cmsim.mesh_stiffness.geometry import ToothProfile
+from cmsim.mesh_stiffness.root_crack import RootCrack
 from cmsim.rig import SpurGear
 
 __all__ = ["InfluenceTable", "influence_table", "compute_influence_table", "flank_points",
@@ -334,7 +335,7 @@ def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_st
         An already assembled model of ``gear`` with ``spec``, ``plane`` and ``crack`` to use
         on a cache miss (saves the mesh generation and factorisation).
     crack : RootCrack, optional
-        A root crack cut into the loaded tooth 0 (:mod:`~cmsim.mesh_stiffness.fe_mesh`):
+        A root crack cut into the loaded tooth 0 (:mod:`~cmsim.mesh_stiffness.root_crack`):
         the table then holds the cracked tooth's own coefficients (offset 0) and its
         coupling to the healthy teeth ±1..±J (load on the cracked tooth). Part of the
         cache key.

@@ -46,10 +46,12 @@ from cmsim.mesh_stiffness.hybrid import HybridMeshModel, work_size
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
 __all__ = ["QuasiStaticMesh", "MeshCycle", "quasi_static_mesh", "mesh_cycle",
-           "slot_contacts"]
+           "hybrid_mesh_table", "slot_contacts"]
 
 #: A pair counts as loaded above this fraction of the total normal force.
 LOADED_FRACTION = 1e-9
+
+_HYBRID_TABLES = {}
 
 
 def slot_contacts(pair, theta1_rad, theta2_rad, centre1_m=(0.0, 0.0), centre2_m=(0.0, 0.0),
@@ -327,3 +329,30 @@ def mesh_cycle(model, torque_nm, centre1_m=(0.0, 0.0), centre2_m=(0.0, 0.0), n_s
                                "hybrid", torque_nm=float(torque_nm), meta=meta)
     return MeshCycle(torque_nm=float(torque_nm), states=states, table=table,
                      seconds=time.perf_counter() - t0)
+
+
+def hybrid_mesh_table(model, output_torque_nm):
+    """Hybrid table of one mesh cycle at the driving torque that ``output_torque_nm`` needs.
+
+    The on-line contact (paper 001 model A) uses it for the mesh damping coefficient (from
+    its mean stiffness) and the quasi-static start guess. Memoised per (model, torque).
+
+    Parameters
+    ----------
+    model : HybridMeshModel
+        Influence tables of the gear pair.
+    output_torque_nm : float
+        Output torque, N·m (below 1e-3 N·m the table at 1e-3 N·m).
+
+    Returns
+    -------
+    MeshStiffnessTable
+        :func:`mesh_cycle` table with 24 steps at the driving torque T_out·Z1/Z2.
+    """
+    pair = model.pair
+    drive = max(output_torque_nm, 1e-3) * pair.driving.n_teeth / pair.driven.n_teeth
+    key = (id(model), drive)
+    if key not in _HYBRID_TABLES:
+        # the model is kept with its table, so its id is not reused while the entry lives
+        _HYBRID_TABLES[key] = (model, mesh_cycle(model, drive, n_steps=24).table)
+    return _HYBRID_TABLES[key][1]

@@ -1,9 +1,10 @@
 """Which tooth-contact model a run uses: the paper's model B by default.
 
-:func:`resolve_mesh` turns the ``mesh`` argument of :func:`cmsim.dynamics.simulate`,
-:func:`cmsim.dynamics.model.build_model`, :func:`cmsim.dynamics.modal.modal_analysis` and the
-``--mesh`` / ``--mesh-table`` options of the ``cmsim`` command into the pair stiffness table
-the dynamics uses and, for the on-line contact (model A), the hybrid contact model:
+:func:`resolve_mesh` turns the ``mesh`` argument of :func:`cmsim.dynamics.simulate` and
+:func:`cmsim.dynamics.modal.modal_analysis`, and the ``--mesh`` / ``--mesh-table`` options of
+the ``cmsim`` command, into the pair the model is built with
+(:func:`cmsim.dynamics.model.build_model`): the pair stiffness table the dynamics uses and,
+for the on-line contact (model A), the hybrid contact model:
 
 ``None`` or ``"hybrid-tables"`` (default)
     Paper 001 §6.1 model B: the rig's hybrid FE + Weber–Banaschek tables
@@ -27,7 +28,7 @@ a :class:`~cmsim.mesh_stiffness.hybrid.HybridMeshModel`
     Model A with this model.
 
 Where the tables come from. The paper's rig (:meth:`cmsim.rig.Rig.paper_2016`) ships them as
-package data (:data:`PAPER_TABLES_FILE`, rebuilt by ``python -m cmsim.dynamics.mesh_choice``),
+package data (:data:`PAPER_TABLES_FILE`, rebuilt by ``python -m cmsim.dynamics.tooth_contact``),
 so a fresh install runs without an FE build. The file stores the hash of the rig parameters
 the tables depend on (:func:`tables_key`: gears, shafts with their bearings, couplings); a rig
 whose set is shipped or cached (:func:`hybrid_table_set` builds and caches a whole set, e.g.
@@ -54,14 +55,13 @@ from cmsim.dynamics import torque_tables as table_builder
 from cmsim.errors import ParameterError, check_range
 from cmsim.mesh_stiffness import cache
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
-from cmsim.mesh_stiffness.mesh_cycle import mesh_cycle
+from cmsim.mesh_stiffness.mesh_cycle import hybrid_mesh_table
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
 from cmsim.rig import Rig
 
 __all__ = ["resolve_mesh", "hybrid_table_set", "tables_key", "default_mesh_table",
-           "hybrid_mesh_table", "build_paper_tables", "MESH_CHOICES", "TORQUE_GRID_NM",
-           "PAPER_TABLES_FILE"]
+           "build_paper_tables", "MESH_CHOICES", "TORQUE_GRID_NM", "PAPER_TABLES_FILE"]
 
 #: Names accepted for ``mesh`` (the first is the default).
 MESH_CHOICES = ("hybrid-tables", "potential-energy", "hybrid")
@@ -84,7 +84,6 @@ PAPER_TABLES_FILE = "data/paper_2016_hybrid_tables.npz"
 _SETS = {}
 _ABOVE = {}
 _PE_CACHE = {}
-_HYBRID_CACHE = {}
 
 
 def tables_key(rig):
@@ -111,20 +110,6 @@ def default_mesh_table(pair):
     if pair not in _PE_CACHE:
         _PE_CACHE[pair] = MeshStiffnessTable.potential_energy(pair)
     return _PE_CACHE[pair]
-
-
-def hybrid_mesh_table(mesh_model, output_torque_nm):
-    """Hybrid table of one mesh cycle at the driving torque that ``output_torque_nm`` needs.
-
-    Memoised per (model, torque): model A uses it for the mesh damping coefficient (from its
-    mean stiffness) and the quasi-static start guess.
-    """
-    pair = mesh_model.pair
-    drive = max(output_torque_nm, 1e-3) * pair.driving.n_teeth / pair.driven.n_teeth
-    key = (id(mesh_model), drive)
-    if key not in _HYBRID_CACHE:
-        _HYBRID_CACHE[key] = (mesh_model, mesh_cycle(mesh_model, drive, n_steps=24).table)
-    return _HYBRID_CACHE[key][1]
 
 
 def _bar_progress(progress, n, what):
@@ -288,9 +273,7 @@ def resolve_mesh(rig, mesh, torque_nm, *, progress=None):
     if mesh == "hybrid":
         mesh = HybridMeshModel.from_pair(pair)
     if isinstance(mesh, HybridMeshModel):
-        if mesh.pair != pair:
-            raise ParameterError("mesh: the hybrid model was built for a different gear pair "
-                                 "than the rig's")
+        mesh.check_pair(pair)
         return hybrid_mesh_table(mesh, torque), mesh
     raise ParameterError(f"mesh must be None, one of {MESH_CHOICES}, a MeshStiffnessTable, a "
                          f"MeshTableSet or a HybridMeshModel, got {type(mesh).__name__}")
@@ -298,6 +281,13 @@ def resolve_mesh(rig, mesh, torque_nm, *, progress=None):
 
 def build_paper_tables(path=None, *, progress=None):
     """Build the paper rig's set and write it (default: the package data file).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path, optional
+        Output ``.npz`` file (default :data:`PAPER_TABLES_FILE` in the package).
+    progress : None, False or callable
+        Progress of the build (see :func:`hybrid_table_set`).
 
     Returns
     -------
@@ -311,7 +301,7 @@ def build_paper_tables(path=None, *, progress=None):
     return target
 
 
-if __name__ == "__main__":          # python -m cmsim.dynamics.mesh_choice [OUT.npz]
+if __name__ == "__main__":          # python -m cmsim.dynamics.tooth_contact [OUT.npz]
     out = build_paper_tables(sys.argv[1] if len(sys.argv) > 1 else None)
     k = [row["mean_stiffness_n_per_m"] for row in MeshTableSet.load(out).summary]
     print(f"wrote {out}: {len(k)} torques, mean mesh stiffness "
