@@ -58,7 +58,7 @@ from cmsim.losses import LossSettings
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
-from cmsim.rig import RANGES, OperatingPoint, Rig
+from cmsim.rig import RANGES, SAMPLING, OperatingPoint, Rig
 
 __all__ = ["DatasetSpec", "SAMPLINGS", "SEED_POLICIES", "mesh_key"]
 
@@ -183,10 +183,11 @@ class DatasetSpec:
     losses: object
 
     def __init__(self, variations=(), *, fixed=None, sampling="grid", records=None, repeats=1,
-                 name="sweep", seed=0, seed_policy="per_run", rig=None, rig_source=None,
+                 name="sweep", seed=SAMPLING.seed, seed_policy="per_run", rig=None, rig_source=None,
                  runup_share=0.0, runup_to_rpm=None, fault_types=(), healthy_share=None,
-                 faults=(), nuisances=None, channels=None, fs_hz=75_000.0, duration_s=1.0,
-                 warmup_s=0.05, substeps=None, mesh=None, losses=None):
+                 faults=(), nuisances=None, channels=None, fs_hz=SAMPLING.fs_hz,
+                 duration_s=SAMPLING.duration_s, warmup_s=SAMPLING.warmup_s,
+                 substeps=SAMPLING.substeps, mesh=None, losses=None):
         set_ = object.__setattr__
         rig = Rig.paper_2016() if rig is None else rig
         if not isinstance(rig, Rig):

@@ -26,7 +26,8 @@ checked, and a bad spec is refused before any work with a message naming the key
                    dte_um, Fmesh_total; or "all": the simulated run in full, as a sweep
                    keeps it), fs_hz (output rate; the integration step is chosen from the
                    model's highest mode and the output is anti-alias decimated), duration_s,
-                   warmup_s (simulated and dropped)
+                   warmup_s (simulated and dropped); the defaults are cmsim.rig.SAMPLING's
+                   (75 kHz, 1 s, 0.05 s), as for simulate and sweep
     [simulation]   mesh (tooth contact model name), substeps (integration steps per sample;
                    default automatic), losses (true: every loss source in every run)
 
@@ -43,7 +44,7 @@ from cmsim.datasets.distribution import Distribution, spec_error
 from cmsim.datasets.plan import NUISANCES, FaultChoice
 from cmsim.datasets.variation import OPERATING_POINT_FIELDS, RIG_TRANSFORMS, setting_kind
 from cmsim.errors import ParameterError
-from cmsim.rig import PRESETS, RANGES, Rig
+from cmsim.rig import PRESETS, RANGES, SAMPLING, Rig
 
 __all__ = ["read_toml", "toml_keywords", "load_rig", "check_channels", "setting_range",
            "OPERATING_DEFAULTS"]
@@ -183,7 +184,7 @@ def toml_keywords(data, base_dir=None):
     sim = data.get("simulation", {})
     return dict(
         variations=settings, sampling=sampling, name=ds.get("name", "dataset"),
-        records=ds.get("records"), seed=ds.get("seed", 0),
+        records=ds.get("records"), seed=ds.get("seed", SAMPLING.seed),
         seed_policy=ds.get("seed_policy", "per_run"), repeats=ds.get("repeats", 1),
         rig=rig, rig_source=source, runup_share=op.get("runup_share", 0.0),
         runup_to_rpm=None if runup is None else Distribution.parse(
@@ -195,8 +196,9 @@ def toml_keywords(data, base_dir=None):
                    for n in NUISANCES if n in nz},
         channels=(None if channels == "all" else
                   [f"accel_{rig.bearing_names[0]}_y", "tacho"] if channels is None else channels),
-        fs_hz=sensor.get("fs_hz", 25_600.0), duration_s=sensor.get("duration_s", 1.0),
-        warmup_s=sensor.get("warmup_s", 0.05), mesh=sim.get("mesh"),
+        fs_hz=sensor.get("fs_hz", SAMPLING.fs_hz),
+        duration_s=sensor.get("duration_s", SAMPLING.duration_s),
+        warmup_s=sensor.get("warmup_s", SAMPLING.warmup_s), mesh=sim.get("mesh"),
         substeps=sim.get("substeps"), losses=sim.get("losses"))
 
 

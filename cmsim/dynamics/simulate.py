@@ -25,6 +25,7 @@ from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
                           operating_modulation, rig_with_faults, slip_from_faults)
 from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
+from cmsim.rig import RANGES, SAMPLING
 from cmsim.run import Run
 
 __all__ = ["simulate", "integrate", "check_memory", "kernels_cached",
@@ -284,8 +285,9 @@ def _compile_seconds():
     return _compile_seconds.value
 
 
-def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
-             scheme="ode3", slip=None, seed=None, warmup_s=0.05, cage_phases_rad="random",
+def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLING.fs_hz,
+             substeps=SAMPLING.substeps, scheme="ode3", slip=None, seed=SAMPLING.seed,
+             warmup_s=SAMPLING.warmup_s, cage_phases_rad="random",
              profile=None, faults=(), progress=None, loads=None, friction_table=None,
              damping_table=None, losses=None, record=None, on_start=None):
     """Simulate ``rig`` at ``op`` and return a :class:`~cmsim.run.Run`.
@@ -307,7 +309,8 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
     rig : Rig
     op : OperatingPoint
     duration_s : float
-        Recorded duration, s (0 < duration_s <= 600).
+        Recorded duration, s (0 < duration_s <= 600). The sampling defaults are
+        :data:`cmsim.rig.SAMPLING`, shared with the command line and dataset specs.
     fs_hz : float
         Output sample rate, Hz (the paper: 75 kHz).
     substeps : int, optional
@@ -324,8 +327,9 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
     slip : RollingSlip, optional
         Random rolling slip (:class:`cmsim.faults.RollingSlip`: cage-speed fluctuation and
         ball jitter); uses ``seed``. A ``rolling_slip`` among ``faults`` takes its place.
-    seed : int, optional
-        Seed for the jitter and the cage phases; drawn at random and recorded when omitted.
+    seed : int or None
+        Seed of the cage phases and slip (default 0: a run is reproducible); ``None`` draws
+        one at random. The run's meta records it.
     warmup_s : float
         Simulated time discarded before recording, s.
     profile : SpeedProfile, optional
@@ -372,14 +376,14 @@ def simulate(rig, op, duration_s, *, mesh=None, fs_hz=75_000.0, substeps=None,
     -------
     Run
     """
-    duration_s = check_range("duration_s", duration_s, 0.0, 600.0, lo_open=True, unit="s")
-    fs_hz = check_range("fs_hz", fs_hz, 1e3, 1e7, unit="Hz")
-    warmup_s = check_range("warmup_s", warmup_s, 0.0, 60.0, unit="s")
-    if substeps is not None and (isinstance(substeps, bool)
-                                 or not isinstance(substeps, (int, np.integer))
-                                 or substeps < 1 or substeps > 1000):
-        raise ParameterError(f"substeps must be an integer in [1, 1000], got {substeps!r}")
-    if seed is None:
+    duration_s = RANGES["duration_s"].check("duration_s", duration_s)
+    fs_hz = RANGES["fs_hz"].check("fs_hz", fs_hz)
+    warmup_s = RANGES["warmup_s"].check("warmup_s", warmup_s)
+    if substeps is not None:
+        substeps = RANGES["substeps"].check("substeps", substeps)
+    if seed is not None:
+        seed = RANGES["seed"].check("seed", seed)
+    else:
         seed = int(np.random.SeedSequence().entropy % (2 ** 31))
     slip = NO_SLIP if slip is None else slip
     if not isinstance(slip, RollingSlip):
