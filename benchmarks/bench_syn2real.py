@@ -24,7 +24,7 @@ sys.path.insert(0, str(ROOT))
 
 from cmsim.datasets import generate_dataset                      # noqa: E402
 from cmsim.datasets.dataset_spec import DatasetSpec             # noqa: E402
-from cmsim.diagnostics.measured import data_root                # noqa: E402
+from cmsim.measured import data_root                            # noqa: E402
 from cmsim.diagnostics.syn2real import evaluate_syn2real, measured_windows  # noqa: E402
 
 

@@ -37,7 +37,6 @@ classes), the confusion matrix, and record-level votes (majority of a record's w
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,9 +44,10 @@ from pathlib import Path
 import numpy as np
 
 from cmsim.datasets import load
-from cmsim.diagnostics.measured import load_measured
 from cmsim.diagnostics.metrics import confusion_matrix, roc_auc
 from cmsim.errors import ParameterError
+from cmsim.measured import load_measured
+from cmsim.measured.schema import read_metadata
 
 try:                                    # optional: pip install cmsim[ml]
     from sklearn.ensemble import RandomForestClassifier
@@ -176,7 +176,7 @@ def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None
 
 
 def _measured_channel(folder, bearing):
-    meta = json.loads((Path(folder) / "metadata.json").read_text())
+    meta = read_metadata(folder)
     sensors = meta.get("sensors") or {}
     bearings = list(((meta.get("geometry") or {}).get("bearings") or {}))
     key = bearing or (bearings[0] if bearings else None)
@@ -227,7 +227,8 @@ def measured_windows(folder, channel=None, window=None, hop=None, bearing=None,
         w = _cut(sig[ch], win, int(hop or win), max_windows)
         bf = rec.frequencies.bearing(key)
         n = len(w)
-        parts.append((w, np.full(n, rec.labels["fault_label"], dtype=object),
+        label = ds.answer_key(rec.record_id)["fault_label"]
+        parts.append((w, np.full(n, label, dtype=object),
                       np.full(n, f"real:{rec.record_id}", dtype=object),
                       np.tile(_orders(bf), (n, 1)), np.full(n, bf.shaft_hz)))
     return _assemble(parts, fs0)

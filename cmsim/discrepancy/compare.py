@@ -222,7 +222,7 @@ class _Evaluator:
         self.seed = seed
         self.budget = budget
         self.count = 0
-        self.freqs = record.frequencies()
+        self.freqs = record.model_frequencies()
         self.sensor_bearing = signal_info(record.model_signal).component
         self.bearings = list(record.rig.bearing_names)
         self.fs = max(record.fs_hz, 1e3)
@@ -342,7 +342,7 @@ def _prepare(record, seg_s, max_segments):
     fs = record.fs_hz
     duration = x.size / fs
     seg_s = float(seg_s) if seg_s is not None else min(0.5, duration / 4.0)
-    freqs = record.frequencies()
+    freqs = record.model_frequencies()
     names, F = record_features(x, fs, freqs, list(record.rig.bearing_names), seg_s,
                                max_segments)
     if F.shape[0] < 4:
@@ -369,7 +369,7 @@ def compare(record, *, budget=DEFAULT_BUDGET, seed=0, seg_s=None, max_segments=8
     Parameters
     ----------
     record : MeasuredRecord
-        From :func:`~cmsim.discrepancy.records.read_record` (or a test generator).
+        From :func:`~cmsim.measured.read_record` (or a test generator).
     budget : int
         Most simulations (model runs) used: ranking, fit and the held-out re-simulations
         (>= 2·VAR_SEEDS + 2·SIM_SEEDS).
