@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from cmsim.datasets import DatasetSpec, generate_dataset         # noqa: E402
-from cmsim.diagnostics.measured import data_root                # noqa: E402
+from cmsim.measured import data_root                            # noqa: E402
 from cmsim.diagnostics.syn2real import evaluate_syn2real, measured_windows  # noqa: E402
 
 

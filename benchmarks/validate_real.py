@@ -14,8 +14,8 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from cmsim.diagnostics.measured import data_root
-from cmsim.discrepancy import compare, read_record
+from cmsim.discrepancy import compare
+from cmsim.measured import data_root, read_record
 
 #: Catalogue finding that matches a metadata fault location or fault (first word of it).
 MATCH = {"inner_race": "bearing_inner_race", "outer_race": "bearing_outer_race",

@@ -18,7 +18,7 @@ import pytest
 from cmsim.discrepancy import CAUSES, Cause, compare, read_record, register_cause
 from cmsim.discrepancy.causes import applicable_causes
 from cmsim.discrepancy.compare import DEFAULT_BUDGET, MIN_DELTA_CHI2
-from cmsim.discrepancy.records import RECORDING_KEYS, estimate_shaft_hz
+from cmsim.measured import RECORDING_KEYS, estimate_shaft_hz
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
 from cmsim.errors import ParameterError
 from cmsim.features import relative_features

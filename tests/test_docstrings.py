@@ -39,7 +39,6 @@ OBJECTS = sorted(public_objects())
 #: to this list: document the parameters instead.
 UNDOCUMENTED = frozenset({
     "cmsim.discrepancy.causes.Cause.components",
-    "cmsim.discrepancy.records.MeasuredRecord.frequencies",
     "cmsim.bearings.forces.ball_offsets",
     "cmsim.bearings.forces.bearing_tangent_stiffness",
     "cmsim.bearings.forces.loaded_balls",
@@ -101,7 +100,6 @@ UNDOCUMENTED = frozenset({
     "cmsim.studies.model_abc.gmf_harmonics",
     # public since the check landed (issue 14 closing note): document them, then remove
     "cmsim.discrepancy.causes.Cause.components",
-    "cmsim.discrepancy.records.MeasuredRecord.frequencies",
 })
 
 #: Parameters documented elsewhere or not yet (function: names), same rule.

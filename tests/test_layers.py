@@ -39,6 +39,9 @@ LAYERS = [
     ("dynamics", {"dynamics"}),
     ("sensors", {"sensors"}),
     ("spectra", {"spectra"}),
+    # the one measured record: reads files, infers speed and fs on the spectra, builds the
+    # model rig; features, diagnostics and discrepancy read records through it
+    ("measured", {"measured"}),
     ("features", {"features"}),
     ("datasets", {"datasets"}),
     # Not in DESIGN.md's list: studies reproduce the paper's results with the whole stack.

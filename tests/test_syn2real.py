@@ -20,7 +20,7 @@ import pytest
 from cmsim.cli import main
 from cmsim.datasets import DatasetSpec, generate_dataset, load
 from cmsim.datasets.export import to_bearing_datasets
-from cmsim.diagnostics.measured import data_root
+from cmsim.measured import data_root
 from cmsim.diagnostics.syn2real import (WindowSet, check_disjoint, envelope_features,
                                         evaluate_syn2real, measured_windows, score_windows,
                                         synthetic_windows)

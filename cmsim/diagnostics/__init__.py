@@ -6,9 +6,9 @@ A diagnostic function has this signature (``cmsim evaluate DIR --algorithm MODUL
         ...
         return Diagnosis(label="outer_race", scores={"healthy": 0.1, "outer_race": 4.2})
 
-* ``signals`` — dict channel name → 1-D array (float32 as stored; e.g. ``accel_1b1_x``,
-  ``accel_1b1_y`` in m/s², ``tacho`` in V; measured records keep their own names: ``DE``,
-  ``acc``, ``a1`` ...), all sampled at ``fs_hz``;
+* ``signals`` — dict channel name → 1-D array (float32 from a generated dataset, float64
+  from measured records; e.g. ``accel_1b1_x``, ``accel_1b1_y`` in m/s², ``tacho`` in V;
+  measured records keep their own names: ``DE``, ``acc``, ``a1`` ...), all at ``fs_hz``;
 * ``fs_hz`` — sample rate, Hz (float);
 * ``operating_point`` — :class:`cmsim.rig.OperatingPoint` (``speed_rpm`` of the input shaft,
   ``torque_nm``, ``radial_load_n``);
@@ -33,7 +33,7 @@ largest score of a non-healthy class, or 1/0 from the label alone).
 Modules: :mod:`~cmsim.diagnostics.diagnosis` (:class:`Diagnosis`),
 :mod:`~cmsim.diagnostics.metrics`, :mod:`~cmsim.diagnostics.harness` (:func:`evaluate`),
 :mod:`~cmsim.diagnostics.baselines` (``envelope``, ``tsa``, ``sideband``),
-:mod:`~cmsim.diagnostics.measured` (measured records of ``../shared/datasets``),
+:mod:`cmsim.measured` (measured records of ``../shared/datasets``; re-exported here),
 :mod:`~cmsim.diagnostics.report` (HTML page).
 
 Example
@@ -47,10 +47,10 @@ from cmsim.diagnostics.baselines import BASELINES
 from cmsim.diagnostics.diagnosis import HEALTHY, Diagnosis, as_diagnosis
 from cmsim.diagnostics.harness import (Evaluation, RecordResult, evaluate, load_algorithm,
                                        load_dataset, score)
-from cmsim.diagnostics.measured import MeasuredDataset, data_root, load_measured
 from cmsim.diagnostics.metrics import (FALSE_ALARM_RATE, accuracy, confusion_matrix,
                                        detection_threshold, detection_vs_severity, macro_f1,
                                        one_vs_rest_auc, roc_auc)
+from cmsim.measured import MeasuredDataset, data_root, load_measured
 
 __all__ = ["Diagnosis", "as_diagnosis", "HEALTHY", "Evaluation", "RecordResult", "evaluate",
            "score", "load_algorithm", "load_dataset", "BASELINES", "MeasuredDataset",

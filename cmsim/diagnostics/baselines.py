@@ -7,19 +7,18 @@ read: the housing accelerometers (``accel_*``) when the record has them, else ev
 except a tacho and shaft angles (``tacho``, ``theta_*``); a class score is the largest over the
 channels (and bearings / shafts).
 
-1. :func:`envelope` — envelope analysis at the bearing defect frequencies. Per channel and
-   bearing, the demodulation band is the kurtogram's best band
-   (:func:`cmsim.spectra.kurtogram.kurtogram` with ``max_fault_hz`` = the highest line
-   below), then the envelope spectrum (:func:`cmsim.spectra.envelope.envelope_spectrum`).
-   Each line is read as its amplitude (largest bin within ±max(1.5 bins,
-   :data:`SLIP_TOLERANCE` × f): real bearings slip by about 1 %) over the median of the
-   envelope spectrum within ±:data:`LOCAL_MEDIAN_FRACTION` × the family's fundamental around
-   it. Class scores are the mean of these ratios over the class's lines:
+1. :func:`envelope` — envelope analysis at the bearing defect frequencies, with the
+   envelope-families extractor of :mod:`cmsim.features.envelope`. Per channel and bearing,
+   the demodulation band is the band rule's (:func:`cmsim.features.lines.demodulation_band`)
+   and each line of the families is read as its amplitude (the line rule at
+   :data:`~cmsim.features.lines.SLIP_TOLERANCE`: real bearings slip by 1-2 %) over the
+   median of the envelope spectrum around it. Class scores are the family scores (geometric
+   mean of the ratios over the class's lines):
 
    * ``outer_race``: h·BPFO, h = 1, 2, 3;
    * ``inner_race``: BPFI, 2·BPFI, BPFI ± fr (fr: the rate of the bearing's shaft);
-   * ``ball``: 2·BSF, 4·BSF, 2·BSF ± FTF (a ball defect hits both races) and FTF (the
-     defect enters and leaves the load zone with the cage);
+   * ``ball``: 2·BSF, 4·BSF, 2·BSF ± FTF (a ball defect hits both races, and enters and
+     leaves the load zone with the cage);
 
    label = the class with the largest score when it exceeds :data:`ENVELOPE_THRESHOLD`
    (3: a bin of Gaussian noise reads about 1.5 times its local median), else ``healthy``;
@@ -60,18 +59,17 @@ import numpy as np
 from cmsim.diagnostics.diagnosis import HEALTHY, Diagnosis
 from cmsim.errors import ParameterError
 from cmsim.features import extract_features, statistics
-from cmsim.spectra.envelope import envelope_spectrum
-from cmsim.spectra.kurtogram import kurtogram
+from cmsim.features.envelope import (FAULT_FAMILIES, demodulated_spectrum, envelope_lines,
+                                     family_scores, line_ratios)
 from cmsim.spectra.order import tacho_pulse_times
 from cmsim.spectra.tsa import time_synchronous_average
-from cmsim.spectra.waterfall import harmonic_amplitudes
 
 __all__ = ["envelope", "tsa", "sideband", "BASELINES", "GEAR_CLASS", "GEAR_FAULTS",
            "BEARING_CLASSES", "ENVELOPE_THRESHOLD", "TSA_THRESHOLD", "SIDEBAND_THRESHOLD_DB",
-           "SLIP_TOLERANCE", "LOCAL_MEDIAN_FRACTION", "signal_channels"]
+           "signal_channels", "envelope_scores"]
 
 #: Classes of the envelope baseline.
-BEARING_CLASSES = ("outer_race", "inner_race", "ball")
+BEARING_CLASSES = FAULT_FAMILIES
 #: Class predicted by the gear baselines.
 GEAR_CLASS = "gear"
 #: Fault labels scored as :data:`GEAR_CLASS` by the gear baselines.
@@ -79,10 +77,6 @@ GEAR_FAULTS = ("tooth_crack", "tooth_spall", "tooth_breakage", "eccentricity", "
 
 #: Envelope line-to-local-median ratio above which a bearing fault is declared.
 ENVELOPE_THRESHOLD = 3.0
-#: Relative search half-width around an envelope line (bearing slip, speed error).
-SLIP_TOLERANCE = 0.01
-#: Half-width of the local-median window around an envelope line, × the family fundamental.
-LOCAL_MEDIAN_FRACTION = 0.5
 #: FM4 above which a local gear fault is declared (3 for Gaussian noise; healthy simulated
 #: gears read 3-8.5 at 10-30 N m, the measured SpectraQuest ones 3.3-3.6).
 TSA_THRESHOLD = 10.0
@@ -115,27 +109,6 @@ def _x(signals, name):
 
 
 # ---------------------------------------------------------------------- envelope
-def _family_lines(bf):
-    """{class: (fundamental, [line frequencies])} of one bearing, Hz."""
-    fr = bf.shaft_hz
-    return {"outer_race": (bf.bpfo_hz, [h * bf.bpfo_hz for h in (1, 2, 3)]),
-            "inner_race": (bf.bpfi_hz, [bf.bpfi_hz, 2 * bf.bpfi_hz, bf.bpfi_hz - fr,
-                                        bf.bpfi_hz + fr]),
-            "ball": (2 * bf.bsf_hz, [2 * bf.bsf_hz, 4 * bf.bsf_hz, 2 * bf.bsf_hz - bf.ftf_hz,
-                                     2 * bf.bsf_hz + bf.ftf_hz, bf.ftf_hz])}
-
-
-def _line_ratio(freq, amp, f_hz, f0_hz, df):
-    if not (0.0 < f_hz < freq[-1]):
-        return math.nan
-    a = float(harmonic_amplitudes(freq, amp, f_hz, 1,
-                                  tolerance_hz=max(1.5 * df, SLIP_TOLERANCE * f_hz))[0])
-    w = max(10 * df, LOCAL_MEDIAN_FRACTION * f0_hz)
-    sel = (freq >= f_hz - w) & (freq <= f_hz + w)
-    med = float(np.median(amp[sel]))
-    return a / med if med > 0 else math.nan
-
-
 def envelope_scores(x, fs_hz, bf):
     """Per-class line-to-median scores of one channel for one bearing (see the module
     docstring) and the demodulation band.
@@ -153,21 +126,9 @@ def envelope_scores(x, fs_hz, bf):
     scores : dict of str to float
     band_hz : tuple of float
     """
-    lines = _family_lines(bf)
-    f_max = max(max(v[1]) for v in lines.values())
-    lo, hi = kurtogram(x, fs_hz, max_fault_hz=min(f_max, 0.15 * fs_hz)).band_hz
-    # a band starting at the first bin reads lo ~ 1e-13 Hz, which makes a singular
-    # Butterworth band-pass: take it as the low-pass it is
-    band = (0.0 if lo < 1e-6 * fs_hz else lo, hi)
-    spec = envelope_spectrum(x, fs_hz, band)
-    freq, amp = np.asarray(spec.freq_hz), np.asarray(spec.amplitude)
-    df = float(freq[1] - freq[0])
-    out = {}
-    for cls, (f0, fl) in lines.items():
-        r = [_line_ratio(freq, amp, f, f0, df) for f in fl]
-        r = [v for v in r if math.isfinite(v)]
-        out[cls] = float(np.mean(r)) if r else math.nan
-    return out, band
+    (freq, amp), band = demodulated_spectrum(x, fs_hz, [bf])
+    lines = envelope_lines(bf)
+    return family_scores(line_ratios(freq, amp, lines), lines), band
 
 
 def envelope(signals, fs_hz, operating_point, frequencies):

@@ -11,9 +11,10 @@ answers with :mod:`cmsim.diagnostics.metrics`.
 
 A dataset is anything with ``.manifest`` (a :class:`pandas.DataFrame` with ``record_id`` and,
 optionally, ``status``), ``.record(record_id)`` → a record with ``.signals``, ``.fs_hz``,
-``.operating_point``, ``.frequencies`` and ``.labels`` (``fault_label``, ``fault_severity``):
+``.operating_point``, ``.frequencies`` and, optionally, ``.labels`` (``fault_label``,
+``fault_severity``; else the manifest's columns of those names are the answer key):
 :func:`cmsim.datasets.load` (a generated dataset) and
-:func:`cmsim.diagnostics.measured.load_measured` (a folder of measured records).
+:func:`cmsim.measured.load_measured` (a folder of measured records).
 """
 
 from __future__ import annotations
@@ -30,12 +31,12 @@ import numpy as np
 
 import cmsim.datasets as _datasets
 from cmsim.diagnostics import baselines as _baselines
-from cmsim.diagnostics import measured as _measured
 from cmsim.diagnostics.diagnosis import Diagnosis, as_diagnosis
 from cmsim.diagnostics.metrics import (FALSE_ALARM_RATE, HEALTHY, accuracy, confusion_matrix,
                                        detection_vs_severity, f1_scores, macro_f1,
                                        one_vs_rest_auc)
 from cmsim.errors import ParameterError
+from cmsim.measured import load_measured
 
 __all__ = ["RecordResult", "Evaluation", "load_algorithm", "score",
            "load_dataset", "evaluate"]
@@ -103,7 +104,7 @@ def load_dataset(path):
     """
     path = Path(path)
     if (path / "metadata.json").is_file():
-        return _measured.load_measured(path)
+        return load_measured(path)
     if not path.is_dir() or not any(path.glob("manifest*")):
         raise ParameterError(f"{path}: not a dataset (no metadata.json of measured records, no "
                              f"manifest of a generated dataset)", param="dataset")

@@ -11,21 +11,21 @@ Layout of the windows (issue 15)
 
 Features (:func:`envelope_features`), in shaft orders so that a model trained at one speed
 transfers to another
-    Each window is band-passed in overlapping bands of width fs/8 spaced fs/16 (12 kHz: 500-
-    2000, 1250-2750, ..., 4250-5750 Hz) by zeroing FFT bins; the envelope (modulus of the
-    analytic signal) of each band gives an amplitude spectrum. At each line of the bearing's
-    families, in orders of the shaft rate (BPFO ×1, 2, 3; BPFI ×1, 2 and ± 1; 2 BSF ×1, 2 and
-    ± FTF; FTF; shaft ×1, 2), the line's peak (± max(1.5 bins, 1.5 % of the line)) is divided
-    by the median of the envelope spectrum within ± max(10 bins, half the family's
-    fundamental) around it. Features: log of that ratio, the largest and the median over the
-    bands, per line; the mean log ratio of each family in its best band; and the log kurtosis
-    of the window and the largest log kurtosis of a band envelope. All ratios are
-    dimensionless, so the unknown units and gains of a real accelerometer do not matter.
+    The envelope-families extractor of :mod:`cmsim.features.envelope` in a fixed bank of
+    bands (:func:`~cmsim.features.envelope.band_bank_features`): each window is band-passed
+    in overlapping bands of width fs/8 spaced fs/16 (12 kHz: 500-2000, 1250-2750, ...,
+    4250-5750 Hz); at each line of the bearing's families (BPFO ×1, 2, 3; BPFI ×1, 2 and ± the
+    shaft rate; 2 BSF ×1, 2 and ± FTF; FTF; shaft ×1, 2; placed at the window's orders × its
+    shaft rate) the line (the one line rule; the ±1.5 bins of a 0.34-s window hold the slip,
+    :data:`~cmsim.features.lines.EXACT_TOLERANCE`) over its local median. Features: log of that ratio, the largest and the median over the
+    bands, per line; each family's mean log ratio in its best band; the log kurtosis of the
+    window and the largest log kurtosis of a band envelope. All ratios are dimensionless, so
+    the unknown units and gains of a real accelerometer do not matter.
 
 Classifiers (:data:`CLASSIFIERS`)
     ``envelope`` — the training-free envelope rule of :mod:`cmsim.diagnostics.baselines`
-    (line-to-local-median ratios at BPFO / BPFI ± shaft / 2 BSF ± FTF) read from the best of
-    the bands above: the family with the largest mean ratio, or healthy when that ratio is
+    (the family scores of :mod:`cmsim.features.envelope`) read from the best of the bands
+    above: the family with the largest mean ratio, or healthy when that ratio is
     below one threshold, chosen on the training windows (largest balanced accuracy).
     ``forest`` — a scikit-learn random forest on the features (``pip install cmsim[ml]``),
     ``logistic`` — a scikit-learn logistic regression on the standardised features.
@@ -37,7 +37,6 @@ classes), the confusion matrix, and record-level votes (majority of a record's w
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -45,9 +44,13 @@ from pathlib import Path
 import numpy as np
 
 from cmsim.datasets import load
-from cmsim.diagnostics.measured import load_measured
 from cmsim.diagnostics.metrics import confusion_matrix, roc_auc
 from cmsim.errors import ParameterError
+from cmsim.features.envelope import ENVELOPE_LINE_NAMES, FAULT_FAMILIES, band_bank_features
+from cmsim.features.lines import EXACT_TOLERANCE
+from cmsim.frequencies import BearingFrequencies
+from cmsim.measured import load_measured
+from cmsim.measured.schema import read_metadata
 
 try:                                    # optional: pip install cmsim[ml]
     from sklearn.ensemble import RandomForestClassifier
@@ -65,7 +68,6 @@ __all__ = ["WindowSet", "synthetic_windows", "measured_windows", "envelope_featu
 DEFAULT_WINDOW = 4096
 #: Fault classes in the order the confusion matrix lists them.
 CLASS_ORDER = ("healthy", "inner_race", "ball", "outer_race")
-_SLIP = 0.015
 
 
 @dataclass(frozen=True, eq=False)
@@ -176,7 +178,7 @@ def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None
 
 
 def _measured_channel(folder, bearing):
-    meta = json.loads((Path(folder) / "metadata.json").read_text())
+    meta = read_metadata(folder)
     sensors = meta.get("sensors") or {}
     bearings = list(((meta.get("geometry") or {}).get("bearings") or {}))
     key = bearing or (bearings[0] if bearings else None)
@@ -227,46 +229,17 @@ def measured_windows(folder, channel=None, window=None, hop=None, bearing=None,
         w = _cut(sig[ch], win, int(hop or win), max_windows)
         bf = rec.frequencies.bearing(key)
         n = len(w)
-        parts.append((w, np.full(n, rec.labels["fault_label"], dtype=object),
+        label = ds.answer_key(rec.record_id)["fault_label"]
+        parts.append((w, np.full(n, label, dtype=object),
                       np.full(n, f"real:{rec.record_id}", dtype=object),
                       np.tile(_orders(bf), (n, 1)), np.full(n, bf.shaft_hz)))
     return _assemble(parts, fs0)
 
 
 # ---------------------------------------------------------------------- features
-def _lines(o):
-    """(name, family, order, family fundamental) of the feature lines for orders ``o``."""
-    bpfo, bpfi, bsf, ftf = o
-    b2 = 2 * bsf
-    return [("bpfo_1", "outer_race", bpfo, bpfo), ("bpfo_2", "outer_race", 2 * bpfo, bpfo),
-            ("bpfo_3", "outer_race", 3 * bpfo, bpfo),
-            ("bpfi_1", "inner_race", bpfi, bpfi), ("bpfi_2", "inner_race", 2 * bpfi, bpfi),
-            ("bpfi_m1", "inner_race", bpfi - 1, bpfi), ("bpfi_p1", "inner_race", bpfi + 1, bpfi),
-            ("bsf2_1", "ball", b2, b2), ("bsf2_2", "ball", 2 * b2, b2),
-            ("bsf2_mftf", "ball", b2 - ftf, b2), ("bsf2_pftf", "ball", b2 + ftf, b2),
-            ("ftf", "cage", ftf, 1.0), ("shaft_1", "shaft", 1.0, 1.0),
-            ("shaft_2", "shaft", 2.0, 1.0)]
-
-
 #: Names of the feature lines (see the module docstring).
-FEATURE_LINES = tuple(n for n, *_ in _lines(np.ones(4)))
-_FAMILIES = ("outer_race", "inner_race", "ball")
-
-
-def _bands(fs_hz):
-    width = fs_hz / 8.0
-    lo = fs_hz / 24.0
-    out = []
-    while lo + width <= 0.48 * fs_hz + 1e-9:
-        out.append((lo, lo + width))
-        lo += width / 2.0
-    return out
-
-
-def _kurt(x):
-    x = x - x.mean(axis=-1, keepdims=True)
-    m2 = (x ** 2).mean(axis=-1)
-    return (x ** 4).mean(axis=-1) / np.maximum(m2 ** 2, 1e-300)
+FEATURE_LINES = ENVELOPE_LINE_NAMES
+_FAMILIES = FAULT_FAMILIES
 
 
 def envelope_features(ws):
@@ -281,52 +254,14 @@ def envelope_features(ws):
     features : numpy.ndarray, shape (n, n_features)
     names : list of str
     family_ratio : numpy.ndarray, shape (n, 3)
-        Mean line-to-median ratio (linear) of outer race, inner race, ball in the band where
-        it is largest: the scores of the envelope rule.
+        Family score (geometric-mean line-to-median ratio) of outer race, inner race, ball
+        in the band where it is largest: the scores of the envelope rule.
     """
-    n, win = ws.x.shape
-    fs = ws.fs_hz
-    spec = np.fft.rfft(ws.x.astype(float), axis=1)
-    f = np.fft.rfftfreq(win, 1.0 / fs)
-    bands = _bands(fs)
-    hann = np.hanning(win)
-    env_amp, env_kurt = [], []
-    for lo, hi in bands:
-        sel = (f >= lo) & (f <= hi)
-        full = np.zeros((n, win), complex)
-        full[:, :f.size][:, sel] = 2.0 * spec[:, sel]
-        env = np.abs(np.fft.ifft(full, axis=1))
-        env_kurt.append(_kurt(env ** 2))
-        e = env - env.mean(axis=1, keepdims=True)
-        env_amp.append(np.abs(np.fft.rfft(e * hann, axis=1)))
-    env_amp = np.stack(env_amp, axis=1)                    # (n, n_bands, n_freq)
-    df = f[1] - f[0]
-    n_lines = len(FEATURE_LINES)
-    logr = np.full((n, len(bands), n_lines), 0.0)
-    fam_idx = {fam: [i for i, (_, fm, *_r) in enumerate(_lines(np.ones(4))) if fm == fam]
-               for fam in _FAMILIES}
-    for i in range(n):
-        fr = ws.shaft_hz[i]
-        for j, (_, _, order, f0) in enumerate(_lines(ws.orders[i])):
-            fl = order * fr
-            if not 0 < fl < f[-1] * 0.95:
-                continue
-            tol = max(1.5 * df, _SLIP * fl)
-            w = max(10 * df, 0.5 * f0 * fr)
-            pk = (f >= fl - tol) & (f <= fl + tol)
-            loc = (f >= fl - w) & (f <= fl + w)
-            a = env_amp[i][:, pk].max(axis=1)
-            med = np.median(env_amp[i][:, loc], axis=1)
-            logr[i, :, j] = np.log(np.maximum(a, 1e-300) / np.maximum(med, 1e-300))
-    fam = np.stack([logr[:, :, fam_idx[c]].mean(axis=2) for c in _FAMILIES], axis=2)
-    family_ratio = np.exp(fam.max(axis=1))                  # (n, 3)
-    kurt_x = np.log(_kurt(ws.x.astype(float)))
-    kurt_env = np.log(np.stack(env_kurt, axis=1)).max(axis=1)
-    feats = np.concatenate([logr.max(axis=1), np.median(logr, axis=1), fam.max(axis=1),
-                            kurt_x[:, None], kurt_env[:, None]], axis=1)
-    names = ([f"max_{k}" for k in FEATURE_LINES] + [f"med_{k}" for k in FEATURE_LINES]
-             + [f"family_{c}" for c in _FAMILIES] + ["log_kurtosis", "log_env_kurtosis"])
-    return feats, names, family_ratio
+    bearings = [BearingFrequencies(shaft_hz=fr, bpfo_hz=o[0] * fr, bpfi_hz=o[1] * fr,
+                                   bsf_hz=o[2] * fr, ftf_hz=o[3] * fr, bpf_hz=math.nan)
+                for fr, o in zip(ws.shaft_hz, ws.orders)]
+    # the windows' ±1.5 bins already hold the slip (cmsim.features.lines: EXACT_TOLERANCE)
+    return band_bank_features(ws.x, ws.fs_hz, bearings, tolerance=EXACT_TOLERANCE)
 
 
 # ---------------------------------------------------------------------- classifiers

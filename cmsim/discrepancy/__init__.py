@@ -4,17 +4,18 @@
 >>> "bearing_outer_race" in CAUSES and "transfer_path" in CAUSES
 True
 
-See :mod:`~cmsim.discrepancy.records` (reading a dataset folder), :mod:`~.features`
-(what is compared), :mod:`~.causes` (the catalogue), :mod:`~.compare` (the loop),
+Measured records come from :mod:`cmsim.measured` (:func:`read_record` is re-exported here);
+what is compared is :func:`cmsim.features.relative_features`. See :mod:`~.causes` (the
+catalogue), :mod:`~.compare` (the loop),
 :mod:`~.synthetic` (records with a hidden effect, for tests and benchmarks) and
-:mod:`~.report` (HTML). Layering: above dynamics, sensors, features, spectra and faults;
+:mod:`~.report` (HTML). Layering: above dynamics, sensors, measured, features, spectra and faults;
 only the CLI imports it.
 """
 
 from cmsim.discrepancy.causes import (CAUSES, Cause, ModelSetup, applicable_causes,
                                       register_cause)
 from cmsim.discrepancy.compare import Comparison, compare, simulate_setup
-from cmsim.discrepancy.records import MeasuredRecord, read_record, record_from_run
+from cmsim.measured import MeasuredRecord, read_record, record_from_run
 
 __all__ = ["CAUSES", "Cause", "ModelSetup", "applicable_causes", "register_cause",
            "Comparison", "compare", "simulate_setup", "MeasuredRecord", "read_record",

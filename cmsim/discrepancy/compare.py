@@ -1,6 +1,6 @@
 """The loop: simulate a record's operating point, compare, rank causes, fit, re-simulate, gain.
 
-1. The record is cut into segments (:func:`~cmsim.discrepancy.features.segments`); the even
+1. The record is cut into segments (:func:`cmsim.features.segments`); the even
    segments are the **fit** set, the odd ones the **held-out** set. Features are the
    scale-free ones of :func:`cmsim.features.relative_features`, plus the absolute level
    ``level_db`` when the record's unit is known (its σ carries the housing path's unknown
@@ -36,23 +36,23 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import minimize_scalar
 
 from cmsim.discrepancy.causes import CAUSES, NUISANCES, ModelSetup, applicable_causes
-from cmsim.discrepancy.features import feature_floor, record_features, segments
 from cmsim.dynamics import simulate
 from cmsim.errors import IntegrationDiverged, ParameterError
-from cmsim.features import N_SHAPE_BANDS, relative_features
+from cmsim.features import N_SHAPE_BANDS, relative_features, segment_features, segments
 from cmsim.losses import LossSettings
 from cmsim.run import signal_info
 from cmsim.sensors import housing_acceleration
 
 __all__ = ["Comparison", "compare", "simulate_setup", "simulate_forces", "sensor_signal",
            "MIN_DELTA_CHI2", "MIN_SCORE", "DEFAULT_BUDGET",
-           "SIM_SEEDS", "VAR_SEEDS", "LEVEL_SIGMA_DB", "Z_CAP"]
+           "SIM_SEEDS", "VAR_SEEDS", "LEVEL_SIGMA_DB", "Z_CAP", "DB_FLOOR", "LOG_FLOOR",
+           "feature_floor"]
 
 #: Least Δχ² (fit segments) for a cause to be named.
 MIN_DELTA_CHI2 = 30.0
@@ -89,6 +89,27 @@ REFINE_TOP = 3
 
 #: Reference of ``level_db``, m/s².
 _LEVEL_REF = 1.0
+
+#: Least model uncertainty of a dB column (a line's level, a band's share), dB.
+DB_FLOOR = 1.5
+
+#: Least model uncertainty of a log column (kurtosis, crest), natural-log units.
+LOG_FLOOR = 0.1
+
+
+def feature_floor(name):
+    """Model-uncertainty floor of a feature column, in its own unit.
+
+    Parameters
+    ----------
+    name : str
+        Column name (``*_log`` columns are natural logs, the others dB).
+
+    Returns
+    -------
+    float
+    """
+    return LOG_FLOOR if name.endswith("_log") else DB_FLOOR
 
 
 def simulate_forces(setup, fs_hz, duration_s, model_signal, seed):
@@ -222,7 +243,7 @@ class _Evaluator:
         self.seed = seed
         self.budget = budget
         self.count = 0
-        self.freqs = record.frequencies()
+        self.freqs = record.model_frequencies()
         self.sensor_bearing = signal_info(record.model_signal).component
         self.bearings = list(record.rig.bearing_names)
         self.fs = max(record.fs_hz, 1e3)
@@ -342,8 +363,8 @@ def _prepare(record, seg_s, max_segments):
     fs = record.fs_hz
     duration = x.size / fs
     seg_s = float(seg_s) if seg_s is not None else min(0.5, duration / 4.0)
-    freqs = record.frequencies()
-    names, F = record_features(x, fs, freqs, list(record.rig.bearing_names), seg_s,
+    freqs = record.model_frequencies()
+    names, F = segment_features(x, fs, freqs, list(record.rig.bearing_names), seg_s,
                                max_segments)
     if F.shape[0] < 4:
         raise ParameterError(f"record of {duration:.3g} s gives {F.shape[0]} segments of "
@@ -369,7 +390,7 @@ def compare(record, *, budget=DEFAULT_BUDGET, seed=0, seg_s=None, max_segments=8
     Parameters
     ----------
     record : MeasuredRecord
-        From :func:`~cmsim.discrepancy.records.read_record` (or a test generator).
+        From :func:`~cmsim.measured.read_record` (or a test generator).
     budget : int
         Most simulations (model runs) used: ranking, fit and the held-out re-simulations
         (>= 2·VAR_SEEDS + 2·SIM_SEEDS).

@@ -5,7 +5,7 @@ random severity on a random component, plus nuisances the pipeline is not told a
 housing modes moved by ±5 % and their damping by ±25 %, sensor noise of 7-14 % of the
 healthy signal's RMS, a 0.2 % speed wobble at 0.5-2 Hz and a load off by ±10 %.
 ``effect=None`` gives a record with no hidden effect. The pipeline receives only the
-documented rig and operating point, as :func:`~cmsim.discrepancy.records.read_record` would
+documented rig and operating point, as :func:`~cmsim.measured.read_record` would
 build them.
 
 Bearing, operating and measurement-chain effects sit on the CWRU-like rig (drive-end 6205
@@ -32,7 +32,7 @@ import numpy as np
 
 from cmsim.discrepancy.causes import CAUSES, ModelSetup
 from cmsim.discrepancy.compare import simulate_setup
-from cmsim.discrepancy.records import record_from_run
+from cmsim.measured import record_from_run
 from cmsim.faults import SpeedFluctuation
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
 from cmsim.run import Run

@@ -1,0 +1,211 @@
+"""Scale-free features: compare a model with a measurement whose absolute scale is unknown.
+
+Every column of :func:`relative_features` is a ratio (dB) or a shape statistic, never an
+absolute level, so an unknown sensor gain, unit or transfer-path gain drops out; the
+measured-data loop of :mod:`cmsim.discrepancy` compares them segment by segment
+(:func:`segment_features`). Lines are read with the one line rule
+(:func:`~cmsim.features.lines.line_amplitude`) at
+:data:`~cmsim.features.lines.SLIP_TOLERANCE` on both sides of a comparison; the envelope
+families are those of :mod:`cmsim.features.envelope`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cmsim.errors import ParameterError
+from cmsim.features.absolute import extract_features, statistics
+from cmsim.features.envelope import (band_excess, demodulated_spectrum, envelope_lines,
+                                     line_amplitudes)
+from cmsim.features.lines import SLIP_TOLERANCE, line_amplitude
+from cmsim.features.sidebands import sideband_energies
+from cmsim.spectra._checks import sampling_rate, signal_1d
+from cmsim.spectra.amplitude import amplitude_spectrum
+
+__all__ = ["relative_features", "segment_features", "segments", "N_SHAPE_BANDS",
+           "N_RELATIVE_GMF_HARMONICS"]
+
+#: Bands of the spectral-shape columns (3 log-spaced up to 0.05·fs, then linear to fs/2).
+N_SHAPE_BANDS = 12
+
+#: GMF harmonics whose levels relative to the largest are read.
+N_RELATIVE_GMF_HARMONICS = 4
+
+
+def _db(a, ref=1.0):
+    if not (math.isfinite(a) and ref > 0):
+        return math.nan
+    return 20.0 * math.log10(max(a, 1e-30 * ref) / ref)
+
+
+def _mean(*values):
+    v = [a for a in values if a == a]
+    return float(np.mean(v)) if v else math.nan
+
+
+def _db_power(p):
+    return 10.0 * math.log10(max(p, 1e-6)) if p == p else p
+
+
+def _shape_bands(freq, power, fs, df):
+    edges = np.concatenate([np.geomspace(max(20.0, 2 * df), 0.05 * fs, 4)[:-1],
+                            np.linspace(0.05 * fs, 0.5 * fs, N_SHAPE_BANDS - 2)])
+    total = power[freq >= edges[0]].sum()
+    return {f"shape_b{i}_db": 10.0 * math.log10(max(
+        power[(freq >= edges[i]) & (freq < edges[i + 1])].sum() / total, 1e-12))
+        for i in range(len(edges) - 1)}
+
+
+def relative_features(signal, fs_hz, freqs, bearings=None):
+    """Scale-free features of a segment (see the module docstring).
+
+    * ``kurtosis_log``, ``crest_log``: natural log of the kurtosis and crest factor;
+    * ``shape_b{i}_db``: share of the spectrum's energy in each of :data:`N_SHAPE_BANDS`
+      bands (the spectral shape after the transfer path), dB;
+    * ``raw_fr_h1_db``, ``raw_fr_h2_db``: shaft lines of the (Hann) amplitude spectrum over
+      its median level between half the shaft rate and 20 × the highest BPFI, dB; per
+      bearing b, ``raw_bpfo_{b}_db`` (the ball-pass line of a fixed outer ring: varying
+      compliance, an outer-race defect) and ``raw_bpfo_{b}_band_db``, the power in its bins
+      over the floor's (a line smeared by slip keeps it);
+    * envelope spectrum (:func:`~cmsim.features.envelope.demodulated_spectrum`: one band
+      for all bearings, the band rule) over its median level between half the shaft rate and
+      4 × the highest BPFI, dB: ``env_fr_h1_db``; per bearing b, lines of
+      :func:`~cmsim.features.envelope.envelope_lines`: ``env_{bpfo|bpfi|bsf2}_{b}_h{1|2}_db``
+      (bsf2 = 2·BSF, a ball defect hitting both races), ``env_ftf_{b}_db``,
+      ``env_bpfi_{b}_sb_db`` (BPFI ± the shaft rate), ``env_bpfo_{b}_sb_db`` (BPFO and
+      2·BPFO ± the shaft rate: a once-per-rev speed or load modulation) and
+      ``env_bpfo_{b}_band_db`` (the power in the BPFO line's bins over the median's);
+    * gear rigs: ``gmf{k}_rel_db`` (k = 1..4, relative to the largest) and
+      ``tsa_residual_kurtosis_log`` from :func:`~cmsim.features.absolute.extract_features`,
+      and the sideband energies of :func:`~cmsim.features.sidebands.sideband_energies`.
+
+    Parameters
+    ----------
+    signal : array_like, shape (n,)
+        Segment, any unit.
+    fs_hz : float
+        Sample rate, Hz.
+    freqs : cmsim.frequencies.RigFrequencies
+        Frequencies of the rig at the record's speed.
+    bearings : sequence of str, optional
+        Bearings whose families are read (default all of ``freqs``).
+
+    Returns
+    -------
+    dict of str to float
+        NaN where a line lies outside the spectrum.
+    """
+    x = signal_1d(signal, "signal")
+    fs = sampling_rate(fs_hz, "fs_hz")
+    x = x - x.mean()
+    names = list(freqs.bearing_names) if bearings is None else list(bearings)
+    bfs = {b: freqs.bearing(b) for b in names}
+    out = {}
+    _, kurt, crest = statistics(x)
+    out["kurtosis_log"] = math.log(max(kurt, 1e-3))
+    out["crest_log"] = math.log(max(crest, 1e-3))
+    freq, amp = amplitude_spectrum(x, fs, window="hann")
+    df = freq[1]
+    out.update(_shape_bands(freq, amp ** 2, fs, df))
+    fr = freqs.fr1_hz
+    top = max([bf.bpfi_hz for bf in bfs.values()] + [4.0 * fr])
+    sel = (freq >= 0.5 * fr) & (freq <= min(fs / 2, 20 * top))
+    floor = float(np.median(amp[sel]))
+    tol = SLIP_TOLERANCE
+    out["raw_fr_h1_db"] = _db(line_amplitude(freq, amp, fr, tol), floor)
+    out["raw_fr_h2_db"] = _db(line_amplitude(freq, amp, 2 * fr, tol), floor)
+    for b, bf in bfs.items():
+        out[f"raw_bpfo_{b}_db"] = _db(line_amplitude(freq, amp, bf.bpfo_hz, tol), floor)
+        out[f"raw_bpfo_{b}_band_db"] = _db_power(band_excess(freq, amp, bf.bpfo_hz, floor,
+                                                             tol))
+    if bfs:
+        (ef, ea), _ = demodulated_spectrum(x, fs, bfs.values())
+        top_e = max(bf.bpfi_hz for bf in bfs.values())
+        esel = (ef >= 0.5 * fr) & (ef <= 4.0 * top_e)
+        efloor = float(np.median(ea[esel])) if np.any(esel) else 1.0
+        out["env_fr_h1_db"] = _db(line_amplitude(ef, ea, fr, tol), efloor)
+        for b, bf in bfs.items():
+            a = line_amplitudes(ef, ea, envelope_lines(bf), tol)
+            for fam, key in (("bpfo", "bpfo"), ("bpfi", "bpfi"), ("bsf2", "bsf2")):
+                for h in (1, 2):
+                    out[f"env_{fam}_{b}_h{h}_db"] = _db(a[f"{key}_{h}"], efloor)
+            out[f"env_ftf_{b}_db"] = _db(a["ftf"], efloor)
+            out[f"env_bpfi_{b}_sb_db"] = _db(_mean(a["bpfi_m1"], a["bpfi_p1"]), efloor)
+            sb = [line_amplitude(ef, ea, h * bf.bpfo_hz + s * bf.shaft_hz, tol)
+                  for h in (1, 2) for s in (-1, 1)]
+            out[f"env_bpfo_{b}_sb_db"] = _db(_mean(*sb), efloor)
+            out[f"env_bpfo_{b}_band_db"] = _db_power(band_excess(ef, ea, bf.bpfo_hz, efloor,
+                                                                 tol))
+    if freqs.gmf_hz is not None:
+        n_gmf = N_RELATIVE_GMF_HARMONICS
+        row = extract_features(x, fs, freqs, bearing=names[0] if names else None,
+                               envelope=False, n_gmf_harmonics=n_gmf)
+        g = np.asarray(row.gmf_amp, dtype=float)
+        gmax = np.nanmax(g) if np.any(np.isfinite(g)) else math.nan
+        for k in range(1, n_gmf + 1):
+            out[f"gmf{k}_rel_db"] = _db(g[k - 1], gmax)
+        out.update(sideband_energies(x, fs, freqs))
+        tk = row.tsa_residual_kurtosis
+        out["tsa_residual_kurtosis_log"] = math.log(tk) if math.isfinite(tk) and tk > 0 \
+            else math.nan
+    return out
+
+
+def segments(n_samples, fs_hz, seg_s, max_segments=None):
+    """(start, stop) sample indices of consecutive segments of ``seg_s`` seconds.
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples in the record.
+    fs_hz : float
+        Sample rate, Hz.
+    seg_s : float
+        Segment length, s.
+    max_segments : int, optional
+        At most this many segments, spread evenly over the record.
+
+    Returns
+    -------
+    list of (int, int)
+    """
+    n = int(round(seg_s * fs_hz))
+    k = n_samples // n
+    if max_segments is not None and k > max_segments:
+        starts = np.linspace(0, n_samples - n, max_segments).astype(int)
+    else:
+        starts = np.arange(k) * n
+    return [(int(s), int(s) + n) for s in starts]
+
+
+def segment_features(x, fs_hz, freqs, bearings, seg_s, max_segments=None):
+    """:func:`relative_features` of every segment of a record (:func:`segments`).
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Record.
+    fs_hz : float
+        Sample rate, Hz.
+    freqs : cmsim.frequencies.RigFrequencies
+        Frequencies at the record's speed.
+    bearings : sequence of str
+        Bearings whose defect families are read.
+    seg_s : float
+        Segment length, s.
+    max_segments : int, optional
+        At most this many segments, spread over the record.
+
+    Returns
+    -------
+    names : list of str
+    values : numpy.ndarray, shape (n_segments, n_features)
+    """
+    rows = [relative_features(x[a:b], fs_hz, freqs, bearings)
+            for a, b in segments(x.size, fs_hz, seg_s, max_segments)]
+    if not rows:
+        raise ParameterError(f"record shorter than one {seg_s:g}-s segment", param="RECORD")
+    names = list(rows[0])
+    return names, np.array([[r[k] for k in names] for r in rows], dtype=float)

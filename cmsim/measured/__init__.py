@@ -1,0 +1,34 @@
+"""The one measured record: ``metadata.json`` schema, signal readers, inference, model, dataset.
+
+A measured recording is a signal file in a folder with ``metadata.json`` (the schema of
+``../shared/datasets/README.md``). Modules, in reading order:
+
+* :mod:`~cmsim.measured.schema` — the keys the pipeline reads, the answer key it never reads,
+  unit constants (lbf, inch, g);
+* :mod:`~cmsim.measured.readers` — file I/O (``.npz``, ``.csv``, ``.wav``; one function per
+  type);
+* :mod:`~cmsim.measured.inference` — speed and sample rate from the signal when the metadata
+  lacks them (one rule for an undocumented sample rate; a metadata note only cross-checks);
+* :mod:`~cmsim.measured.model_rig` — the model rig, operating point and characteristic
+  frequencies from the documented geometry;
+* :mod:`~cmsim.measured.record` — :class:`MeasuredRecord` (a measured :class:`~cmsim.run.Run`
+  plus what a diagnosis and a comparison need) and :func:`read_record`;
+* :mod:`~cmsim.measured.dataset` — a folder as a dataset for the diagnostics harness.
+
+Layering: above :mod:`cmsim.spectra`, below features, diagnostics and discrepancy.
+
+>>> from cmsim.measured import LBF_N, unit_scale_of
+>>> round(LBF_N, 4), unit_scale_of("g (believed)")
+(4.4482, 9.80665)
+"""
+
+from cmsim.measured.dataset import MEASURED_DATASETS, MeasuredDataset, data_root, load_measured
+from cmsim.measured.inference import estimate_shaft_hz
+from cmsim.measured.record import MeasuredRecord, read_record, record_from_run
+from cmsim.measured.schema import (ACCELERATION_UNITS, INCH_M, LBF_N, RECORDING_KEYS,
+                                   STANDARD_GRAVITY_M_S2, answer_key, label_of, unit_scale_of)
+
+__all__ = ["MeasuredRecord", "read_record", "record_from_run", "MeasuredDataset",
+           "load_measured", "data_root", "MEASURED_DATASETS", "estimate_shaft_hz",
+           "RECORDING_KEYS", "ACCELERATION_UNITS", "LBF_N", "INCH_M", "STANDARD_GRAVITY_M_S2",
+           "answer_key", "label_of", "unit_scale_of"]

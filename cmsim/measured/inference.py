@@ -1,0 +1,199 @@
+"""What a record's metadata lacks, inferred from its signal (and reported as inferred).
+
+* **Shaft speed** — :func:`estimate_shaft_hz`: the input-shaft rate whose comb of lines
+  (shaft harmonics; with gears also the output shaft and the first mesh harmonics) stands
+  highest over the spectrum's median level. A documented speed is refined within
+  ±:data:`SPEED_SEARCH_FRACTION` when the comb is clear (:data:`MIN_COMB_DB`) and its
+  interpolated rate lies in that range, more than :data:`MIN_SPEED_CHANGE` away
+  (:func:`refine_speed`); an undocumented one is searched
+  between 5 Hz and min(100 Hz, fs/40).
+* **Sample rate** (``fs_hz: null``, e.g. the SpectraQuest gearbox) — one rule,
+  :func:`infer_sample_rate`: the mesh comb of the documented tooth counts is found in
+  cycles per sample, and the documented input-shaft speed turns it into Hz. A prose
+  ``fs_note`` in the metadata is only a cross-check (:func:`sample_rate_from_note`): a
+  disagreement of more than :data:`NOTE_AGREEMENT` is reported; the note is used only when
+  the signal cannot say (no tooth counts or no speed), and then reported as unverified.
+
+Spectra come from :func:`cmsim.spectra.amplitude.amplitude_spectrum` (Hann window).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from cmsim.spectra.amplitude import amplitude_spectrum
+
+__all__ = ["estimate_shaft_hz", "refine_speed", "infer_sample_rate", "sample_rate_from_note",
+           "SPEED_SEARCH_FRACTION", "MIN_COMB_DB", "MIN_SPEED_CHANGE", "NOTE_AGREEMENT"]
+
+#: Half-width of the search around a documented speed, relative (a stored nominal speed and
+#: an induction motor's slip under load differ by a few per cent at most).
+SPEED_SEARCH_FRACTION = 0.03
+
+#: Least comb prominence (mean line level over the spectrum's median), dB, for a refined
+#: speed to replace the documented one.
+MIN_COMB_DB = 10.0
+
+#: Least relative change for a refined speed to replace the documented one.
+MIN_SPEED_CHANGE = 2e-3
+
+#: Largest relative disagreement between an inferred sample rate and a metadata note's value
+#: that passes without a warning.
+NOTE_AGREEMENT = 0.02
+
+
+def estimate_shaft_hz(x, fs_hz, *, lo_hz, hi_hz, teeth=None, n_harmonics=4):
+    """Input-shaft rate that best explains the spectrum's comb of shaft harmonics.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Signal, any unit.
+    fs_hz : float
+        Sample rate, Hz (1.0 gives the rate in cycles per sample).
+    lo_hz, hi_hz : float
+        Search range of the shaft rate, Hz.
+    teeth : tuple of int, optional
+        (Z1, Z2): the mesh comb k·Z1·f (k = 1..3) and the output shaft f·Z1/Z2 are added.
+    n_harmonics : int
+        Shaft harmonics in the comb (without ``teeth``).
+
+    Returns
+    -------
+    (float, float)
+        Shaft rate, Hz, and the comb score (mean prominence of its lines over the median
+        spectrum level, dB).
+    """
+    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
+    df = freq[1]
+    logamp = np.log10(np.maximum(amp, 1e-300))
+    floor = np.median(logamp[1:])
+    n_grid = int(min(20000, max(200, (hi_hz - lo_hz) / (df / 4))))
+    grid = np.geomspace(lo_hz, hi_hz, n_grid)
+    best = (-np.inf, grid[0])
+    mults = [float(m) for m in range(1, n_harmonics + 1)]
+    if teeth is not None:
+        z1, z2 = teeth
+        mults = [1.0, 2.0, z1 / z2] + [k * z1 for k in (1, 2, 3)]
+    for f in grid:
+        s, n = 0.0, 0
+        for m in mults:
+            fm = m * f
+            if fm >= fs_hz / 2 or fm < 2 * df:
+                continue
+            k = int(round(fm / df))
+            s += 20 * (np.max(logamp[max(k - 1, 1):k + 2]) - floor)
+            n += 1
+        if n and s / n > best[0]:
+            best = (s / n, f)
+    return _refine(freq, logamp, best[1], mults, fs_hz), float(best[0])
+
+
+def _refine(freq, logamp, f, mults, fs_hz):
+    """Shaft rate from the interpolated peaks of its comb lines (amplitude-weighted)."""
+    df = freq[1]
+    num = den = 0.0
+    for m in mults:
+        k = int(round(m * f / df))
+        if m * f >= fs_hz / 2 or k < 2 or k + 3 >= logamp.size:
+            continue
+        j = k - 2 + int(np.argmax(logamp[k - 2:k + 3]))
+        a, b, c = logamp[j - 1], logamp[j], logamp[j + 1]
+        d = 0.5 * (a - c) / (a - 2 * b + c) if (a - 2 * b + c) < 0 else 0.0
+        w = 10 ** b
+        num += w * (j + d) * df / m
+        den += w
+    return float(num / den) if den > 0 else float(f)
+
+
+def refine_speed(x, fs_hz, speed_rpm, teeth=None):
+    """A documented speed, or the comb's within ±:data:`SPEED_SEARCH_FRACTION` when clear.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Signal, any unit.
+    fs_hz : float
+        Sample rate, Hz.
+    speed_rpm : float or None
+        Documented input-shaft speed, rpm (None: searched between 5 Hz and
+        min(100 Hz, fs/40)).
+    teeth : tuple of int, optional
+        (Z1, Z2) of a gear rig.
+
+    Returns
+    -------
+    speed_rpm : float
+        The speed to use, rpm.
+    how : str or None
+        How it was inferred, or None when the documented speed is kept.
+    """
+    if speed_rpm is None:
+        f, score = estimate_shaft_hz(x, fs_hz, lo_hz=5.0, hi_hz=min(100.0, fs_hz / 40),
+                                     teeth=teeth)
+        return 60.0 * f, f"shaft-harmonic comb, {score:.1f} dB over the median level"
+    f0 = float(speed_rpm) / 60.0
+    f, score = estimate_shaft_hz(x, fs_hz, lo_hz=(1 - SPEED_SEARCH_FRACTION) * f0,
+                                 hi_hz=(1 + SPEED_SEARCH_FRACTION) * f0, teeth=teeth)
+    if score > MIN_COMB_DB and MIN_SPEED_CHANGE < abs(f / f0 - 1) <= SPEED_SEARCH_FRACTION:
+        return 60.0 * f, (f"refined from the documented {float(speed_rpm):g} rpm by the "
+                          f"shaft-harmonic comb ({score:.1f} dB)")
+    return float(speed_rpm), None
+
+
+def infer_sample_rate(x, shaft_hz, teeth):
+    """Sample rate of a gear record with an undocumented rate: its mesh comb in cycles per
+    sample, scaled by the documented input-shaft rate.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Signal, any unit.
+    shaft_hz : float
+        Documented input-shaft rate, Hz.
+    teeth : tuple of int
+        (Z1, Z2).
+
+    Returns
+    -------
+    fs_hz : float
+        Sample rate, Hz.
+    cycles_per_sample : float
+        Input-shaft rate found in the signal, cycles per sample.
+    score : float
+        Comb prominence, dB over the median level.
+    """
+    nu, score = estimate_shaft_hz(x, 1.0, lo_hz=2e-4, hi_hz=0.45 / (3 * teeth[0]),
+                                  teeth=teeth)
+    return shaft_hz / nu, nu, score
+
+
+def sample_rate_from_note(note):
+    """The ``fs ~= 12.97 kHz`` of a prose metadata note, Hz, or None.
+
+    Parameters
+    ----------
+    note : str or None
+
+    Returns
+    -------
+    float or None
+    """
+    m = re.search(r"fs\s*~?=\s*([0-9.]+)\s*kHz", str(note or ""))
+    return 1e3 * float(m.group(1)) if m else None
+
+
+def note_disagreement(fs_hz, note_hz):
+    """Relative disagreement |fs/note − 1| (NaN without a note value).
+
+    Parameters
+    ----------
+    fs_hz : float
+        Inferred sample rate, Hz.
+    note_hz : float or None
+        The note's value, Hz.
+    """
+    return abs(fs_hz / note_hz - 1.0) if note_hz else math.nan

@@ -1,0 +1,187 @@
+"""The model of a measured record from its metadata: rig, operating point, characteristic lines.
+
+* :func:`model_rig` — the rig the model simulates for a record: with gear tooth counts, the
+  paper rig with those counts (nothing else of the gears is documented); else a rotor of
+  :data:`DEFAULT_ROTOR_MASS_KG` on the documented bearings (bearing ``1b1`` = the one the
+  sensor sits near). What was assumed is returned as notes.
+* :func:`documented_frequencies` — the characteristic frequencies of the documented geometry
+  at a speed (bearing keys as in the metadata): what a diagnosis is given.
+* :func:`model_operating_point` — the operating point the model runs at: the documented
+  radial load plus, on a bearing rig, the assumed rotor's weight; on a gear rig the
+  documented torque, else one assumed from ``load_percent``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from cmsim.errors import ParameterError
+from cmsim.frequencies import RigFrequencies, bearing_frequencies
+from cmsim.measured.schema import STANDARD_GRAVITY_M_S2, documented_radial_load_n
+from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
+
+__all__ = ["model_rig", "documented_frequencies", "model_operating_point",
+           "documented_operating_point", "DEFAULT_ROTOR_MASS_KG", "DEFAULT_CLEARANCE_M"]
+
+#: Rotor mass assumed for a bearing rig whose rotor is not documented, kg.
+DEFAULT_ROTOR_MASS_KG = 10.0
+
+#: Radial clearance assumed for a documented bearing (not documented in the records), m.
+DEFAULT_CLEARANCE_M = 5e-6
+
+
+def _bearing(geom):
+    try:
+        n = int(geom["n_balls"])
+        d = float(geom["ball_diameter_mm"]) * 1e-3
+        pd_ = float(geom["pitch_diameter_mm"]) * 1e-3
+    except (KeyError, TypeError, ValueError):
+        raise ParameterError(f"bearing geometry needs n_balls, ball_diameter_mm and "
+                             f"pitch_diameter_mm, got {geom!r}", param="geometry.bearings")
+    return RollingBearing.from_pitch(n, d, pd_, clearance_m=DEFAULT_CLEARANCE_M)
+
+
+def _gear_stages(geometry):
+    return [s for s in ((geometry or {}).get("gears") or [])
+            if s.get("input_teeth") and s.get("output_teeth")]
+
+
+def _gear_rig(stage):
+    """Paper rig with the documented tooth counts (other gear data undocumented)."""
+    base = Rig.paper_2016()
+    g = base.gears
+    z1, z2 = int(stage["input_teeth"]), int(stage["output_teeth"])
+    pair = replace(g, driving=replace(g.driving, n_teeth=z1),
+                   driven=replace(g.driven, n_teeth=z2))
+    return replace(base, gears=pair)
+
+
+def model_rig(geometry, near=None):
+    """The model rig of a record's documented geometry.
+
+    Parameters
+    ----------
+    geometry : dict or None
+        ``geometry`` of ``metadata.json`` (``gears``, ``bearings``).
+    near : str, optional
+        Bearing key the compared sensor sits near (becomes ``1b1`` of a bearing rig).
+
+    Returns
+    -------
+    rig : cmsim.rig.Rig
+    components : dict of str to str
+        Model component → dataset name (``{"1b1": "drive_end", "1b2": "fan_end"}``).
+    notes : list of str
+        What was assumed.
+
+    Raises
+    ------
+    ParameterError
+        Neither bearing geometry nor gear tooth counts.
+    """
+    geometry = geometry or {}
+    bearings = geometry.get("bearings") or {}
+    gears = _gear_stages(geometry)
+    if gears:
+        return _gear_rig(gears[0]), {"1G1": "input gear", "2G1": "output gear"}, \
+            ["gear data beyond tooth counts undocumented: the paper rig's gears and 209 "
+             "bearings with the documented tooth counts"]
+    if not bearings:
+        raise ParameterError("metadata.json has neither bearing geometry nor gear tooth "
+                             "counts: give a rig with --rig", param="geometry",
+                             allowed="geometry.bearings or geometry.gears")
+    keys = list(bearings)
+    first = near if near in bearings else keys[0]
+    other = next((k for k in keys if k != first), first)
+    rig = Rig.rotor_on_bearings(_bearing(bearings[first]),
+                                Rotor(mass_kg=DEFAULT_ROTOR_MASS_KG, inertia_kg_m2=0.02),
+                                bearing_2=_bearing(bearings[other]))
+    return rig, {"1b1": first, "1b2": other}, [
+        f"rotor {DEFAULT_ROTOR_MASS_KG:g} kg assumed (undocumented)"]
+
+
+def documented_frequencies(geometry, shaft_hz):
+    """Characteristic frequencies of the documented geometry at an input-shaft rate.
+
+    Parameters
+    ----------
+    geometry : dict or None
+        ``geometry`` of ``metadata.json``.
+    shaft_hz : float
+        Input-shaft rate, Hz.
+
+    Returns
+    -------
+    cmsim.frequencies.RigFrequencies
+        Shaft rates and GMF of the first stage with tooth counts; bearings by their metadata
+        keys (a bearing on the ``output`` shaft turns at the output rate).
+    """
+    gears = _gear_stages(geometry)
+    fr2 = gmf = None
+    if gears:
+        z1, z2 = gears[0]["input_teeth"], gears[0]["output_teeth"]
+        fr2, gmf = shaft_hz * z1 / z2, shaft_hz * z1
+    out = {}
+    for name, b in ((geometry or {}).get("bearings") or {}).items():
+        rate = fr2 if b.get("shaft") == "output" and fr2 is not None else shaft_hz
+        out[name] = bearing_frequencies(
+            rate, int(b["n_balls"]), 1e-3 * float(b["ball_diameter_mm"]),
+            1e-3 * float(b["pitch_diameter_mm"]),
+            math.radians(float(b.get("contact_angle_deg") or 0.0)))
+    return RigFrequencies(fr1_hz=shaft_hz, fr2_hz=fr2, gmf_hz=gmf, bearings=out)
+
+
+def documented_operating_point(entry, speed_rpm):
+    """The documented operating point: speed, torque (0 when undocumented), radial load.
+
+    Parameters
+    ----------
+    entry : dict
+        Readable keys of the recording entry.
+    speed_rpm : float
+        Input-shaft speed (documented or inferred), rpm.
+
+    Returns
+    -------
+    cmsim.rig.OperatingPoint
+    """
+    return OperatingPoint(speed_rpm=float(speed_rpm),
+                          torque_nm=float(entry.get("torque_nm") or 0.0),
+                          radial_load_n=documented_radial_load_n(entry))
+
+
+def model_operating_point(entry, rig, speed_rpm, notes):
+    """The operating point the model of a record runs at.
+
+    Parameters
+    ----------
+    entry : dict
+        Readable keys of the recording entry.
+    rig : cmsim.rig.Rig
+        Model rig.
+    speed_rpm : float
+        Input-shaft speed (documented or inferred), rpm.
+    notes : list of str
+        Assumptions made here are appended.
+
+    Returns
+    -------
+    cmsim.rig.OperatingPoint
+        Radial load: the documented one plus, without gears, the assumed rotor's weight,
+        pointing down; torque: documented, else 5 + 0.4·``load_percent`` N·m (20 N·m without
+        it) on a gear rig.
+    """
+    radial = documented_radial_load_n(entry)
+    torque = 0.0
+    if rig.gears is None:
+        radial += DEFAULT_ROTOR_MASS_KG * STANDARD_GRAVITY_M_S2
+    elif entry.get("torque_nm") is not None:
+        torque = float(entry["torque_nm"])
+    else:
+        pct = entry.get("load_percent")
+        torque = 20.0 if pct is None else 5.0 + 0.4 * float(pct)
+        notes.append(f"output torque {torque:g} N m assumed from load_percent={pct} "
+                     "(brake capacity undocumented)")
+    return OperatingPoint(speed_rpm=float(speed_rpm), torque_nm=torque, radial_load_n=radial,
+                          radial_load_angle_rad=-math.pi / 2)

@@ -1,0 +1,272 @@
+"""The one measured record: a measured :class:`~cmsim.run.Run` with what a diagnosis and a
+comparison with the model need.
+
+:func:`read_record` turns a signal file in a folder with ``metadata.json`` into a
+:class:`MeasuredRecord`: it reads the schema's readable keys (:mod:`cmsim.measured.schema`),
+the channels (:mod:`cmsim.measured.readers`), fills in what the metadata lacks from the signal
+(:mod:`cmsim.measured.inference`: sample rate, speed) and builds the model of the record
+(:mod:`cmsim.measured.model_rig`). The same record serves the diagnostics harness (signals,
+sample rate, documented operating point and characteristic frequencies) and
+:func:`cmsim.discrepancy.compare` (the compared channel, the model rig and operating point).
+The answer key never enters it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from cmsim.errors import ParameterError
+from cmsim.frequencies import RigFrequencies, rig_frequencies
+from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
+                                      refine_speed, sample_rate_from_note)
+from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
+                                      model_operating_point, model_rig)
+from cmsim.measured.readers import read_signals, resolve_path
+from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metadata,
+                                   recording_entry, unit_scale_of)
+from cmsim.rig import OperatingPoint, Rig
+from cmsim.run import Run
+
+__all__ = ["MeasuredRecord", "read_record", "record_from_run", "MIN_SAMPLES"]
+
+#: Fewest samples of the compared channel (the speed and sample-rate inference need a few
+#: hundred shaft revolutions' worth of resolution; a kurtogram needs 1024).
+MIN_SAMPLES = 4096
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredRecord:
+    """A measured record (one recording of a folder, or an in-memory measured run).
+
+    Attributes
+    ----------
+    run : cmsim.run.Run
+        ``source="measured"``: every channel of the file (unit as recorded, float64) sampled
+        at :attr:`fs_hz`; its meta holds the readable metadata, the notes on what was assumed
+        and what was inferred — never the answer key or the file name.
+    channel : str
+        Channel compared with the model (default: the first sensor near a documented
+        bearing, else the first channel).
+    rig : cmsim.rig.Rig
+        Model rig (:func:`~cmsim.measured.model_rig.model_rig`, or the user's).
+    op : cmsim.rig.OperatingPoint
+        Operating point of the model: speed (documented or inferred), torque and radial load
+        with the model's assumptions (:func:`~cmsim.measured.model_rig.model_operating_point`).
+    model_signal : str
+        Model output that corresponds to :attr:`channel` (``accel_1b1_y``, ...).
+    components : dict of str to str
+        Model component → dataset name (``{"1b1": "drive_end"}``).
+    inferred : dict
+        Quantity → ``{"value": ..., "how": ...}`` for what was inferred from the signal.
+    path : str
+        The signal file ("" for an in-memory record).
+    unit_scale : float or None
+        Factor from the channel's unit to m/s² (``g`` → 9.80665), or None when the unit is
+        not an acceleration unit cmsim knows (then only scale-free features are compared).
+    record_id : str
+        File stem ("" for an in-memory record); names the record in reports, never read by a
+        diagnosis.
+    frequencies : cmsim.frequencies.RigFrequencies or None
+        Characteristic frequencies of the documented geometry at the record's speed (bearing
+        keys as in the metadata): what a diagnosis is given. None for an in-memory record.
+    operating_point : cmsim.rig.OperatingPoint or None
+        Documented operating point at the record's speed (no model assumption): what a
+        diagnosis is given. None for an in-memory record.
+    """
+
+    run: Run
+    channel: str
+    rig: Rig
+    op: OperatingPoint
+    model_signal: str
+    components: dict = field(default_factory=dict)
+    inferred: dict = field(default_factory=dict)
+    path: str = ""
+    unit_scale: float | None = None
+    record_id: str = ""
+    frequencies: RigFrequencies | None = None
+    operating_point: OperatingPoint | None = None
+
+    @property
+    def fs_hz(self):
+        """Sample rate (documented or inferred), Hz."""
+        return self.run.fs_hz
+
+    @property
+    def signal(self):
+        """The compared channel, float64 with the mean removed."""
+        x = np.asarray(self.run[self.channel], dtype=float)
+        return x - x.mean()
+
+    @property
+    def signals(self):
+        """Channel name → samples (every channel of the record)."""
+        return dict(self.run.signals)
+
+    @property
+    def meta(self):
+        """The run's metadata (readable keys, notes, inferred values; no answer key)."""
+        return self.run.meta
+
+    def model_frequencies(self, speed_rpm=None):
+        """Characteristic frequencies of the model rig (bearings ``1b1``, ...).
+
+        Parameters
+        ----------
+        speed_rpm : float, optional
+            Input-shaft speed, rpm; default the record's.
+
+        Returns
+        -------
+        cmsim.frequencies.RigFrequencies
+        """
+        op = self.op if speed_rpm is None else replace(self.op, speed_rpm=speed_rpm)
+        return rig_frequencies(self.rig, op)
+
+
+def _channel(signals, sensors, bearings, channel, name):
+    if channel is None:
+        near_bearing = [c for c in signals if (sensors.get(c) or {}).get("near") in bearings]
+        channel = near_bearing[0] if near_bearing else sorted(signals)[0]
+    if channel not in signals:
+        raise ParameterError(f"channel {channel!r} is not in {name}; available: "
+                             f"{sorted(signals)}", param="--channel",
+                             allowed=", ".join(sorted(signals)))
+    x = signals[channel]
+    if x.size < MIN_SAMPLES or not np.all(np.isfinite(x)):
+        raise ParameterError(f"channel {channel!r} must hold >= {MIN_SAMPLES} finite samples, "
+                             f"got {x.size}", param="--channel")
+    return channel, x
+
+
+def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes):
+    """The sample rate: documented (entry, folder, file), else inferred from the signal."""
+    fs = entry.get("fs_hz", meta.get("fs_hz")) or file_rate
+    if fs is not None:
+        return float(fs)
+    note_hz = sample_rate_from_note(meta.get("fs_note"))
+    if teeth is not None and speed_rpm is not None:
+        fs, nu, score = infer_sample_rate(x, speed_rpm / 60.0, teeth)
+        how = (f"mesh comb of {teeth[0]}:{teeth[1]} teeth at {nu:.6g} cycles/sample (shaft "
+               f"line), {score:.1f} dB over the median level, scaled by the documented speed")
+        gap = note_disagreement(fs, note_hz)
+        if gap == gap:
+            how += f"; the metadata note says {note_hz:g} Hz ({100 * gap:.1f} % apart)"
+            if gap > NOTE_AGREEMENT:
+                notes.append(f"inferred fs {fs:.6g} Hz disagrees with fs_note {note_hz:g} Hz "
+                             f"by {100 * gap:.1f} %")
+        inferred["fs_hz"] = {"value": fs, "how": how}
+        return float(fs)
+    if note_hz is not None:
+        inferred["fs_hz"] = {"value": note_hz, "how": "fs_note of metadata.json (not verified "
+                             "against the signal: no gear tooth counts or speed)"}
+        return note_hz
+    raise ParameterError("fs_hz is undocumented and cannot be inferred (needs gear tooth "
+                         "counts and a shaft speed)", param="fs_hz",
+                         allowed="a number > 0 in metadata.json")
+
+
+def read_record(path, *, channel=None, rig=None):
+    """Read a measured record (``metadata.json`` schema) into a :class:`MeasuredRecord`.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Signal file (:data:`~cmsim.measured.readers.READERS`) in a folder with
+        ``metadata.json``; a relative path is also looked up under ``$CMSIM_DATA``.
+    channel : str, optional
+        Channel to compare; default the first channel whose sensor sits near a documented
+        bearing, else the first channel (sorted).
+    rig : cmsim.rig.Rig, optional
+        Model rig to use instead of the one built from the metadata geometry.
+
+    Returns
+    -------
+    MeasuredRecord
+
+    Raises
+    ------
+    ParameterError
+        Missing file or metadata, unknown channel, no way to get the sample rate.
+    """
+    p = resolve_path(path)
+    full = read_metadata(p.parent)
+    meta = {k: full.get(k) for k in FOLDER_KEYS}
+    entry = recording_entry(full, p.name)
+    sensors = meta.get("sensors") or {}
+    geometry = meta.get("geometry") or {}
+    signals, file_rate = read_signals(p, entry.get("channels"))
+    if not signals:
+        raise ParameterError(f"record {p} holds no 1-D channel", param="record")
+    channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, p.name)
+    near = (sensors.get(channel) or {}).get("near")
+    inferred, notes = {}, []
+    if rig is None:
+        rig, components, notes = model_rig(geometry, near)
+    else:
+        components = {b: b for b in rig.bearing_names}
+    teeth = None
+    if rig.gears is not None:
+        teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
+
+    speed_rpm = documented_speed_rpm(entry)
+    fs = _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes)
+    if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
+        speed_rpm, how = refine_speed(x, fs, speed_rpm, teeth)
+        if how is not None:
+            inferred["speed_rpm"] = {"value": speed_rpm, "how": how}
+    op = model_operating_point(entry, rig, speed_rpm, notes)
+
+    direction = str((sensors.get(channel) or {}).get("direction", "")).lower()
+    axis = "x" if ("horizontal" in direction or "3 o'clock" in direction) else "y"
+    bearing = "1b1"
+    if rig.gears is None:
+        bearing = next((b for b, key in components.items() if key == near), "1b1")
+    n = x.size
+    run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
+              {"fs_hz": fs, "channel": channel, "sensor": sensors.get(channel),
+               "recording": entry, "operating_point": {
+                   "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
+                   "radial_load_n": op.radial_load_n,
+                   "radial_load_angle_rad": op.radial_load_angle_rad},
+               "rig": rig.to_dict(), "notes": notes, "inferred": inferred},
+              source="measured")
+    return MeasuredRecord(
+        run=run, channel=channel, rig=rig, op=op, model_signal=f"accel_{bearing}_{axis}",
+        components=components, inferred=inferred, path=str(p),
+        unit_scale=unit_scale_of((sensors.get(channel) or {}).get("unit")),
+        record_id=p.stem, frequencies=documented_frequencies(geometry, speed_rpm / 60.0),
+        operating_point=documented_operating_point(entry, speed_rpm))
+
+
+def record_from_run(run, channel, rig, op, model_signal=None, components=None,
+                    unit_scale=None):
+    """A :class:`MeasuredRecord` from an in-memory measured run (the test generator's way).
+
+    Parameters
+    ----------
+    run : cmsim.run.Run
+        The measured signals.
+    channel : str
+        Channel compared.
+    rig : cmsim.rig.Rig
+        Model rig.
+    op : cmsim.rig.OperatingPoint
+        Operating point.
+    model_signal : str, optional
+        Model output of the channel (default: ``channel``).
+    components : dict, optional
+        Model component → dataset name (default: the rig's bearings by their own names).
+    unit_scale : float, optional
+        Factor from the channel's unit to m/s² (None: unknown unit).
+
+    Returns
+    -------
+    MeasuredRecord
+    """
+    return MeasuredRecord(run=run, channel=channel, rig=rig, op=op,
+                          model_signal=model_signal or channel,
+                          components=components or {b: b for b in rig.bearing_names},
+                          unit_scale=unit_scale)

@@ -1,0 +1,224 @@
+"""The ``metadata.json`` schema of measured records: what the pipeline reads, what it never reads.
+
+A folder of measured records holds one ``metadata.json`` (the schema of
+``../shared/datasets/README.md``) and one signal file per recording. The folder keys
+:data:`FOLDER_KEYS` and, of each ``recordings[]`` entry, the keys :data:`RECORDING_KEYS` are
+all the pipeline reads. Everything else of an entry — the answer key ``condition``,
+``fault``, every ``fault_*`` field, expected defect frequencies, provenance — and the file
+name never reach a diagnosis or a comparison (the file name only locates its entry).
+:func:`answer_key` reads the answer key for scoring only (the diagnostics harness and the
+benchmarks).
+
+Unit constants are defined here once: :data:`LBF_N` (pound-force), :data:`INCH_M` (inch) and
+:data:`STANDARD_GRAVITY_M_S2` (the ``g`` of an accelerometer's unit).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+from cmsim.errors import ParameterError
+
+__all__ = ["RECORDING_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_N", "INCH_M",
+           "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
+           "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
+           "documented_radial_load_n", "unit_scale_of"]
+
+#: Keys of a ``recordings[]`` entry the pipeline reads; everything else is ignored.
+RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_hz",
+                  "shaft_speed_rpm_nominal", "shaft_speed_hz_nominal", "torque_nm",
+                  "motor_load_hp", "radial_load_lbs", "radial_load_n", "load_percent",
+                  "channels", "segment")
+
+#: Folder-level keys the pipeline reads (``fs_note`` only to cross-check an inferred rate).
+FOLDER_KEYS = ("fs_hz", "fs_note", "channels", "sensors", "geometry")
+
+#: Answer-key fields of a recording (with every key starting with ``fault``): for scoring only.
+ANSWER_KEYS = ("condition", "fault")
+
+#: Newtons per pound-force (0.45359237 kg × 9.80665 m/s², exact by definition).
+LBF_N = 4.4482216152605
+
+#: Metres per inch (exact by definition).
+INCH_M = 0.0254
+
+#: Standard gravity, m/s² (the ``g`` of an accelerometer unit; exact by definition).
+STANDARD_GRAVITY_M_S2 = 9.80665
+
+#: Accelerometer units cmsim converts to m/s² (the first word of a metadata ``unit``).
+ACCELERATION_UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0,
+                      "mm/s2": 1e-3, "mm/s^2": 1e-3}
+
+
+def read_metadata(folder):
+    """The ``metadata.json`` of a folder, as parsed JSON (a dict with ``recordings``).
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder of measured records.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    ParameterError
+        No ``metadata.json``, not valid JSON, or no ``recordings`` list.
+    """
+    path = Path(folder) / "metadata.json"
+    if not path.is_file():
+        raise ParameterError(f"no metadata.json in {Path(folder)} (the record format is the "
+                             f"metadata.json schema of the datasets README)", param="record",
+                             allowed="a file in a folder with metadata.json")
+    try:
+        meta = json.loads(path.read_text())
+    except (ValueError, OSError) as exc:
+        raise ParameterError(f"{path}: not valid JSON ({exc})", param="record") from None
+    if not isinstance(meta, dict) or not isinstance(meta.get("recordings", []), list):
+        raise ParameterError(f"{path}: not a dataset metadata file (no recordings list)",
+                             param="record")
+    return meta
+
+
+def is_answer_key(key):
+    """True for a recording key of the answer key (``condition``, ``fault``, ``fault_*``).
+
+    Parameters
+    ----------
+    key : str
+    """
+    return key in ANSWER_KEYS or key.startswith("fault")
+
+
+def recording_entry(meta, file_name):
+    """The readable keys (:data:`RECORDING_KEYS`) of the entry of ``file_name``.
+
+    Parameters
+    ----------
+    meta : dict
+        Parsed ``metadata.json``.
+    file_name : str
+        Name of the signal file (locates the entry; it is not returned).
+
+    Returns
+    -------
+    dict
+        Empty when the folder has no entry for the file.
+    """
+    for rec in meta.get("recordings") or []:
+        if rec.get("file") == file_name:
+            return {k: rec[k] for k in RECORDING_KEYS if k in rec and k != "file"}
+    return {}
+
+
+def label_of(rec):
+    """Class of a recording from its answer key (for scoring only).
+
+    ``condition == "healthy"`` → ``"healthy"``; a ``fault_location`` starting with
+    ``inner_race`` / ``outer_race`` / ``ball`` → that class; a ``fault`` naming a broken tooth
+    → ``"tooth_breakage"``, a crack → ``"tooth_crack"``; else the fault text.
+
+    Parameters
+    ----------
+    rec : dict
+        One entry of ``recordings[]`` of ``metadata.json``.
+
+    Returns
+    -------
+    str
+    """
+    if str(rec.get("condition", "")).lower() == "healthy":
+        return "healthy"
+    loc = str(rec.get("fault_location") or "").lower()
+    for cls in ("inner_race", "outer_race", "ball"):
+        if loc.startswith(cls):
+            return cls
+    fault = str(rec.get("fault") or "").lower()
+    if "tooth" in fault and ("broken" in fault or "break" in fault):
+        return "tooth_breakage"
+    if "crack" in fault:
+        return "tooth_crack"
+    return fault.replace(" ", "_") or loc.replace(" ", "_") or "unknown"
+
+
+def answer_key(rec):
+    """The answer key of a recording, for scoring only.
+
+    Parameters
+    ----------
+    rec : dict
+        One entry of ``recordings[]``.
+
+    Returns
+    -------
+    dict
+        ``fault_label`` (:func:`label_of`), ``fault_severity`` (``fault_diameter_in`` in m,
+        else NaN) and ``condition``.
+    """
+    dia = rec.get("fault_diameter_in")
+    return {"fault_label": label_of(rec),
+            "fault_severity": float(dia) * INCH_M if dia else math.nan,
+            "condition": rec.get("condition")}
+
+
+def documented_speed_rpm(entry):
+    """Input-shaft speed of a recording entry, rpm, or None when undocumented.
+
+    Reads, in this order, ``shaft_speed_rpm``, ``shaft_speed_hz``,
+    ``shaft_speed_rpm_nominal``, ``shaft_speed_hz_nominal``.
+
+    Parameters
+    ----------
+    entry : dict
+        Readable keys of the entry (:func:`recording_entry`).
+
+    Returns
+    -------
+    float or None
+    """
+    for key, factor in (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0),
+                        ("shaft_speed_rpm_nominal", 1.0), ("shaft_speed_hz_nominal", 60.0)):
+        if entry.get(key) is not None:
+            return factor * float(entry[key])
+    return None
+
+
+def documented_radial_load_n(entry):
+    """Radial load of a recording entry, N (``radial_load_n``, else ``radial_load_lbs``
+    converted with :data:`LBF_N`), or 0 when undocumented.
+
+    Parameters
+    ----------
+    entry : dict
+        Readable keys of the entry.
+
+    Returns
+    -------
+    float
+    """
+    if entry.get("radial_load_n") is not None:
+        return float(entry["radial_load_n"])
+    if entry.get("radial_load_lbs") is not None:
+        return LBF_N * float(entry["radial_load_lbs"])
+    return 0.0
+
+
+def unit_scale_of(unit):
+    """Factor from an accelerometer unit (``"g"``, ``"g (believed)"``, ``"m/s^2"``) to m/s²,
+    or None for anything else (volts, an unknown unit).
+
+    Parameters
+    ----------
+    unit : str or None
+
+    Returns
+    -------
+    float or None
+    """
+    if not isinstance(unit, str) or not unit.strip():
+        return None
+    return ACCELERATION_UNITS.get(unit.strip().split()[0].lower())
