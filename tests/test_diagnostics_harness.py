@@ -21,7 +21,8 @@ import pandas as pd
 import pytest
 
 from cmsim.cli import main
-from cmsim.diagnostics import BASELINES, data_root, evaluate, load_measured
+from cmsim.diagnostics import BASELINES, evaluate
+from cmsim.measured import data_root, load_measured
 from cmsim.dynamics import simulate
 from cmsim.faults import parse_fault
 from cmsim.frequencies import rig_frequencies

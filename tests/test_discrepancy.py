@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cmsim.discrepancy import CAUSES, Cause, compare, read_record, register_cause
+from cmsim.discrepancy import CAUSES, Cause, compare, register_cause
+from cmsim.measured import read_record
 from cmsim.discrepancy.causes import applicable_causes
 from cmsim.discrepancy.compare import DEFAULT_BUDGET, MIN_DELTA_CHI2
 from cmsim.measured import RECORDING_KEYS, estimate_shaft_hz

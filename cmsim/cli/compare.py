@@ -33,7 +33,8 @@ def register(sub):
 
 def run(args):
     """Read the record, compare, write the report."""
-    from cmsim.discrepancy import compare, read_record
+    from cmsim.discrepancy import compare
+    from cmsim.measured import read_record
     from cmsim.discrepancy.report import write_report
 
     rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None

@@ -33,7 +33,7 @@ largest score of a non-healthy class, or 1/0 from the label alone).
 Modules: :mod:`~cmsim.diagnostics.diagnosis` (:class:`Diagnosis`),
 :mod:`~cmsim.diagnostics.metrics`, :mod:`~cmsim.diagnostics.harness` (:func:`evaluate`),
 :mod:`~cmsim.diagnostics.baselines` (``envelope``, ``tsa``, ``sideband``),
-:mod:`cmsim.measured` (measured records of ``../shared/datasets``; re-exported here),
+measured records of ``../shared/datasets`` come from :mod:`cmsim.measured`;
 :mod:`~cmsim.diagnostics.report` (HTML page).
 
 Example
@@ -50,10 +50,8 @@ from cmsim.diagnostics.harness import (Evaluation, RecordResult, evaluate, load_
 from cmsim.diagnostics.metrics import (FALSE_ALARM_RATE, accuracy, confusion_matrix,
                                        detection_threshold, detection_vs_severity, macro_f1,
                                        one_vs_rest_auc, roc_auc)
-from cmsim.measured import MeasuredDataset, data_root, load_measured
 
 __all__ = ["Diagnosis", "as_diagnosis", "HEALTHY", "Evaluation", "RecordResult", "evaluate",
-           "score", "load_algorithm", "load_dataset", "BASELINES", "MeasuredDataset",
-           "load_measured", "data_root", "FALSE_ALARM_RATE", "accuracy", "confusion_matrix",
+           "score", "load_algorithm", "load_dataset", "BASELINES", "FALSE_ALARM_RATE", "accuracy", "confusion_matrix",
            "detection_threshold", "detection_vs_severity", "macro_f1", "one_vs_rest_auc",
            "roc_auc"]

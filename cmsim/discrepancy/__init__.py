@@ -4,7 +4,7 @@
 >>> "bearing_outer_race" in CAUSES and "transfer_path" in CAUSES
 True
 
-Measured records come from :mod:`cmsim.measured` (:func:`read_record` is re-exported here);
+Measured records come from :mod:`cmsim.measured` (:func:`cmsim.measured.read_record`);
 what is compared is :func:`cmsim.features.relative_features`. See :mod:`~.causes` (the
 catalogue), :mod:`~.compare` (the loop),
 :mod:`~.synthetic` (records with a hidden effect, for tests and benchmarks) and
@@ -15,8 +15,6 @@ only the CLI imports it.
 from cmsim.discrepancy.causes import (CAUSES, Cause, ModelSetup, applicable_causes,
                                       register_cause)
 from cmsim.discrepancy.compare import Comparison, compare, simulate_setup
-from cmsim.measured import MeasuredRecord, read_record, record_from_run
 
 __all__ = ["CAUSES", "Cause", "ModelSetup", "applicable_causes", "register_cause",
-           "Comparison", "compare", "simulate_setup", "MeasuredRecord", "read_record",
-           "record_from_run"]
+           "Comparison", "compare", "simulate_setup"]
