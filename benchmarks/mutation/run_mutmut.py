@@ -37,9 +37,9 @@ MODULES = ("cmsim/frequencies.py", "cmsim/bearings/kinematics.py", "cmsim/spectr
 
 #: Fast test files that exercise those modules, quickest killers first (pytest stops at the
 #: first failure); the dynamics tests are left out to keep a mutant at a few seconds.
-TESTS = ("tests/test_frequencies_contract.py", "tests/test_kinematics_envelope_contract.py",
-         "tests/test_frequencies.py", "tests/test_bearings.py", "tests/test_envelope_edges.py",
-         "tests/test_spectra_envelope.py", "tests/test_rollers.py")
+TESTS = ("tests/unit/frequencies/test_contract.py", "tests/unit/bearings/test_kinematics_envelope_contract.py",
+         "tests/unit/frequencies/test_frequencies.py", "tests/unit/bearings/test_bearings.py", "tests/unit/spectra/test_envelope_edges.py",
+         "tests/unit/spectra/test_envelope.py", "tests/unit/bearings/test_rollers.py")
 
 
 def main(argv=None):

@@ -65,7 +65,7 @@ f965f91944cc6d18ac70efcbbe502718c8dca91c); Mohammed & Rantatalo's crack-size stu
 Chaari's FE validation are summarised in Mechanics & Industry 20 (2019) 629,
 https://doi.org/10.1051/meca/2019065. Neither source's numbers were readable to us (no full
 text in the searchable corpora), so the published band used by
-``tests/test_faults_crack.py`` remains the one of issue 16's brief (5-10 % at 25 % of the
+``tests/literature/test_crack_stiffness.py`` remains the one of issue 16's brief (5-10 % at 25 % of the
 tooth thickness, 20-40 % at 50 %); the FE losses at those points (q/q_max = 0.5, 1) are
 15.9 % and 32.4 %, i.e. above the first band and inside the second.
 

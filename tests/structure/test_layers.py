@@ -13,7 +13,7 @@ belongs to a *unit* (its top-level module or package under ``cmsim``), each unit
 * other function-local imports are allowed only for heavy optional libraries (matplotlib,
   pandas, ...), and anywhere in ``cmsim/cli/`` (start-up time of the command).
 
-Run ``python tests/test_layers.py`` to print every import that breaks a rule.
+Run ``python tests/structure/test_layers.py`` to print every import that breaks a rule.
 """
 
 import ast
@@ -22,7 +22,7 @@ import sys
 
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[1] / "cmsim"
+ROOT = pathlib.Path(__file__).resolve().parents[2] / "cmsim"
 
 #: Layers from the bottom up (DESIGN.md, Layout). A unit is the first name under ``cmsim``;
 #: ``__init__`` is the package facade ``cmsim/__init__.py``, which re-exports only the rig's

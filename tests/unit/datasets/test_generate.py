@@ -23,7 +23,7 @@ from cmsim.datasets import DatasetSpec, generate_dataset, load
 from cmsim.datasets.manifest import PARQUET_NAME, RECORDS_DIR, ROWS_DIR, consolidate
 from cmsim.errors import ParameterError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 CI_SPEC = ROOT / "datasets" / "ci.toml"
 
 SMALL = {

@@ -26,7 +26,7 @@ from cmsim.diagnostics.syn2real import (WindowSet, check_disjoint, envelope_feat
                                         synthetic_windows)
 from cmsim.errors import ParameterError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 CWRU = data_root() / "cwru_bearing_12k_de"
 needs_cwru = pytest.mark.skipif(not (CWRU / "metadata.json").is_file(),
                                 reason="../shared/datasets/cwru_bearing_12k_de absent")

@@ -8,8 +8,8 @@ is for the literature and closed-form tiers to say.
 
 Regenerate (from the repository root) with::
 
-    .venv/bin/python -m tests.test_golden --regenerate
-    # or: .venv/bin/python tests/test_golden.py --regenerate
+    .venv/bin/python -m tests.golden.test_golden --regenerate
+    # or: .venv/bin/python tests/golden/test_golden.py --regenerate
 
 then review the diff of the JSON file before committing it.
 
@@ -66,7 +66,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-GOLDEN_PATH = Path(__file__).resolve().parent / "golden" / "dynamics_golden.json"
+GOLDEN_PATH = Path(__file__).resolve().parent / "dynamics_golden.json"
 
 #: Relative tolerance on every stored number, relative to the quantity's own scale (see the
 #: module docstring for the measurements behind it).
@@ -264,7 +264,7 @@ def deviations(ref, new):
 def golden():
     if not GOLDEN_PATH.exists():
         pytest.fail(f"{GOLDEN_PATH} missing; regenerate with "
-                    f"`python -m tests.test_golden --regenerate`")
+                    f"`python -m tests.golden.test_golden --regenerate`")
     return json.loads(GOLDEN_PATH.read_text())
 
 
@@ -310,7 +310,7 @@ def regenerate(path=GOLDEN_PATH):
     """Run every case and write the golden JSON (inputs and outputs per case)."""
     import cmsim
     data = {"about": "golden regression of cmsim dynamics; written by "
-                     "`python -m tests.test_golden --regenerate`; review the diff before "
+                     "`python -m tests.golden.test_golden --regenerate`; review the diff before "
                      "committing",
             "cmsim_version": cmsim.__version__, "rtol": RTOL, "cases": {}}
     for name, case in CASES.items():

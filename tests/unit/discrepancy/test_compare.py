@@ -10,22 +10,20 @@ import json
 import math
 import shutil
 import wave
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from cmsim.discrepancy import CAUSES, Cause, compare, register_cause
-from cmsim.measured import read_record
 from cmsim.discrepancy.causes import applicable_causes
 from cmsim.discrepancy.compare import DEFAULT_BUDGET, MIN_DELTA_CHI2
-from cmsim.measured import RECORDING_KEYS, estimate_shaft_hz
+from cmsim.measured import RECORDING_KEYS, data_root, estimate_shaft_hz, read_record
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
 from cmsim.errors import ParameterError
 from cmsim.features import relative_features
 from cmsim.frequencies import rig_frequencies
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "datasets"
+DATA = data_root()
 REQUIRED = ("eccentricity", "tooth_fault", "bearing_outer_race", "bearing_inner_race",
             "bearing_ball", "rolling_slip", "clearance", "preload", "friction",
             "torque_mismatch", "speed_fluctuation", "transfer_path", "noise")

@@ -8,7 +8,7 @@ scalar per example is pinned. A new script in ``examples/`` fails
 
 Pinned values were taken from the code at commit 3d95ac0 (the same code as the golden tier,
 ``tests/golden/dynamics_golden.json``). Tolerance ``rel=1e-5``, justified by the golden-tier
-measurements (see ``tests/test_golden.py``): reruns are bit-identical, round-off between
+measurements (see ``tests/golden/test_golden.py``): reruns are bit-identical, round-off between
 machines moves the DTE standard deviation by less than 1e-10 relative, while halving the
 integration step moves it by 2.4e-4 (potential-energy table) to 3.0e-4 (on-line hybrid).
 
@@ -26,7 +26,7 @@ from pathlib import Path
 
 import pytest
 
-EXAMPLES_DIR = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES_DIR = Path(__file__).resolve().parents[2] / "examples"
 
 
 def _model_abc_check(out_dir):

@@ -26,8 +26,6 @@ ratios 3.5848 / 5.4152 / 2.357 / 0.3983 × shaft rate within 0.5 %.
 import functools
 import json
 import math
-import os
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -37,6 +35,7 @@ from cmsim.dynamics import simulate
 from cmsim.faults import FAULT_TYPES, BallDefect, compile_faults, parse_fault
 from cmsim.faults.compile import DEFECT_COLUMNS
 from cmsim.frequencies import rig_frequencies
+from cmsim.measured import data_root
 from cmsim.run import Run
 from cmsim.sensors import add_sensors
 from cmsim.spectra import amplitude_spectrum, envelope_spectrum, kurtogram
@@ -229,10 +228,7 @@ def test_cwru_characteristic_frequencies_match_published_ratios():
 
 # ---------------------------------------------------------------------- measured CWRU records
 def _cwru_dir():
-    root = os.environ.get("CMSIM_DATA")
-    base = Path(root) if root else Path(__file__).resolve().parents[1].parent / "shared" \
-        / "datasets"
-    d = base / "cwru_bearing_12k_de"
+    d = data_root() / "cwru_bearing_12k_de"
     if not (d / "metadata.json").is_file():
         pytest.skip(f"CWRU records not found in {d} (set CMSIM_DATA to the datasets folder)")
     return d
