@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 import cmsim
-from cmsim.dynamics.simulate import simulate
+from cmsim.dynamics.simulation import simulate
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.influence import influence_table
 from cmsim.dynamics.torque_tables import torque_tables

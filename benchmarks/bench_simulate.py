@@ -31,7 +31,7 @@ from cmsim.dynamics._mesh_kernels import (MI_SIZE, MP_A0, MP_BETA, MP_DTHR, MP_K
                                           MP_TAB0, MP_TABD, MP_V0, MP_ZAFTER, MP_ZBEFORE)
 from cmsim.dynamics._rhs_kernels import integrate_jit, make_integrator_buffers, make_work
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.simulate import integrate
+from cmsim.dynamics.simulation import integrate
 from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit
 

@@ -60,7 +60,7 @@ def _plain_negative_numbers(argv):
 def _notice_compile(args):
     """Once per process, before the first heavy step of a command: say that the numba
     kernels compile when their cache is cold (nothing with ``--json``)."""
-    from cmsim.dynamics.simulate import kernels_cached
+    from cmsim.dynamics.simulation import kernels_cached
 
     if not args.json and not args._compile_noticed and not kernels_cached():
         print("cmsim: compiling numba kernels (first run only, about 30 s)...", file=sys.stderr)

@@ -223,8 +223,12 @@ class _RaceDefect(Fault):
         return self
 
     def defect_row(self, rig, default_angle_rad):
-        """Row of ``FaultArrays.bearing_defects`` for this defect on ``rig``."""
-        self.validate(rig)
+        """Row of ``FaultArrays.bearing_defects`` for this defect on ``rig``, validated
+        against it first (with ``default_angle_rad`` the position of a pit given none)."""
+        return self.validate(rig)._row(rig, default_angle_rad)
+
+    def _row(self, rig, default_angle_rad):
+        """:meth:`defect_row` of a defect already checked against ``rig``."""
         ib = check_bearing(rig, self.bearing)
         brg = rig.bearings[ib]
         rb, r = 0.5 * brg.ball_diameter_m, self.race_radius_m(brg)
@@ -369,7 +373,10 @@ class BallDefect(Fault):
             Load of a ball in the load zone, N: sets the contact band's half-width (the
             wider of the outer and inner race contacts, :func:`track_share`).
         """
-        self.validate(rig)
+        return self.validate(rig)._row(rig, ball_load_n)
+
+    def _row(self, rig, ball_load_n):
+        """:meth:`defect_row` of a defect already checked against ``rig``."""
         ib = check_bearing(rig, self.bearing)
         brg = rig.bearings[ib]
         rb = 0.5 * brg.ball_diameter_m

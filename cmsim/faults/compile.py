@@ -248,9 +248,9 @@ def compile_faults(rig, faults, mesh_table=None, *, op=None):
         if isinstance(f, (OuterRaceDefect, InnerRaceDefect)):
             ib = check_bearing(rig, f.bearing)
             default = _load_zone_angle(rig, ib, op) if isinstance(f, OuterRaceDefect) else 0.0
-            rows.append(f.defect_row(rig, default))
+            rows.append(f._row(rig, default))          # checked above
         elif isinstance(f, BallDefect):
-            rows.append(f.defect_row(rig, _ball_load_n(rig, check_bearing(rig, f.bearing), op)))
+            rows.append(f._row(rig, _ball_load_n(rig, check_bearing(rig, f.bearing), op)))
         elif isinstance(f, OffSizeBall):
             ball_offset[check_bearing(rig, f.bearing), f.ball] += f.diameter_excess_m
         elif isinstance(f, Eccentricity):

@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmsim.dynamics.simulate import simulate
+from cmsim.dynamics.simulation import simulate
 from cmsim.dynamics.torque_tables import torque_tables
 from cmsim.errors import ParameterError, check_range
 from cmsim.features import N_GMF_HARMONICS, gmf_levels

@@ -161,7 +161,7 @@ def _run_case(case, *, substeps=None, perturb=0.0):
     -------
     Run
     """
-    from cmsim.dynamics.simulate import simulate
+    from cmsim.dynamics.simulation import simulate
     from cmsim.rig import OperatingPoint
     rig = _build_rig(case, perturb)
     op = OperatingPoint(case["speed_rpm"], case["torque_nm"],

@@ -21,7 +21,7 @@ from cmsim.dynamics._mesh_kernels import MI_SIZE, MP_SIZE, no_hybrid
 from cmsim.dynamics._rhs_kernels import (KernelParams, integrate_jit, make_integrator_buffers,
                                          make_work, no_profile)
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.simulate import check_memory, integrate
+from cmsim.dynamics.simulation import check_memory, integrate
 from cmsim.errors import ParameterError
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
