@@ -7,8 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from cmsim.cli.contract import ranged
-from cmsim.cli.options import (add_mesh_options, add_rig_options, load_rig, mesh_argument,
-                               number, operating_point)
+from cmsim.cli.options import add_mesh_options, add_rig_options, number, resolved_setup
 from cmsim.cli.output import save_figure
 from cmsim.rig import Range
 
@@ -42,16 +41,12 @@ def register(sub):
 
 def run(args):
     """The loss breakdown (and its figure against speed)."""
-    from cmsim.dynamics.tooth_contact import resolve_mesh
     from cmsim.losses import LossSettings, operating_losses
 
-    rig = load_rig(args)
-    op = operating_point(args, rig)
+    rig, op, (table, _) = resolved_setup(args)
     settings = LossSettings(air_pressure_pa=args.air_pressure_pa,
                             air_temperature_c=args.air_temperature_c,
                             oil_jet_kg_s=args.oil_jet_kg_s, roughness_m=args.roughness_m)
-    mesh = mesh_argument(args, rig, [op.torque_nm])
-    table, _ = resolve_mesh(rig, mesh, op.torque_nm, progress=False if args.json else None)
     res = operating_losses(rig, op, settings, table).to_dict()
     res["rig"] = rig.name
     res["plot"] = None

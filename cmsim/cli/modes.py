@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from cmsim.cli.contract import ranged
-from cmsim.cli.options import (add_mesh_options, add_rig_options, load_rig, mesh_argument,
-                               number, operating_point)
+from cmsim.cli.options import add_mesh_options, add_rig_options, number, resolved_setup
 from cmsim.rig import Range
 
 
@@ -26,13 +25,9 @@ def register(sub):
 
 def run(args):
     """Modal analysis at the operating point."""
-    from cmsim.dynamics.tooth_contact import resolve_mesh
     from cmsim.dynamics.modal import modal_analysis
 
-    rig = load_rig(args)
-    op = operating_point(args, rig)
-    mesh = mesh_argument(args, rig, [op.torque_nm])
-    table, model = resolve_mesh(rig, mesh, op.torque_nm, progress=False if args.json else None)
+    rig, op, (table, model) = resolved_setup(args)
     args.notice_compile()
     res = modal_analysis(rig, op, model if model is not None else table,
                          n_positions=args.positions)

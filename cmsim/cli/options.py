@@ -16,7 +16,7 @@ from cmsim.rig.plausibility import load_warnings
 
 __all__ = ["number", "add_rig_options", "load_rig", "add_sampling_options", "add_mesh_options",
            "mesh_argument", "prepare_tables", "add_fault_options", "faults_of", "add_losses_option",
-           "check_losses_options", "operating_point", "operating_warnings", "FAULT_NAMES"]
+           "check_losses_options", "resolved_setup", "operating_point", "operating_warnings", "FAULT_NAMES"]
 
 #: The catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
 #: pulls in the mesh-stiffness stack; tests check the two agree).
@@ -215,6 +215,18 @@ def check_losses_options(args):
     if getattr(args, "losses", False) and getattr(args, "friction", None) is not None:
         raise CLIError("--losses sets the tooth friction from the lubricant film along the "
                        "path; leave out --friction", option="--friction")
+
+
+def resolved_setup(args):
+    """``(rig, op, (table, on-line model))`` of a command at one operating point (modes,
+    losses): the rig and operating point of ``args`` and the tooth contact its mesh options
+    name, resolved at the operating torque."""
+    from cmsim.dynamics.tooth_contact import resolve_mesh
+
+    rig = load_rig(args)
+    op = operating_point(args, rig)
+    mesh = mesh_argument(args, rig, [op.torque_nm])
+    return rig, op, resolve_mesh(rig, mesh, op.torque_nm, progress=False if args.json else None)
 
 
 def operating_point(args, rig):

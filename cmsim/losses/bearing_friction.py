@@ -37,11 +37,7 @@ from dataclasses import dataclass
 from cmsim.errors import check_range
 from cmsim.frequencies import cage_speed_ratios
 
-__all__ = ["BearingFriction", "RingKinematics", "ring_kinematics", "bearing_friction_torque",
-           "static_load_rating_n", "ISO76_FACTOR_N_PER_M2"]
-
-#: ISO 76 static load rating factor of deep-groove ball bearings, ~12.3 N/mm².
-ISO76_FACTOR_N_PER_M2 = 12.3e6
+__all__ = ["BearingFriction", "RingKinematics", "ring_kinematics", "bearing_friction_torque"]
 
 
 @dataclass(frozen=True)
@@ -101,19 +97,6 @@ def ring_kinematics(bearing, inner_rpm, outer_rpm=None):
     u_in = 0.5 * (dm - dc) * abs(inner_rpm - cage) * to_rad
     u_out = 0.5 * (dm + dc) * abs(outer_rpm - cage) * to_rad
     return RingKinematics(cage, spin, u_in, u_out, abs(inner_rpm - outer_rpm))
-
-
-def static_load_rating_n(bearing, factor_n_per_m2=ISO76_FACTOR_N_PER_M2):
-    """ISO 76 static load rating C_0 = f_s·Z·D_w²·cos α of a single-row ball bearing, N.
-
-    Parameters
-    ----------
-    bearing : RollingBearing
-    factor_n_per_m2 : float
-        f_s, N/m² (deep-groove ball bearings ~12.3 N/mm²).
-    """
-    return (factor_n_per_m2 * bearing.n_balls * bearing.ball_diameter_m ** 2
-            * math.cos(bearing.effective_contact_angle_rad))
 
 
 @dataclass(frozen=True)
@@ -179,7 +162,7 @@ def bearing_friction_torque(bearing, radial_load_n, relative_rpm, kinematic_visc
     fr, fa = radial_load_n, axial_load_n
     p1 = max(0.9 * fa / math.tan(alpha) - 0.1 * fr if alpha > 1e-6 else fr, fr)
     fs = max(fr, 0.6 * fr + 0.5 * fa)
-    c0 = static_load_rating_n(bearing)
+    c0 = bearing.static_load_rating_n
     f1 = z * (fs / c0) ** y if fs > 0 else 0.0
     m_load = f1 * p1 * dm_mm
     nun = kinematic_viscosity_mm2_s * relative_rpm

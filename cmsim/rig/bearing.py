@@ -170,9 +170,11 @@ class RollingBearing:
 
     @property
     def static_load_rating_n(self):
-        """Basic static radial load rating C0 = f0·Z·d² of a deep-groove ball bearing, N
-        (ISO 76, f0 ≈ 12.3 N/mm² at the nominal contact angle 0)."""
-        return STATIC_LOAD_FACTOR_N_PER_M2 * self.n_balls * self.ball_diameter_m ** 2
+        """Basic static radial load rating C0 = f0·Z·d²·cos α of a single-row ball bearing,
+        N (ISO 76; f0 ≈ 12.3 N/mm² for deep-groove ball bearings, α the effective contact
+        angle)."""
+        return (STATIC_LOAD_FACTOR_N_PER_M2 * self.n_balls * self.ball_diameter_m ** 2
+                * math.cos(self.effective_contact_angle_rad))
 
     @property
     def effective_contact_angle_rad(self):
