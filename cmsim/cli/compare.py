@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cmsim.cli.contract import load_file, ranged
+from cmsim.cli.contract import CLIError, load_file, ranged
+from cmsim.errors import ParameterError
 from cmsim.rig import RANGES, Range, Rig
 
 
@@ -28,34 +29,68 @@ def register(sub):
                                      "re-simulations (default 140, at least 10)")
     p.add_argument("--seed", type=ranged(RANGES["seed"]), default=0,
                    help="seed of the model simulations")
+    p.add_argument("--machine", metavar="MACHINE.toml",
+                   help="the record's machine (cmsim calibrate on a healthy baseline): the "
+                        "nominal model; without it, only path-free evidence is judged "
+                        "unless --rig documents the housing path")
+    p.add_argument("--span", type=ranged(Range(0.0, 1.0e5, unit="s")), nargs=2,
+                   metavar=("START", "STOP"), help="compare only this part of the record, s")
     p.set_defaults(func=run, text=text)
 
 
 def run(args):
     """Read the record, compare, write the report."""
     from cmsim.discrepancy import compare
-    from cmsim.measured import read_record
     from cmsim.discrepancy.report import write_report
+    from cmsim.machine import Machine
+    from cmsim.measured import read_record
 
+    if args.span is not None and not args.span[0] < args.span[1]:
+        raise CLIError(f"--span {args.span[0]:g} {args.span[1]:g}: START must be below STOP",
+                       option="--span")
+    machine = load_file("--machine", args.machine, Machine.load,
+                        "a machine file (cmsim calibrate --out)") if args.machine else None
     rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None
-    record = read_record(args.record, channel=args.channel, rig=rig)
+    channel = args.channel or (machine.channel if machine is not None else None)
+    record = read_record(args.record, channel=channel, rig=rig)
+    if args.span is not None:
+        record = record.span(*args.span)
     kw = {} if args.budget is None else {"budget": args.budget}
-    res = compare(record, seed=args.seed, **kw)
+    args.notice_compile()
+    try:
+        res = compare(record, machine=machine, seed=args.seed, **kw)
+    except ParameterError as exc:
+        if exc.param == "machine":
+            raise CLIError(f"--machine {args.machine}: {exc}", option="--machine") from None
+        raise
     out = res.to_dict()
     out["report"] = str(write_report(res, args.report)) if args.report else None
     return out
 
 
 def text(res):
-    """The finding, the gain, the leading causes and discrepancies."""
-    lines = [f"finding: {res['finding']}" + (f" on {res['component']}" if res["component"]
-                                              else "") + (f" {res['parameters']}"
-                                                          if res["parameters"] else "")]
+    """The finding in words, the gain, the leading causes and discrepancies."""
+    lines = [f"finding: {res['words']} [{res['finding']}"
+             + (f" on {res['component']}" if res["component"] else "") + "]",
+             f"nominal model: {res['mode']}"
+             + (f" (machine {res['record']['machine']})" if res["record"].get("machine")
+                else "")]
+    if res["not_judged"]:
+        lines.append("not judged without a calibrated machine (they depend on the transfer "
+                     "path): " + ", ".join(res["not_judged"]))
+    for t in res["near_ties"]:
+        lines.append(f"near tie: {t['name']} on {t['component']} (evidence "
+                     f"{t['delta_chi2']:.0f})")
+    if res["departures"]:
+        lines.append("departs from the model in: " + ", ".join(res["departures"]))
     g = res["gain"]
-    lines.append(f"held-out discrepancy (chi2 per feature): {g['before']:.3g} -> "
-                 f"{g['after']:.3g} (relative gain {g['relative']:.2f})")
+    lines.append(f"held-out discrepancy (chi2 per feature, ~1 for a record like the model's "
+                 f"own): {g['before']:.3g} -> {g['after']:.3g} (relative gain "
+                 f"{g['relative']:.2f})")
     for c in res["causes"][:5]:
-        lines.append(f"  {c['name']:20s} {str(c['component']):10s} score {c['score']:.3f}")
+        lines.append(f"  {c['name']:20s} {str(c['component']):10s} evidence "
+                     f"{c['delta_chi2']:7.1f} on {c['judged_on']} features (all: "
+                     f"{c['delta_chi2_all']:.1f})")
     for d in res["discrepancies"][:5]:
         lines.append(f"  {d['feature']:24s} measured {d['measured']:.3g} simulated "
                      f"{d['simulated']:.3g} (z {d['z']:.1f})")

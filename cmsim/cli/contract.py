@@ -51,7 +51,8 @@ PATHS = {"rig": "file", "faults": "file", "mesh_table": "file", "run": "file", "
          "out": "out", "plot": "out", ("sweep", "out"): "outdir",
          ("evaluate", "report"): "out", ("dataset", "spec"): "file",
          ("dataset", "out"): "outdir", ("compare", "report"): "outdir",
-         ("evaluate", "train"): "dir", ("evaluate", "test"): "dir"}
+         ("evaluate", "train"): "dir", ("evaluate", "test"): "dir",
+         ("calibrate", "out"): "out", ("calibrate", "report"): "outdir", "machine": "file"}
 
 
 class CLIError(Exception):

@@ -5,12 +5,12 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from cmsim.cli.contract import CLIError, ranged
+from cmsim.cli.contract import CLIError, load_file, ranged
 from cmsim.cli.options import (add_fault_options, add_losses_option, add_mesh_options,
                                add_rig_options, add_sampling_options, check_losses_options,
                                faults_of, load_rig, mesh_argument, number, operating_point,
                                prepare_tables)
-from cmsim.rig import Range
+from cmsim.rig import SAMPLING, Range
 
 #: Simulated seconds above which simulate shows a progress bar (realtime factor ~3-10).
 LONG_RUN_S = 2.0
@@ -44,6 +44,10 @@ def register(sub):
     p.add_argument("--sensor-fs-hz", type=number("fs_hz"), metavar="FS",
                    help="sensor sample rate, Hz (<= --fs-hz, e.g. 12000); the whole run is "
                         "decimated through an 80 dB anti-alias filter")
+    p.add_argument("--machine", metavar="MACHINE.toml",
+                   help="a calibrated machine (cmsim calibrate): the run is made on its rig "
+                        "at its sample rate and the record gets its sensor channel, the "
+                        "model force through the machine's path plus its background")
     add_fault_options(p)
     add_losses_option(p)
     p.add_argument("--ramp-to-rpm", type=number("speed_rpm"), metavar="RPM",
@@ -79,7 +83,26 @@ def run(args):
     from cmsim.faults import RollingSlip
     from cmsim.frequencies import rig_frequencies
 
-    rig = load_rig(args)
+    machine = None
+    if args.machine:
+        from cmsim.machine import Machine
+        machine = load_file("--machine", args.machine, Machine.load,
+                            "a machine file (cmsim calibrate --out)")
+        for option, given in (("--rig", args.rig), ("--fs-hz", args.fs_hz != SAMPLING.fs_hz),
+                              ("--sensor-fs-hz", args.sensor_fs_hz is not None)):
+            if given:
+                raise CLIError(f"{option}: a --machine run is made on the machine's rig at its "
+                               f"sample rate; leave out {option}", option=option)
+        args.fs_hz = machine.fs_hz
+        rig = machine.rig
+        if args.clearance_m is not None:
+            rig = rig.with_clearance(args.clearance_m)
+        if args.friction is not None:
+            if rig.gears is None:
+                raise CLIError("--friction needs a rig with gears", option="--friction")
+            rig = rig.with_friction(args.friction)
+    else:
+        rig = load_rig(args)
     op = operating_point(args, rig)
     faults = faults_of(args, rig)
     profile = _speed_profile(args)
@@ -113,7 +136,9 @@ def run(args):
     finally:
         if bar is not None:
             bar.close()
-    if args.sensors or args.sensor_noise or args.sensor_fs_hz is not None:
+    if machine is not None:
+        run_ = machine_channel(run_, machine, args.seed)
+    elif args.sensors or args.sensor_noise or args.sensor_fs_hz is not None:
         from cmsim.sensors import add_sensors
         run_ = add_sensors(run_, noise_rms=args.sensor_noise, fs_hz=args.sensor_fs_hz)
     if args.out:
@@ -171,3 +196,19 @@ def text(res):
     if res["out"]:
         lines.append(f"wrote {res['out']} (seed {res['seed']})")
     return "\n".join(lines)
+
+
+def machine_channel(run_, machine, seed):
+    """``run_`` with the machine's sensor channel: the model force behind it through the
+    machine's path plus its background (the run made at the machine's sample rate)."""
+    import numpy as np
+
+    from cmsim.run import signal_info
+
+    info = signal_info(machine.model_signal)
+    force = np.asarray(run_[f"F_{info.component}_{info.direction}"], dtype=float)
+    y = machine.sensor_signal(force, 0, force.size, seed,
+                              speed_rpm=run_.operating_point.speed_rpm)
+    return run_.with_signals(**{machine.channel: y}).with_meta(
+        machine={"name": machine.name, "channel": machine.channel,
+                 "unit": machine.unit, "model_signal": machine.model_signal})

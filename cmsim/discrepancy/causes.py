@@ -37,7 +37,7 @@ from cmsim.faults import (BallDefect, Eccentricity, InnerRaceDefect, OuterRaceDe
 from cmsim.rig import HousingPath, OperatingPoint, Rig
 
 __all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
-           "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO"]
+           "MACHINE_NUISANCES", "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO"]
 
 #: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
 NOMINAL_NOISE_RATIO = 0.1
@@ -60,6 +60,17 @@ class ModelSetup:
     mixed_friction : bool
         Tooth friction from the mixed-lubrication film of the rig's lubricant (roughness,
         viscosity; ``simulate(losses=...)``) instead of the rig's constant coefficient.
+    machine : cmsim.machine.Machine or None
+        The calibrated machine whose path and background replace ``housing`` and the
+        sensor noise (:mod:`cmsim.machine`).
+    frequency_factor : float
+        Scale of the machine path's frequencies (1: as calibrated).
+    background_gain : float
+        Factor on the machine's background (1: as calibrated).
+    shaft_forces : tuple of (float, float)
+        (shaft order, relative amplitude): a rotating force laid on the bearing force after
+        the dynamics, ``F·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
+        misalignment: order 2); quasi-static, the shaft rate being far below the modes.
     """
 
     rig: Rig
@@ -68,14 +79,25 @@ class ModelSetup:
     housing: HousingPath = HousingPath()
     noise_ratio: float = NOMINAL_NOISE_RATIO
     mixed_friction: bool = False
+    machine: object = None
+    frequency_factor: float = 1.0
+    background_gain: float = 1.0
+    shaft_forces: tuple = ()
 
     def with_faults(self, *faults):
         """Same setup with ``faults`` added."""
         return replace(self, faults=self.faults + tuple(faults))
 
     def dynamics_key(self):
-        """What the simulated forces depend on (not the housing path nor the noise)."""
-        return repr(replace(self, housing=None, noise_ratio=0.0))
+        """What the simulated forces depend on (not the measurement chain nor the shaft
+        forces laid on the force after the dynamics)."""
+        return repr(replace(self, housing=None, noise_ratio=0.0, machine=None,
+                            frequency_factor=1.0, background_gain=1.0, shaft_forces=()))
+
+    def chain_key(self):
+        """What the sensor signal depends on besides the dynamics."""
+        return (self.housing, self.noise_ratio, self.frequency_factor, self.background_gain,
+                self.shaft_forces)
 
 
 @dataclass(frozen=True)
@@ -151,6 +173,31 @@ class Cause:
     needs_gears: typing.ClassVar[bool] = False
     #: Acts after the dynamics (transfer path, noise): no simulation of its own.
     post_dynamics: typing.ClassVar[bool] = False
+    #: Acts on the simulated force after the dynamics (a shaft force): no new simulation,
+    #: but ranked and fitted like a model cause.
+    force_level: typing.ClassVar[bool] = False
+    #: Prefixes of the features the cause is judged on (its families, sidebands, bands;
+    #: ``{b}`` stands for its bearing); None: it reshapes the spectrum and is judged on all.
+    signature: typing.ClassVar[tuple | None] = None
+
+    def judged_on(self, names, component):
+        """The features of ``names`` this cause is judged on (its :attr:`signature`).
+
+        Parameters
+        ----------
+        names : sequence of str
+            Feature names.
+        component : str or None
+            The component it sits on (fills ``{b}``).
+
+        Returns
+        -------
+        list of str
+        """
+        if self.signature is None:
+            return list(names)
+        pre = tuple(p.format(b=component) for p in self.signature)
+        return [k for k in names if k.startswith(pre)]
 
     @property
     def params(self):
@@ -246,6 +293,7 @@ class EccentricityCause(Cause):
     probes = (1e-5, 5e-5)
     kind = "gear"
     needs_gears = True
+    signature = ("sb1_", "raw_fr_h1_db", "env_fr_h1_db", "gmf")
 
     def apply(self, setup, value, component):
         return setup.with_faults(Eccentricity(gear=_gear_index(component), amplitude_m=value))
@@ -260,6 +308,8 @@ class ToothFaultCause(Cause):
     probes = (5e-4, 2e-3)
     kind = "gear"
     needs_gears = True
+    signature = ("sb1_", "sb23_", "tsa_residual_kurtosis_log", "kurtosis_log", "crest_log",
+                 "gmf")
 
     def apply(self, setup, value, component):
         g = setup.rig.gears.driving if _gear_index(component) == 1 else setup.rig.gears.driven
@@ -312,6 +362,7 @@ class OuterRaceCause(_Defect):
     """Outer-race spall (in the load zone)."""
     name = "bearing_outer_race"
     fault = OuterRaceDefect
+    signature = ("env_bpfo_{b}", "raw_bpfo_{b}", "kurtosis_log", "crest_log")
 
 
 @register_cause
@@ -319,6 +370,7 @@ class InnerRaceCause(_Defect):
     """Inner-race spall."""
     name = "bearing_inner_race"
     fault = InnerRaceDefect
+    signature = ("env_bpfi_{b}", "kurtosis_log", "crest_log")
 
 
 @register_cause
@@ -326,6 +378,40 @@ class BallCause(_Defect):
     """Ball spall."""
     name = "bearing_ball"
     fault = BallDefect
+    signature = ("env_bsf2_{b}", "env_ftf_{b}", "kurtosis_log", "crest_log")
+
+
+# ---------------------------------------------------------------------- shaft forces
+class _ShaftForce(Cause):
+    """A rotating force at a shaft order laid on the bearing force after the dynamics."""
+    parameter = "relative_amplitude"
+    bounds = (0.02, 2.0)
+    probes = (0.1, 0.5)
+    force_level = True
+    orders = ()
+
+    def apply(self, setup, value, component):
+        return replace(setup, shaft_forces=setup.shaft_forces + tuple(
+            (k, value * share) for k, share in self.orders))
+
+
+@register_cause
+class UnbalanceCause(_ShaftForce):
+    """Rotor unbalance: a force rotating at the shaft rate, m·e·Ω², as a share of the static
+    bearing load: the 1× line and a once-per-revolution load modulation."""
+    name = "unbalance"
+    orders = ((1, 1.0),)
+    signature = ("raw_fr_h1_db", "env_fr_h1_db", "sb1_")
+
+
+@register_cause
+class MisalignmentCause(_ShaftForce):
+    """Shaft misalignment (angular or parallel, through the coupling): a force at twice the
+    shaft rate with half as much at the rate, as a share of the static bearing load: the 2×
+    line and a twice-per-revolution load modulation."""
+    name = "misalignment"
+    orders = ((2, 1.0), (1, 0.5))
+    signature = ("raw_fr_h2_db", "sb23_", "sb1_")
 
 
 # ---------------------------------------------------------------------- uncertain parameters
@@ -404,6 +490,8 @@ class TransferPathCause(Cause):
     post_dynamics = True
 
     def apply(self, setup, value, component):
+        if setup.machine is not None:
+            return replace(setup, frequency_factor=value)
         return replace(setup, housing=_scaled_path(setup.rig.housing, value))
 
 
@@ -417,6 +505,8 @@ class NoiseCause(Cause):
     post_dynamics = True
 
     def apply(self, setup, value, component):
+        if setup.machine is not None:                # the calibrated background, scaled
+            return replace(setup, background_gain=value / NOMINAL_NOISE_RATIO)
         return replace(setup, noise_ratio=value)
 
 
@@ -427,7 +517,8 @@ def _scaled_path(path, factor):
 
 #: The measurement-chain nuisances refitted for every setup: a housing whose modes sit within
 #: ±15 % of the model's and sensor noise within 3-30 % of the healthy signal are what an
-#: uncalibrated chain may differ by; beyond, the cause is named.
+#: uncalibrated chain may differ by; beyond, the cause is named. (Against a calibrated
+#: machine the chain is known: :data:`MACHINE_NUISANCES`.)
 NUISANCES = (
     Nuisance("transfer_path", 1.0, (0.87, 1.15),
              tuple(float(v) for v in (0.35, 0.45, 0.55, 0.66, 0.76, 0.87, 1.0, 1.15, 1.32,
@@ -435,4 +526,14 @@ NUISANCES = (
     Nuisance("noise", NOMINAL_NOISE_RATIO, (0.03, 0.3),
              tuple(float(v) for v in (0.01, 0.03, 0.06, 0.1, 0.18, 0.3, 0.55, 1.0, 1.8,
                                       3.2, 6.0))),
+)
+
+#: Against a calibrated machine: its path within ±3 % (temperature, mounting) and its
+#: background within ±25 % (the noise as the fraction :data:`NOMINAL_NOISE_RATIO` of 1).
+MACHINE_NUISANCES = (
+    Nuisance("transfer_path", 1.0, (0.97, 1.03),
+             tuple(float(v) for v in (0.5, 0.65, 0.8, 0.9, 0.97, 1.0, 1.03, 1.1, 1.25, 1.5,
+                                      2.0))),
+    Nuisance("noise", NOMINAL_NOISE_RATIO, (0.08, 0.125),
+             tuple(float(v) for v in (0.02, 0.05, 0.08, 0.1, 0.125, 0.2, 0.35, 0.6, 1.0))),
 )

@@ -31,7 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from cmsim.discrepancy.causes import CAUSES, ModelSetup
-from cmsim.discrepancy.compare import simulate_setup
+from cmsim.discrepancy.evaluator import simulate_setup
 from cmsim.measured import record_from_run
 from cmsim.faults import SpeedFluctuation
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor

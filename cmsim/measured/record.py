@@ -74,6 +74,11 @@ class MeasuredRecord:
     operating_point : cmsim.rig.OperatingPoint or None
         Documented operating point at the record's speed (no model assumption): what a
         diagnosis is given. None for an in-memory record.
+    path_documented : bool
+        Whether the model rig's housing path is the machine's (a rig the user gave, an
+        in-memory record made through that rig); a rig built from metadata geometry carries
+        the generic path, and only path-free evidence is then judged without a calibrated
+        machine (:func:`cmsim.discrepancy.compare`).
     """
 
     run: Run
@@ -88,6 +93,7 @@ class MeasuredRecord:
     record_id: str = ""
     frequencies: RigFrequencies | None = None
     operating_point: OperatingPoint | None = None
+    path_documented: bool = True
 
     @property
     def fs_hz(self):
@@ -109,6 +115,38 @@ class MeasuredRecord:
     def meta(self):
         """The run's metadata (readable keys, notes, inferred values; no answer key)."""
         return self.run.meta
+
+    def span(self, start_s, stop_s=None):
+        """The same record cut to the time span [``start_s``, ``stop_s``) (s from its first
+        sample; ``stop_s`` None: to the end) — e.g. to calibrate a machine on one half of a
+        baseline and compare the other half with it.
+
+        Parameters
+        ----------
+        start_s : float
+            Start, s (>= 0).
+        stop_s : float, optional
+            End, s (> start_s, at most the record's duration).
+
+        Returns
+        -------
+        MeasuredRecord
+        """
+        n = self.run.t.size
+        duration = n / self.fs_hz
+        stop = duration if stop_s is None else float(stop_s)
+        if not (0.0 <= float(start_s) < stop <= duration * (1 + 1e-9)):
+            raise ParameterError(f"span must satisfy 0 <= start < stop <= {duration:g} s, got "
+                                 f"[{start_s:g}, {stop:g}]", param="span",
+                                 allowed=f"0 <= start < stop <= {duration:g} s")
+        a, b = int(round(float(start_s) * self.fs_hz)), min(int(round(stop * self.fs_hz)), n)
+        if b - a < MIN_SAMPLES:
+            raise ParameterError(f"span [{start_s:g}, {stop:g}] s holds {b - a} samples; needs "
+                                 f">= {MIN_SAMPLES}", param="span")
+        run = Run(self.run.t[a:b] - self.run.t[a],
+                  {k: np.asarray(v)[a:b] for k, v in self.run.signals.items()},
+                  dict(self.run.meta, span_s=[float(start_s), stop]), source="measured")
+        return replace(self, run=run)
 
     def model_frequencies(self, speed_rpm=None):
         """Characteristic frequencies of the model rig (bearings ``1b1``, ...).
@@ -203,6 +241,7 @@ def read_record(path, *, channel=None, rig=None):
     channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, p.name)
     near = (sensors.get(channel) or {}).get("near")
     inferred, notes = {}, []
+    rig_given = rig is not None
     if rig is None:
         rig, components, notes = model_rig(geometry, near)
     else:
@@ -238,7 +277,8 @@ def read_record(path, *, channel=None, rig=None):
         components=components, inferred=inferred, path=str(p),
         unit_scale=unit_scale_of((sensors.get(channel) or {}).get("unit")),
         record_id=p.stem, frequencies=documented_frequencies(geometry, speed_rpm / 60.0),
-        operating_point=documented_operating_point(entry, speed_rpm))
+        operating_point=documented_operating_point(entry, speed_rpm),
+        path_documented=rig_given)
 
 
 def record_from_run(run, channel, rig, op, model_signal=None, components=None,

@@ -58,6 +58,7 @@ BASE = {
     "compare": "compare {record}",
     "dataset": "dataset {ds_spec} --out {work}/ds",
     "losses": "losses --speed-rpm 1000 --torque-nm 10",
+    "calibrate": "calibrate {record} --out {work}/machine.toml",
 }
 
 CATALOGUE = [
@@ -314,6 +315,19 @@ CATALOGUE = [
     R("losses-plot-dir", "losses --speed-rpm 1000 --torque-nm 10 --plot {work}", "--plot"),
     R("losses-rig-text", "losses --speed-rpm 1000 --torque-nm 10 --rig {text}", "--rig"),
     # ---- compare
+    R("compare-machine-missing", "compare {record} --machine {work}/none.toml", "--machine"),
+    R("compare-machine-text", "compare {record} --machine {text}", "--machine"),
+    R("compare-span-reversed", "compare {record} --span 1 0.5", "--span"),
+    R("calibrate-missing-out", "calibrate {record}", "--out"),
+    R("calibrate-record-missing", "calibrate {work}/none.npz --out {work}/m.toml", "BASELINE",
+      "does not exist"),
+    R("calibrate-span-reversed", "calibrate {record} --span 1 0.5 --out {work}/m.toml",
+      "--span"),
+    R("calibrate-span-negative", "calibrate {record} --span -1 0.5 --out {work}/m.toml",
+      "--span", numeric=True),
+    R("calibrate-out-directory", "calibrate {record} --out {work}", "--out"),
+    R("simulate-machine-missing", "simulate --speed-rpm 1000 --machine {work}/none.toml",
+      "--machine"),
     R("compare-record-missing-arg", "compare", "RECORD"),
     R("compare-record-missing", "compare {work}/none.npz", "RECORD", "does not exist"),
     R("compare-no-metadata", "compare {run}", "RECORD", "metadata.json"),
@@ -508,8 +522,10 @@ def test_every_option_is_validated():
     parser = build_parser()
     # checked against the run's signals / bearings; --fault by cmsim.faults.parse_fault
     # --algorithm: load_algorithm; --scheduler: checked by connecting (names --scheduler)
-    # compare's RECORD may be relative to $CMSIM_DATA: the library checks it (and names it)
-    free_text = {"signal", "bearing", "fault", "algorithm", "scheduler", "record", "channel"}
+    # compare's RECORD and calibrate's BASELINE may be relative to $CMSIM_DATA: the library
+    # checks them (and the command names them)
+    free_text = {"signal", "bearing", "fault", "algorithm", "scheduler", "record", "channel",
+                 "baseline"}
     for command, sub in contract.subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):

@@ -43,6 +43,8 @@ LAYERS = [
     # model rig; features, diagnostics and discrepancy read records through it
     ("measured", {"measured"}),
     ("features", {"features"}),
+    # A calibrated machine: the model's forces through a real machine's path and background.
+    ("machine", {"machine"}),
     ("datasets", {"datasets"}),
     # Not in DESIGN.md's list: studies reproduce the paper's results with the whole stack.
     ("studies", {"studies"}),

@@ -16,7 +16,8 @@ import pytest
 
 from cmsim.discrepancy import CAUSES, Cause, compare, register_cause
 from cmsim.discrepancy.causes import applicable_causes
-from cmsim.discrepancy.compare import DEFAULT_BUDGET, MIN_DELTA_CHI2
+from cmsim.discrepancy.compare import DEFAULT_BUDGET
+from cmsim.discrepancy.ranking import MIN_DELTA_CHI2
 from cmsim.measured import RECORDING_KEYS, data_root, estimate_shaft_hz, read_record
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
 from cmsim.errors import ParameterError

@@ -1,0 +1,279 @@
+"""The model of a record, simulated and read like the record: forces, measurement chain,
+features, and the robust χ² between two feature sets.
+
+A setup's bearing force (:func:`cmsim.machine.model_force`) is simulated once per seed and
+cached by its dynamics; what acts after the dynamics — the shaft forces of unbalance and
+misalignment, and the measurement chain (the rig's housing path and white sensor noise, or a
+calibrated machine's path and background) — is applied to the cached force without a new
+simulation. Features are :func:`cmsim.features.relative_features` (plus ``level_db`` when the
+record's unit is known), as the record's.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from cmsim.errors import IntegrationDiverged, ParameterError
+from cmsim.features import N_SHAPE_BANDS, relative_features
+from cmsim.machine import model_force
+from cmsim.run import signal_info
+from cmsim.sensors import housing_acceleration
+
+__all__ = ["simulate_setup", "sensor_signal", "feature_floor", "path_free", "chi2",
+           "Evaluator", "Budget", "Z_CAP", "DB_FLOOR", "LOG_FLOOR", "LEVEL_REF"]
+
+#: A feature adds at most Z_CAP² to the χ² (robust: a misfit the catalogue cannot mend, such
+#: as an unknown transfer path next to a fault, does not hide what another cause explains).
+Z_CAP = 4.0
+
+#: Least model uncertainty of a dB column (a line's level, a band's share), dB.
+DB_FLOOR = 1.5
+
+#: Least model uncertainty of a log column (kurtosis, crest), natural-log units.
+LOG_FLOOR = 0.1
+
+#: Reference of ``level_db``, m/s².
+LEVEL_REF = 1.0
+
+#: Features that depend on the transfer path (its shape or gain): the spectral-shape bands,
+#: the absolute level, the GMF harmonics against each other and the raw spectrum's lines
+#: against its wide median. The others compare a line with its own neighbourhood, or are
+#: statistics of the waveform.
+PATH_DEPENDENT = ("shape_", "level_db", "gmf", "raw_")
+
+
+def feature_floor(name):
+    """Model-uncertainty floor of a feature column, in its own unit.
+
+    Parameters
+    ----------
+    name : str
+        Column name (``*_log`` columns are natural logs, the others dB).
+
+    Returns
+    -------
+    float
+    """
+    return LOG_FLOOR if name.endswith("_log") else DB_FLOOR
+
+
+def path_free(name):
+    """Whether a feature is free of the transfer path (see :data:`PATH_DEPENDENT`).
+
+    Parameters
+    ----------
+    name : str
+        Column name.
+    """
+    return not name.startswith(PATH_DEPENDENT)
+
+
+def _shaft_forces(force, fs, shaft_hz, terms, seed):
+    """``force`` with the rotating shaft forces ``terms`` ((order, relative amplitude) …)
+    laid on it: F·(1 + Σ a cos(kθ + φ)) + Σ a·|F̄|·cos(kθ + φ)."""
+    if not terms:
+        return force
+    t = np.arange(force.size) / fs
+    static = max(abs(float(force.mean())), float(np.std(force)))
+    phase = np.random.default_rng([int(seed), 65537]).uniform(0.0, 2.0 * math.pi)
+    mod = np.zeros_like(force)
+    for k, a in terms:
+        mod += a * np.cos(2.0 * math.pi * k * shaft_hz * t + k * phase)
+    return force * (1.0 + mod) + static * mod
+
+
+def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, seed):
+    """Housing acceleration of a simulated force plus sensor noise (edges trimmed).
+
+    Parameters
+    ----------
+    force : ndarray
+        Bearing force with ``edge`` extra samples at each end, N.
+    edge, n : int
+        Samples trimmed at each end, samples kept.
+    fs_hz : float
+        Sample rate, Hz.
+    housing : HousingPath
+        Transfer path.
+    noise_ratio : float
+        Noise RMS relative to ``noise_ref_rms``.
+    noise_ref_rms : float or None
+        Reference RMS (None: the signal's own).
+    seed : int
+        Seed of the noise.
+
+    Returns
+    -------
+    ndarray
+    """
+    x = housing_acceleration(force - force.mean(), fs_hz, housing)[edge:edge + n]
+    x = x - x.mean()
+    ref = float(np.std(x)) if noise_ref_rms is None else float(noise_ref_rms)
+    rng = np.random.default_rng(seed + 7919)
+    return x + noise_ratio * ref * rng.standard_normal(x.size)
+
+
+def _chain(setup, force, edge, n, fs, seed, noise_ref_rms):
+    """The sensor signal of a simulated force through ``setup``'s shaft forces and chain."""
+    force = _shaft_forces(force, fs, setup.op.shaft_hz, setup.shaft_forces, seed)
+    if setup.machine is not None:
+        return setup.machine.sensor_signal(force, edge, n, seed, speed_rpm=setup.op.speed_rpm,
+                                           frequency_factor=setup.frequency_factor,
+                                           noise_gain=setup.background_gain,
+                                           line_gain=setup.background_gain)
+    return sensor_signal(force, edge, n, fs, setup.housing, setup.noise_ratio, noise_ref_rms,
+                         seed)
+
+
+def simulate_setup(setup, fs_hz, duration_s, model_signal, seed, noise_ref_rms=None):
+    """The model's sensor signal for ``setup`` (simulation, shaft forces, chain).
+
+    Parameters
+    ----------
+    setup : ModelSetup
+    fs_hz : float
+        Sample rate, Hz.
+    duration_s : float
+        Duration, s.
+    model_signal : str
+        ``accel_<bearing>_<x|y>``.
+    seed : int
+        Seed of the simulation and of the sensor noise.
+    noise_ref_rms : float, optional
+        RMS the noise ratio refers to (the healthy model's signal, so that a fault raises
+        the signal above a fixed sensor noise); default the signal's own RMS.
+
+    Returns
+    -------
+    ndarray
+    """
+    force, edge, n = model_force(setup.rig, setup.op, model_signal, fs_hz, duration_s, seed,
+                                 faults=setup.faults, mixed_friction=setup.mixed_friction)
+    return _chain(setup, force, edge, n, max(fs_hz, 1e3), seed, noise_ref_rms)
+
+
+def weight(name):
+    """Weight of a feature: the spectral-shape bands share one family's weight of 4."""
+    return 4.0 / N_SHAPE_BANDS if name.startswith("shape_") else 1.0
+
+
+def chi2(meas, sim, sigma, names):
+    """Robust χ² of ``sim`` against ``meas`` over ``names`` (inf when ``sim`` is None).
+
+    Parameters
+    ----------
+    meas, sim : dict of str to float
+        Feature values (a feature the model lost, NaN, counts as 3σ off).
+    sigma : dict of str to float
+        Uncertainty of each feature.
+    names : iterable of str
+        The features summed.
+
+    Returns
+    -------
+    float
+    """
+    if sim is None:
+        return math.inf
+    total = 0.0
+    for k in names:
+        s = sim.get(k, math.nan)
+        if not math.isfinite(s):
+            s = meas[k] - 3.0 * sigma[k]
+        total += weight(k) * min(((meas[k] - s) / sigma[k]) ** 2, Z_CAP ** 2)
+    return total
+
+
+class Budget(Exception):
+    """The simulation budget is spent."""
+
+
+class Evaluator:
+    """Simulated forces of setups (cached by their dynamics), the chain applied after them,
+    and the features; counts the simulations against the budget.
+
+    Parameters
+    ----------
+    record : MeasuredRecord
+        The record (its model rig, signal, sample rate and unit).
+    seg_s : float
+        Segment length, s.
+    seed : int
+        Base seed.
+    budget : int
+        Most simulations.
+    """
+
+    def __init__(self, record, seg_s, seed, budget):
+        self.record = record
+        self.seg_s = seg_s
+        self.seed = seed
+        self.budget = budget
+        self.count = 0
+        self.freqs = record.model_frequencies()
+        self.sensor_bearing = signal_info(record.model_signal).component
+        self.bearings = list(record.rig.bearing_names)
+        self.fs = max(record.fs_hz, 1e3)
+        self.forces = {}
+        self.cache = {}
+        self.ref_rms = None
+        self.scale = record.unit_scale
+
+    def _forces(self, setup, seed):
+        key = (setup.dynamics_key(), seed)
+        if key not in self.forces:
+            if self.count >= self.budget:
+                raise Budget()
+            self.count += 1
+            try:
+                self.forces[key] = model_force(setup.rig, setup.op, self.record.model_signal,
+                                               self.fs, self.seg_s, seed, faults=setup.faults,
+                                               mixed_friction=setup.mixed_friction)
+            except (IntegrationDiverged, ParameterError):
+                self.forces[key] = None
+        return self.forces[key]
+
+    def seeds(self, n, base=None):
+        """The first ``n`` simulation seeds of a base seed."""
+        base = self.seed if base is None else base
+        return [base + 7777 * i for i in range(n)]
+
+    def signal(self, setup, seed):
+        """The sensor signal of one run of ``setup`` with simulation seed ``seed`` (None if
+        it diverged)."""
+        run = self._forces(setup, seed)
+        if run is None:
+            return None
+        if self.ref_rms is None and setup.machine is None:  # the healthy level fixes the noise
+            self.ref_rms = float(np.std(sensor_signal(*run, self.fs, setup.housing, 0.0,
+                                                      None, seed)))
+        return _chain(setup, *run, self.fs, seed, self.ref_rms)
+
+    def row(self, setup, seed):
+        """Features of one run of ``setup`` with simulation seed ``seed`` (None if it
+        diverged)."""
+        key = (setup.dynamics_key(), setup.chain_key(), seed)
+        if key not in self.cache:
+            x = self.signal(setup, seed)
+            if x is None:
+                self.cache[key] = None
+            else:
+                f = relative_features(x, self.record.fs_hz, self.freqs, self.bearings)
+                if self.scale is not None:
+                    scale = self.scale if setup.machine is not None else 1.0
+                    f["level_db"] = 20.0 * math.log10(max(float(np.std(x)) * scale, 1e-30)
+                                                      / LEVEL_REF)
+                self.cache[key] = f
+        return self.cache[key]
+
+    def features(self, setup, seeds):
+        """Features of ``setup`` averaged over ``seeds`` (None if a run diverged)."""
+        rows = [self.row(setup, s) for s in seeds]
+        if any(r is None for r in rows):
+            return None
+        with warnings.catch_warnings():          # a column NaN in every run stays NaN
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return {k: float(np.nanmean([r[k] for r in rows])) for k in rows[0]}

@@ -1,0 +1,306 @@
+"""Ranking the causes on the fit segments, deciding on a finding, fitting its parameters.
+
+* **Nuisances.** The measurement chain (the path's frequency factor, the noise or background
+  level) is refitted for every setup within its prior range without a new simulation
+  (:class:`Nuisances`).
+* **Probes.** Each cause is simulated at its probe values on each component it may sit on,
+  and the :data:`REFINE_TOP` best model causes are re-ranked over a coarse grid of their
+  bounds.
+* **Evidence on its own signature.** A cause's evidence is Δχ² = χ²(nominal) − χ²(cause)
+  summed over the features its signature moves (:meth:`Cause.judged_on
+  <cmsim.discrepancy.causes.Cause.judged_on>`: a bearing defect's families, a tooth fault's
+  sidebands and statistics ...); a cause that reshapes the spectrum (load, clearance, speed
+  fluctuation, the chain) is judged on every feature. A fault whose evidence reaches
+  :data:`MIN_DELTA_CHI2` wins over any reshaping cause: what stands out in a fault family is
+  that fault, whatever else the record shows.
+* **The nearest bearing.** A bearing cause on a bearing other than the sensor's wins only
+  with :data:`FAR_MARGIN` times the evidence of the same cause on the sensor's bearing.
+* **Near ties.** A runner-up of the same kind within :data:`NEAR_TIE` of the winner's
+  evidence is reported beside it.
+* **Fit.** The named cause's parameters are fitted (coarse grid over the bounds, then
+  bounded Brent in log scale) within the budget; the range of each over which χ² stays
+  within :data:`SEVERITY_DELTA_CHI2` of its best is reported with it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from cmsim.discrepancy.causes import CAUSES
+from cmsim.discrepancy.evaluator import Budget
+from cmsim.errors import ParameterError
+
+__all__ = ["Nuisances", "rank", "refine", "fit", "decide", "nuisance_params",
+           "MIN_DELTA_CHI2", "MIN_SCORE", "FIT_GRID", "REFINE_TOP", "FAR_MARGIN",
+           "NEAR_TIE", "SEVERITY_DELTA_CHI2"]
+
+#: Least evidence (Δχ² on the cause's own signature, fit segments) for a cause to be named.
+MIN_DELTA_CHI2 = 30.0
+
+#: Least share of the nominal χ² a reshaping cause must remove to be named.
+MIN_SCORE = 0.25
+
+#: Points of the coarse grid of the fit (over the parameter's bounds, log scale).
+FIT_GRID = 6
+
+#: Leading model causes (by their probes) re-ranked at their best over the coarse grid.
+REFINE_TOP = 3
+
+#: A bearing cause away from the sensor's bearing needs this many times the evidence of the
+#: same cause on the sensor's bearing.
+FAR_MARGIN = 1.25
+
+#: A runner-up with at least this share of the winner's evidence is a near tie.
+NEAR_TIE = 0.8
+
+#: Rise of χ² over its best that bounds the reported range of a fitted parameter (~2σ).
+SEVERITY_DELTA_CHI2 = 4.0
+
+
+class Nuisances:
+    """Refit of the measurement chain for a setup: a coordinate search over the path's
+    frequency factor and the noise level, each within its prior range or released.
+
+    Parameters
+    ----------
+    ev : Evaluator
+        Simulations and features.
+    score : callable
+        χ² of a feature dict (fit segments).
+    seeds : sequence of int
+        Seeds a setup's features are averaged over.
+    nuisances : sequence of Nuisance
+        The chain's parameters and their priors.
+    """
+
+    def __init__(self, ev, score, seeds, nuisances):
+        self.ev, self.score, self.seeds, self.nuisances = ev, score, seeds, nuisances
+
+    def grid(self, nuisance, released):
+        """Values tried for ``nuisance`` (its prior's only, unless ``released``)."""
+        if released:
+            return nuisance.grid
+        lo, hi = nuisance.prior
+        return tuple(v for v in nuisance.grid if lo <= v <= hi)
+
+    @staticmethod
+    def set(setup, name, value):
+        """The setup with nuisance ``name`` at ``value`` (its catalogue cause applied)."""
+        return CAUSES[name]().apply(setup, value, None)
+
+    def fit(self, setup, release=None):
+        """(χ², setup) with the nuisances refitted; ``release`` names the one searched
+        beyond its prior."""
+        best = (self.score(self.ev.features(setup, self.seeds)), setup)
+        for _ in range(2):
+            start = best[0]
+            for nu in self.nuisances:
+                for v in self.grid(nu, nu.name == release):
+                    cand = self.set(best[1], nu.name, v)
+                    c = self.score(self.ev.features(cand, self.seeds))
+                    if c < best[0]:
+                        best = (c, cand)
+            if best[0] >= start:
+                break
+        return best
+
+
+def nuisance_params(setup, nominal):
+    """The fitted chain of ``setup`` against the ``nominal`` one: ``noise_ratio`` and
+    ``frequency_factor`` (the parameters of the ``noise`` and ``transfer_path`` causes)."""
+    if setup.machine is not None:
+        return {"noise_ratio": setup.background_gain * nominal.noise_ratio,
+                "frequency_factor": setup.frequency_factor}
+    return {"noise_ratio": setup.noise_ratio,
+            "frequency_factor": setup.housing.natural_frequencies_hz[0]
+            / nominal.rig.housing.natural_frequencies_hz[0]}
+
+
+def _probes(cause, rig):
+    """Probe value sets: each parameter's probes with the others at their start."""
+    start = cause.start(rig)
+    return [{**start, p.name: v} for p in cause.params for v in p.probes]
+
+
+def rank(cause, nominal, nuis, ev):
+    """The cause's best probe on each component: ``[{name, cause, component, probe, chi2,
+    setup}]`` (empty when every probe failed); the probes extend the ``nominal`` setup, the
+    chain refitted by ``nuis`` (:class:`Nuisances`) on the evaluator ``ev``'s simulations."""
+    if cause.post_dynamics:                       # a nuisance released beyond its prior
+        chi, st = nuis.fit(nominal, release=cause.name)
+        name = cause.params[0].name
+        return [{"name": cause.name, "cause": cause, "component": None,
+                 "probe": {name: nuisance_params(st, nominal)[name]}, "chi2": chi,
+                 "setup": st}]
+    out = []
+    for comp in cause.components(nominal.rig, ev.sensor_bearing):
+        best = None
+        for values in _probes(cause, nominal.rig):
+            try:
+                chi, st = nuis.fit(cause.extend(nominal, values, comp))
+            except ParameterError:
+                continue
+            if best is None or chi < best["chi2"]:
+                best = {"name": cause.name, "cause": cause, "component": comp,
+                        "probe": values, "chi2": chi, "setup": st}
+        if best is not None:
+            out.append(best)
+    return out
+
+
+def refine(r, nominal, nuis):
+    """Re-rank the leading cause ``r`` (a row of :func:`rank`) at its best over a coarse
+    grid of each parameter's bounds, extending ``nominal`` with the chain refitted by
+    ``nuis`` (the probes may miss a severity far from them); the fit starts from there."""
+    cause, comp = r["cause"], r["component"]
+    for p in cause.params:
+        fwd, back = (math.log, math.exp) if p.log_scale else (float, float)
+        for u in np.linspace(fwd(p.bounds[0]), fwd(p.bounds[1]), FIT_GRID):
+            values = {**r["probe"], p.name: p.clamp(back(u))}
+            try:
+                chi, st = nuis.fit(cause.extend(nominal, values, comp))
+            except ParameterError:
+                continue
+            if chi < r["chi2"]:
+                r.update(chi2=chi, setup=st, probe=values)
+
+
+def evidence(r, chi_of, nominal_features, names):
+    """Fill ``r["delta_chi2"]`` (evidence on the cause's signature), ``r["total"]`` (over
+    every feature) and ``r["judged_on"]`` (the signature's features) of a ranked cause.
+
+    Parameters
+    ----------
+    r : dict
+        A row of :func:`rank`.
+    chi_of : callable
+        ``chi_of(features, names)``: χ² of a feature dict over some names.
+    nominal_features : dict
+        Features of the nominal setup (its chain refitted).
+    names : list of str
+        Every feature compared.
+    """
+    judged = r["cause"].judged_on(names, r["component"])
+    sim = r.get("features")
+    r["judged_on"] = judged
+    r["total"] = chi_of(nominal_features, names) - chi_of(sim, names)
+    r["delta_chi2"] = chi_of(nominal_features, judged) - chi_of(sim, judged) if judged else 0.0
+
+
+def decide(ranked, sensor_bearing, chi_nominal):
+    """(winner or None, near ties) from ranked causes with their evidence filled.
+
+    Faults (causes with a signature) are decided first: the strongest whose evidence reaches
+    :data:`MIN_DELTA_CHI2` wins, preferring the sensor's bearing (:data:`FAR_MARGIN`);
+    without one, the reshaping cause with the largest evidence, if it reaches
+    :data:`MIN_DELTA_CHI2` and removes :data:`MIN_SCORE` of the nominal χ².
+
+    Parameters
+    ----------
+    ranked : list of dict
+        Rows of :func:`rank` with :func:`evidence` filled.
+    sensor_bearing : str
+        The bearing the sensor sits on (model name).
+    chi_nominal : float
+        χ² of the nominal model over every feature (fit segments).
+
+    Returns
+    -------
+    (dict or None, list of dict)
+    """
+    faults = [r for r in ranked if r["cause"].signature is not None
+              and r["delta_chi2"] >= MIN_DELTA_CHI2]
+    if faults:
+        # the same cause on the sensor's bearing beats it elsewhere unless clearly weaker
+        best = {}
+        for r in faults:
+            key = (r["name"], r["cause"].kind)
+            near = r["component"] == sensor_bearing
+            prev = best.get(key)
+            if prev is None:
+                best[key] = r
+                continue
+            prev_near = prev["component"] == sensor_bearing
+            if near and not prev_near:
+                if prev["delta_chi2"] < FAR_MARGIN * r["delta_chi2"]:
+                    best[key] = r
+            elif prev_near and not near:
+                if r["delta_chi2"] >= FAR_MARGIN * prev["delta_chi2"]:
+                    best[key] = r
+            elif r["delta_chi2"] > prev["delta_chi2"]:
+                best[key] = r
+        pool = sorted(best.values(), key=lambda r: -r["delta_chi2"])
+    else:
+        pool = sorted((r for r in ranked if r["cause"].signature is None
+                       and r["delta_chi2"] >= MIN_DELTA_CHI2
+                       and r["delta_chi2"] >= MIN_SCORE * chi_nominal),
+                      key=lambda r: -r["delta_chi2"])
+    if not pool:
+        return None, []
+    top = pool[0]
+    ties = [r for r in pool[1:] if r["delta_chi2"] >= NEAR_TIE * top["delta_chi2"]]
+    return top, ties
+
+
+def fit(top, nominal, nuis, ev):
+    """Fit the named cause's parameters, one after the other (coarse grid over the bounds,
+    then bounded Brent), within the budget.
+
+    Parameters
+    ----------
+    top : dict
+        The winner of :func:`decide`.
+    nominal : ModelSetup
+        The nominal setup it extends.
+    nuis : Nuisances
+        Refits the chain of each setup tried.
+    ev : Evaluator
+        Simulations, features and the budget.
+
+    Returns
+    -------
+    (dict, dict, ModelSetup)
+        Parameters (with the fitted chain), each parameter's range ``(lo, hi)`` within
+        :data:`SEVERITY_DELTA_CHI2` of the best χ² over the values tried, the fitted setup.
+    """
+    cause, comp = top["cause"], top["component"]
+    if cause.post_dynamics:                       # its value is one of the nuisances
+        return nuisance_params(top["setup"], nominal), {}, top["setup"]
+    values = dict(top["probe"])
+    best_c, best_st = top["chi2"], top["setup"]
+    ranges = {}
+    for p in cause.params:
+        lo, hi = p.bounds
+        fwd, back = (math.log, math.exp) if p.log_scale else (float, float)
+        states = {}
+
+        def objective(u, p=p, states=states):
+            v = p.clamp(back(u))
+            try:
+                c, st = nuis.fit(cause.extend(nominal, {**values, p.name: v}, comp))
+            except (Budget, ParameterError):
+                return math.inf
+            states[float(u)] = (c, st, v)
+            return c
+
+        grid = np.linspace(fwd(lo), fwd(hi), FIT_GRID)
+        if ev.budget - ev.count < len(nuis.seeds) * (FIT_GRID + 3) and not cause.force_level:
+            break
+        vals = [objective(u) for u in grid]
+        i = int(np.argmin(vals))
+        a, b = grid[max(i - 1, 0)], grid[min(i + 1, FIT_GRID - 1)]
+        n_fit = (ev.budget - ev.count) // max(len(nuis.seeds), 1)
+        if n_fit >= 3 or cause.force_level:
+            minimize_scalar(objective, bounds=(a, b), method="bounded",
+                            options={"maxiter": max(n_fit, 8), "xatol": 0.02})
+        if states:
+            c, st, v = min(states.values(), key=lambda s: s[0])
+            within = [s[2] for s in states.values() if s[0] <= c + SEVERITY_DELTA_CHI2]
+            ranges[p.name] = (min(within), max(within))
+            if c < best_c:
+                best_c, best_st = c, st
+                values[p.name] = v
+    return {**values, **nuisance_params(best_st, nominal)}, ranges, best_st

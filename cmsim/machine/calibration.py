@@ -1,0 +1,448 @@
+"""Calibrate a machine on healthy baseline records: what the model cannot know of it.
+
+From one or more healthy records of one machine (same channel and sample rate), every
+segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
+**held-out** set (odd). On the fit set:
+
+1. **Spectrum and lines.** The averaged power spectrum (Hann) of the segments; its narrow
+   lines are the bins standing :data:`LINE_MIN_DB` over a running median of ±
+   :data:`FLOOR_HALF_WIDTH_HZ` (lines have no width there, the broadband has); the running
+   mean with the lines' bins masked is the smooth **background spectrum** B(f) (a running
+   median alone would sit 0.3-1.6 dB under the mean of a noisy estimate).
+2. **Model force.** The nominal (healthy) model at the record's operating point is
+   simulated for :data:`N_SEEDS` seeds; its force spectrum gives the lines the model makes
+   (GMF harmonics, the ball pass of the sensor's bearing: those standing 20 dB over the
+   force's own floor) and its broadband level.
+3. **Transfer path.** Its *shape* is that of the background, √B(f) smoothed over
+   :data:`PATH_SMOOTHING_OCTAVE` octave: a machine's structure shapes both its broadband
+   excitation and the response to the model's forces (the assumption behind choosing a
+   demodulation band where the background resonates, Randall & Antoni 2011). A 1/12-octave
+   smoothing resolves resonances down to about 3 % damping (half-power width 2ζf ≥ f/16)
+   and averages the spectral estimate over enough bins to leave a ±0.5 dB scatter. Below
+   :data:`HOUSING_BAND_LOW`·fs the path falls as f² (stiffness-controlled). Its
+   *gain* is pinned where a model line (GMF harmonics on a gear rig, the sensor bearing's
+   ball pass on a bearing rig) stands in the record too (the ratio of the measured line to
+   the model's, interpolated in log frequency between such lines); where none does
+   (a healthy ball bearing's ball pass is usually below the floor) the gain is that of the
+   rig's nominal housing path averaged over 0.05-0.45·fs, lowered if that would show a model
+   line the record does not, and the machine file says so: fault sizes read through such a
+   path carry that uncertainty.
+4. **Background.** The coloured noise is B(f) less what the model's broadband force puts
+   there through the path (at least 10 % of B); the lines are the measured lines less what
+   the model's own lines put there through the path (powers subtracted), each filed as an
+   order of the input or output shaft when it sits on one (so it follows the speed), else
+   at its frequency (the mains, other machines).
+5. **Spread and fit quality.** :func:`cmsim.features.relative_features` of every baseline
+   segment give each feature's mean and segment-to-segment spread; the twin (model force →
+   path + background, :data:`N_TWIN_SEEDS` new seeds, a segment each) is compared with the
+   held-out segments feature by feature: z = (twin − baseline) / spread, and, since one
+   record is one realisation of the model's random parts (cage phases, slip) while the twin
+   averages several, also over √(spread² + the twin's own spread²).
+
+The operating point is the record's (speed read from the signal); the speed wobble is the
+relative RMS of the strongest shaft-order line's instantaneous frequency, recorded for
+information.
+
+References
+----------
+.. [1] R. B. Randall, J. Antoni, "Rolling element bearing diagnostics — a tutorial",
+   MSSP 25 (2011) 485-520.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+from scipy.ndimage import median_filter
+
+from cmsim.errors import ParameterError
+from cmsim.features import relative_features
+from cmsim.features.relative import segments
+from cmsim.frequencies import rig_frequencies
+from cmsim.machine.background import Background, BackgroundLine
+from cmsim.machine.machine import Machine, model_force
+from cmsim.machine.path import TransferPath, smooth_log
+from cmsim.run import signal_info
+
+__all__ = ["calibrate", "SEGMENT_S", "N_SEEDS", "LINE_MIN_DB", "FLOOR_HALF_WIDTH_HZ",
+           "PATH_SMOOTHING_OCTAVE", "MAX_LINES", "feature_rows"]
+
+#: Segment length, s (the segments compare reads).
+SEGMENT_S = 0.5
+#: Seeds of the nominal model simulated for the force spectrum.
+N_SEEDS = 3
+#: Seeds (one segment each) of the twin compared with the held-out baseline segments.
+N_TWIN_SEEDS = 6
+#: Least height of a narrow line over the running median, dB (the median of a PSD averaged
+#: over ~10 segments exceeds this by chance in about one bin in a thousand).
+LINE_MIN_DB = 6.0
+#: Half-width of the running median that gives the background spectrum, Hz.
+FLOOR_HALF_WIDTH_HZ = 25.0
+#: Smoothing of the path's shape, octave.
+PATH_SMOOTHING_OCTAVE = 1.0 / 12.0
+#: Most background lines kept (the strongest).
+MAX_LINES = 300
+#: Least height of a model line over the model force's own floor to pin the path, dB.
+MODEL_LINE_MIN_DB = 20.0
+#: Most a pinned gain may exceed the lowest bound set by model lines the record does not
+#: show (6 dB) before the record's line is taken for another line at that frequency.
+PIN_CONSISTENCY = 2.0
+#: Most of the record's broadband power the model's own broadband force may account for
+#: through the path, at any frequency: the rest is the machine's background.
+BROADBAND_SHARE = 0.5
+#: Relative tolerance of a line's frequency against a shaft order or a model line.
+LINE_TOLERANCE = 0.004
+#: Lower edge of a housing's resonant band, as a share of the sample rate: below it the
+#: path is taken stiffness-controlled (accelerance ∝ f², the ω²/k of a structure below its
+#: first mode); the background there (rocking, the motor, the mains) does not shape it.
+HOUSING_BAND_LOW = 0.04
+
+
+def _power_spectrum(segs, fs):
+    """(freq, one-sided PSD averaged over segments) with a Hann window, unit²/Hz."""
+    n = segs[0].size
+    w = np.hanning(n)
+    p = np.mean([np.abs(np.fft.rfft((s - s.mean()) * w)) ** 2 for s in segs], axis=0)
+    return np.fft.rfftfreq(n, 1.0 / fs), 2.0 * p / (fs * np.sum(w ** 2))
+
+
+def _window_bins(freq):
+    """Odd number of bins of the ± :data:`FLOOR_HALF_WIDTH_HZ` running windows."""
+    return max(5, 2 * int(round(FLOOR_HALF_WIDTH_HZ / (freq[1] - freq[0]))) + 1)
+
+
+def _floor(freq, psd):
+    """Running median of the PSD over ± :data:`FLOOR_HALF_WIDTH_HZ`: blind to lines, but
+    biased low on a noisy estimate (what line detection needs, not the level)."""
+    return np.maximum(median_filter(psd, size=_window_bins(freq), mode="nearest"), 1e-300)
+
+
+def _lines_and_floor(freq, psd):
+    """(lines, floor): the narrow lines [(frequency, amplitude)] standing
+    :data:`LINE_MIN_DB` over the running median, strongest first, and the broadband floor —
+    the running mean of the PSD with the lines' bins replaced by the median (unbiased: the
+    power of a line too weak to be called stays in the broadband)."""
+    df = freq[1] - freq[0]
+    med = _floor(freq, psd)
+    ratio = psd / med
+    thr = 10.0 ** (LINE_MIN_DB / 10.0)
+    peaks = [i for i in range(2, psd.size - 2) if ratio[i] > thr and freq[i] >= 2.0
+             and psd[i] >= psd[i - 1] and psd[i] >= psd[i + 1]]
+    masked = psd.copy()
+    for i in peaks:
+        masked[i - 2:i + 3] = med[i - 2:i + 3]
+    k = _window_bins(freq)
+    floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
+                                   mode="valid"), 1e-300)
+    found = []
+    for i in peaks:
+        excess = float(np.sum(psd[i - 2:i + 3] - floor[i - 2:i + 3])) * df
+        if excess > 0:
+            # Hann: the line's power spreads over its main lobe; ∑ (P − floor)·df = A²/2
+            found.append((float(freq[i]), math.sqrt(2.0 * excess)))
+    found.sort(key=lambda fa: -fa[1])
+    kept = []
+    for f, a in found:
+        if all(abs(f - g) > 2.5 * df for g, _ in kept):
+            kept.append((f, a))
+    return kept[:MAX_LINES], floor
+
+
+def _refined(lines, x, fs, df):
+    """The lines' frequencies read on the spectrum of the whole record ``x`` (its bins far
+    finer than a segment's), within ± 1.5 segment bins of each."""
+    n = x.size
+    amp = np.abs(np.fft.rfft((x - x.mean()) * np.hanning(n)))
+    freq = np.fft.rfftfreq(n, 1.0 / fs)
+    out = []
+    for f, a in lines:
+        sel = np.abs(freq - f) <= 1.5 * df
+        out.append((float(freq[sel][np.argmax(amp[sel])]) if np.any(sel) else f, a))
+    return out, freq[1]
+
+
+def _near(f, g, df):
+    return abs(f - g) <= max(1.5 * df, LINE_TOLERANCE * g)
+
+
+def _classify(f, shaft_hz, fine_df):
+    """(reference, value) of a background line read at the whole record's resolution
+    ``fine_df``: an order of a shaft when it sits on one within a bin (or 0.1 %), else a
+    fixed frequency (the mains and its sub-harmonics sit within a few tenths of a hertz of
+    a 4-pole motor's shaft orders, and only the fine bins tell them apart)."""
+    for ref, rate in zip(("input", "output"), shaft_hz):
+        k = round(f / rate)
+        if k >= 1 and abs(f - k * rate) <= max(fine_df, 1e-3 * f):
+            return ref, float(k)
+    return "fixed", f
+
+
+def _model_lines(freqs, bearing):
+    """Frequencies of the lines the path is read at: on a gear rig the GMF harmonics (the
+    gears' tooth counts are what a gearbox's metadata documents; its bearings often are
+    not), on a bearing rig the ball pass of the sensor's bearing and its harmonics."""
+    if freqs.gmf_hz:
+        return [k * freqs.gmf_hz for k in range(1, 13)]
+    if bearing in freqs.bearing_names:
+        return [h * freqs.bearing(bearing).bpf_hz for h in range(1, 6)]
+    return []
+
+
+def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
+    """Features of each segment: :func:`cmsim.features.relative_features`, plus ``level_db``
+    (dB re 1 m/s²) when the unit is known; ``(names, array (n_segments, n_features))``.
+
+    Parameters
+    ----------
+    segs : sequence of numpy.ndarray
+        Segments of a signal, sensor unit.
+    fs_hz : float
+        Sample rate, Hz.
+    freqs : cmsim.frequencies.RigFrequencies
+        Frequencies of the model rig at the record's speed.
+    bearings : sequence of str
+        Bearings whose families are read.
+    unit_scale : float or None
+        Sensor unit → m/s² (None: no ``level_db``).
+    """
+    rows = []
+    for x in segs:
+        f = relative_features(x, fs_hz, freqs, bearings)
+        if unit_scale is not None:
+            f["level_db"] = 20.0 * math.log10(max(float(np.std(x)) * unit_scale, 1e-30))
+        rows.append(f)
+    if not rows:
+        raise ParameterError("no segment to read features from", param="baseline")
+    names = list(rows[0])
+    return names, np.array([[r[k] for k in names] for r in rows], dtype=float)
+
+
+def _speed_wobble(x, fs, shaft_hz):
+    """Relative RMS of the instantaneous frequency of the strongest of the first four shaft
+    orders (complex demodulation, low-passed below half the shaft rate)."""
+    n = x.size
+    spec = np.fft.rfft(x * np.hanning(n))
+    freq = np.fft.rfftfreq(n, 1.0 / fs)
+    best = None
+    for k in range(1, 5):
+        sel = np.abs(freq - k * shaft_hz) <= 0.02 * k * shaft_hz
+        if np.any(sel):
+            a = float(np.max(np.abs(spec[sel])))
+            if best is None or a > best[0]:
+                best = (a, k)
+    if best is None:
+        return 0.0
+    k = best[1]
+    t = np.arange(n) / fs
+    base = x * np.exp(-2j * math.pi * k * shaft_hz * t)
+    width = max(1, int(round(2.0 * fs / shaft_hz)))
+    kernel = np.ones(width) / width
+    base = np.convolve(base, kernel, mode="valid")
+    inst = np.diff(np.unwrap(np.angle(base))) * fs / (2.0 * math.pi)
+    return float(np.std(inst) / (k * shaft_hz)) if inst.size > 10 else 0.0
+
+
+def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
+    """Calibrate the twin of a machine on its healthy baseline record(s).
+
+    Parameters
+    ----------
+    records : sequence of MeasuredRecord
+        Healthy records of one machine (:func:`cmsim.measured.read_record`, or a part of
+        one: :meth:`MeasuredRecord.span <cmsim.measured.MeasuredRecord.span>`), same channel
+        and sample rate; the model rig and operating point of the first are the machine's.
+    seg_s : float
+        Segment length, s (each record needs at least 4 segments).
+    n_seeds : int
+        Model simulations for the force spectrum.
+    seed : int
+        Seed of the model simulations and of the twin's background.
+    name : str, optional
+        Name of the machine (default: the first record's file).
+
+    Returns
+    -------
+    Machine
+
+    Raises
+    ------
+    ParameterError
+        No record, records of different channels or sample rates, too short a record.
+    """
+    records = list(records)
+    if not records:
+        raise ParameterError("calibrate needs at least one baseline record", param="baseline")
+    ref = records[0]
+    fs = ref.fs_hz
+    for r in records[1:]:
+        if r.channel != ref.channel or abs(r.fs_hz / fs - 1.0) > 1e-3:
+            raise ParameterError(f"baseline records must share a channel and a sample rate: "
+                                 f"{ref.channel} at {fs:g} Hz vs {r.channel} at {r.fs_hz:g} Hz",
+                                 param="baseline")
+    fit, held = [], []
+    for r in records:
+        x = r.signal
+        segs = [x[a:b] for a, b in segments(x.size, fs, seg_s)]
+        if len(segs) < 4:
+            raise ParameterError(f"baseline {r.record_id or r.path or 'record'} gives "
+                                 f"{len(segs)} segments of {seg_s:g} s; needs >= 4",
+                                 param="baseline")
+        fit += segs[0::2]
+        held += segs[1::2]
+    rig, op = ref.rig, ref.op
+    freqs = rig_frequencies(rig, op)
+    bearing = signal_info(ref.model_signal).component
+    shaft_hz = (freqs.fr1_hz, freqs.fr2_hz if freqs.fr2_hz is not None else freqs.fr1_hz)
+    notes = [f"operating point: {op.speed_rpm:.2f} rpm from the record; torque "
+             f"{op.torque_nm:g} N m and radial load {op.radial_load_n:g} N as the record's "
+             "model assumes (the load is not identified from a healthy record)"]
+
+    # 1. the record: spectrum, its lines, the smooth background spectrum
+    freq, psd = _power_spectrum(fit, fs)
+    df = freq[1] - freq[0]
+    lines, floor = _lines_and_floor(freq, psd)
+
+    # 2. the nominal model's force
+    forces = []
+    for s in range(n_seeds):
+        force, edge, n = model_force(rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
+        forces.append(force[edge:edge + n])
+    _, pf = _power_spectrum(forces, fs)
+    amp_f = np.sqrt(pf * df * 2.0)                 # a line's amplitude at its bin (approx.)
+
+    # 3. the path: shape of the background (stiffness-controlled below the housing band),
+    # gain pinned by the model lines the record shows, bounded by those it does not show
+    shape = np.sqrt(np.exp(smooth_log(np.log(floor), freq, PATH_SMOOTHING_OCTAVE)))
+    f_low = HOUSING_BAND_LOW * fs
+    i_low = int(np.searchsorted(freq, f_low))
+    shape[:i_low] = shape[i_low] * (np.maximum(freq[:i_low], df) / freq[i_low]) ** 2
+    force_lines, pf_floor = _lines_and_floor(freq, pf)
+    strong = [(f, a) for f, a in force_lines
+              if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
+              * pf_floor[int(round(f / df))]]
+    pin_at = _model_lines(freqs, bearing)
+    pins, bounds = [], []
+    for fm, force_amp in strong:
+        j = int(round(fm / df))
+        match = [(f, a) for f, a in lines if abs(f - fm) <= 1.5 * df]
+        if match and any(_near(fm, g, df) for g in pin_at):
+            f, a = max(match, key=lambda fa: fa[1])
+            pins.append((f, a / force_amp / shape[int(round(f / df))]))
+        elif not match:            # not in the record: 10 dB under its floor there
+            floor_amp = math.sqrt(2.0 * float(floor[j]) * df * 5 / 10.0)
+            bounds.append((fm, floor_amp / force_amp / shape[j]))
+    if bounds and pins:
+        # a record line at one harmonic of the family the path is read at, at a gain that
+        # would show another harmonic of that family the record does not show, is some other
+        # line at that frequency
+        family = [(fb, gb) for fb, gb in bounds if any(_near(fb, g, df) for g in pin_at)]
+        dropped = [p for p in pins if any(p[1] > PIN_CONSISTENCY * gb for _, gb in family)]
+        pins = [p for p in pins if p not in dropped]
+        if dropped:
+            notes.append(f"{len(dropped)} line(s) of the record at a model line's frequency "
+                         f"({', '.join(f'{p[0]:.1f}' for p in dropped[:4])} Hz) not taken as "
+                         "the model's: the gain they imply would show other harmonics of "
+                         "that family, which the record does not have")
+    band = (freq >= 0.05 * fs) & (freq <= 0.45 * fs)
+    if pins:
+        points = sorted(pins)
+        notes.append(f"path gain pinned by {len(pins)} model line(s) the record shows "
+                     f"({', '.join(f'{p[0]:.1f}' for p in points[:8])} Hz)")
+    else:
+        nominal = np.abs(rig.housing.accelerance(freq[band]))
+        scale = ref.unit_scale if ref.unit_scale is not None else 1.0
+        g = math.exp(float(np.mean(np.log(nominal / scale)) - np.mean(np.log(shape[band]))))
+        points = [(float(freq[band][0]), g), (float(freq[band][-1]), g)]
+        notes.append("path gain not identifiable on this baseline (no model line stands out "
+                     "in it): the rig's nominal housing path averaged over 0.05-0.45·fs; "
+                     "fault sizes read through it carry that uncertainty")
+        if ref.unit_scale is None:
+            notes.append("sensor unit unknown: the path is in sensor unit per N with the "
+                         "nominal housing's accelerance taken as 1 unit = 1 m/s²")
+
+    def correction(pts):
+        pts = sorted(pts)
+        f_, c_ = np.array([p[0] for p in pts]), np.log([p[1] for p in pts])
+        return np.exp(np.interp(np.log(np.maximum(freq, df)), np.log(f_), c_))
+
+    corr = correction(points)
+    capped = [(fb, gb) for fb, gb in bounds if corr[int(round(fb / df))] > gb]
+    if capped:                  # model lines the record does not show cap the path there
+        corr = correction(points + capped)
+        notes.append(f"path gain capped at {len(capped)} model line(s) the record does not "
+                     f"show ({', '.join(f'{f:.1f}' for f, _ in sorted(capped)[:6])} Hz), 10 "
+                     "dB under its floor there")
+    gain = shape * corr
+    if not pins:      # a prior gain must keep the model's broadband under the record's floor
+        gain = np.minimum(gain, np.sqrt(BROADBAND_SHARE * floor / pf_floor))
+    unit = str((ref.meta.get("sensor") or {}).get("unit") or "")
+    path = TransferPath(f"F_{bearing}_{signal_info(ref.model_signal).direction}",
+                        tuple(freq), tuple(np.maximum(gain, 1e-30)), unit)
+
+    # 4. the background: the rest of the broadband, and the lines the model does not make
+    noise = np.maximum(floor - gain ** 2 * pf_floor, 0.1 * floor)
+    pinned = [p[0] for p in pins]
+    own = []              # what the model's own lines put there is not background
+    for f, a in lines:
+        if any(abs(f - g) <= 2.5 * df for g in pinned):
+            continue
+        made = [fa for fa in force_lines if abs(fa[0] - f) <= 1.5 * df]
+        if made:
+            model_amp = float(np.interp(f, freq, gain)) * max(fa[1] for fa in made)
+            a = math.sqrt(max(a * a - model_amp * model_amp, 0.0))
+        if a > 0.0:
+            own.append((f, a))
+    longest = max(records, key=lambda r: r.signal.size).signal
+    fine, fine_df = _refined(own, longest, fs, df)
+    bg_lines = [BackgroundLine(*_classify(f, shaft_hz, fine_df), a) for f, a in fine]
+    background = Background(tuple(freq), tuple(noise), tuple(bg_lines))
+
+    wobble = _speed_wobble(np.concatenate([r.signal for r in records]), fs, freqs.fr1_hz)
+    machine = Machine(
+        name=name or (ref.record_id or "machine"), rig=rig, channel=ref.channel,
+        model_signal=ref.model_signal, fs_hz=fs, op=op, path=path, background=background,
+        unit=path.unit, unit_scale=ref.unit_scale, components=dict(ref.components),
+        segment_s=seg_s, speed_wobble=wobble,
+        calibrated_on=tuple(f"{r.record_id or r.path or 'record'}"
+                            + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
+                               if r.meta.get("span_s") else "")
+                            + " (even segments fit, odd held out)" for r in records),
+        notes=tuple(notes))
+
+    # 5. the baseline's spread and the twin on the held-out segments
+    bearings = list(rig.bearing_names)
+    names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale)
+    mean = np.nanmean(all_rows, axis=0)
+    std = np.nanstd(all_rows, axis=0, ddof=1)
+    spread = {k: (float(m), float(s)) for k, m, s in zip(names, mean, std)
+              if math.isfinite(m) and math.isfinite(s)}
+    held_rows = all_rows[len(fit):]
+    twin = []
+    for s in range(N_TWIN_SEEDS):
+        force, edge, n = model_force(rig, op, ref.model_signal, fs, seg_s,
+                                     seed + 1 + 7777 * (s + n_seeds))
+        twin.append(machine.sensor_signal(force, edge, n, seed + 31 * s))
+    _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale)
+    z, z_model = {}, {}
+    for i, k in enumerate(names):
+        if k in spread and spread[k][1] > 0:
+            a, b = np.nanmean(twin_rows[:, i]), np.nanmean(held_rows[:, i])
+            if math.isfinite(a) and math.isfinite(b):
+                z[k] = float((a - b) / spread[k][1])
+                model = float(np.nanstd(twin_rows[:, i], ddof=1))
+                z_model[k] = float((a - b) / math.hypot(spread[k][1], model))
+    worst = max(z, key=lambda k: abs(z[k])) if z else None
+    worst_m = max(z_model, key=lambda k: abs(z_model[k])) if z_model else None
+    quality = {"z": z, "worst_feature": worst,
+               "worst_z": float(z[worst]) if worst else float("nan"),
+               "chi2_per_feature": float(np.mean([v * v for v in z.values()])) if z else 0.0,
+               "z_with_model_spread": z_model, "worst_feature_with_model_spread": worst_m,
+               "worst_z_with_model_spread": float(z_model[worst_m]) if worst_m
+               else float("nan"),
+               "chi2_per_feature_with_model_spread":
+                   float(np.mean([v * v for v in z_model.values()])) if z_model else 0.0,
+               "n_features": len(z), "held_out_segments": len(held),
+               "twin_segments": int(twin_rows.shape[0])}
+    return replace(machine, spread=spread, fit_quality=quality)

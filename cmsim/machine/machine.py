@@ -1,0 +1,296 @@
+"""A machine: the model of a rig seen through one real machine's sensor (its twin).
+
+The rig says what the physics is; a :class:`Machine` says what this particular housing,
+sensor and background do to it, as calibrated on a record of the machine when it was known
+to be healthy (:func:`cmsim.machine.calibration.calibrate`). A sensor signal of the machine is
+
+    y(t) = h ∗ F(t) + b(t),
+
+the model's bearing force ``F`` (:func:`model_force`) through the machine's transfer path
+``h`` (:class:`~cmsim.machine.path.TransferPath`, minimum phase, in the time domain) plus its
+background ``b`` (:class:`~cmsim.machine.background.Background`: coloured noise and the lines
+the model does not make). The machine file (TOML, :meth:`Machine.save`) holds the rig, the
+identified operating point, the path and background, the baseline's own segment-to-segment
+spread of every feature and the fit quality on baseline segments the fit did not use.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import tomli_w
+
+from cmsim._io import atomic_write_text
+from cmsim.dynamics import simulate
+from cmsim.errors import ParameterError
+from cmsim.losses import LossSettings
+from cmsim.machine.background import Background, BackgroundLine
+from cmsim.machine.path import TransferPath
+from cmsim.rig import OperatingPoint, Rig
+from cmsim.rig.codec import drop_none
+from cmsim.run import signal_info
+
+__all__ = ["Machine", "model_force", "MACHINE_FORMAT_VERSION", "EDGE_S"]
+
+#: Version written in a machine file; :meth:`Machine.load` refuses other versions.
+MACHINE_FORMAT_VERSION = 1
+
+#: Simulated time dropped at each end of a model force (filter edges), s.
+EDGE_S = 0.05
+
+
+def model_force(rig, op, model_signal, fs_hz, duration_s, seed, *, faults=(),
+                mixed_friction=False):
+    """The bearing force behind a sensor signal of the model, with spare samples at each end.
+
+    Parameters
+    ----------
+    rig : Rig
+    op : OperatingPoint
+    model_signal : str
+        ``accel_<bearing>_<x|y>``: the force is ``F_<bearing>_<x|y>``.
+    fs_hz : float
+        Sample rate, Hz (at least 1 kHz).
+    duration_s : float
+        Duration kept, s.
+    seed : int
+        Seed of the simulation.
+    faults : sequence of Fault
+        Faults of the model.
+    mixed_friction : bool
+        Tooth friction from the mixed-lubrication film (``simulate(losses=...)``).
+
+    Returns
+    -------
+    (numpy.ndarray, int, int)
+        The force (N) with ``edge`` extra samples at each end, ``edge``, and the samples
+        kept ``n``.
+    """
+    info = signal_info(model_signal)
+    name = f"F_{info.component}_{info.direction}"
+    mesh = "potential-energy" if rig.gears is not None else None
+    run = simulate(rig, op, duration_s + 2 * EDGE_S, fs_hz=max(fs_hz, 1e3), seed=seed,
+                   faults=faults, mesh=mesh, warmup_s=0.1, record=(name,),
+                   losses=LossSettings() if mixed_friction else None)
+    edge = int(round(EDGE_S * run.fs_hz))
+    n = int(round(duration_s * run.fs_hz))
+    return np.asarray(run[name], dtype=float)[: n + 2 * edge], edge, n
+
+
+@dataclass(frozen=True, eq=False)
+class Machine:
+    """One real machine: a rig, its sensor's transfer path and background, calibrated.
+
+    Attributes
+    ----------
+    name : str
+        Free text (the baseline it was calibrated on).
+    rig : Rig
+        The model rig.
+    channel : str
+        The measured channel the machine reproduces.
+    model_signal : str
+        Model output behind the channel (``accel_1b1_y``: the path is applied to
+        ``F_1b1_y``).
+    fs_hz : float
+        Sample rate of the channel, Hz.
+    op : OperatingPoint
+        Operating point identified on the baseline (speed from the signal).
+    path : TransferPath
+        Model force → sensor, sensor unit per N.
+    background : Background
+        Coloured noise and lines, sensor unit.
+    unit : str
+        Sensor unit as the metadata gives it (``"g"``; ``""`` unknown).
+    unit_scale : float or None
+        Factor from the sensor unit to m/s² (None: unknown unit).
+    components : dict
+        Model component → the machine's name for it (``{"1b1": "drive_end"}``).
+    segment_s : float
+        Segment length the features and their spread are computed on, s.
+    speed_wobble : float
+        Relative RMS of the input speed's slow fluctuation seen on the baseline.
+    spread : dict
+        Feature name → (mean, std) over the baseline's segments.
+    fit_quality : dict
+        On baseline segments the fit did not use: ``z`` (feature → (twin − baseline) /
+        spread), ``worst_feature``, ``worst_z``, ``chi2_per_feature``.
+    calibrated_on : tuple of str
+        The baseline records and the segments used.
+    notes : tuple of str
+        What was assumed (an unidentified path gain, an undocumented load ...).
+    """
+
+    name: str
+    rig: Rig
+    channel: str
+    model_signal: str
+    fs_hz: float
+    op: OperatingPoint
+    path: TransferPath
+    background: Background
+    unit: str = ""
+    unit_scale: float | None = None
+    components: dict = field(default_factory=dict)
+    segment_s: float = 0.5
+    speed_wobble: float = 0.0
+    spread: dict = field(default_factory=dict)
+    fit_quality: dict = field(default_factory=dict)
+    calibrated_on: tuple = ()
+    notes: tuple = ()
+
+    @property
+    def shaft_hz(self):
+        """(input, output) shaft rates at the machine's operating point, Hz."""
+        fr1 = self.op.speed_rpm / 60.0
+        return (fr1, fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1)
+
+    def sensor_signal(self, force, edge, n, seed, *, speed_rpm=None, frequency_factor=1.0,
+                      noise_gain=1.0, line_gain=1.0):
+        """The machine's sensor signal of a model force (:func:`model_force`'s output).
+
+        Parameters
+        ----------
+        force : numpy.ndarray
+            Model force, N, at :attr:`fs_hz`, with ``edge`` spare samples at each end.
+        edge, n : int
+            Spare samples at each end, samples kept.
+        seed : int
+            Seed of the background (noise and line phases).
+        speed_rpm : float, optional
+            Input speed the shaft-order lines follow (default the machine's).
+        frequency_factor : float
+            Scale of the path's frequencies (1 as calibrated).
+        noise_gain, line_gain : float
+            Factors on the background noise and lines (1 as calibrated).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            Sensor unit.
+        """
+        y = self.path.apply(force, self.fs_hz, frequency_factor)[edge:edge + n]
+        fr1 = (self.op.speed_rpm if speed_rpm is None else speed_rpm) / 60.0
+        fr2 = fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1
+        rng = np.random.default_rng([int(seed), 104729])
+        y = y + self.background.synthesize(n, self.fs_hz, (fr1, fr2), rng, noise_gain,
+                                           line_gain)
+        return y - y.mean()
+
+    def with_rig(self, rig):
+        """The same machine on another model rig (a fault, another clearance)."""
+        return replace(self, rig=rig)
+
+    # ------------------------------------------------------------------ file
+    def to_dict(self):
+        """Plain nested dict (TOML-ready) with a format version."""
+        return {
+            "format_version": MACHINE_FORMAT_VERSION,
+            "machine": {"name": self.name, "channel": self.channel,
+                        "model_signal": self.model_signal, "fs_hz": self.fs_hz,
+                        "unit": self.unit,
+                        "unit_scale": -1.0 if self.unit_scale is None else self.unit_scale,
+                        "segment_s": self.segment_s, "speed_wobble": self.speed_wobble,
+                        "components": dict(self.components),
+                        "calibrated_on": list(self.calibrated_on), "notes": list(self.notes)},
+            "operating": {"speed_rpm": self.op.speed_rpm, "torque_nm": self.op.torque_nm,
+                          "radial_load_n": self.op.radial_load_n,
+                          "radial_load_angle_rad": self.op.radial_load_angle_rad},
+            "rig": drop_none(self.rig.to_dict()),
+            "path": self.path.to_dict(),
+            "background": self.background.to_dict(),
+            "spread": {k: [float(m), float(s)] for k, (m, s) in self.spread.items()},
+            "fit_quality": _finite(self.fit_quality),
+        }
+
+    @classmethod
+    def from_dict(cls, data):
+        """Machine from :meth:`to_dict` output (every table checked).
+
+        Parameters
+        ----------
+        data : dict
+            The parsed machine file.
+        """
+        version = data.get("format_version")
+        if version != MACHINE_FORMAT_VERSION:
+            raise ParameterError(f"machine format_version {version!r} is not supported (this "
+                                 f"cmsim reads version {MACHINE_FORMAT_VERSION})",
+                                 param="machine")
+        try:
+            m, o, p, b = data["machine"], data["operating"], data["path"], data["background"]
+            scale = float(m["unit_scale"])
+            return cls(
+                name=str(m["name"]), rig=Rig.from_dict(data["rig"]), channel=str(m["channel"]),
+                model_signal=str(m["model_signal"]), fs_hz=float(m["fs_hz"]),
+                op=OperatingPoint(**{k: float(v) for k, v in o.items()}),
+                path=TransferPath(str(p["source"]), tuple(p["freq_hz"]), tuple(p["gain"]),
+                                  str(p.get("unit", ""))),
+                background=Background(tuple(b["freq_hz"]), tuple(b["psd"]), tuple(
+                    BackgroundLine(str(ln["reference"]), float(ln["value"]),
+                                   float(ln["amplitude"])) for ln in b.get("lines", ()))),
+                unit=str(m.get("unit", "")), unit_scale=None if scale < 0 else scale,
+                components=dict(m.get("components", {})),
+                segment_s=float(m.get("segment_s", 0.5)),
+                speed_wobble=float(m.get("speed_wobble", 0.0)),
+                spread={k: (float(v[0]), float(v[1])) for k, v in data.get("spread", {}).items()},
+                fit_quality=dict(data.get("fit_quality", {})),
+                calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())))
+        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            raise ParameterError(f"not a machine file ({type(exc).__name__}: {exc})",
+                                 param="machine") from None
+
+    def save(self, path):
+        """Write the machine file (TOML, atomically).
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file.
+        """
+        text = ("# cmsim machine: a rig calibrated on a healthy baseline of one machine "
+                "(cmsim calibrate); auto-generated.\n" + tomli_w.dumps(self.to_dict()))
+        atomic_write_text(Path(path), text)
+
+    @classmethod
+    def load(cls, path):
+        """Read a machine file written by :meth:`save`.
+
+        Parameters
+        ----------
+        path : str or pathlib.Path
+            The file.
+
+        Raises
+        ------
+        ParameterError
+            Missing, unreadable or not a machine file (the message names the file).
+        """
+        path = Path(path)
+        try:
+            with path.open("rb") as fh:
+                data = tomllib.load(fh)
+        except FileNotFoundError:
+            raise ParameterError(f"machine file {path} does not exist", param="machine") \
+                from None
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+            raise ParameterError(f"machine file {path} cannot be read as TOML ({exc})",
+                                 param="machine") from None
+        try:
+            return cls.from_dict(data)
+        except ParameterError as exc:
+            raise ParameterError(f"machine file {path}: {exc}", param="machine") from None
+
+
+def _finite(d):
+    """``d`` with non-finite floats dropped (TOML has no NaN a reader would expect)."""
+    if isinstance(d, dict):
+        return {k: _finite(v) for k, v in d.items()
+                if not (isinstance(v, float) and not math.isfinite(v))}
+    if isinstance(d, (list, tuple)):
+        return [_finite(x) for x in d]
+    return d
