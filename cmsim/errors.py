@@ -1,4 +1,4 @@
-"""Exceptions raised by cmsim, and the one helper that checks a parameter's range.
+"""Exceptions raised by cmsim, and the helpers that check a parameter's range or choice.
 
 A :class:`ParameterError` carries the name of the parameter it is about (``.param``, the
 Python name, e.g. ``"max_peaks"``) and its allowed range as text (``.allowed``), so a front end
@@ -12,8 +12,8 @@ import math
 import numbers
 import re
 
-__all__ = ["ParameterError", "IntegrationDiverged", "check_range", "format_range",
-           "format_value"]
+__all__ = ["ParameterError", "IntegrationDiverged", "check_range", "check_choice",
+           "format_range", "format_value"]
 
 _LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
 
@@ -118,3 +118,29 @@ def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_ope
         raise ParameterError(f"{name} must be {allowed}, got {format_value(v)}", param=name,
                              allowed=allowed)
     return v
+
+
+def check_choice(name, value, allowed):
+    """Return ``value`` if it is one of ``allowed``, else raise :class:`ParameterError`.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name (e.g. ``"window"``); recorded as the error's ``param``.
+    value : object
+        Value to check.
+    allowed : tuple or list
+        The options; the message shows them as given (``('hann', 'boxcar')``).
+
+    Examples
+    --------
+    >>> try:
+    ...     check_choice("plane", "3d", ("strain", "stress"))
+    ... except ParameterError as exc:
+    ...     print(exc)
+    plane must be one of ('strain', 'stress'), got '3d'
+    """
+    if value not in allowed:
+        raise ParameterError(f"{name} must be one of {allowed!r}, got {value!r}", param=name,
+                             allowed=", ".join(map(repr, allowed)))
+    return value

@@ -20,7 +20,7 @@ from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
 from cmsim.dynamics.tooth_contact import resolve_mesh
-from cmsim.errors import IntegrationDiverged, ParameterError, check_range
+from cmsim.errors import IntegrationDiverged, ParameterError, check_choice, check_range
 from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
                           operating_modulation, rig_with_faults, slip_from_faults)
 from cmsim.losses import LossSettings, power_balance, run_losses
@@ -61,8 +61,7 @@ class _Integrator:
     """
 
     def __init__(self, model, scheme, progress=None):
-        if scheme not in SCHEMES:
-            raise ParameterError(f"scheme must be one of {tuple(SCHEMES)}, got {scheme!r}")
+        check_choice("scheme", scheme, tuple(SCHEMES))
         self.model = model
         self.tab = SCHEMES[scheme]
         self.progress = progress

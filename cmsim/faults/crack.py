@@ -87,7 +87,7 @@ import math
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.mesh_stiffness.fe_mesh import MeshSpec
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
 from cmsim.mesh_stiffness.influence import influence_table
@@ -233,9 +233,7 @@ def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1
     >>> bool(0.0 < crack_stiffness_factor(pair, 1, 1e-3, math.pi / 4, s)[0] < 1.0)
     True
     """
-    if method not in CRACK_METHODS:
-        raise ParameterError(f"method must be one of {CRACK_METHODS}, got {method!r}",
-                             param="method", allowed=" or ".join(CRACK_METHODS))
+    check_choice("method", method, CRACK_METHODS)
     s = np.atleast_1d(np.asarray(position_m, dtype=float))
     lo, hi = _involute_domain(pair)
     s = np.clip(s, lo, hi)

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_choice
 from cmsim.rig import SpurGear
 
 __all__ = [
@@ -399,8 +399,7 @@ class ToothProfile:
         ndarray, shape (k, 2)
             Points, m, in outline order.
         """
-        if label not in SEGMENT_LABELS:
-            raise ParameterError(f"label must be one of {SEGMENT_LABELS}, got {label!r}")
+        check_choice("label", label, SEGMENT_LABELS)
         if side not in ("right", "left"):
             raise ParameterError(f"side must be 'right' or 'left', got {side!r}")
         sel = self.labels == label

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import choice, signal_1d
+from cmsim.errors import ParameterError, check_choice, check_range
+from cmsim.spectra._checks import signal_1d
 
 __all__ = ["plot_spectrum", "plot_waterfall", "plot_orbit", "plot_kurtogram", "WATERFALL_STYLES"]
 
@@ -146,7 +146,7 @@ def plot_waterfall(freqs, amps_list, values, value_label="Torque [N m]", *, styl
     -------
     matplotlib.figure.Figure
     """
-    choice("style", style, WATERFALL_STYLES)
+    check_choice("style", style, WATERFALL_STYLES)
     values = np.asarray(values, dtype=float).ravel()
     amps = [signal_1d(a, name="amps_list[i]", min_samples=2) for a in amps_list]
     if len(amps) != values.size or not amps:

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import choice, positive_int, signal_1d, spectrum_arrays
+from cmsim.errors import ParameterError, check_choice, check_range
+from cmsim.spectra._checks import positive_int, signal_1d, spectrum_arrays
 
 __all__ = ["harmonic_amplitudes", "dominant_harmonic", "plot_family_waterfall",
            "plot_harmonic_trend", "FAMILY_MARKERS"]
@@ -175,7 +175,7 @@ def plot_family_waterfall(freq, amps, values, *, families=None, peaks=None, domi
     -------
     matplotlib.figure.Figure
     """
-    choice("freq_unit", freq_unit, ("Hz", "order"))
+    check_choice("freq_unit", freq_unit, ("Hz", "order"))
     freq = signal_1d(freq, name="freq", min_samples=2)
     values = np.asarray(values, dtype=float).ravel()
     amps = [signal_1d(a, name=f"amps[{i}]", min_samples=2) for i, a in enumerate(amps)]
