@@ -317,7 +317,7 @@ def hertz_stiffness(pair):
     return math.pi * b / (2.0 * soft)
 
 
-def tooth_compliance(profile, contact_radius_m, n_nodes=1001):
+def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=None):
     """Compliance of one tooth loaded on its involute at the given radii.
 
     Parameters
@@ -328,6 +328,12 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001):
         Contact radii on the involute, within [form radius, tip-rounding start], m.
     n_nodes : int
         Nodes of the beam integration.
+    half_thickness : callable, optional
+        h(u): half-thickness, m, of the section that carries the load at height u (m, array)
+        above the root chord; default the tooth's own,
+        ``profile.half_thickness_at(min(y0 + u, r_a))``. A cracked tooth passes its reduced
+        section (:func:`cmsim.faults.crack.cracked_tooth_compliance`); the foundation term
+        stays the healthy one.
 
     Returns
     -------
@@ -348,10 +354,12 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001):
     x_c, y_c = r * np.sin(theta_c), r * np.cos(theta_c)
     a1 = alpha_r - theta_c
     y0 = profile.root_chord_y_m
+    if half_thickness is None:
+        def half_thickness(u):
+            return profile.half_thickness_at(np.minimum(y0 + u, profile.tip_radius_m))
     bending, shear, axial = cantilever_compliance(
-        lambda u: profile.half_thickness_at(np.minimum(y0 + u, profile.tip_radius_m)),
-        y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio, gear.face_width_m,
-        n_nodes=n_nodes)
+        half_thickness, y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio,
+        gear.face_width_m, n_nodes=n_nodes)
     u_f = y_c - x_c * np.tan(a1) - y0      # force line meets the centreline below y_c
     foundation = fillet_foundation_compliance(profile, u_f, a1)
     return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
