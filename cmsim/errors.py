@@ -1,4 +1,4 @@
-"""Exceptions raised by cmsim, and the helpers that check a parameter's range or choice.
+"""Exceptions raised by cmsim, and the helpers that check a parameter's range, choice or type.
 
 A :class:`ParameterError` carries the name of the parameter it is about (``.param``, the
 Python name, e.g. ``"max_peaks"``) and its allowed range as text (``.allowed``), so a front end
@@ -13,7 +13,7 @@ import numbers
 import re
 
 __all__ = ["ParameterError", "IntegrationDiverged", "check_range", "check_choice",
-           "format_range", "format_value"]
+           "check_type", "format_range", "format_value"]
 
 _LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
 
@@ -143,4 +143,30 @@ def check_choice(name, value, allowed):
     if value not in allowed:
         raise ParameterError(f"{name} must be one of {allowed!r}, got {value!r}", param=name,
                              allowed=", ".join(map(repr, allowed)))
+    return value
+
+
+def check_type(name, value, cls):
+    """Return ``value`` if it is a ``cls``, else raise :class:`ParameterError` naming both types.
+
+    Parameters
+    ----------
+    name : str
+        Parameter name (e.g. ``"gear"``); recorded as the error's ``param``.
+    value : object
+        Value to check.
+    cls : type
+        The class expected.
+
+    Examples
+    --------
+    >>> try:
+    ...     check_type("gear", 20, str)
+    ... except ParameterError as exc:
+    ...     print(exc)
+    gear must be a str, got int
+    """
+    if not isinstance(value, cls):
+        raise ParameterError(f"{name} must be a {cls.__name__}, got {type(value).__name__}",
+                             param=name, allowed=f"a {cls.__name__}")
     return value

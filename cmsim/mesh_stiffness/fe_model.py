@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from cmsim.errors import ParameterError, check_choice, check_range
+from cmsim.errors import ParameterError, check_choice, check_range, check_type
 from cmsim.mesh_stiffness.fe_mesh import GearMesh, MeshSpec, gear_mesh
 from cmsim.rig import SpurGear
 
@@ -275,8 +275,7 @@ class GearBodyModel:
         -------
         GearBodyModel
         """
-        if not isinstance(gear, SpurGear):
-            raise ParameterError(f"gear must be a SpurGear, got {type(gear).__name__}")
+        check_type("gear", gear, SpurGear)
         check_choice("plane", plane, PLANE_MODES)
         t0 = time.perf_counter()
         gm = gear_mesh(gear, spec, crack)

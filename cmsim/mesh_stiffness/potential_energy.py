@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import simpson
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_range, check_type
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
 from cmsim.rig import GearPair, SpurGear
 
@@ -339,8 +339,7 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=Non
     -------
     ToothCompliance
     """
-    if not isinstance(profile, ToothProfile):
-        raise ParameterError(f"profile must be a ToothProfile, got {type(profile).__name__}")
+    check_type("profile", profile, ToothProfile)
     gear = profile.gear
     r = np.atleast_1d(np.asarray(contact_radius_m, dtype=float))
     lo, hi = profile.form_radius_m, profile.tip_round_start_radius_m
@@ -551,8 +550,7 @@ def iso6336_stiffness(pair, c_m=0.8, c_r=1.0):
 
 # --------------------------------------------------------------------------- internals
 def _check_pair(pair):
-    if not isinstance(pair, GearPair):
-        raise ParameterError(f"pair must be a GearPair, got {type(pair).__name__}")
+    check_type("pair", pair, GearPair)
 
 
 def _path_length(pair):
