@@ -121,24 +121,11 @@ def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_ope
 
 
 def check_choice(name, value, allowed):
-    """Return ``value`` if it is one of ``allowed``, else raise :class:`ParameterError`.
+    """Return ``value`` if it is one of ``allowed`` (a tuple or list of options), else raise
+    :class:`ParameterError` naming ``name`` (its ``param``) and the options as given.
 
-    Parameters
-    ----------
-    name : str
-        Parameter name (e.g. ``"window"``); recorded as the error's ``param``.
-    value : object
-        Value to check.
-    allowed : tuple or list
-        The options; the message shows them as given (``('hann', 'boxcar')``).
-
-    Examples
-    --------
-    >>> try:
-    ...     check_choice("plane", "3d", ("strain", "stress"))
-    ... except ParameterError as exc:
-    ...     print(exc)
-    plane must be one of ('strain', 'stress'), got '3d'
+    >>> check_choice("plane", "strain", ("strain", "stress"))
+    'strain'
     """
     if value not in allowed:
         raise ParameterError(f"{name} must be one of {allowed!r}, got {value!r}", param=name,
@@ -147,25 +134,8 @@ def check_choice(name, value, allowed):
 
 
 def check_type(name, value, cls):
-    """Return ``value`` if it is a ``cls``, else raise :class:`ParameterError` naming both types.
-
-    Parameters
-    ----------
-    name : str
-        Parameter name (e.g. ``"gear"``); recorded as the error's ``param``.
-    value : object
-        Value to check.
-    cls : type
-        The class expected.
-
-    Examples
-    --------
-    >>> try:
-    ...     check_type("gear", 20, str)
-    ... except ParameterError as exc:
-    ...     print(exc)
-    gear must be a str, got int
-    """
+    """Return ``value`` if it is an instance of ``cls``, else raise :class:`ParameterError`
+    naming ``name`` (its ``param``) and both types: ``gear must be a SpurGear, got int``."""
     if not isinstance(value, cls):
         raise ParameterError(f"{name} must be a {cls.__name__}, got {type(value).__name__}",
                              param=name, allowed=f"a {cls.__name__}")
