@@ -279,6 +279,11 @@ def check_int(name, value, lo, hi=None):
     return int(value)
 
 
+def check_angle(name, value):
+    """Refuse an angle or phase outside [−2π, 2π] rad; return it as float."""
+    return check_range(name, value, -2 * math.pi, 2 * math.pi, unit="rad")
+
+
 def mm(x):
     """Metres as a short millimetre string for labels."""
     return f"{1e3 * x:.3g}mm"

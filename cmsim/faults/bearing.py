@@ -59,7 +59,7 @@ import numpy as np
 
 from cmsim.bearings.hertz import bearing_raceway_contacts, contact_semi_axes_m
 from cmsim.errors import ParameterError, check_range
-from cmsim.faults.base import Fault, check_bearing, check_int, mm, register
+from cmsim.faults.base import Fault, check_angle, check_bearing, check_int, mm, register
 
 __all__ = ["OuterRaceDefect", "InnerRaceDefect", "BallDefect", "BearingWear", "OffSizeBall",
            "RollingSlip", "NO_SLIP", "ball_drop_m", "defect_profile", "track_share",
@@ -226,7 +226,7 @@ class _RaceDefect(_LocalizedDefect):
     def __post_init__(self):
         super().__post_init__()
         if self.angle_rad is not None:
-            check_range("angle_rad", self.angle_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+            check_angle("angle_rad", self.angle_rad)
 
     @property
     def label(self):
@@ -359,7 +359,7 @@ class BallDefect(_LocalizedDefect):
     def __post_init__(self):
         super().__post_init__()
         check_int("ball", self.ball, 0)
-        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+        check_angle("phase_rad", self.phase_rad)
         check_range("axis_offset", self.axis_offset, -1.0, 1.0, unit="")
         check_range("wander_s", self.wander_s, 0.0, 1e3, unit="s")
 
