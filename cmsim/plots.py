@@ -12,17 +12,9 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.spectra._checks import signal_1d
+from cmsim.spectra.plots import agg_figure
 
 __all__ = ["plot_orbit_family", "plot_trace_family"]
-
-
-def _figure(figsize):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
 
 
 def _colour_by_value(values):
@@ -75,7 +67,7 @@ def plot_orbit_family(orbits, values, *, bearing_names, clearances_m=None,
         raise ParameterError("clearances_m needs one value per bearing")
     detail = {int(order[0]), int(order[-1])} if detail_runs is None else set(detail_runs)
     n_b = len(orbits)
-    fig = _figure((4.6 * n_b + 1.8, 9.4))
+    fig = agg_figure((4.6 * n_b + 1.8, 9.4))
     grid = fig.subplots(2, n_b, squeeze=False)
     for b, name in enumerate(bearing_names):
         ax, axc = grid[0, b], grid[1, b]
@@ -140,7 +132,7 @@ def plot_trace_family(panels, values, *, value_label="Torque [N·m]", title=None
     matplotlib.figure.Figure
     """
     values, _, colour_of = _colour_by_value(values)
-    fig = _figure((11.0, 3.4 * len(panels) + 0.6))
+    fig = agg_figure((11.0, 3.4 * len(panels) + 0.6))
     axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
     for ax, p in zip(axes, panels):
         runs = p.get("runs", range(values.size))

@@ -24,12 +24,19 @@ FAMILY_COLOURS = {"GMF": "tab:blue", "BPF": "tab:red", "fr": "tab:green", "BPFO"
                   "unlabelled": "0.5"}
 
 
-def _figure(figsize, projection=None):
+def agg_figure(figsize, layout="constrained"):
+    """A new figure of ``figsize`` (inches) on its own Agg canvas, with ``layout`` (matplotlib's
+    layout engine, ``None`` for none): no pyplot state. Every figure of cmsim starts here."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=figsize, layout="constrained")
+    fig = Figure(figsize=figsize, layout=layout)
     FigureCanvasAgg(fig)
+    return fig
+
+
+def _figure(figsize, projection=None):
+    fig = agg_figure(figsize)
     ax = fig.add_subplot(projection=projection) if projection else fig.add_subplot()
     return fig, ax
 
