@@ -1,4 +1,4 @@
-"""Exceptions raised by cmsim, and the one helper that checks a parameter's range.
+"""Exceptions raised by cmsim, and the helpers that check a parameter's range, choice or type.
 
 A :class:`ParameterError` carries the name of the parameter it is about (``.param``, the
 Python name, e.g. ``"max_peaks"``) and its allowed range as text (``.allowed``), so a front end
@@ -12,8 +12,8 @@ import math
 import numbers
 import re
 
-__all__ = ["ParameterError", "IntegrationDiverged", "check_range", "format_range",
-           "format_value"]
+__all__ = ["ParameterError", "IntegrationDiverged", "check_range", "check_choice",
+           "check_type", "format_range", "format_value"]
 
 _LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
 
@@ -118,3 +118,25 @@ def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_ope
         raise ParameterError(f"{name} must be {allowed}, got {format_value(v)}", param=name,
                              allowed=allowed)
     return v
+
+
+def check_choice(name, value, allowed):
+    """Return ``value`` if it is one of ``allowed`` (a tuple or list of options), else raise
+    :class:`ParameterError` naming ``name`` (its ``param``) and the options as given.
+
+    >>> check_choice("plane", "strain", ("strain", "stress"))
+    'strain'
+    """
+    if value not in allowed:
+        raise ParameterError(f"{name} must be one of {allowed!r}, got {value!r}", param=name,
+                             allowed=", ".join(map(repr, allowed)))
+    return value
+
+
+def check_type(name, value, cls):
+    """Return ``value`` if it is an instance of ``cls``, else raise :class:`ParameterError`
+    naming ``name`` (its ``param``) and both types: ``gear must be a SpurGear, got int``."""
+    if not isinstance(value, cls):
+        raise ParameterError(f"{name} must be a {cls.__name__}, got {type(value).__name__}",
+                             param=name, allowed=f"a {cls.__name__}")
+    return value

@@ -36,7 +36,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_range, check_type
 
 __all__ = ["BearingFrequencies", "RigFrequencies", "bearing_frequencies", "rig_frequencies",
            "peak_families", "cage_speed_ratios", "FAMILY_KEYS"]
@@ -346,6 +346,5 @@ def peak_families(freqs, bearing=None):
             raise ParameterError("freqs must be a RigFrequencies or its to_dict() "
                                  "(no bearing entries found)")
         freqs = RigFrequencies.from_dict(freqs)
-    if not isinstance(freqs, RigFrequencies):
-        raise ParameterError(f"freqs must be a RigFrequencies, got {type(freqs).__name__}")
+    check_type("freqs", freqs, RigFrequencies)
     return freqs.families(bearing)

@@ -12,23 +12,20 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.spectra._checks import signal_1d
+from cmsim.spectra.plots import agg_figure
 
 __all__ = ["plot_orbit_family", "plot_trace_family"]
 
 
-def _figure(figsize):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _colours(n):
+def _colour_by_value(values):
+    """The sweep ``values`` as floats, the runs in increasing value (stable), and the colour
+    of each run, ``{run: colour}``: viridis by rank, the lowest value darkest."""
     import matplotlib as mpl
     cmap = mpl.colormaps["viridis"]
-    return [cmap(0.85 * j / max(n - 1, 1)) for j in range(n)]
+    values = np.asarray(values, dtype=float).ravel()
+    order = np.argsort(values, kind="stable")
+    n = values.size
+    return values, order, {int(i): cmap(0.85 * j / max(n - 1, 1)) for j, i in enumerate(order)}
 
 
 def plot_orbit_family(orbits, values, *, bearing_names, clearances_m=None,
@@ -62,30 +59,28 @@ def plot_orbit_family(orbits, values, *, bearing_names, clearances_m=None,
     -------
     matplotlib.figure.Figure
     """
-    values = np.asarray(values, dtype=float).ravel()
+    values, order, colour_of = _colour_by_value(values)
     if len(orbits) != len(bearing_names) or not orbits:
         raise ParameterError(f"orbits has {len(orbits)} bearings but bearing_names has "
                              f"{len(bearing_names)}")
     if clearances_m is not None and len(clearances_m) != len(orbits):
         raise ParameterError("clearances_m needs one value per bearing")
-    order = np.argsort(values, kind="stable")
-    colours = _colours(values.size)
     detail = {int(order[0]), int(order[-1])} if detail_runs is None else set(detail_runs)
     n_b = len(orbits)
-    fig = _figure((4.6 * n_b + 1.8, 9.4))
+    fig = agg_figure((4.6 * n_b + 1.8, 9.4))
     grid = fig.subplots(2, n_b, squeeze=False)
     for b, name in enumerate(bearing_names):
         ax, axc = grid[0, b], grid[1, b]
         if len(orbits[b]) != values.size:
             raise ParameterError(f"orbits[{b}] has {len(orbits[b])} runs, values has "
                                  f"{values.size}")
-        for j, i in enumerate(order):
+        for i in order:
             x = signal_1d(orbits[b][i][0], name="x_m", min_samples=2) * 1e6
             y = signal_1d(orbits[b][i][1], name="y_m", min_samples=2) * 1e6
-            ax.plot(x, y, lw=0.9, color=colours[j], label=f"{values[i]:g}")
-            ax.plot(x[0], y[0], "o", ms=3, color=colours[j], mfc="white")
+            ax.plot(x, y, lw=0.9, color=colour_of[i], label=f"{values[i]:g}")
+            ax.plot(x[0], y[0], "o", ms=3, color=colour_of[i], mfc="white")
             if i in detail:
-                axc.plot(x - x.mean(), y - y.mean(), lw=0.9, color=colours[j],
+                axc.plot(x - x.mean(), y - y.mean(), lw=0.9, color=colour_of[i],
                          label=f"{values[i]:g}")
         extra = ""
         if clearances_m is not None:
@@ -136,11 +131,8 @@ def plot_trace_family(panels, values, *, value_label="Torque [N·m]", title=None
     -------
     matplotlib.figure.Figure
     """
-    values = np.asarray(values, dtype=float).ravel()
-    order = np.argsort(values, kind="stable")
-    colours = _colours(values.size)
-    colour_of = {int(i): colours[j] for j, i in enumerate(order)}
-    fig = _figure((11.0, 3.4 * len(panels) + 0.6))
+    values, _, colour_of = _colour_by_value(values)
+    fig = agg_figure((11.0, 3.4 * len(panels) + 0.6))
     axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
     for ax, p in zip(axes, panels):
         runs = p.get("runs", range(values.size))

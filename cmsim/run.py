@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim._io import atomic_savez
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_choice
 from cmsim.rig import OperatingPoint, Rig
 
 __all__ = ["Run", "SignalInfo", "signal_info", "SOURCES", "SIGNAL_QUANTITIES"]
@@ -168,8 +168,7 @@ class Run:
     source: str = "simulated"
 
     def __post_init__(self):
-        if self.source not in SOURCES:
-            raise ParameterError(f"source must be one of {SOURCES}, got {self.source!r}")
+        check_choice("source", self.source, SOURCES)
         t = np.asarray(self.t)
         if t.ndim != 1:
             raise ParameterError(f"t must be 1-D, got shape {t.shape}")

@@ -34,8 +34,8 @@ from cmsim._io import atomic_write_bytes, atomic_write_text
 from cmsim.errors import ParameterError
 
 __all__ = ["PARQUET_NAME", "RECORDS_DIR", "ROWS_DIR", "SPEC_NAME", "FORMAT_VERSION",
-           "file_sha256", "write_row", "read_rows", "consolidate", "open_directory",
-           "done_indices", "read_spec"]
+           "file_sha256", "json_default", "write_row", "read_rows", "consolidate",
+           "open_directory", "done_indices", "read_spec"]
 
 PARQUET_NAME = "manifest.parquet"
 RECORDS_DIR = "records"
@@ -66,7 +66,9 @@ def file_sha256(path, chunk_bytes=1 << 20):
     return digest.hexdigest()
 
 
-def _json_default(obj):
+def json_default(obj):
+    """``json.dumps(..., default=json_default)`` of rows and record meta: a numpy scalar
+    ``obj`` as the Python number it holds; anything else raises ``TypeError``."""
     if isinstance(obj, (np.floating, np.integer, np.bool_)):
         return obj.item()
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
@@ -83,7 +85,7 @@ def write_row(out_dir, row):
         The manifest row.
     """
     atomic_write_text(Path(out_dir) / ROWS_DIR / f"{row['record_id']}.json",
-                      json.dumps(row, default=_json_default, allow_nan=True))
+                      json.dumps(row, default=json_default, allow_nan=True))
 
 
 def read_spec(out_dir):

@@ -108,18 +108,19 @@ def _worker_init(parent_pid):
                      name="cmsim-parent-watch").start()
 
 
-class _SignalsRaise:
-    """While active (main thread only), SIGTERM and SIGINT raise :class:`Interrupted`."""
+class _SignalHandlers:
+    """While active (main thread only), SIGTERM and SIGINT go to :attr:`handler`; the
+    previous handlers come back on exit."""
+
+    handler = signal.SIG_DFL
 
     def __enter__(self):
         self._old = {}
         if threading.current_thread() is not threading.main_thread():
             return self
         for sig in (signal.SIGTERM, signal.SIGINT):
-            def handler(signum, frame):
-                raise Interrupted(signal.Signals(signum).name)
             try:
-                self._old[sig] = signal.signal(sig, handler)
+                self._old[sig] = signal.signal(sig, self.handler)
             except (ValueError, OSError):      # pragma: no cover - not settable here
                 pass
         return self
@@ -128,6 +129,14 @@ class _SignalsRaise:
         for sig, old in self._old.items():
             signal.signal(sig, old)
         return False
+
+
+class _SignalsRaise(_SignalHandlers):
+    """While active (main thread only), SIGTERM and SIGINT raise :class:`Interrupted`."""
+
+    @staticmethod
+    def handler(signum, frame):
+        raise Interrupted(signal.Signals(signum).name)
 
 
 def run_tasks(fn, tasks, on_result, *, workers, start_method=None, scheduler=None,
@@ -227,20 +236,10 @@ def _run_local(fn, tasks, done, n_workers, method):
     return n_workers
 
 
-class _SignalsIgnored:
+class _SignalsIgnored(_SignalHandlers):
     """While active (main thread only), a second Ctrl-C/SIGTERM does not cut the clean-up."""
 
-    def __enter__(self):
-        self._old = {}
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGTERM, signal.SIGINT):
-                self._old[sig] = signal.signal(sig, signal.SIG_IGN)
-        return self
-
-    def __exit__(self, *exc):
-        for sig, old in self._old.items():
-            signal.signal(sig, old)
-        return False
+    handler = signal.SIG_IGN
 
 
 def _terminate(pool):

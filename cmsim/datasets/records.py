@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_savez
-from cmsim.datasets.manifest import RECORDS_DIR, file_sha256, write_row
+from cmsim.datasets.manifest import RECORDS_DIR, file_sha256, json_default, write_row
 from cmsim.datasets.spec import mesh_key
 from cmsim.dynamics import simulate
 from cmsim.dynamics.profiles import SpeedProfile
@@ -255,16 +255,10 @@ def run_record(spec, index, out_dir):
                setup_s=timing["setup"], sensors_s=timing["sensors"],
                features_s=t_save - t_features)
     meta["row"] = row
-    atomic_savez(path, meta=json.dumps(meta, default=_json_default), **arrays)
+    atomic_savez(path, meta=json.dumps(meta, default=json_default), **arrays)
     row["bytes"] = path.stat().st_size
     row["sha256"] = file_sha256(path)
     row["save_s"] = time.perf_counter() - t_save
     row["wall_s"] = time.perf_counter() - start
     write_row(out, row)
     return row
-
-
-def _json_default(obj):
-    if isinstance(obj, (np.floating, np.integer, np.bool_)):
-        return obj.item()
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")

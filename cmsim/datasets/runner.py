@@ -34,7 +34,7 @@ from cmsim.datasets.pool import check_start_method, check_workers, run_tasks
 from cmsim.datasets.records import run_record
 from cmsim.datasets.spec import DatasetSpec
 from cmsim.dynamics import simulate
-from cmsim.errors import ParameterError
+from cmsim.errors import check_type
 
 __all__ = ["generate_dataset", "DatasetSummary"]
 
@@ -163,9 +163,7 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
     cmsim.datasets.pool.Interrupted
         On Ctrl-C or SIGTERM (finished records are kept; rerun to resume).
     """
-    if not isinstance(spec, DatasetSpec):
-        raise ParameterError(f"spec must be a DatasetSpec, got {type(spec).__name__}",
-                             param="spec")
+    check_type("spec", spec, DatasetSpec)
     workers = check_workers(workers)
     method = check_start_method(start_method)
     if progress is None:

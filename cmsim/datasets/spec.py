@@ -52,7 +52,7 @@ from cmsim.datasets.spec_toml import (check_channels, read_toml, setting_range, 
 from cmsim.datasets.variation import (OPERATING_POINT_FIELDS, Variation, _check_value,
                                       apply_rig_setting, setting_kind, value_token)
 from cmsim.dynamics.tooth_contact import MESH_CHOICES
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.faults import FAULT_TYPES, check_faults
 from cmsim.losses import LossSettings
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
@@ -201,9 +201,7 @@ class DatasetSpec:
         set_(self, "sampling", sampling)
         set_(self, "settings", _settings(variations, fixed, rig, sampling))
         set_(self, "seed", RANGES["seed"].check("seed", seed))
-        if seed_policy not in SEED_POLICIES:
-            raise ParameterError(f"seed_policy must be one of {SEED_POLICIES}, "
-                                 f"got {seed_policy!r}", param="seed_policy")
+        check_choice("seed_policy", seed_policy, SEED_POLICIES)
         set_(self, "seed_policy", seed_policy)
         set_(self, "repeats", _integer("repeats", repeats, 1, 10_000))
         n_default = self.n_points * self.repeats if sampling == "grid" else None

@@ -16,17 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_text
+from cmsim.spectra.plots import agg_figure
 
 __all__ = ["write_report", "confusion_figure", "detection_figure"]
-
-
-def _figure(figsize):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize)
-    FigureCanvasAgg(fig)
-    return fig
 
 
 def _png(fig):
@@ -44,7 +36,8 @@ def confusion_figure(evaluation):
     """
     conf = evaluation.metrics["confusion"]
     classes, m = conf["classes"], np.asarray(conf["matrix"], dtype=float)
-    fig = _figure((1.2 + 0.7 * max(len(classes), 2), 1.0 + 0.6 * max(len(classes), 2)))
+    fig = agg_figure((1.2 + 0.7 * max(len(classes), 2), 1.0 + 0.6 * max(len(classes), 2)),
+                     layout=None)
     ax = fig.add_subplot()
     if m.size:
         ax.imshow(m, cmap="Blues")
@@ -69,7 +62,7 @@ def detection_figure(evaluation):
     evaluation : cmsim.diagnostics.harness.Evaluation
     """
     det = evaluation.metrics["detection"]
-    fig = _figure((10, 3.8))
+    fig = agg_figure((10, 3.8), layout=None)
     ax1, ax2 = fig.add_subplot(1, 2, 1), fig.add_subplot(1, 2, 2)
     healthy = [r.fault_score for r in evaluation.records if r.error is None
                and r.true_label == "healthy"]

@@ -104,6 +104,20 @@ def _averaged_bearing_stiffness(model, states, times):
     return out / len(states)
 
 
+def _linearised_stiffness(model, k_brg, k_mesh):
+    """Symmetric K of the linearised model: the linear part, each bearing's tangent stiffness
+    ``k_brg`` (nb, 2, 2) on its x, y DOFs and the mesh stiffness ``k_mesh`` (N/m) along the
+    mesh Jacobian (a rig without gears has no mesh term)."""
+    kmat = model.stiffness.copy()
+    for ib in range(k_brg.shape[0]):
+        ix = int(model.kernel_params.b_int[ib, BI_X])
+        kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
+    if model.rig.gears is not None:
+        g = model.mesh_jacobian()
+        kmat += k_mesh * np.outer(g, g)
+    return 0.5 * (kmat + kmat.T)
+
+
 def highest_frequency_hz(model, q, t=0.0):
     """Highest natural frequency of ``model`` linearised at state ``q`` (time ``t``), Hz.
 
@@ -113,15 +127,10 @@ def highest_frequency_hz(model, q, t=0.0):
     :func:`cmsim.dynamics.simulate`. One 19×19 eigenvalue problem: cheap.
     """
     k_brg = _averaged_bearing_stiffness(model, [np.asarray(q, float)], [t])
-    kmat = model.stiffness.copy()
-    for ib in range(k_brg.shape[0]):
-        ix = int(model.kernel_params.b_int[ib, BI_X])
-        kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
-    if model.rig.gears is not None:
-        k_peak = float(np.max(model.mesh_table.mesh_stiffness(model.rig.gears)[1]))
-        g = model.mesh_jacobian()
-        kmat += k_peak * np.outer(g, g)
-    eig = scipy.linalg.eigvalsh(0.5 * (kmat + kmat.T), np.diag(model.mass))
+    gears = model.rig.gears
+    k_peak = 0.0 if gears is None else float(np.max(model.mesh_table.mesh_stiffness(gears)[1]))
+    eig = scipy.linalg.eigvalsh(_linearised_stiffness(model, k_brg, k_peak),
+                                np.diag(model.mass))
     return float(math.sqrt(max(eig[-1], 0.0)) / (2.0 * math.pi))
 
 
@@ -149,17 +158,9 @@ def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     times = _bearing_cycle_times(model, n_positions)
     states = quasi_static_orbit(model, times)
     k_brg = _averaged_bearing_stiffness(model, states, times)
-    kmat = model.stiffness.copy()
-    for ib in range(k_brg.shape[0]):
-        ix = int(model.kernel_params.b_int[ib, BI_X])
-        kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
-    k_mean = 0.0
-    if rig.gears is not None:
-        k_mean = model.mesh_table.mean_mesh_stiffness(rig.gears)
-        g = model.mesh_jacobian()
-        kmat += k_mean * np.outer(g, g)
-    kmat = 0.5 * (kmat + kmat.T)
-    eigvals, shapes = scipy.linalg.eigh(kmat, np.diag(model.mass))
+    k_mean = 0.0 if rig.gears is None else model.mesh_table.mean_mesh_stiffness(rig.gears)
+    eigvals, shapes = scipy.linalg.eigh(_linearised_stiffness(model, k_brg, k_mean),
+                                        np.diag(model.mass))
     freqs = np.sqrt(np.clip(eigvals, 0.0, None)) / (2.0 * math.pi)
     types, details, shares = _classify(model, shapes)
     return ModalResult(freqs, shapes, tuple(types), tuple(details), np.array(shares),

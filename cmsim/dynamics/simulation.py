@@ -20,7 +20,7 @@ from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
 from cmsim.dynamics.tooth_contact import resolve_mesh
-from cmsim.errors import IntegrationDiverged, ParameterError, check_range
+from cmsim.errors import IntegrationDiverged, ParameterError, check_choice, check_range, check_type
 from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
                           operating_modulation, rig_with_faults, slip_from_faults)
 from cmsim.losses import LossSettings, power_balance, run_losses
@@ -61,8 +61,7 @@ class _Integrator:
     """
 
     def __init__(self, model, scheme, progress=None):
-        if scheme not in SCHEMES:
-            raise ParameterError(f"scheme must be one of {tuple(SCHEMES)}, got {scheme!r}")
+        check_choice("scheme", scheme, tuple(SCHEMES))
         self.model = model
         self.tab = SCHEMES[scheme]
         self.progress = progress
@@ -403,8 +402,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     if profile is not None or speed_factor is not None or torque_factor is not None:
         if profile is None:
             profile = SpeedProfile((0.0,), (op.speed_rpm,))
-        if not isinstance(profile, SpeedProfile):
-            raise ParameterError(f"profile must be a SpeedProfile, got {type(profile).__name__}")
+        check_type("profile", profile, SpeedProfile)
         op = replace(op, speed_rpm=profile.initial_rpm,
                      torque_nm=op.torque_nm if profile.torques_nm is None
                      else profile.torques_nm[0])

@@ -35,7 +35,7 @@ import numpy as np
 from cmsim.bearings.kinematics import ball_pass_cycles_per_rev
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_orbit, quasi_static_state
-from cmsim.errors import IntegrationDiverged, ParameterError, check_range
+from cmsim.errors import IntegrationDiverged, ParameterError, check_choice, check_range
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.mesh_cycle import hybrid_mesh_table, mesh_cycle
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
@@ -83,8 +83,7 @@ def torque_tables(rig, torques_nm, method="hybrid", *, mesh_model=None, speed_rp
     """
     if rig.gears is None:
         raise ParameterError("torque_tables needs a rig with gears")
-    if method not in TABLE_METHODS:
-        raise ParameterError(f"method must be one of {TABLE_METHODS}, got {method!r}")
+    check_choice("method", method, TABLE_METHODS)
     if centres not in ("centroid", "nominal"):
         raise ParameterError(f"centres must be 'centroid' or 'nominal', got {centres!r}")
     torques = sorted(check_range("torques_nm", q, 0.0, 1e6, lo_open=True, unit="N m")

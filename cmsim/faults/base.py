@@ -108,6 +108,10 @@ def _field_kind(cls, name):
     return "any"
 
 
+#: Text-to-number parsers of the numeric field kinds, with the allowed text of their errors.
+_NUMBER_PARSERS = {"int": (int, "an integer"), "float": (float, "a number")}
+
+
 def _coerce(cls, key, value):
     """Convert a value read from text/TOML to the field's type; refuse what does not fit."""
     kind = _field_kind(cls, key)
@@ -121,23 +125,16 @@ def _coerce(cls, key, value):
                      for x in value)
     if isinstance(value, bool):
         raise ParameterError(f"{key} must be a {kind}, got {value!r}", param=key, allowed=kind)
-    if kind == "int":
+    if kind in _NUMBER_PARSERS:
+        parse, allowed = _NUMBER_PARSERS[kind]
         if isinstance(value, str):
             try:
-                return int(value)
+                return parse(value)
             except ValueError:
-                raise ParameterError(f"{key} must be an integer, got {value!r}", param=key,
-                                     allowed="an integer") from None
-        if isinstance(value, float) and value.is_integer():
+                raise ParameterError(f"{key} must be {allowed}, got {value!r}", param=key,
+                                     allowed=allowed) from None
+        if kind == "int" and isinstance(value, float) and value.is_integer():
             return int(value)
-        return value
-    if kind == "float":
-        if isinstance(value, str):
-            try:
-                return float(value)
-            except ValueError:
-                raise ParameterError(f"{key} must be a number, got {value!r}", param=key,
-                                     allowed="a number") from None
         return value
     if kind == "str":
         return str(value)
@@ -280,6 +277,11 @@ def check_int(name, value, lo, hi=None):
         raise ParameterError(f"{name} must be {allowed}, got {value!r}", param=name,
                              allowed=allowed)
     return int(value)
+
+
+def check_angle(name, value):
+    """Refuse an angle or phase outside [−2π, 2π] rad; return it as float."""
+    return check_range(name, value, -2 * math.pi, 2 * math.pi, unit="rad")
 
 
 def mm(x):

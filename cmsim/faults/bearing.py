@@ -59,7 +59,7 @@ import numpy as np
 
 from cmsim.bearings.hertz import bearing_raceway_contacts, contact_semi_axes_m
 from cmsim.errors import ParameterError, check_range
-from cmsim.faults.base import Fault, check_bearing, check_int, mm, register
+from cmsim.faults.base import Fault, check_angle, check_bearing, check_int, mm, register
 
 __all__ = ["OuterRaceDefect", "InnerRaceDefect", "BallDefect", "BearingWear", "OffSizeBall",
            "RollingSlip", "NO_SLIP", "ball_drop_m", "defect_profile", "track_share",
@@ -185,14 +185,17 @@ def _check_size(name, value, unit="m"):
 
 
 @dataclass(frozen=True)
-class _RaceDefect(Fault):
-    """Common part of the outer- and inner-race defects."""
+class _LocalizedDefect(Fault):
+    """Common part of the race and ball defects: a pit of ``size_m`` × ``depth_m`` in one
+    bearing that a ball rolls over (Sawalhi & Randall [1]).
+
+    Subclasses also hold ``exit_ramp_fraction`` (after their own defaulted fields, so the
+    order of the constructor's arguments stays that of each entry).
+    """
 
     bearing: str
     size_m: float
     depth_m: float
-    angle_rad: float | None = None
-    exit_ramp_fraction: float = EXIT_RAMP_FRACTION
 
     def __post_init__(self):
         if not isinstance(self.bearing, str):
@@ -201,8 +204,29 @@ class _RaceDefect(Fault):
         _check_size("size_m", self.size_m)
         check_range("depth_m", self.depth_m, 0.0, 0.01, lo_open=True, unit="m")
         check_range("exit_ramp_fraction", self.exit_ramp_fraction, 0.0, 1.0, unit="")
+
+    def _check_depth_fits(self, brg):
+        """Refuse a pit deeper than the ball radius of ``brg``."""
+        check_range("depth_m", self.depth_m, 0.0, 0.5 * brg.ball_diameter_m, lo_open=True,
+                    unit=f"m (up to the ball radius of {self.bearing})")
+
+    def _drop_and_entry_m(self, ball_radius_m):
+        """(largest loss of overlap, entry distance over which it builds up), m."""
+        drop = ball_drop_m(ball_radius_m, self.size_m, self.depth_m)
+        return drop, _entry_distance_m(ball_radius_m, self.size_m, drop)
+
+
+@dataclass(frozen=True)
+class _RaceDefect(_LocalizedDefect):
+    """Common part of the outer- and inner-race defects."""
+
+    angle_rad: float | None = None
+    exit_ramp_fraction: float = EXIT_RAMP_FRACTION
+
+    def __post_init__(self):
+        super().__post_init__()
         if self.angle_rad is not None:
-            check_range("angle_rad", self.angle_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+            check_angle("angle_rad", self.angle_rad)
 
     @property
     def label(self):
@@ -218,8 +242,7 @@ class _RaceDefect(Fault):
         check_range("size_m", self.size_m, 0.0, spacing, lo_open=True,
                     unit=f"m (up to the ball spacing on the {self.race} race of "
                          f"{self.bearing}, 2*pi*{r * 1e3:.4g} mm / {brg.n_balls})")
-        check_range("depth_m", self.depth_m, 0.0, 0.5 * brg.ball_diameter_m, lo_open=True,
-                    unit=f"m (up to the ball radius of {self.bearing})")
+        self._check_depth_fits(brg)
         return self
 
     def defect_row(self, rig, default_angle_rad):
@@ -232,8 +255,7 @@ class _RaceDefect(Fault):
         ib = check_bearing(rig, self.bearing)
         brg = rig.bearings[ib]
         rb, r = 0.5 * brg.ball_diameter_m, self.race_radius_m(brg)
-        drop = ball_drop_m(rb, self.size_m, self.depth_m)
-        entry = _entry_distance_m(rb, self.size_m, drop)
+        drop, entry = self._drop_and_entry_m(rb)
         centre = default_angle_rad if self.angle_rad is None else self.angle_rad
         return [float(ib), self.kind, float(centre), 0.5 * self.size_m / r, drop, entry / r,
                 self.exit_ramp_fraction * entry / r, -1.0, 0.0, 0.0, 0.0]
@@ -300,7 +322,7 @@ class InnerRaceDefect(_RaceDefect):
 
 @register
 @dataclass(frozen=True)
-class BallDefect(Fault):
+class BallDefect(_LocalizedDefect):
     """Localized defect (a spall) on one ball, striking both races (2 × BSF).
 
     Attributes
@@ -328,9 +350,6 @@ class BallDefect(Fault):
 
     name = "ball"
 
-    bearing: str
-    size_m: float
-    depth_m: float
     ball: int = 0
     phase_rad: float = 0.0
     exit_ramp_fraction: float = EXIT_RAMP_FRACTION
@@ -338,14 +357,9 @@ class BallDefect(Fault):
     wander_s: float = 0.0
 
     def __post_init__(self):
-        if not isinstance(self.bearing, str):
-            raise ParameterError(f"bearing must be a bearing name such as '1b1', got "
-                                 f"{self.bearing!r}", param="bearing")
-        _check_size("size_m", self.size_m)
-        check_range("depth_m", self.depth_m, 0.0, 0.01, lo_open=True, unit="m")
-        check_range("exit_ramp_fraction", self.exit_ramp_fraction, 0.0, 1.0, unit="")
+        super().__post_init__()
         check_int("ball", self.ball, 0)
-        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+        check_angle("phase_rad", self.phase_rad)
         check_range("axis_offset", self.axis_offset, -1.0, 1.0, unit="")
         check_range("wander_s", self.wander_s, 0.0, 1e3, unit="s")
 
@@ -358,8 +372,7 @@ class BallDefect(Fault):
         brg = rig.bearings[check_bearing(rig, self.bearing)]
         check_range("size_m", self.size_m, 0.0, brg.ball_diameter_m, lo_open=True,
                     hi_open=True, unit=f"m (below the ball diameter of {self.bearing})")
-        check_range("depth_m", self.depth_m, 0.0, 0.5 * brg.ball_diameter_m, lo_open=True,
-                    unit=f"m (up to the ball radius of {self.bearing})")
+        self._check_depth_fits(brg)
         check_int("ball", self.ball, 0, brg.n_balls - 1)
         return self
 
@@ -380,8 +393,7 @@ class BallDefect(Fault):
         ib = check_bearing(rig, self.bearing)
         brg = rig.bearings[ib]
         rb = 0.5 * brg.ball_diameter_m
-        drop = ball_drop_m(rb, self.size_m, self.depth_m)
-        entry = _entry_distance_m(rb, self.size_m, drop)
+        drop, entry = self._drop_and_entry_m(rb)
         band = max(contact_semi_axes_m(c, ball_load_n)[1] for c in bearing_raceway_contacts(brg))
         return [float(ib), KIND_BALL, float(self.phase_rad), 0.5 * self.size_m / rb, drop,
                 entry / rb, self.exit_ramp_fraction * entry / rb, float(self.ball),

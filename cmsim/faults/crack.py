@@ -87,15 +87,15 @@ import math
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.mesh_stiffness.fe_mesh import MeshSpec
-from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
+from cmsim.mesh_stiffness.geometry import ToothProfile
 from cmsim.mesh_stiffness.influence import influence_table
 from cmsim.mesh_stiffness.local_deflection import (contact_modulus, hertz_half_width,
                                                    local_approach)
-from cmsim.mesh_stiffness.potential_energy import (
-    ToothCompliance, _involute_domain, _path_length, cantilever_compliance,
-    fillet_foundation_compliance, pair_compliance_potential_energy)
+from cmsim.mesh_stiffness.potential_energy import (_involute_domain, _path_length,
+                                                   pair_compliance_potential_energy,
+                                                   tooth_compliance)
 from cmsim.mesh_stiffness.root_crack import RootCrack, crack_start_point
 
 __all__ = ["crack_start", "crack_tip_offset_m", "max_crack_depth_m", "cracked_tooth_compliance",
@@ -163,17 +163,6 @@ def cracked_tooth_compliance(profile, contact_radius_m, depth_m, angle_rad, n_no
     .. [2] S. Wu, M. J. Zuo, A. Parey, J. Sound Vib. 317 (2008) 608-624, eqs. (14)-(17).
     """
     q, nu = _check_crack(profile, depth_m, angle_rad)
-    gear = profile.gear
-    r = np.atleast_1d(np.asarray(contact_radius_m, dtype=float))
-    lo, hi = profile.form_radius_m, profile.tip_round_start_radius_m
-    if not np.all(np.isfinite(r)) or np.any(r < lo - 1e-9) or np.any(r > hi + 1e-9):
-        raise ParameterError(f"contact radii must lie on the involute, in [{lo:g}, {hi:g}] m")
-    r = np.clip(r, lo, hi)
-    rb = gear.base_radius_m
-    alpha_r = np.arccos(rb / r)
-    theta_c = involute_half_angle(r, rb, gear.base_half_thickness_angle_rad)
-    x_c, y_c = r * np.sin(theta_c), r * np.cos(theta_c)
-    a1 = alpha_r - theta_c
     y0 = profile.root_chord_y_m
     h_q = crack_tip_offset_m(profile, q, nu)
     y_s = crack_start(profile)[0]
@@ -184,12 +173,7 @@ def cracked_tooth_compliance(profile, contact_radius_m, depth_m, angle_rad, n_no
         cut = (y >= y_s) & (h > h_q)                # thickness h + h_q behind the crack
         return np.where(cut, 0.5 * (h + h_q), h)
 
-    bending, shear, axial = cantilever_compliance(
-        h_eff, y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio,
-        gear.face_width_m, n_nodes=n_nodes)
-    u_f = y_c - x_c * np.tan(a1) - y0
-    foundation = fillet_foundation_compliance(profile, u_f, a1)
-    return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
+    return tooth_compliance(profile, contact_radius_m, n_nodes=n_nodes, half_thickness=h_eff)
 
 
 def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1001,
@@ -233,9 +217,7 @@ def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1
     >>> bool(0.0 < crack_stiffness_factor(pair, 1, 1e-3, math.pi / 4, s)[0] < 1.0)
     True
     """
-    if method not in CRACK_METHODS:
-        raise ParameterError(f"method must be one of {CRACK_METHODS}, got {method!r}",
-                             param="method", allowed=" or ".join(CRACK_METHODS))
+    check_choice("method", method, CRACK_METHODS)
     s = np.atleast_1d(np.asarray(position_m, dtype=float))
     lo, hi = _involute_domain(pair)
     s = np.clip(s, lo, hi)

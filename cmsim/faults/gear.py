@@ -30,7 +30,7 @@ import math
 from dataclasses import dataclass
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.faults.base import Fault, check_gear, check_int, mm, register
+from cmsim.faults.base import Fault, check_angle, check_gear, check_int, mm, register
 from cmsim.faults.crack import max_crack_depth_m
 from cmsim.mesh_stiffness.geometry import ToothProfile
 
@@ -92,7 +92,7 @@ class Eccentricity(Fault):
     def __post_init__(self):
         _check_gear_field(self.gear)
         check_range("amplitude_m", self.amplitude_m, 0.0, 1e-3, lo_open=True, unit="m")
-        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+        check_angle("phase_rad", self.phase_rad)
 
     @property
     def label(self):

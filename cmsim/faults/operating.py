@@ -26,12 +26,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.faults.base import Fault, register
+from cmsim.faults.base import Fault, check_angle, register
 
 __all__ = ["SpeedFluctuation", "TorqueRipple", "MAX_TOTAL_RELATIVE_AMPLITUDE"]
 
 #: Largest Σ ε_k: the modulated speed or torque stays above half its mean.
 MAX_TOTAL_RELATIVE_AMPLITUDE = 0.5
+
+
+def _check_frequency(name, value):
+    """A line's frequency, Hz, in (0, 100 kHz]."""
+    return check_range(name, value, 0.0, 1e5, lo_open=True, unit="Hz")
 
 
 def _check_spectrum(spectrum):
@@ -40,12 +45,10 @@ def _check_spectrum(spectrum):
         if len(row) != 3:
             raise ParameterError(f"spectrum[{i}] must be (frequency_hz, relative_amplitude, "
                                  f"phase_rad), got {row!r}", param="spectrum")
-        f = check_range(f"spectrum[{i}] frequency_hz", row[0], 0.0, 1e5, lo_open=True,
-                        unit="Hz")
+        f = _check_frequency(f"spectrum[{i}] frequency_hz", row[0])
         a = check_range(f"spectrum[{i}] relative_amplitude", row[1], 0.0,
                         MAX_TOTAL_RELATIVE_AMPLITUDE)
-        p = check_range(f"spectrum[{i}] phase_rad", row[2], -2 * math.pi, 2 * math.pi,
-                        unit="rad")
+        p = check_angle(f"spectrum[{i}] phase_rad", row[2])
         rows.append((f, a, p))
     return tuple(rows)
 
@@ -62,7 +65,7 @@ class _Modulation(Fault):
     def __post_init__(self):
         check_range("relative_amplitude", self.relative_amplitude, 0.0,
                     MAX_TOTAL_RELATIVE_AMPLITUDE)
-        check_range("phase_rad", self.phase_rad, -2 * math.pi, 2 * math.pi, unit="rad")
+        check_angle("phase_rad", self.phase_rad)
         object.__setattr__(self, "spectrum", _check_spectrum(self.spectrum))
         self._check_fields()
         if self.relative_amplitude > 0:
@@ -121,7 +124,7 @@ class SpeedFluctuation(_Modulation):
         if self.frequency_hz is None:
             raise ParameterError("frequency_hz must be given with relative_amplitude "
                                  "(a number > 0 Hz)", param="frequency_hz", allowed="> 0 Hz")
-        check_range("frequency_hz", self.frequency_hz, 0.0, 1e5, lo_open=True, unit="Hz")
+        _check_frequency("frequency_hz", self.frequency_hz)
 
     def lines(self, shaft_hz=None):
         """All lines as (frequency Hz, relative amplitude, phase rad)."""
@@ -176,7 +179,7 @@ class TorqueRipple(_Modulation):
                                  "relative_amplitude", param="frequency_hz",
                                  allowed="frequency_hz > 0 Hz or order > 0")
         if self.frequency_hz is not None:
-            check_range("frequency_hz", self.frequency_hz, 0.0, 1e5, lo_open=True, unit="Hz")
+            _check_frequency("frequency_hz", self.frequency_hz)
         else:
             check_range("order", self.order, 0.0, 1e3, lo_open=True)
 

@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_type
 from cmsim.features.lines import (EXACT_TOLERANCE, demodulation_band, highest_fault_hz,
                                   line_amplitude)
 from cmsim.frequencies import RigFrequencies
@@ -314,8 +314,7 @@ def extract_features(signal, fs_hz, freqs, *, bearing=None, band_hz=None,
     """
     x = signal_1d(signal, "signal")
     fs = sampling_rate(fs_hz, "fs_hz")
-    if not isinstance(freqs, RigFrequencies):
-        raise ParameterError(f"freqs must be a RigFrequencies, got {type(freqs).__name__}")
+    check_type("freqs", freqs, RigFrequencies)
     n_gmf = positive_int("n_gmf_harmonics", n_gmf_harmonics, lo=1, hi=100)
     top_n = positive_int("top_n", top_n, lo=0)
     bf = freqs.bearing(bearing) if freqs.bearings else None

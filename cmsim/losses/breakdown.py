@@ -17,7 +17,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_range, check_type
 from cmsim.rig import OperatingPoint
 from cmsim.losses.bearing_friction import bearing_friction_torque, ring_kinematics
 from cmsim.losses.gear_losses import (air_density_kg_m3, meshing_torque_nm, oil_jet_torque_nm,
@@ -276,9 +276,7 @@ def run_losses(rig, op, mesh_table=None, settings=None):
     RunLosses
     """
     settings = LossSettings() if settings is None else settings
-    if not isinstance(settings, LossSettings):
-        raise ParameterError(f"losses must be a LossSettings, got {type(settings).__name__}",
-                             param="losses")
+    check_type("losses", settings, LossSettings)
     if rig.gears is not None and mesh_table is None:
         raise ParameterError("run_losses needs the run's mesh_table on a gear rig",
                              param="mesh_table")

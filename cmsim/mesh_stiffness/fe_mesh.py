@@ -89,7 +89,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_range, check_type
 from cmsim.mesh_stiffness.distmesh import (check_boundary_loops, distmesh_smooth, hex_lattice,
                                            orient, thin_points, triangulate)
 from cmsim.mesh_stiffness.geometry import ToothProfile
@@ -510,12 +510,10 @@ def gear_mesh(gear, spec=MeshSpec(), crack=None):
         If ``gear`` is not a SpurGear or the triangulation does not follow the boundary
         (or the crack).
     """
-    if not isinstance(gear, SpurGear):
-        raise ParameterError(f"gear must be a SpurGear, got {type(gear).__name__}")
-    if not isinstance(spec, MeshSpec):
-        raise ParameterError(f"spec must be a MeshSpec, got {type(spec).__name__}")
-    if crack is not None and not isinstance(crack, RootCrack):
-        raise ParameterError(f"crack must be a RootCrack, got {type(crack).__name__}")
+    check_type("gear", gear, SpurGear)
+    check_type("spec", spec, MeshSpec)
+    if crack is not None:
+        check_type("crack", crack, RootCrack)
     profile = ToothProfile.from_gear(gear, n_points=800)
     geo = _Geometry(gear, profile, spec)
     cnodes = np.zeros((0, 2))

@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.sparse.linalg import splu
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range, check_type
 from cmsim.mesh_stiffness.fe_mesh import GearMesh, MeshSpec, gear_mesh
 from cmsim.rig import SpurGear
 
@@ -81,8 +81,7 @@ def lame_parameters(youngs_modulus_pa, poisson_ratio, plane):
     >>> round(lam / 1e9, 3), round(mu / 1e9, 3)
     (69.231, 80.769)
     """
-    if plane not in PLANE_MODES:
-        raise ParameterError(f"plane must be one of {PLANE_MODES}, got {plane!r}")
+    check_choice("plane", plane, PLANE_MODES)
     e, nu = float(youngs_modulus_pa), float(poisson_ratio)
     mu = e / (2.0 * (1.0 + nu))
     lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)) if plane == "strain" else e * nu / (1 - nu ** 2)
@@ -276,10 +275,8 @@ class GearBodyModel:
         -------
         GearBodyModel
         """
-        if not isinstance(gear, SpurGear):
-            raise ParameterError(f"gear must be a SpurGear, got {type(gear).__name__}")
-        if plane not in PLANE_MODES:
-            raise ParameterError(f"plane must be one of {PLANE_MODES}, got {plane!r}")
+        check_type("gear", gear, SpurGear)
+        check_choice("plane", plane, PLANE_MODES)
         t0 = time.perf_counter()
         gm = gear_mesh(gear, spec, crack)
         t_mesh = time.perf_counter() - t0

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_choice, check_type
 from cmsim.rig import SpurGear
 
 __all__ = [
@@ -259,8 +259,7 @@ class ToothProfile:
             teeth overlap, no involute is left between the undercut and the tip rounding, or
             the tip rounding does not fit on the tooth (pointed tooth).
         """
-        if not isinstance(gear, SpurGear):
-            raise ParameterError(f"gear must be a SpurGear, got {type(gear).__name__}")
+        check_type("gear", gear, SpurGear)
         if isinstance(n_points, bool) or not isinstance(n_points, (int, np.integer)) \
                 or n_points < 16:
             raise ParameterError(f"n_points must be an integer >= 16, got {n_points!r}")
@@ -399,8 +398,7 @@ class ToothProfile:
         ndarray, shape (k, 2)
             Points, m, in outline order.
         """
-        if label not in SEGMENT_LABELS:
-            raise ParameterError(f"label must be one of {SEGMENT_LABELS}, got {label!r}")
+        check_choice("label", label, SEGMENT_LABELS)
         if side not in ("right", "left"):
             raise ParameterError(f"side must be 'right' or 'left', got {side!r}")
         sel = self.labels == label

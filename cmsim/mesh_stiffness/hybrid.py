@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import root
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_type
 from cmsim.mesh_stiffness._hybrid_kernels import (HP_SIZE, WORK_PER_N, WORK_PER_N2,
                                                   coupling_matrix_jit, hybrid_forces_jit)
 from cmsim.mesh_stiffness.fe_mesh import MeshSpec
@@ -119,8 +119,7 @@ class HybridMeshModel:
         -------
         HybridMeshModel
         """
-        if not isinstance(pair, GearPair):
-            raise ParameterError(f"pair must be a GearPair, got {type(pair).__name__}")
+        check_type("pair", pair, GearPair)
         kw = dict(depth_m=depth_m, spec=spec, plane=plane, use_cache=use_cache)
         t1 = influence_table(pair.driving, **kw)
         t2 = t1 if pair.driven == pair.driving else influence_table(pair.driven, **kw)
@@ -146,8 +145,7 @@ class HybridMeshModel:
     @classmethod
     def from_tables(cls, pair, driving, driven):
         """Model from given influence tables (no FE)."""
-        if not isinstance(pair, GearPair):
-            raise ParameterError(f"pair must be a GearPair, got {type(pair).__name__}")
+        check_type("pair", pair, GearPair)
         for name, t in (("driving", driving), ("driven", driven)):
             if not isinstance(t, InfluenceTable):
                 raise ParameterError(f"{name} must be an InfluenceTable")

@@ -50,7 +50,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range, check_type
 from cmsim.mesh_stiffness import cache
 from cmsim.mesh_stiffness.fe_mesh import MeshSpec, tooth_rotation_rad
 from cmsim.mesh_stiffness.fe_model import PLANE_MODES, GearBodyModel
@@ -255,10 +255,8 @@ def compute_influence_table(body, roll_m, depth_m, max_offset=3, load="point",
     -------
     InfluenceTable
     """
-    if not isinstance(body, GearBodyModel):
-        raise ParameterError(f"body must be a GearBodyModel, got {type(body).__name__}")
-    if load not in LOAD_MODES:
-        raise ParameterError(f"load must be one of {LOAD_MODES}, got {load!r}")
+    check_type("body", body, GearBodyModel)
+    check_choice("load", load, LOAD_MODES)
     gear, model = body.gear, body.model
     h = check_range("depth_m", depth_m, 0.0, 2.0 * gear.module_m, lo_open=True, unit="m")
     if isinstance(max_offset, bool) or not isinstance(max_offset, (int, np.integer)) \
@@ -345,10 +343,8 @@ def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_st
     InfluenceTable
         ``meta["cache"]`` is ``"hit"``, ``"miss"`` or ``"off"``.
     """
-    if not isinstance(gear, SpurGear):
-        raise ParameterError(f"gear must be a SpurGear, got {type(gear).__name__}")
-    if plane not in PLANE_MODES:
-        raise ParameterError(f"plane must be one of {PLANE_MODES}, got {plane!r}")
+    check_type("gear", gear, SpurGear)
+    check_choice("plane", plane, PLANE_MODES)
     m = gear.module_m
     h = DEFAULT_DEPTH_MODULES * m if depth_m is None else depth_m
     step = DEFAULT_ROLL_STEP_MODULES * m if roll_step_m is None else roll_step_m
@@ -361,8 +357,7 @@ def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_st
               "max_offset": int(max_offset), "load": load,
               "hertz_half_width_m": hertz_half_width_m}
     if crack is not None:
-        if not isinstance(crack, RootCrack):
-            raise ParameterError(f"crack must be a RootCrack, got {type(crack).__name__}")
+        check_type("crack", crack, RootCrack)
         inputs["crack"] = crack.as_dict()
     key = cache.cache_key("influence", inputs)
     if use_cache:

@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_range, check_type
 from cmsim.mesh_stiffness._hybrid_kernels import hybrid_forces_jit
 from cmsim.mesh_stiffness.contact import pair_contacts, potential_slots, table_range_m
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel, work_size
@@ -183,8 +183,7 @@ def quasi_static_mesh(model, torque_nm, theta1_rad=0.0, centre1_m=(0.0, 0.0),
     -------
     QuasiStaticMesh
     """
-    if not isinstance(model, HybridMeshModel):
-        raise ParameterError(f"model must be a HybridMeshModel, got {type(model).__name__}")
+    check_type("model", model, HybridMeshModel)
     torque = check_range("torque_nm", torque_nm, 0.0, 1e6, lo_open=True, unit="N m")
     theta1 = check_range("theta1_rad", theta1_rad, -1e3, 1e3, unit="rad")
     c1, c2 = _check_offset("centre1_m", centre1_m), _check_offset("centre2_m", centre2_m)
@@ -301,8 +300,7 @@ def mesh_cycle(model, torque_nm, centre1_m=(0.0, 0.0), centre2_m=(0.0, 0.0), n_s
     if isinstance(n_points, bool) or not isinstance(n_points, (int, np.integer)) \
             or n_points < 2:
         raise ParameterError(f"n_points must be an integer >= 2, got {n_points!r}")
-    if not isinstance(model, HybridMeshModel):
-        raise ParameterError(f"model must be a HybridMeshModel, got {type(model).__name__}")
+    check_type("model", model, HybridMeshModel)
     t0 = time.perf_counter()
     c1, c2 = _check_offset("centre1_m", centre1_m), _check_offset("centre2_m", centre2_m)
     pair = model.pair

@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import simpson
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_range, check_type
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
 from cmsim.rig import GearPair, SpurGear
 
@@ -317,7 +317,7 @@ def hertz_stiffness(pair):
     return math.pi * b / (2.0 * soft)
 
 
-def tooth_compliance(profile, contact_radius_m, n_nodes=1001):
+def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=None):
     """Compliance of one tooth loaded on its involute at the given radii.
 
     Parameters
@@ -328,13 +328,18 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001):
         Contact radii on the involute, within [form radius, tip-rounding start], m.
     n_nodes : int
         Nodes of the beam integration.
+    half_thickness : callable, optional
+        h(u): half-thickness, m, of the section that carries the load at height u (m, array)
+        above the root chord; default the tooth's own,
+        ``profile.half_thickness_at(min(y0 + u, r_a))``. A cracked tooth passes its reduced
+        section (:func:`cmsim.faults.crack.cracked_tooth_compliance`); the foundation term
+        stays the healthy one.
 
     Returns
     -------
     ToothCompliance
     """
-    if not isinstance(profile, ToothProfile):
-        raise ParameterError(f"profile must be a ToothProfile, got {type(profile).__name__}")
+    check_type("profile", profile, ToothProfile)
     gear = profile.gear
     r = np.atleast_1d(np.asarray(contact_radius_m, dtype=float))
     lo, hi = profile.form_radius_m, profile.tip_round_start_radius_m
@@ -348,10 +353,12 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001):
     x_c, y_c = r * np.sin(theta_c), r * np.cos(theta_c)
     a1 = alpha_r - theta_c
     y0 = profile.root_chord_y_m
+    if half_thickness is None:
+        def half_thickness(u):
+            return profile.half_thickness_at(np.minimum(y0 + u, profile.tip_radius_m))
     bending, shear, axial = cantilever_compliance(
-        lambda u: profile.half_thickness_at(np.minimum(y0 + u, profile.tip_radius_m)),
-        y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio, gear.face_width_m,
-        n_nodes=n_nodes)
+        half_thickness, y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio,
+        gear.face_width_m, n_nodes=n_nodes)
     u_f = y_c - x_c * np.tan(a1) - y0      # force line meets the centreline below y_c
     foundation = fillet_foundation_compliance(profile, u_f, a1)
     return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
@@ -543,8 +550,7 @@ def iso6336_stiffness(pair, c_m=0.8, c_r=1.0):
 
 # --------------------------------------------------------------------------- internals
 def _check_pair(pair):
-    if not isinstance(pair, GearPair):
-        raise ParameterError(f"pair must be a GearPair, got {type(pair).__name__}")
+    check_type("pair", pair, GearPair)
 
 
 def _path_length(pair):

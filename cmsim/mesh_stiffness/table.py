@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim._io import atomic_savez
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_choice
 from cmsim.mesh_stiffness.contact import active_path_m, table_range_m
 from cmsim.mesh_stiffness.potential_energy import pair_stiffness_potential_energy
 
@@ -77,8 +77,7 @@ class MeshStiffnessTable:
             raise ParameterError("stiffness_n_per_m must be finite and >= 0")
         if not np.all(np.isfinite(e)):
             raise ParameterError("separation_m must be finite")
-        if self.method not in MESH_METHODS:
-            raise ParameterError(f"method must be one of {MESH_METHODS}, got {self.method!r}")
+        check_choice("method", self.method, MESH_METHODS)
         for name, arr in (("position_m", s), ("stiffness_n_per_m", k), ("separation_m", e)):
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)

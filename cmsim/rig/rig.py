@@ -34,7 +34,7 @@ import numpy as np
 import tomli_w
 
 from cmsim._io import atomic_write_text
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.rig.bearing import RollingBearing
 from cmsim.rig.codec import drop_none, from_plain, to_plain
 from cmsim.rig.contact import Lubricant, MeshContact
@@ -142,8 +142,7 @@ class Rig:
         >>> [rig.dof_index(node, "theta") for node in ("1G1", "2b2", "2J2")]
         [5, 17, 18]
         """
-        if axis not in AXES:
-            raise ParameterError(f"axis must be one of {AXES}, got {axis!r}", param="axis")
+        check_choice("axis", axis, AXES)
         if node == "2J2" and self.has_gears and axis == "theta":
             return self.n_dof - 1
         try:

@@ -1,7 +1,8 @@
 """Input checks shared by the spectra modules.
 
 Every public function of :mod:`cmsim.spectra` validates its inputs here, at the boundary, and
-raises :class:`~cmsim.errors.ParameterError` naming the parameter and the allowed range.
+raises :class:`~cmsim.errors.ParameterError` naming the parameter and the allowed range (a
+choice among options is :func:`cmsim.errors.check_choice`, shared with the other packages).
 """
 
 from __future__ import annotations
@@ -61,13 +62,6 @@ def spectrum_arrays(freq, amp, min_samples=2):
 def sampling_rate(fs, name="fs"):
     """Return ``fs`` as a float > 0 (Hz)."""
     return check_range(name, fs, 0.0, lo_open=True, unit="Hz")
-
-
-def choice(name, value, allowed):
-    """Return ``value`` if it is one of ``allowed``, else raise naming the options."""
-    if value not in allowed:
-        raise ParameterError(f"{name} must be one of {allowed!r}, got {value!r}")
-    return value
 
 
 def positive_int(name, value, lo=1, hi=None):

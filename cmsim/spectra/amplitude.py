@@ -25,9 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.signal
 
-from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import (DETRENDS, WINDOWS, choice, positive_int, readonly,
-                                   sampling_rate, signal_1d)
+from cmsim.errors import ParameterError, check_choice, check_range
+from cmsim.spectra._checks import (DETRENDS, WINDOWS, positive_int, readonly, sampling_rate,
+                                   signal_1d)
 
 __all__ = ["Spectrum", "amplitude_spectrum", "welch_amplitude", "SPECTRUM_KINDS"]
 
@@ -75,7 +75,7 @@ class Spectrum:
         object.__setattr__(self, "amplitude", readonly(self.amplitude))
         if self.freq_hz.shape != self.amplitude.shape or self.freq_hz.ndim != 1:
             raise ParameterError("freq_hz and amplitude must be 1-D arrays of the same shape")
-        choice("kind", self.kind, SPECTRUM_KINDS)
+        check_choice("kind", self.kind, SPECTRUM_KINDS)
 
     def __iter__(self):
         yield self.freq_hz
@@ -123,7 +123,7 @@ def _power_to_amplitude(power, n_fft):
 
 
 def _detrend_arg(detrend):
-    choice("detrend", detrend, DETRENDS)
+    check_choice("detrend", detrend, DETRENDS)
     return False if detrend is None else detrend
 
 
@@ -160,7 +160,7 @@ def amplitude_spectrum(x, fs, window="flattop", detrend="constant", *, resolutio
     """
     x = signal_1d(x)
     fs = sampling_rate(fs)
-    choice("window", window, WINDOWS)
+    check_choice("window", window, WINDOWS)
     det = _detrend_arg(detrend)
     n = x.size
     df = fs / n
@@ -211,8 +211,8 @@ def welch_amplitude(x, fs, nperseg, window="flattop", detrend="constant", *, ove
     """
     x = signal_1d(x)
     fs = sampling_rate(fs)
-    choice("window", window, WINDOWS)
-    choice("average", average, ("mean", "median"))
+    check_choice("window", window, WINDOWS)
+    check_choice("average", average, ("mean", "median"))
     det = _detrend_arg(detrend)
     nperseg = positive_int("nperseg", nperseg, lo=8)
     if nperseg > x.size:

@@ -56,10 +56,10 @@ import pandas as pd
 import scipy.ndimage
 import scipy.signal
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.frequencies import FAMILY_KEYS, RigFrequencies, peak_families
-from cmsim.spectra._checks import (WINDOWS, band, choice, positive_int, sampling_rate,
-                                   signal_1d, spectrum_arrays)
+from cmsim.spectra._checks import (WINDOWS, band, positive_int, sampling_rate, signal_1d,
+                                   spectrum_arrays)
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
 from cmsim.spectra.kurtogram import kurtogram
@@ -347,8 +347,8 @@ def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=No
         As :func:`label_peaks`; for ``kind="order"`` the columns ``frequency_hz``,
         ``expected_hz``, ``error_hz`` are named ``order``, ``expected_order``, ``error_order``.
     """
-    choice("kind", kind, PEAK_KINDS)
-    choice("window", window, WINDOWS)
+    check_choice("kind", kind, PEAK_KINDS)
+    check_choice("window", window, WINDOWS)
     fs = sampling_rate(fs)
     if isinstance(freqs, RigFrequencies):
         fam = freqs.families(bearing)

@@ -33,9 +33,8 @@ import scipy.integrate
 import scipy.interpolate
 import scipy.signal
 
-from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import (WINDOWS, choice, positive_int, readonly, sampling_rate,
-                                  signal_1d)
+from cmsim.errors import ParameterError, check_choice, check_range
+from cmsim.spectra._checks import WINDOWS, positive_int, readonly, sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["OrderSpectrum", "tacho_pulse_times", "shaft_angle", "angle_resample",
@@ -255,7 +254,7 @@ def order_spectrum(x, fs, *, speed_rpm=None, speed_time_s=None, tacho=None, puls
     OrderSpectrum
         Order resolution 1/n_revolutions.
     """
-    choice("window", window, WINDOWS)
+    check_choice("window", window, WINDOWS)
     angle, xa = angle_resample(x, fs, speed_rpm=speed_rpm, speed_time_s=speed_time_s,
                                tacho=tacho, pulses_per_rev=pulses_per_rev,
                                samples_per_rev=samples_per_rev)

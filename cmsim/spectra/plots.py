@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import choice, signal_1d
+from cmsim.errors import ParameterError, check_choice, check_range
+from cmsim.spectra._checks import signal_1d
 
 __all__ = ["plot_spectrum", "plot_waterfall", "plot_orbit", "plot_kurtogram", "WATERFALL_STYLES"]
 
@@ -24,12 +24,19 @@ FAMILY_COLOURS = {"GMF": "tab:blue", "BPF": "tab:red", "fr": "tab:green", "BPFO"
                   "unlabelled": "0.5"}
 
 
-def _figure(figsize, projection=None):
+def agg_figure(figsize, layout="constrained"):
+    """A new figure of ``figsize`` (inches) on its own Agg canvas, with ``layout`` (matplotlib's
+    layout engine, ``None`` for none): no pyplot state. Every figure of cmsim starts here."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=figsize, layout="constrained")
+    fig = Figure(figsize=figsize, layout=layout)
     FigureCanvasAgg(fig)
+    return fig
+
+
+def _figure(figsize, projection=None):
+    fig = agg_figure(figsize)
     ax = fig.add_subplot(projection=projection) if projection else fig.add_subplot()
     return fig, ax
 
@@ -146,7 +153,7 @@ def plot_waterfall(freqs, amps_list, values, value_label="Torque [N m]", *, styl
     -------
     matplotlib.figure.Figure
     """
-    choice("style", style, WATERFALL_STYLES)
+    check_choice("style", style, WATERFALL_STYLES)
     values = np.asarray(values, dtype=float).ravel()
     amps = [signal_1d(a, name="amps_list[i]", min_samples=2) for a in amps_list]
     if len(amps) != values.size or not amps:

@@ -13,11 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.frequencies import rig_frequencies
 from cmsim.run import signal_info
 from cmsim.spectra._checks import band as check_band
-from cmsim.spectra._checks import choice, positive_int
+from cmsim.spectra._checks import positive_int
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
 from cmsim.spectra.kurtogram import kurtogram
@@ -176,7 +176,7 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
     if not isinstance(signal, str) or signal not in run.signals:
         raise ParameterError(f"signal must be one of the run's signals {run.names}, "
                              f"got {signal!r}")
-    choice("kind", kind, PEAK_KINDS)
+    check_choice("kind", kind, PEAK_KINDS)
     max_peaks = positive_int("max_peaks", max_peaks, lo=1, hi=10000)
     fs = run.fs_hz
     if band_hz is not None and kind != "envelope":

@@ -22,8 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._checks import choice, positive_int, signal_1d, spectrum_arrays
+from cmsim.errors import ParameterError, check_choice, check_range
+from cmsim.spectra._checks import positive_int, signal_1d, spectrum_arrays
+from cmsim.spectra.plots import agg_figure
 
 __all__ = ["harmonic_amplitudes", "dominant_harmonic", "plot_family_waterfall",
            "plot_harmonic_trend", "FAMILY_MARKERS"]
@@ -117,15 +118,6 @@ def _marker_group(family, k, m):
     return "other"
 
 
-def _figure(figsize):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
 def plot_family_waterfall(freq, amps, values, *, families=None, peaks=None, dominant=None,
                           value_label="Torque [N·m]", amplitude_unit="", max_freq=None,
                           dynamic_range_db=60.0, offset_db=None, n_harmonics=None,
@@ -175,7 +167,7 @@ def plot_family_waterfall(freq, amps, values, *, families=None, peaks=None, domi
     -------
     matplotlib.figure.Figure
     """
-    choice("freq_unit", freq_unit, ("Hz", "order"))
+    check_choice("freq_unit", freq_unit, ("Hz", "order"))
     freq = signal_1d(freq, name="freq", min_samples=2)
     values = np.asarray(values, dtype=float).ravel()
     amps = [signal_1d(a, name=f"amps[{i}]", min_samples=2) for i, a in enumerate(amps)]
@@ -204,7 +196,7 @@ def plot_family_waterfall(freq, amps, values, *, families=None, peaks=None, domi
 
     import matplotlib as mpl
     cmap = mpl.colormaps["viridis"]
-    fig = _figure((11.0, 3.2 + 0.55 * n_sp))
+    fig = agg_figure((11.0, 3.2 + 0.55 * n_sp))
     ax = fig.add_subplot()
     fam = families or {}
     gmf, bpf = fam.get("GMF"), fam.get("BPF")
@@ -304,7 +296,7 @@ def plot_harmonic_trend(values, harmonic_amps, *, value_label="Torque [N·m]",
     v, h = values[order], h[order]
     import matplotlib as mpl
     cmap = mpl.colormaps["tab10"]
-    fig = _figure((8.0, 4.6))
+    fig = agg_figure((8.0, 4.6))
     ax = fig.add_subplot()
     for k in range(h.shape[1]):
         if np.all(~np.isfinite(h[:, k])):
