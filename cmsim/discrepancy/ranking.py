@@ -186,6 +186,7 @@ def evidence(r, chi_of, nominal_features, names):
     judged = r["cause"].judged_on(names, r["component"])
     sim = r.get("features")
     r["judged_on"] = judged
+    r["per_feature"] = {k: chi_of(nominal_features, [k]) - chi_of(sim, [k]) for k in names}
     r["total"] = chi_of(nominal_features, names) - chi_of(sim, names)
     r["delta_chi2"] = chi_of(nominal_features, judged) - chi_of(sim, judged) if judged else 0.0
 
@@ -214,6 +215,11 @@ def decide(ranked, sensor_bearing, chi_nominal):
     faults = [r for r in ranked if r["cause"].signature is not None
               and r["delta_chi2"] >= MIN_DELTA_CHI2]
     if faults:
+        # faults that stand out in their own family are weighed on the same features: the
+        # union of their signatures (a small signature must not win by its size alone)
+        union = set().union(*(r["judged_on"] for r in faults))
+        for r in faults:
+            r["contest"] = sum(r["per_feature"][k] for k in union)
         # the same cause on the sensor's bearing beats it elsewhere unless clearly weaker
         best = {}
         for r in faults:
@@ -225,14 +231,14 @@ def decide(ranked, sensor_bearing, chi_nominal):
                 continue
             prev_near = prev["component"] == sensor_bearing
             if near and not prev_near:
-                if prev["delta_chi2"] < FAR_MARGIN * r["delta_chi2"]:
+                if prev["contest"] < FAR_MARGIN * r["contest"]:
                     best[key] = r
             elif prev_near and not near:
-                if r["delta_chi2"] >= FAR_MARGIN * prev["delta_chi2"]:
+                if r["contest"] >= FAR_MARGIN * prev["contest"]:
                     best[key] = r
-            elif r["delta_chi2"] > prev["delta_chi2"]:
+            elif r["contest"] > prev["contest"]:
                 best[key] = r
-        pool = sorted(best.values(), key=lambda r: -r["delta_chi2"])
+        pool = sorted(best.values(), key=lambda r: -r["contest"])
     else:
         pool = sorted((r for r in ranked if r["cause"].signature is None
                        and r["delta_chi2"] >= MIN_DELTA_CHI2
@@ -241,7 +247,8 @@ def decide(ranked, sensor_bearing, chi_nominal):
     if not pool:
         return None, []
     top = pool[0]
-    ties = [r for r in pool[1:] if r["delta_chi2"] >= NEAR_TIE * top["delta_chi2"]]
+    key = "contest" if faults else "delta_chi2"
+    ties = [r for r in pool[1:] if r[key] >= NEAR_TIE * top[key]]
     return top, ties
 
 

@@ -56,6 +56,8 @@ HIDDEN_EFFECTS = {
     "eccentricity": [(2.5e-5, 1e-4)],
     "tooth_fault": [(5e-4, 2e-3)],
     "friction": [(8e-7, 2.5e-6)],
+    "unbalance": [(0.2, 0.8)],
+    "misalignment": [(0.2, 0.8)],
 }
 
 #: Effects simulated on the gear rig.
@@ -99,7 +101,8 @@ class HiddenRecord:
     component: str | None
 
 
-def hidden_effect_record(effect, seed, *, duration_s=DURATION_S, rig_kind=None):
+def hidden_effect_record(effect, seed, *, duration_s=DURATION_S, rig_kind=None,
+                         sim_seed=None):
     """A "measured" record with one hidden effect (or none) and nuisances.
 
     Parameters
@@ -113,6 +116,10 @@ def hidden_effect_record(effect, seed, *, duration_s=DURATION_S, rig_kind=None):
     rig_kind : {"bearing", "gear"}, optional
         Rig of a record without a hidden effect (default: the bearing rig); an effect
         brings its own rig.
+    sim_seed : int, optional
+        Seed of the simulation (default ``seed + 100000``): the machine (its nuisances)
+        follows ``seed`` alone, so ``hidden_effect_record(None, seed, sim_seed=...)`` is a
+        healthy baseline of the same machine, another realisation.
 
     Returns
     -------
@@ -149,7 +156,8 @@ def hidden_effect_record(effect, seed, *, duration_s=DURATION_S, rig_kind=None):
         component = comps[int(rng.integers(len(comps)))]
         values = {**cause.start(rig), cause.params[0].name: value}
         setup = cause.extend(setup, values, component)
-    x = simulate_setup(setup, fs, duration_s, "accel_1b1_y", int(seed) + 100_000,
+    x = simulate_setup(setup, fs, duration_s, "accel_1b1_y",
+                       int(seed) + 100_000 if sim_seed is None else int(sim_seed),
                        noise_ref_rms=ref)
     run = Run(np.arange(x.size) / fs, {"DE": x}, {"fs_hz": fs}, source="measured")
     comps = ({"1G1": "input gear", "2G1": "output gear"} if gear
