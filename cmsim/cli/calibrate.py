@@ -87,11 +87,15 @@ def run(args):
     return out
 
 
+def _wobble(w):
+    return "not identifiable" if w is None else f"{100 * w:.2f} % rms"
+
+
 def text(res):
     """What was fitted and how well."""
     q = res["fit_quality"]
     lines = [f"machine {res['name']} ({res['channel']}, {res['fs_hz']:g} Hz, "
-             f"{res['speed_rpm']:.1f} rpm, speed wobble {100 * res['speed_wobble']:.2f} %): "
+             f"{res['speed_rpm']:.1f} rpm, speed wobble {_wobble(res['speed_wobble'])}): "
              f"{res['lines']} background lines",
              f"fit on held-out baseline segments: worst z {q['worst_z']:.2f} "
              f"({q['worst_feature']}), chi2 per feature {q['chi2_per_feature']:.2f} over "

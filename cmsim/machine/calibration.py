@@ -40,8 +40,9 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    averages several, also over √(spread² + the twin's own spread²).
 
 The operating point is the record's (speed read from the signal); the speed wobble is the
-relative RMS of the strongest shaft-order line's instantaneous frequency, recorded for
-information.
+relative RMS of the strongest shaft-order line's instantaneous frequency, less what the noise
+under the line makes of it, recorded for information — or not identifiable (None) when no
+shaft order stands :data:`WOBBLE_MIN_SNR` over its noise.
 
 References
 ----------
@@ -92,6 +93,10 @@ PIN_CONSISTENCY = 2.0
 #: Most of the record's broadband power the model's own broadband force may account for
 #: through the path, at any frequency: the rest is the machine's background.
 BROADBAND_SHARE = 0.5
+#: Least power ratio of a shaft-order line over the noise beside it for its instantaneous
+#: frequency to tell the speed wobble (20 dB: the noise then adds under 0.5 % of the line's
+#: phase wander).
+WOBBLE_MIN_SNR = 100.0
 #: Relative tolerance of a line's frequency against a shaft order or a model line.
 LINE_TOLERANCE = 0.004
 #: Lower edge of a housing's resonant band, as a share of the sample rate: below it the
@@ -220,28 +225,39 @@ def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
 
 
 def _speed_wobble(x, fs, shaft_hz):
-    """Relative RMS of the instantaneous frequency of the strongest of the first four shaft
-    orders (complex demodulation, low-passed below half the shaft rate)."""
+    """Relative RMS of the slow fluctuation of the input speed, or None where the baseline
+    cannot tell it.
+
+    The strongest of the first four shaft orders is demodulated and averaged over two shaft
+    periods; its instantaneous frequency fluctuates with the speed and with the noise under
+    the line. The noise's share, read the same way half a shaft order beside the line, is
+    removed; a line less than :data:`WOBBLE_MIN_SNR` over that noise tells nothing.
+    """
     n = x.size
-    spec = np.fft.rfft(x * np.hanning(n))
+    spec = np.abs(np.fft.rfft(x * np.hanning(n)))
     freq = np.fft.rfftfreq(n, 1.0 / fs)
-    best = None
-    for k in range(1, 5):
-        sel = np.abs(freq - k * shaft_hz) <= 0.02 * k * shaft_hz
-        if np.any(sel):
-            a = float(np.max(np.abs(spec[sel])))
-            if best is None or a > best[0]:
-                best = (a, k)
-    if best is None:
-        return 0.0
-    k = best[1]
-    t = np.arange(n) / fs
-    base = x * np.exp(-2j * math.pi * k * shaft_hz * t)
+    orders = [(float(np.max(spec[sel])), k) for k in range(1, 5)
+              if np.any(sel := np.abs(freq - k * shaft_hz) <= 0.02 * k * shaft_hz)]
+    if not orders:
+        return None
+    k = max(orders)[1]
     width = max(1, int(round(2.0 * fs / shaft_hz)))
-    kernel = np.ones(width) / width
-    base = np.convolve(base, kernel, mode="valid")
-    inst = np.diff(np.unwrap(np.angle(base))) * fs / (2.0 * math.pi)
-    return float(np.std(inst) / (k * shaft_hz)) if inst.size > 10 else 0.0
+    t = np.arange(n) / fs
+
+    def demodulated(f0):
+        b = np.convolve(x * np.exp(-2j * math.pi * f0 * t), np.ones(width) / width, "valid")
+        return b[::width]
+
+    line = demodulated(k * shaft_hz)
+    noise = 0.5 * sum(float(np.mean(np.abs(demodulated(k * shaft_hz + d)) ** 2))
+                      for d in (-0.5 * shaft_hz, 0.5 * shaft_hz))
+    power = float(np.abs(np.mean(line)) ** 2)
+    if line.size < 10 or power < WOBBLE_MIN_SNR * noise:
+        return None
+    step = width / fs
+    inst = np.diff(np.unwrap(np.angle(line))) / (2.0 * math.pi * step)
+    var_noise = noise / power / (2.0 * math.pi * step) ** 2
+    return float(math.sqrt(max(float(np.var(inst)) - var_noise, 0.0)) / (k * shaft_hz))
 
 
 def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):

@@ -112,8 +112,9 @@ class Machine:
         Model component → the machine's name for it (``{"1b1": "drive_end"}``).
     segment_s : float
         Segment length the features and their spread are computed on, s.
-    speed_wobble : float
-        Relative RMS of the input speed's slow fluctuation seen on the baseline.
+    speed_wobble : float or None
+        Relative RMS of the input speed's slow fluctuation seen on the baseline (None: not
+        identifiable on it, no shaft order standing out of its noise).
     spread : dict
         Feature name → (mean, std) over the baseline's segments.
     fit_quality : dict
@@ -137,7 +138,7 @@ class Machine:
     unit_scale: float | None = None
     components: dict = field(default_factory=dict)
     segment_s: float = 0.5
-    speed_wobble: float = 0.0
+    speed_wobble: float | None = None
     spread: dict = field(default_factory=dict)
     fit_quality: dict = field(default_factory=dict)
     calibrated_on: tuple = ()
@@ -194,7 +195,8 @@ class Machine:
                         "model_signal": self.model_signal, "fs_hz": self.fs_hz,
                         "unit": self.unit,
                         "unit_scale": -1.0 if self.unit_scale is None else self.unit_scale,
-                        "segment_s": self.segment_s, "speed_wobble": self.speed_wobble,
+                        "segment_s": self.segment_s,
+                        "speed_wobble": -1.0 if self.speed_wobble is None else self.speed_wobble,
                         "components": dict(self.components),
                         "calibrated_on": list(self.calibrated_on), "notes": list(self.notes)},
             "operating": {"speed_rpm": self.op.speed_rpm, "torque_nm": self.op.torque_nm,
@@ -224,6 +226,7 @@ class Machine:
         try:
             m, o, p, b = data["machine"], data["operating"], data["path"], data["background"]
             scale = float(m["unit_scale"])
+            wobble = float(m.get("speed_wobble", -1.0))
             return cls(
                 name=str(m["name"]), rig=Rig.from_dict(data["rig"]), channel=str(m["channel"]),
                 model_signal=str(m["model_signal"]), fs_hz=float(m["fs_hz"]),
@@ -236,7 +239,7 @@ class Machine:
                 unit=str(m.get("unit", "")), unit_scale=None if scale < 0 else scale,
                 components=dict(m.get("components", {})),
                 segment_s=float(m.get("segment_s", 0.5)),
-                speed_wobble=float(m.get("speed_wobble", 0.0)),
+                speed_wobble=None if wobble < 0 else wobble,
                 spread={k: (float(v[0]), float(v[1])) for k, v in data.get("spread", {}).items()},
                 fit_quality=dict(data.get("fit_quality", {})),
                 calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())))

@@ -78,12 +78,14 @@ def write_calibration_report(machine, records, out_dir, seed=0):
         for k, z in sorted((q.get("z") or {}).items(), key=lambda kv: -abs(kv[1])))
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in machine.notes)
     on = "".join(f"<li>{html.escape(c)}</li>" for c in machine.calibrated_on)
+    wobble = ("not identifiable" if machine.speed_wobble is None
+              else f"{100 * machine.speed_wobble:.2f} % rms")
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>cmsim calibrate</title>
 <style>body{{font-family:sans-serif;max-width:1000px;margin:auto}}td,th{{padding:2px 8px}}
 </style></head><body><h1>Machine {html.escape(machine.name)}</h1>
 <p>Channel {html.escape(machine.channel)} at {machine.fs_hz:g} Hz, model signal
 {html.escape(machine.model_signal)}, {machine.op.speed_rpm:.2f} rpm, speed wobble
-{100 * machine.speed_wobble:.2f} % rms; {len(machine.background.lines)} background lines.</p>
+{wobble}; {len(machine.background.lines)} background lines.</p>
 <ul>{on}</ul><ul>{notes}</ul>
 <img src="data:image/png;base64,{png}" alt="baseline and twin">
 <h2>Twin against held-out baseline segments</h2>

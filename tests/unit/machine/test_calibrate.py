@@ -100,3 +100,23 @@ def test_the_machine_file_round_trips(case, tmp_path):
     assert back.rig == m.rig and back.op == m.op and back.spread.keys() == m.spread.keys()
     assert all(back.spread[k] == pytest.approx(m.spread[k]) for k in m.spread)
     assert back.fit_quality["worst_feature"] == m.fit_quality["worst_feature"]
+
+
+@pytest.mark.parametrize("relative, noise, expected", [
+    (0.01, 0.3, 0.01 / math.sqrt(2)),      # 1 % sinusoidal speed wobble: RMS 0.71 %
+    (0.0, 0.3, 0.0),                       # a steady line: the noise's share is removed
+    (0.01, 3.0, None),                     # a line 13 dB under its noise tells nothing
+])
+def test_speed_wobble_is_read_where_a_shaft_order_stands_out(relative, noise, expected):
+    from cmsim.machine.calibration import _speed_wobble
+    fs, f0, f_mod = 12000.0, 30.0, 1.0
+    t = np.arange(120_000) / fs
+    phase = 2 * math.pi * f0 * (t + relative * np.sin(2 * math.pi * f_mod * t)
+                                / (2 * math.pi * f_mod))
+    x = np.sin(phase) + noise * np.random.default_rng(0).standard_normal(t.size)
+    got = _speed_wobble(x, fs, f0)
+    if expected is None:
+        assert got is None
+    else:
+        # averaging over two shaft periods takes ~4 % off a 1-Hz wobble
+        assert got == pytest.approx(expected, abs=0.08 * 0.01)
