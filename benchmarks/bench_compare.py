@@ -61,9 +61,31 @@ def _angle_case(eff, s, folder):
             severity, "drive_end" if effect and effect.startswith("bearing") else None)
 
 
+def _spy_on_decisions():
+    """Keep what :func:`~cmsim.discrepancy.ranking.decide` was given (each ranked cause's
+    evidence per feature and signature), so that thresholds can be replayed on the rows."""
+    import importlib
+    cm = importlib.import_module("cmsim.discrepancy.compare")
+    original = cm.decide
+    seen = {}
+
+    def decide(ranked, sensor_bearing, chi_nominal):
+        seen["decide"] = {
+            "sensor_bearing": sensor_bearing, "chi_nominal": chi_nominal,
+            "ranked": [{"name": r["name"], "component": r["component"],
+                        "fault": r["cause"].signature is not None,
+                        "delta_chi2": r["delta_chi2"], "judged_on": r["judged_on"],
+                        "per_feature": r["per_feature"]} for r in ranked]}
+        return original(ranked, sensor_bearing, chi_nominal)
+
+    cm.decide = decide
+    return seen
+
+
 def one(job):
     """Generate and compare one record; the row of the report."""
     eff, s, budget, generator, with_machine = job
+    seen = _spy_on_decisions()
     effect = None if eff.startswith("none") else eff
     with tempfile.TemporaryDirectory() as tmp:
         record, baseline, value, component = (_model_case(eff, s) if generator == "model"
@@ -83,7 +105,7 @@ def one(job):
             "mode": c.mode, "near_ties": c.near_ties,
             "causes": [{k: r[k] for k in ("name", "component", "score", "delta_chi2",
                                            "delta_chi2_all")} for r in c.causes],
-            "wall_s": wall}
+            "wall_s": wall, "decide": seen.get("decide")}
 
 
 def main(argv=None):
@@ -94,12 +116,17 @@ def main(argv=None):
     ap.add_argument("--budget", type=int, default=None)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--effects", nargs="*", default=None)
+    ap.add_argument("--clean-seeds", type=int, default=None,
+                    help="seeds of the records with no hidden effect (default --seeds)")
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
     budget = a.budget or DEFAULT_BUDGET
     catalogue = list(HIDDEN_EFFECTS) if a.generator == "model" else list(ANGLE_EFFECTS)
     effects = a.effects or (catalogue + ["none", "none_gear"])
-    jobs = [(e, s, budget, a.generator, a.machine) for s in range(a.seeds) for e in effects]
+    clean_seeds = a.seeds if a.clean_seeds is None else a.clean_seeds
+    jobs = [(e, s, budget, a.generator, a.machine)
+            for s in range(max(a.seeds, clean_seeds)) for e in effects
+            if s < (clean_seeds if e.startswith("none") else a.seeds)]
     rows = []
     t_all = time.perf_counter()
     with ProcessPoolExecutor(a.workers) as pool:

@@ -411,7 +411,7 @@ class MisalignmentCause(_ShaftForce):
     line and a twice-per-revolution load modulation."""
     name = "misalignment"
     orders = ((2, 1.0), (1, 0.5))
-    signature = ("raw_fr_h2_db", "sb23_", "sb1_")
+    signature = ("raw_fr_h2_db", "raw_fr_h1_db", "sb23_", "sb1_")
 
 
 # ---------------------------------------------------------------------- uncertain parameters

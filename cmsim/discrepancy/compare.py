@@ -67,8 +67,11 @@ VAR_SEEDS = 6
 LEVEL_SIGMA_DB = 6.0
 
 #: χ² per feature of the nominal model above which a record no cause explains is
-#: ``unexplained`` rather than ``none`` (twice what the uncertainties allow).
-UNEXPLAINED_CHI2_PER_FEATURE = 2.0
+#: ``unexplained`` rather than ``none``: records with no hidden effect reach 2.1 (model
+#: generator, 13 records of benchmarks/bench_compare.py and the tests; features are
+#: correlated, so the χ² of independent features would understate the spread), records
+#: with an effect the catalogue misses sit at 2.9-4.8.
+UNEXPLAINED_CHI2_PER_FEATURE = 2.5
 
 #: The nominal models (see the module docstring).
 MODES = ("machine", "documented", "path-free")
@@ -333,6 +336,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
                   "delta_chi2": r["delta_chi2"]} for r in ties]
     departures = [d["feature"] for d in discrepancies if abs(d["z"]) > 2.0][:8]
     spectra = {"measured": record.signal, "fs_hz": record.fs_hz,
+               "bearing": ev.freqs.bearings.get(ev.sensor_bearing),
+               "bearing_name": _component_name(record, ev.sensor_bearing),
                "nominal": _concat([ev.signal(setup_nom, s) for s in held_seeds]),
                "fitted": None if fitted is setup_nom else _concat(
                    [ev.signal(fitted, s) for s in held_seeds])}

@@ -1,4 +1,5 @@
-"""HTML report of a comparison: measured and simulated spectra overlaid before and after."""
+"""HTML report of a comparison: the finding in words, measured and simulated spectra and
+envelope spectra overlaid before and after, the families marked, the causes ranked."""
 
 from __future__ import annotations
 
@@ -27,13 +28,26 @@ def _norm_spectrum(x, fs):
     return np.fft.rfftfreq(n, 1 / fs), 20 * np.log10(np.maximum(amp, 1e-30) / np.median(amp))
 
 
+#: Envelope families marked on the report's envelope spectra: (attribute, label, colour).
+FAMILIES = (("bpfo_hz", "BPFO", "tab:blue"), ("bpfi_hz", "BPFI", "tab:green"),
+            ("bsf_hz", "2×BSF", "tab:purple"))
+
+
+def _envelope(x, fs, bearing, band):
+    from cmsim.features.envelope import demodulated_spectrum
+    spec, band = demodulated_spectrum(np.asarray(x, dtype=float), fs, [bearing], band)
+    amp = np.asarray(spec.amplitude)
+    return np.asarray(spec.freq_hz), 20 * np.log10(np.maximum(amp, 1e-30) / np.median(amp)), band
+
+
 def _figure(spectra, title_after):
-    import matplotlib
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    from cmsim.spectra.plots import agg_figure
 
     fs = spectra["fs_hz"]
-    fig, axes = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
+    bearing = spectra.get("bearing")
+    rows = 2 if bearing is None else 3
+    fig = agg_figure((9, 3.2 * rows))
+    axes = fig.subplots(rows, 1)
     m = _norm_spectrum(spectra["measured"], fs)
     for ax, key, title in ((axes[0], "nominal", "before: nominal model"),
                            (axes[1], "fitted", title_after)):
@@ -43,12 +57,31 @@ def _figure(spectra, title_after):
                     label="simulated")
         ax.set_title(title)
         ax.set_ylabel("dB re median level")
+        ax.set_xlabel("frequency, Hz")
         ax.legend(loc="upper right")
-    axes[1].set_xlabel("frequency, Hz")
+    if bearing is not None:
+        ax = axes[2]
+        f, a, band = _envelope(spectra["measured"], fs, bearing, None)
+        top = 4.5 * max(bearing.bpfi_hz, 2 * bearing.bsf_hz)
+        sel = f <= top
+        ax.plot(f[sel], a[sel], lw=0.7, color="k", label="measured")
+        for key, colour in (("nominal", "tab:gray"), ("fitted", "tab:red")):
+            if spectra.get(key) is not None:
+                fe, ae, _ = _envelope(spectra[key], fs, bearing, band)
+                ax.plot(fe[fe <= top], ae[fe <= top], lw=0.7, color=colour, alpha=0.8,
+                        label=key)
+        for attr, label, colour in FAMILIES:
+            f0 = getattr(bearing, attr) * (2.0 if attr == "bsf_hz" else 1.0)
+            for k in range(1, 4):
+                ax.axvline(k * f0, color=colour, lw=0.8, ls="--",
+                           label=label if k == 1 else None)
+        ax.set_title(f"envelope spectrum, {spectra.get('bearing_name') or 'sensor'} bearing, "
+                     f"band {band[0]:.0f}-{band[1]:.0f} Hz (the measured record's)")
+        ax.set_xlabel("frequency, Hz")
+        ax.set_ylabel("dB re median level")
+        ax.legend(loc="upper right", fontsize=7, ncol=2)
     buf = io.BytesIO()
-    fig.tight_layout()
     fig.savefig(buf, format="png", dpi=90)
-    plt.close(fig)
     return base64.b64encode(buf.getvalue()).decode()
 
 
@@ -70,28 +103,44 @@ def write_report(comparison, out_dir):
     out.mkdir(parents=True, exist_ok=True)
     d = comparison.to_dict()
     after = ("after: extended by " + d["finding"] + " " + json.dumps(d["parameters"])
-             if d["finding"] != "none" else "after: no extension (no significant discrepancy)")
+             if d["finding"] not in ("none", "unexplained") else
+             "after: no extension (" + ("no significant discrepancy" if d["finding"] == "none"
+                                       else "no cause explains the departure") + ")")
+    named = (f" on {html.escape(str(d['component']))}" if d["component"] else "") + (
+        " " + html.escape(json.dumps(d["parameters"])) if d["parameters"] else "")
     png = _figure(comparison.spectra, after)
     rows = "".join(f"<tr><td>{html.escape(x['feature'])}</td><td>{x['measured']:.3g}</td>"
                    f"<td>{x['simulated']:.3g}</td><td>{x['z']:.2f}</td></tr>"
                    for x in d["discrepancies"])
     causes = "".join(f"<tr><td>{html.escape(c['name'])}</td><td>{c['component']}</td>"
-                     f"<td>{c['score']:.3f}</td><td>{html.escape(json.dumps(c['parameters']))}"
-                     f"</td></tr>" for c in d["causes"])
+                     f"<td>{c['delta_chi2']:.1f}</td><td>{c['judged_on']}</td>"
+                     f"<td>{c['delta_chi2_all']:.1f}</td>"
+                     f"<td>{html.escape(json.dumps(c['parameters']))}</td></tr>"
+                     for c in d["causes"])
+    not_judged = ("; spectral shape and levels not judged (no documented path): "
+                  + html.escape(", ".join(d["not_judged"])) if d.get("not_judged") else "")
+    ties = ("; near tie with " + html.escape(", ".join(
+        f"{t['name']} ({t['component']})" for t in d["near_ties"]))
+        if d.get("near_ties") else "")
+    departures = ("; departs from the model in " + html.escape(", ".join(d["departures"]))
+                  if d.get("departures") else "")
     g = d["gain"]
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>cmsim compare</title>
 <style>body{{font-family:sans-serif;max-width:1000px;margin:auto}}td,th{{padding:2px 8px}}
 </style></head><body><h1>cmsim compare</h1>
-<p>Finding: <b>{html.escape(d['finding'])}</b> on {d['component']}
-{html.escape(json.dumps(d['parameters']))}; gain on held-out segments: χ²/feature
-{g['before']:.3g} → {g['after']:.3g} (relative {g['relative']:.2f});
+<p><b>{html.escape(d['words'])}</b></p>
+<p>Nominal model: {html.escape(d['mode'])}{not_judged}. Finding <b>{html.escape(d['finding'])}</b>
+{named}{ties}{departures}; gain on
+held-out segments: χ²/feature {g['before']:.3g} → {g['after']:.3g} (relative
+{g['relative']:.2f}; a record like the model's own sits near {g['baseline_level']:g});
 {d['simulations']} simulations, {d['wall_s']:.1f} s.</p>
 <p>Record: {html.escape(json.dumps(d['record']))}<br>Inferred: {html.escape(json.dumps(d['inferred']))}</p>
 <img src="data:image/png;base64,{png}" alt="spectra">
 <h2>Largest discrepancies (nominal model, fit segments)</h2>
 <table><tr><th>feature</th><th>measured</th><th>simulated</th><th>z</th></tr>{rows}</table>
 <h2>Causes, ranked</h2>
-<table><tr><th>cause</th><th>component</th><th>score</th><th>parameters</th></tr>{causes}</table>
+<table><tr><th>cause</th><th>component</th><th>Δχ² on its signature</th><th>features in it</th>
+<th>Δχ² on all</th><th>parameters</th></tr>{causes}</table>
 </body></html>"""
     path = out / "compare.html"
     atomic_write_text(path, page)

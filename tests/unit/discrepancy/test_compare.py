@@ -17,7 +17,7 @@ import pytest
 from cmsim.discrepancy import CAUSES, Cause, compare, register_cause
 from cmsim.discrepancy.causes import applicable_causes
 from cmsim.discrepancy.compare import DEFAULT_BUDGET
-from cmsim.discrepancy.ranking import MIN_DELTA_CHI2
+from cmsim.discrepancy.ranking import MIN_SIGNATURE_DELTA_CHI2
 from cmsim.measured import RECORDING_KEYS, data_root, estimate_shaft_hz, read_record
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
 from cmsim.errors import ParameterError
@@ -191,7 +191,7 @@ def test_clean_record_reports_no_discrepancy():
     h, c = _hidden(None, 1000)
     assert c.finding == "none"
     assert c.parameters == {}
-    assert c.causes[0]["delta_chi2"] < MIN_DELTA_CHI2
+    assert c.causes[0]["delta_chi2"] < MIN_SIGNATURE_DELTA_CHI2
 
 
 #: Effects named in every seed of the benchmark (benchmarks/bench_compare.py, 4 seeds), with
@@ -211,6 +211,20 @@ def test_hidden_effect_is_named(effect):
     if NAMED[effect] is not None:
         fitted = c.parameters[CAUSES[effect]().params[0].name]
         assert abs(math.log(fitted / h.value)) <= math.log(NAMED[effect])
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason=(
+    "finding (issue 25): unbalance and misalignment are laid on the bearing force after the "
+    "dynamics, so they add a 1x/2x line and nothing else; through the housing path that line "
+    "sits under the record's floor (Δχ² on their signature 6-7 at 0.26-0.66 of the static "
+    "load, under the 16 needed), and the once-per-revolution load modulation a real unbalance "
+    "makes (shaft-rate sidebands of the ball passes and mesh harmonics) needs the rotating "
+    "force inside the equations of motion"))
+@pytest.mark.parametrize("effect", ["unbalance", "misalignment"])
+def test_hidden_shaft_force_is_named(effect):
+    h, c = _hidden(effect, 1000)
+    assert c.finding == effect
 
 
 @pytest.mark.slow
