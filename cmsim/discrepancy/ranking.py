@@ -13,9 +13,8 @@
   fluctuation, the chain) is judged on every feature. A fault whose evidence reaches
   :data:`MIN_SIGNATURE_DELTA_CHI2`, and exceeds what any reshaping cause that could be named
   makes of the same features, wins over the reshaping causes: what stands out in a fault
-  family beyond what a load or a clearance does to it is that fault. Faults that stand out
-  are weighed against each other on the union of their signatures (a small signature must
-  not win by its size alone).
+  family beyond what a load or a clearance does to it is that fault; of the faults that stand
+  out, the one with the most evidence on its own signature wins.
 * **The nearest bearing.** A bearing cause on a bearing other than the sensor's wins only
   with :data:`FAR_MARGIN` times the evidence of the same cause on the sensor's bearing.
 * **Near ties.** A runner-up of the same kind within :data:`NEAR_TIE` of the winner's
@@ -205,7 +204,7 @@ def decide(ranked, sensor_bearing, chi_nominal):
 
     Faults (causes with a signature) are decided first: of those whose evidence reaches
     :data:`MIN_SIGNATURE_DELTA_CHI2` and exceeds a nameable reshaping cause's Δχ² on the same
-    features, the strongest on the union of their signatures wins, preferring the sensor's
+    features, the strongest on its own signature wins, preferring the sensor's
     bearing (:data:`FAR_MARGIN`); without one, the reshaping cause with the largest evidence,
     if it reaches :data:`MIN_DELTA_CHI2` and removes :data:`MIN_SCORE` of the nominal χ².
 
@@ -234,11 +233,6 @@ def decide(ranked, sensor_bearing, chi_nominal):
     faults = [r for r in ranked if r["cause"].signature is not None
               and r["delta_chi2"] >= MIN_SIGNATURE_DELTA_CHI2 and stands_out(r)]
     if faults:
-        # faults that stand out in their own family are weighed on the same features: the
-        # union of their signatures (a small signature must not win by its size alone)
-        union = set().union(*(r["judged_on"] for r in faults))
-        for r in faults:
-            r["contest"] = sum(r["per_feature"][k] for k in union)
         # the same cause on the sensor's bearing beats it elsewhere unless clearly weaker
         best = {}
         for r in faults:
@@ -250,21 +244,20 @@ def decide(ranked, sensor_bearing, chi_nominal):
                 continue
             prev_near = prev["component"] == sensor_bearing
             if near and not prev_near:
-                if prev["contest"] < FAR_MARGIN * r["contest"]:
+                if prev["delta_chi2"] < FAR_MARGIN * r["delta_chi2"]:
                     best[key] = r
             elif prev_near and not near:
-                if r["contest"] >= FAR_MARGIN * prev["contest"]:
+                if r["delta_chi2"] >= FAR_MARGIN * prev["delta_chi2"]:
                     best[key] = r
-            elif r["contest"] > prev["contest"]:
+            elif r["delta_chi2"] > prev["delta_chi2"]:
                 best[key] = r
-        pool = sorted(best.values(), key=lambda r: -r["contest"])
+        pool = sorted(best.values(), key=lambda r: -r["delta_chi2"])
     else:
         pool = sorted(reshaping, key=lambda r: -r["delta_chi2"])
     if not pool:
         return None, []
     top = pool[0]
-    key = "contest" if faults else "delta_chi2"
-    ties = [r for r in pool[1:] if r[key] >= NEAR_TIE * top[key]]
+    ties = [r for r in pool[1:] if r["delta_chi2"] >= NEAR_TIE * top["delta_chi2"]]
     return top, ties
 
 
