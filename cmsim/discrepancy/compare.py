@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmsim.discrepancy.causes import (MACHINE_NUISANCES, NUISANCES, ModelSetup,
+from cmsim.discrepancy.causes import (CAUSES, MACHINE_NUISANCES, NUISANCES, ModelSetup,
                                       applicable_causes)
 from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, feature_floor,
                                          path_free, weight)
@@ -124,8 +124,8 @@ class Comparison:
 
 
 def describe(finding, component, parameters, ranges):
-    """The finding in words: ``"inner-race defect, drive_end bearing, about 0.4 mm
-    (0.2-0.8 mm)"``.
+    """The finding in words: ``"inner-race defect, drive-end bearing, size about 0.4 mm
+    (0.2-0.8 mm)"``; a value the fit left at a bound of the cause's range says so.
 
     Parameters
     ----------
@@ -144,7 +144,8 @@ def describe(finding, component, parameters, ranges):
         return "the record departs from the model in ways no cause of the catalogue explains"
     text = _WORDS.get(finding, finding.replace("_", " "))
     if component:
-        text += f", {component}" + (" bearing" if finding.startswith("bearing_") else "")
+        text += f", {component.replace('_', '-')}" + (
+            " bearing" if finding.startswith("bearing_") else "")
     for name, v in parameters.items():
         if name in ("noise_ratio", "frequency_factor") and not finding.startswith(
                 ("noise", "transfer")):
@@ -160,6 +161,9 @@ def describe(finding, component, parameters, ranges):
             if lo is not None and hi is not None and hi > lo else ""
         label = name.rsplit("_", 1)[0] if unit else name
         text += f", {label.replace('_', ' ')} about {k * v:.2g}{' ' + unit if unit else ''}{span}"
+        bounds = _bounds_of(finding, name)
+        if bounds is not None and not bounds[0] * 1.02 < v < bounds[1] / 1.02:
+            text += " (at the bound of the range searched: it may lie beyond)"
         break
     return text
 
@@ -358,6 +362,13 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         near_ties=near_ties, departures=departures if finding == "unexplained" else [],
         not_judged=not_judged, words=describe(finding, component, params, ranges),
         spectra=spectra)
+
+
+def _bounds_of(finding, name):
+    cause = CAUSES.get(finding)
+    if cause is None:
+        return None
+    return next((p.bounds for p in cause().params if p.name == name), None)
 
 
 def _concat(xs):

@@ -328,3 +328,14 @@ def test_hidden_effect_is_applied_at_its_drawn_severity():
     h = hidden_effect_record("noise", 77)
     assert 0.8 <= h.value <= 3.0
     assert np.std(h.record.signal) > math.sqrt(1.0 + 0.5 * h.value ** 2) * np.std(clean)
+
+
+def test_the_finding_reads_as_an_engineer_says_it():
+    from cmsim.discrepancy.compare import describe
+    words = describe("bearing_inner_race", "drive_end", {"size_m": 4e-4, "noise_ratio": 0.1},
+                     {"size_m": (2e-4, 8e-4)})
+    assert words == "inner-race defect, drive-end bearing, size about 0.4 mm (0.2-0.8 mm)"
+    hi = CAUSES["bearing_ball"]().params[0].bounds[1]
+    assert "at the bound" in describe("bearing_ball", "drive_end", {"size_m": hi}, {})
+    assert describe("none", None, {}, {}).startswith("no departure")
+    assert "no cause" in describe("unexplained", None, {}, {})
