@@ -137,7 +137,7 @@ def run(args):
         if bar is not None:
             bar.close()
     if machine is not None:
-        run_ = machine_channel(run_, machine, args.seed)
+        run_ = machine.sensor_channel(run_, args.seed)
     elif args.sensors or args.sensor_noise or args.sensor_fs_hz is not None:
         from cmsim.sensors import add_sensors
         run_ = add_sensors(run_, noise_rms=args.sensor_noise, fs_hz=args.sensor_fs_hz)
@@ -196,19 +196,3 @@ def text(res):
     if res["out"]:
         lines.append(f"wrote {res['out']} (seed {res['seed']})")
     return "\n".join(lines)
-
-
-def machine_channel(run_, machine, seed):
-    """``run_`` with the machine's sensor channel: the model force behind it through the
-    machine's path plus its background (the run made at the machine's sample rate)."""
-    import numpy as np
-
-    from cmsim.run import signal_info
-
-    info = signal_info(machine.model_signal)
-    force = np.asarray(run_[f"F_{info.component}_{info.direction}"], dtype=float)
-    y = machine.sensor_signal(force, 0, force.size, seed,
-                              speed_rpm=run_.operating_point.speed_rpm)
-    return run_.with_signals(**{machine.channel: y}).with_meta(
-        machine={"name": machine.name, "channel": machine.channel,
-                 "unit": machine.unit, "model_signal": machine.model_signal})

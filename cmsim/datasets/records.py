@@ -4,7 +4,8 @@ A record's file ``DIR/records/<record_id>.npz`` holds its signals and ``meta`` (
 manifest row, rig, operating point, faults, the answer key, timing):
 
 * a spec with ``channels`` keeps those channels only, float32 at the sensor rate
-  (accelerometers and tacho through the rig's housing path, with the drawn sensor noise);
+  (accelerometers and tacho through the rig's housing path, with the drawn sensor noise;
+  a calibrated machine's channel through its path, plus its background: :mod:`cmsim.machine`);
 * a spec without (a sweep) keeps the simulated run in full — ``t``, every signal at full
   precision and the run's own meta — so the file is a :class:`~cmsim.run.Run`
   (:meth:`Run.load <cmsim.run.Run.load>` reads it; ``cmsim report`` draws it), and its
@@ -96,12 +97,15 @@ def base_row(spec, plan):
     return row
 
 
-def _simulated_channels(channels):
+def _simulated_channels(channels, machine=None):
     """The simulated signals a record's channels are made from: an accelerometer needs both
-    force components of its bearing, the tacho the input shaft's rotation."""
+    force components of its bearing, the tacho the input shaft's rotation, a machine's
+    channel the force of its model signal's bearing."""
     out = set()
     for c in channels:
-        if c.startswith("accel_"):
+        if machine is not None and c == machine.channel:
+            out |= set(machine.force_signals)
+        elif c.startswith("accel_"):
             b = c.split("_")[1]
             out |= {f"F_{b}_x", f"F_{b}_y"}
         elif c == "tacho":
@@ -143,8 +147,11 @@ def simulate_record(spec, index):
     run = simulate(rig, op, spec.duration_s, mesh=spec.mesh, fs_hz=spec.fs_hz,
                    substeps=spec.substeps, seed=plan.sim_seed, warmup_s=spec.warmup_s,
                    faults=plan.faults, profile=profile, losses=spec.losses,
-                   record=None if channels is None else _simulated_channels(channels))
+                   record=None if channels is None else _simulated_channels(channels,
+                                                                            spec.machine))
     t1 = time.perf_counter()
+    if spec.machine is not None and (channels is None or spec.machine.channel in channels):
+        run = spec.machine.sensor_channel(run, plan.sim_seed)
     if sensed:
         accel = [c.split("_") for c in sensed if c.startswith("accel_")]
         bearings = sorted({a[1] for a in accel}) or None

@@ -157,6 +157,10 @@ class DatasetSpec:
         Tooth contact model passed to :func:`cmsim.dynamics.simulate`.
     losses : LossSettings or True, optional
         Every loss source in every run (their breakdown and power balance in the meta).
+    machine : cmsim.machine.Machine, optional
+        A calibrated machine (:func:`cmsim.machine.calibrate`): the records are made on its
+        rig at its sample rate, and the channel named as the machine's is the model force
+        through its calibrated path plus its background.
     """
 
     name: str
@@ -181,14 +185,28 @@ class DatasetSpec:
     substeps: object
     mesh: object
     losses: object
+    machine: object
 
     def __init__(self, variations=(), *, fixed=None, sampling="grid", records=None, repeats=1,
                  name="sweep", seed=SAMPLING.seed, seed_policy="per_run", rig=None, rig_source=None,
                  runup_share=0.0, runup_to_rpm=None, fault_types=(), healthy_share=None,
                  faults=(), nuisances=None, channels=None, fs_hz=SAMPLING.fs_hz,
                  duration_s=SAMPLING.duration_s, warmup_s=SAMPLING.warmup_s,
-                 substeps=SAMPLING.substeps, mesh=None, losses=None):
+                 substeps=SAMPLING.substeps, mesh=None, losses=None, machine=None):
         set_ = object.__setattr__
+        if machine is not None:
+            from cmsim.machine import Machine
+            if not isinstance(machine, Machine):
+                raise ParameterError(f"machine must be a cmsim.machine.Machine, got "
+                                     f"{type(machine).__name__}", param="machine")
+            if rig is not None and rig != machine.rig:
+                raise ParameterError("a machine brings its rig: leave rig out",
+                                     param="machine")
+            rig = machine.rig
+            if abs(float(fs_hz) / machine.fs_hz - 1.0) > 1e-9:
+                raise ParameterError(f"fs_hz must be the machine's sample rate "
+                                     f"({machine.fs_hz:g} Hz), got {fs_hz!r}", param="fs_hz")
+        set_(self, "machine", machine)
         rig = Rig.paper_2016() if rig is None else rig
         if not isinstance(rig, Rig):
             raise ParameterError(f"rig must be a cmsim.rig.Rig, got {type(rig).__name__}")
@@ -233,7 +251,7 @@ class DatasetSpec:
         set_(self, "nuisances", tuple(
             (n, v if isinstance(v, Distribution) else Distribution.parse(n, v, NUISANCES[n]))
             for n, v in ((n, nuisances[n]) for n in NUISANCES if n in nuisances)))
-        set_(self, "channels", check_channels(channels, rig))
+        set_(self, "channels", check_channels(channels, rig, machine))
         set_(self, "fs_hz", RANGES["fs_hz"].check("fs_hz", fs_hz))
         set_(self, "duration_s", RANGES["duration_s"].check("duration_s", duration_s))
         set_(self, "warmup_s", RANGES["warmup_s"].check("warmup_s", warmup_s))
@@ -454,7 +472,7 @@ class DatasetSpec:
     # ------------------------------------------------------------------ identity
     def to_dict(self):
         """JSON-ready dict of the resolved spec (the rig in full)."""
-        return {"name": self.name, "records": self.n_records, "seed": self.seed,
+        out = {"name": self.name, "records": self.n_records, "seed": self.seed,
                 "seed_policy": self.seed_policy, "sampling": self.sampling,
                 "repeats": self.repeats, "rig": self.rig.to_dict(),
                 "rig_source": self.rig_source,
@@ -469,6 +487,9 @@ class DatasetSpec:
                 "fs_hz": self.fs_hz, "duration_s": self.duration_s, "warmup_s": self.warmup_s,
                 "substeps": self.substeps, "mesh": mesh_key(self.mesh),
                 "losses": None if self.losses is None else dataclasses.asdict(self.losses)}
+        if self.machine is not None:            # (absent otherwise: digests stay as they were)
+            out["machine"] = self.machine.to_dict()
+        return out
 
     @property
     def digest(self):
@@ -491,7 +512,8 @@ class DatasetSpec:
                       "op": dataclasses.asdict(self.record_operating_point(plan)),
                       "faults": [f.to_dict() for f in plan.faults],
                       **{k: spec[k] for k in ("channels", "fs_hz", "duration_s", "warmup_s",
-                                              "substeps", "mesh", "losses")}})
+                                              "substeps", "mesh", "losses", "machine")
+                         if k in spec}})
 
     def __eq__(self, other):
         if not isinstance(other, DatasetSpec):

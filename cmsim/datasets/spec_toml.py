@@ -30,6 +30,11 @@ checked, and a bad spec is refused before any work with a message naming the key
                    (75 kHz, 1 s, 0.05 s), as for simulate and sweep
     [simulation]   mesh (tooth contact model name), substeps (integration steps per sample;
                    default automatic), losses (true: every loss source in every run)
+    [machine]      file = "MACHINE.toml" (``cmsim calibrate --out``; relative to the spec
+                   file): the records are made on the machine's rig at its sample rate, and
+                   its channel (e.g. ``DE``; the default channels are it and ``tacho``) is the
+                   model force through the machine's calibrated path plus its background;
+                   leave ``[rig]`` out
 
 Values are :class:`~cmsim.datasets.distribution.Distribution` s: a number (constant), a list
 (grid values; drawn uniformly under random sampling) or a distribution table.
@@ -46,7 +51,7 @@ from cmsim.datasets.variation import OPERATING_POINT_FIELDS, RIG_TRANSFORMS, set
 from cmsim.errors import ParameterError
 from cmsim.rig import PRESETS, RANGES, SAMPLING, Rig
 
-__all__ = ["read_toml", "toml_keywords", "load_rig", "check_channels", "setting_range",
+__all__ = ["read_toml", "toml_keywords", "load_rig", "load_machine", "check_channels", "setting_range",
            "OPERATING_DEFAULTS"]
 
 #: Operating settings a TOML spec always has (with these values when it leaves them out),
@@ -59,7 +64,7 @@ _TABLES = {"dataset": {"name", "records", "seed", "seed_policy", "repeats"},
            "operating": {"sampling", "runup_share", "runup_to_rpm"},
            "faults": {"healthy_share", "types"}, "nuisances": set(NUISANCES),
            "sensor": {"channels", "fs_hz", "duration_s", "warmup_s"},
-           "simulation": {"mesh", "substeps", "losses"}}
+           "simulation": {"mesh", "substeps", "losses"}, "machine": {"file"}}
 
 #: DatasetSpec keyword -> its TOML key (errors of the constructor are renamed to these).
 _TOML_KEYS = {"name": "dataset.name", "records": "dataset.records", "seed": "dataset.seed",
@@ -153,7 +158,11 @@ def toml_keywords(data, base_dir=None):
             if sub not in _TABLES[key] and key != "operating":
                 raise spec_error(f"{key}.{sub}", f"unknown key; allowed: {sorted(_TABLES[key])}")
     ds = data.get("dataset", {})
-    rig, source = load_rig(data.get("rig", {}), base_dir)
+    machine = load_machine(data["machine"], base_dir) if "machine" in data else None
+    if machine is not None and "rig" in data:
+        raise spec_error("rig", "a [machine] brings its rig; leave [rig] out")
+    rig, source = ((machine.rig, f"machine:{machine.name}") if machine is not None
+                   else load_rig(data.get("rig", {}), base_dir))
     op = data.get("operating", {})
     sampling = op.get("sampling", "random")
     named = [n for n in OPERATING_DEFAULTS if n in op or OPERATING_DEFAULTS[n] is not None]
@@ -194,12 +203,39 @@ def toml_keywords(data, base_dir=None):
         healthy_share=fl.get("healthy_share"),
         nuisances={n: Distribution.parse(f"nuisances.{n}", nz[n], NUISANCES[n])
                    for n in NUISANCES if n in nz},
-        channels=(None if channels == "all" else
-                  [f"accel_{rig.bearing_names[0]}_y", "tacho"] if channels is None else channels),
-        fs_hz=sensor.get("fs_hz", SAMPLING.fs_hz),
+        channels=(None if channels == "all" else channels if channels is not None else
+                  [f"accel_{rig.bearing_names[0]}_y" if machine is None else machine.channel,
+                   "tacho"]),
+        fs_hz=sensor.get("fs_hz", SAMPLING.fs_hz if machine is None else machine.fs_hz),
+        machine=machine,
         duration_s=sensor.get("duration_s", SAMPLING.duration_s),
         warmup_s=sensor.get("warmup_s", SAMPLING.warmup_s), mesh=sim.get("mesh"),
         substeps=sim.get("substeps"), losses=sim.get("losses"))
+
+
+def load_machine(table, base_dir):
+    """The calibrated machine of a ``[machine]`` table (``{"file": path}``).
+
+    Parameters
+    ----------
+    table : dict
+        ``{"file": "MACHINE.toml"}``.
+    base_dir : str or Path or None
+        Folder a relative ``file`` is in.
+    """
+    from cmsim.machine import Machine
+
+    if "file" not in table:
+        raise spec_error("machine.file", "is required (a machine file of cmsim calibrate)")
+    path = Path(table["file"])
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    if not path.is_file():
+        raise spec_error("machine.file", f"{path} does not exist")
+    try:
+        return Machine.load(path)
+    except ParameterError as exc:
+        raise spec_error("machine.file", f"{path}: {exc}") from None
 
 
 def load_rig(table, base_dir):
@@ -230,7 +266,7 @@ def load_rig(table, base_dir):
     return PRESETS[name](), f"builtin:{name}"
 
 
-def check_channels(raw, rig):
+def check_channels(raw, rig, machine=None):
     """``raw`` as a tuple of channel names this rig can give (None: the run in full).
 
     Parameters
@@ -239,6 +275,8 @@ def check_channels(raw, rig):
         Channel names.
     rig : cmsim.rig.Rig
         The spec's rig.
+    machine : cmsim.machine.Machine, optional
+        A calibrated machine, whose channel is one more.
     """
     if raw is None:
         return None
@@ -247,6 +285,8 @@ def check_channels(raw, rig):
         f"F_{b}_{a}" for b in bearings for a in ("x", "y", "loa", "oloa")}
     if rig.gears is not None:
         allowed |= {"dte", "dte_um", "Fmesh_total"}
+    if machine is not None:
+        allowed.add(machine.channel)
     if isinstance(raw, (str, bytes)) or not hasattr(raw, "__iter__") or not list(raw):
         raise ParameterError('channels must be a non-empty list of signal names (or "all")',
                              param="channels")

@@ -182,6 +182,40 @@ class Machine:
                                            line_gain)
         return y - y.mean()
 
+    @property
+    def force_signals(self):
+        """The simulated force components the machine's channel is made from."""
+        info = signal_info(self.model_signal)
+        return (f"F_{info.component}_x", f"F_{info.component}_y")
+
+    def sensor_channel(self, run, seed):
+        """``run`` with the machine's sensor channel added: the model force behind it through
+        the machine's path plus its background (``run`` made at :attr:`fs_hz` on
+        :attr:`rig`; its shaft-order lines follow the run's speed).
+
+        Parameters
+        ----------
+        run : cmsim.run.Run
+            A simulated run holding the force of :attr:`model_signal`'s bearing.
+        seed : int
+            Seed of the background.
+
+        Returns
+        -------
+        cmsim.run.Run
+        """
+        if abs(run.fs_hz / self.fs_hz - 1.0) > 1e-6:
+            raise ParameterError(f"a run at {run.fs_hz:g} Hz cannot go through machine "
+                                 f"{self.name!r}, calibrated at {self.fs_hz:g} Hz",
+                                 param="machine")
+        info = signal_info(self.model_signal)
+        force = np.asarray(run[f"F_{info.component}_{info.direction}"], dtype=float)
+        y = self.sensor_signal(force, 0, force.size, seed,
+                               speed_rpm=run.operating_point.speed_rpm)
+        return run.with_signals(**{self.channel: y}).with_meta(
+            machine={"name": self.name, "channel": self.channel, "unit": self.unit,
+                     "model_signal": self.model_signal})
+
     def with_rig(self, rig):
         """The same machine on another model rig (a fault, another clearance)."""
         return replace(self, rig=rig)

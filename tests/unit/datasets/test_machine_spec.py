@@ -1,0 +1,84 @@
+"""A dataset generated through a calibrated machine (issue 25: ``[machine]`` in a spec).
+
+Tier (a) closed form: a machine with a known flat path and a known background line; a
+record's machine channel must carry that line at its amplitude, be the model force through
+the path (the same as ``simulate --machine`` makes of the same run), and the spec must refuse
+what contradicts the machine (another rig, another sample rate, a missing file).
+"""
+
+import numpy as np
+import pytest
+
+from cmsim.datasets import DatasetSpec, generate_dataset, load
+from cmsim.dynamics import simulate
+from cmsim.errors import ParameterError
+from cmsim.machine import Background, BackgroundLine, Machine, TransferPath
+from cmsim.rig import OperatingPoint, Rig
+
+FS = 12_800.0
+GAIN = 0.01                     # sensor unit per N, flat
+LINE = BackgroundLine("fixed", 50.0, 0.3)
+
+
+def _machine():
+    f = tuple(np.linspace(0.0, FS / 2, 65))
+    return Machine(name="bench", rig=Rig.paper_2016(), channel="DE",
+                   model_signal="accel_1b1_y", fs_hz=FS, op=OperatingPoint(1000.0, 40.0),
+                   path=TransferPath("F_1b1_y", f, (GAIN,) * len(f), "g"),
+                   background=Background(f, (1e-12,) * len(f), (LINE,)), unit="g")
+
+
+def _spec_dict(tmp_path, **machine):
+    _machine().save(tmp_path / "m.toml")
+    return {"dataset": {"name": "through", "records": 4, "seed": 3},
+            "operating": {"speed_rpm": 1000.0, "torque_nm": 40.0},
+            "faults": {"healthy_share": 0.5,
+                       "types": [{"type": "outer_race", "bearing": ["1b1"], "size_m": 1e-3,
+                                  "depth_m": 1e-4}]},
+            "sensor": {"duration_s": 1.0, "warmup_s": 0.02},
+            "machine": {"file": "m.toml", **machine}}
+
+
+def test_records_go_through_the_machine(tmp_path):
+    spec = DatasetSpec.from_dict(_spec_dict(tmp_path), base_dir=tmp_path)
+    assert spec.fs_hz == FS and spec.channels == ("DE", "tacho")
+    assert spec.rig == Rig.paper_2016() and spec.rig_source == "machine:bench"
+    generate_dataset(spec, tmp_path / "ds", workers=1)
+    ds = load(tmp_path / "ds")
+    assert len(ds) == 4
+    machine = _machine()
+    healthy = 0
+    for r in ds:
+        x = np.asarray(r.signals["DE"], dtype=float)
+        n = x.size
+        assert n == int(FS)
+        amp = np.abs(np.fft.rfft(x * np.hanning(n))) * 2 / np.hanning(n).sum()
+        assert amp[int(round(LINE.value * n / FS))] == pytest.approx(LINE.amplitude, rel=0.05)
+        if r.meta["labels"]["faults"]:
+            continue
+        healthy += 1
+        # the healthy record is the model force through the path: what simulate --machine
+        # makes of the same run
+        run = simulate(Rig.paper_2016(), OperatingPoint(1000.0, 40.0), 1.0, fs_hz=FS,
+                       seed=r.meta["record"]["seed"], warmup_s=0.02,
+                       record=list(machine.force_signals))
+        want = machine.sensor_channel(run, r.meta["record"]["seed"])["DE"]
+        np.testing.assert_allclose(x, want, atol=1e-5 * np.abs(want).max())
+        force = np.asarray(run["F_1b1_y"])
+        assert np.std(x - want) < 1e-3 * GAIN * np.std(force - force.mean())
+    assert 1 <= healthy < len(ds)
+
+
+def test_a_spec_refuses_what_contradicts_its_machine(tmp_path):
+    with pytest.raises(ParameterError, match="rig"):
+        DatasetSpec.from_dict({**_spec_dict(tmp_path), "rig": {"builtin": "paper_2016"}},
+                              base_dir=tmp_path)
+    bad = _spec_dict(tmp_path)
+    bad["sensor"]["fs_hz"] = 25_600.0
+    with pytest.raises(ParameterError, match="sensor.fs_hz.*12800"):
+        DatasetSpec.from_dict(bad, base_dir=tmp_path)
+    with pytest.raises(ParameterError, match="machine.file"):
+        DatasetSpec.from_dict({**_spec_dict(tmp_path), "machine": {"file": "nope.toml"}},
+                              base_dir=tmp_path)
+    with pytest.raises(ParameterError, match="machine.file"):
+        DatasetSpec.from_dict({**_spec_dict(tmp_path), "machine": {}}, base_dir=tmp_path)
