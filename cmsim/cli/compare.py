@@ -92,7 +92,9 @@ def text(res):
                      f"{c['delta_chi2']:7.1f} on {c['judged_on']} features (all: "
                      f"{c['delta_chi2_all']:.1f})")
     for d in res["discrepancies"][:5]:
-        lines.append(f"  {d['feature']:24s} measured {d['measured']:.3g} simulated "
+        band = (f" ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)" if "band_hz" in d
+                else "")
+        lines.append(f"  {d['feature'] + band:24s} measured {d['measured']:.3g} simulated "
                      f"{d['simulated']:.3g} (z {d['z']:.1f})")
     for k, v in res["inferred"].items():
         lines.append(f"inferred {k}: {v['value']:.6g} ({v['how']})")

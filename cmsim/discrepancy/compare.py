@@ -49,6 +49,7 @@ from cmsim.discrepancy.ranking import (REFINE_TOP, Nuisances, decide, evidence, 
                                        refine)
 from cmsim.errors import ParameterError
 from cmsim.features import segment_features, segments
+from cmsim.features.relative import shape_band_edges
 
 __all__ = ["Comparison", "compare", "describe", "DEFAULT_BUDGET", "SIM_SEEDS", "VAR_SEEDS",
            "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "MODES"]
@@ -305,9 +306,11 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         r["score"] = max(0.0, r["total"] / chi_nom) if chi_nom > 0 else 0.0
     ranked.sort(key=lambda r: -r["delta_chi2"])
 
+    edges = shape_band_edges(record.fs_hz, 1.0 / seg_s)
     discrepancies = sorted(
         ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k],
-          "sigma": sigma[k], "z": (meas_fit[k] - f_nom_fit[k]) / sigma[k]} for k in cols),
+          "sigma": sigma[k], "z": (meas_fit[k] - f_nom_fit[k]) / sigma[k],
+          **_band_of(k, edges)} for k in cols),
         key=lambda d: -abs(d["z"]))
     top, ties = decide(ranked, ev.sensor_bearing, chi_nom)
     finding, component, params, ranges, fitted = "none", None, {}, {}, setup_nom
@@ -338,7 +341,9 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
                    "parameters": r.get("fitted", r["probe"])} for r in ranked]
     near_ties = [{"name": r["name"], "component": _component_name(record, r["component"]),
                   "delta_chi2": r["delta_chi2"]} for r in ties]
-    departures = [d["feature"] for d in discrepancies if abs(d["z"]) > 2.0][:8]
+    departures = [d["feature"] + (f" ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)"
+                                  if "band_hz" in d else "")
+                  for d in discrepancies if abs(d["z"]) > 2.0][:8]
     spectra = {"measured": record.signal, "fs_hz": record.fs_hz,
                "bearing": ev.freqs.bearings.get(ev.sensor_bearing),
                "bearing_name": _component_name(record, ev.sensor_bearing),
@@ -346,8 +351,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
                "fitted": None if fitted is setup_nom else _concat(
                    [ev.signal(fitted, s) for s in held_seeds])}
     return Comparison(
-        discrepancies=[{k: (float(v) if k != "feature" else v) for k, v in d.items()}
-                       for d in discrepancies[:12]],
+        discrepancies=[{k: (v if k in ("feature", "band_hz") else float(v))
+                        for k, v in d.items()} for d in discrepancies[:12]],
         causes=causes_out, finding=finding, component=component, parameters=params,
         gain=gain, simulations=ev.count, wall_s=time.perf_counter() - start,
         chi2_per_feature=chi_nom / max(n_eff, 1e-9), n_features=len(cols),
@@ -362,6 +367,14 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         near_ties=near_ties, departures=departures if finding == "unexplained" else [],
         not_judged=not_judged, words=describe(finding, component, params, ranges),
         spectra=spectra)
+
+
+def _band_of(name, edges):
+    """``{"band_hz": [lo, hi]}`` of a spectral-shape feature, else ``{}``."""
+    if not name.startswith("shape_b"):
+        return {}
+    i = int(name[len("shape_b"):].split("_")[0])
+    return {"band_hz": [float(edges[i]), float(edges[i + 1])]}
 
 
 def _bounds_of(finding, name):

@@ -109,7 +109,9 @@ def write_report(comparison, out_dir):
     named = (f" on {html.escape(str(d['component']))}" if d["component"] else "") + (
         " " + html.escape(json.dumps(d["parameters"])) if d["parameters"] else "")
     png = _figure(comparison.spectra, after)
-    rows = "".join(f"<tr><td>{html.escape(x['feature'])}</td><td>{x['measured']:.3g}</td>"
+    rows = "".join(f"<tr><td>{html.escape(x['feature'])}"
+                   + (f" ({x['band_hz'][0]:.0f}-{x['band_hz'][1]:.0f} Hz)" if "band_hz" in x
+                      else "") + f"</td><td>{x['measured']:.3g}</td>"
                    f"<td>{x['simulated']:.3g}</td><td>{x['z']:.2f}</td></tr>"
                    for x in d["discrepancies"])
     causes = "".join(f"<tr><td>{html.escape(c['name'])}</td><td>{c['component']}</td>"

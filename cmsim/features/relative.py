@@ -25,6 +25,7 @@ from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["relative_features", "segment_features", "segments", "N_SHAPE_BANDS",
+           "shape_band_edges",
            "N_RELATIVE_GMF_HARMONICS"]
 
 #: Bands of the spectral-shape columns (3 log-spaced up to 0.05·fs, then linear to fs/2).
@@ -49,9 +50,23 @@ def _db_power(p):
     return 10.0 * math.log10(max(p, 1e-6)) if p == p else p
 
 
+def shape_band_edges(fs, df):
+    """Edges of the :data:`N_SHAPE_BANDS` spectral-shape bands, Hz: three log-spaced from
+    20 Hz (or two bins) to 0.05·fs, then nine of equal width to fs/2.
+
+    Parameters
+    ----------
+    fs : float
+        Sample rate, Hz.
+    df : float
+        Frequency resolution of the spectrum, Hz.
+    """
+    return np.concatenate([np.geomspace(max(20.0, 2 * df), 0.05 * fs, 4)[:-1],
+                           np.linspace(0.05 * fs, 0.5 * fs, N_SHAPE_BANDS - 2)])
+
+
 def _shape_bands(freq, power, fs, df):
-    edges = np.concatenate([np.geomspace(max(20.0, 2 * df), 0.05 * fs, 4)[:-1],
-                            np.linspace(0.05 * fs, 0.5 * fs, N_SHAPE_BANDS - 2)])
+    edges = shape_band_edges(fs, df)
     total = power[freq >= edges[0]].sum()
     return {f"shape_b{i}_db": 10.0 * math.log10(max(
         power[(freq >= edges[i]) & (freq < edges[i + 1])].sum() / total, 1e-12))
