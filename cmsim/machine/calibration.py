@@ -430,10 +430,11 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     # 5. the baseline's spread and the twin on the held-out segments
     bearings = list(rig.bearing_names)
     names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale)
-    mean = np.nanmean(all_rows, axis=0)
-    std = np.nanstd(all_rows, axis=0, ddof=1)
-    spread = {k: (float(m), float(s)) for k, m, s in zip(names, mean, std)
-              if math.isfinite(m) and math.isfinite(s)}
+    # a feature a segment cannot read (a line beyond its resolution) is NaN there; one no
+    # two segments read has no spread and is left out
+    seen = np.sum(np.isfinite(all_rows), axis=0) >= 2
+    spread = {k: (float(np.nanmean(all_rows[:, i])), float(np.nanstd(all_rows[:, i], ddof=1)))
+              for i, k in enumerate(names) if seen[i]}
     held_rows = all_rows[len(fit):]
     twin = []
     for s in range(N_TWIN_SEEDS):
