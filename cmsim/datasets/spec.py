@@ -55,6 +55,7 @@ from cmsim.dynamics.tooth_contact import MESH_CHOICES
 from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.faults import FAULT_TYPES, check_faults
 from cmsim.losses import LossSettings
+from cmsim.machine import Machine
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
@@ -195,7 +196,6 @@ class DatasetSpec:
                  substeps=SAMPLING.substeps, mesh=None, losses=None, machine=None):
         set_ = object.__setattr__
         if machine is not None:
-            from cmsim.machine import Machine
             if not isinstance(machine, Machine):
                 raise ParameterError(f"machine must be a cmsim.machine.Machine, got "
                                      f"{type(machine).__name__}", param="machine")

@@ -49,6 +49,7 @@ from cmsim.datasets.distribution import Distribution, spec_error
 from cmsim.datasets.plan import NUISANCES, FaultChoice
 from cmsim.datasets.variation import OPERATING_POINT_FIELDS, RIG_TRANSFORMS, setting_kind
 from cmsim.errors import ParameterError
+from cmsim.machine import Machine
 from cmsim.rig import PRESETS, RANGES, SAMPLING, Rig
 
 __all__ = ["read_toml", "toml_keywords", "load_rig", "load_machine", "check_channels", "setting_range",
@@ -223,8 +224,6 @@ def load_machine(table, base_dir):
     base_dir : str or Path or None
         Folder a relative ``file`` is in.
     """
-    from cmsim.machine import Machine
-
     if "file" not in table:
         raise spec_error("machine.file", "is required (a machine file of cmsim calibrate)")
     path = Path(table["file"])

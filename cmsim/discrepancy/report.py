@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_text
+from cmsim.features.envelope import demodulated_spectrum
+from cmsim.spectra.plots import agg_figure
 
 __all__ = ["write_report"]
 
@@ -34,15 +36,12 @@ FAMILIES = (("bpfo_hz", "BPFO", "tab:blue"), ("bpfi_hz", "BPFI", "tab:green"),
 
 
 def _envelope(x, fs, bearing, band):
-    from cmsim.features.envelope import demodulated_spectrum
     spec, band = demodulated_spectrum(np.asarray(x, dtype=float), fs, [bearing], band)
     amp = np.asarray(spec.amplitude)
     return np.asarray(spec.freq_hz), 20 * np.log10(np.maximum(amp, 1e-30) / np.median(amp)), band
 
 
 def _figure(spectra, title_after):
-    from cmsim.spectra.plots import agg_figure
-
     fs = spectra["fs_hz"]
     bearing = spectra.get("bearing")
     rows = 2 if bearing is None else 3
