@@ -137,7 +137,8 @@ def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None
     ----------
     dataset : cmsim.datasets.Dataset or str or Path
     channel : str, optional
-        Default: the first ``accel_*`` channel.
+        Default: the channel of the machine the dataset was made through, else the first
+        ``accel_*`` channel.
     window : int, optional
         Samples per window (default :func:`default_window`).
     hop : int, optional
@@ -153,7 +154,8 @@ def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None
     """
     ds = load(dataset) if isinstance(dataset, (str, Path)) else dataset
     if channel is None:
-        accel = [c for c in ds.channels if c.startswith("accel_")]
+        machine = (ds.spec.get("machine") or {}).get("machine", {}).get("channel")
+        accel = [machine] if machine else [c for c in ds.channels if c.startswith("accel_")]
         if not accel:
             raise ParameterError("channel: the dataset has no accel_* channel",
                                  param="channel")

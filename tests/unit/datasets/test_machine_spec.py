@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from cmsim.datasets import DatasetSpec, generate_dataset, load
+from cmsim.diagnostics.syn2real import synthetic_windows
 from cmsim.dynamics import simulate
 from cmsim.errors import ParameterError
 from cmsim.machine import Background, BackgroundLine, Machine, TransferPath
@@ -67,6 +68,11 @@ def test_records_go_through_the_machine(tmp_path):
         force = np.asarray(run["F_1b1_y"])
         assert np.std(x - want) < 1e-3 * GAIN * np.std(force - force.mean())
     assert 1 <= healthy < len(ds)
+    # sim-to-real training reads the machine's channel by default
+    ws = synthetic_windows(tmp_path / "ds")
+    first = np.asarray(next(iter(ds)).signals["DE"], dtype=np.float32)
+    np.testing.assert_allclose(ws.x[0], first[:ws.x.shape[1]] - first[:ws.x.shape[1]].mean(),
+                               atol=1e-6 * np.abs(first).max())
 
 
 def test_a_spec_refuses_what_contradicts_its_machine(tmp_path):
