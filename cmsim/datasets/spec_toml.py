@@ -214,6 +214,16 @@ def toml_keywords(data, base_dir=None):
         substeps=sim.get("substeps"), losses=sim.get("losses"))
 
 
+def _spec_file(key, name, base_dir):
+    """The file a spec key names (relative to the spec's folder), which must exist."""
+    path = Path(name)
+    if not path.is_absolute() and base_dir is not None:
+        path = Path(base_dir) / path
+    if not path.is_file():
+        raise spec_error(key, f"{path} does not exist")
+    return path
+
+
 def load_machine(table, base_dir):
     """The calibrated machine of a ``[machine]`` table (``{"file": path}``).
 
@@ -226,11 +236,7 @@ def load_machine(table, base_dir):
     """
     if "file" not in table:
         raise spec_error("machine.file", "is required (a machine file of cmsim calibrate)")
-    path = Path(table["file"])
-    if not path.is_absolute() and base_dir is not None:
-        path = Path(base_dir) / path
-    if not path.is_file():
-        raise spec_error("machine.file", f"{path} does not exist")
+    path = _spec_file("machine.file", table["file"], base_dir)
     try:
         return Machine.load(path)
     except ParameterError as exc:
@@ -250,11 +256,7 @@ def load_rig(table, base_dir):
     if "builtin" in table and "file" in table:
         raise spec_error("rig.file", "give builtin or file, not both")
     if "file" in table:
-        path = Path(table["file"])
-        if not path.is_absolute() and base_dir is not None:
-            path = Path(base_dir) / path
-        if not path.is_file():
-            raise spec_error("rig.file", f"{path} does not exist")
+        path = _spec_file("rig.file", table["file"], base_dir)
         try:
             return Rig.load(path), str(table["file"])
         except ParameterError as exc:
