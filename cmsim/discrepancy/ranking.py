@@ -36,8 +36,8 @@ from cmsim.discrepancy.evaluator import Budget
 from cmsim.errors import ParameterError
 
 __all__ = ["Nuisances", "rank", "refine", "fit", "decide", "nuisance_params",
-           "MIN_DELTA_CHI2", "MIN_SIGNATURE_DELTA_CHI2", "MIN_SCORE", "FIT_GRID", "REFINE_TOP", "FAR_MARGIN",
-           "NEAR_TIE", "SEVERITY_DELTA_CHI2"]
+           "MIN_DELTA_CHI2", "MIN_SIGNATURE_DELTA_CHI2", "MIN_SCORE", "FIT_GRID",
+           "REFINE_TOP", "FAR_MARGIN", "NEAR_TIE", "SEVERITY_DELTA_CHI2"]
 
 #: Least evidence (Δχ² over every feature, fit segments) for a cause that reshapes the
 #: spectrum to be named.

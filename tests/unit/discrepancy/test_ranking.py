@@ -1,0 +1,73 @@
+"""The decision rule of compare (cmsim.discrepancy.ranking.decide) on evidence rows.
+
+Tier (a) closed form: rows with given per-feature evidence, no simulation; each rule of the
+module docstring is a case that another rule would decide the other way.
+"""
+
+from types import SimpleNamespace
+
+from cmsim.discrepancy.ranking import (FAR_MARGIN, MIN_DELTA_CHI2, MIN_SIGNATURE_DELTA_CHI2,
+                                       NEAR_TIE, decide)
+
+FEATURES = ["env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "env_bpfi_1b1_h1_db", "shape_b3_db",
+            "shape_b4_db", "kurtosis_log"]
+
+
+def _row(name, per_feature, signature=None, component=None):
+    judged = [k for k in FEATURES if signature is None or k.startswith(signature)
+              or k == "kurtosis_log" and signature is not None]
+    pf = {k: per_feature.get(k, 0.0) for k in FEATURES}
+    return {"name": name, "component": component, "judged_on": judged, "per_feature": pf,
+            "delta_chi2": sum(pf[k] for k in judged),
+            "cause": SimpleNamespace(signature=None if signature is None else (signature,),
+                                     kind=name)}
+
+
+def _outer(level, component="1b1"):
+    return _row("bearing_outer_race", {"env_bpfo_1b1_h1_db": level / 2,
+                                       "env_bpfo_1b1_h2_db": level / 2},
+                "env_bpfo_1b1", component)
+
+
+def _load(level, on_family=0.0):
+    return _row("torque_mismatch", {"shape_b3_db": level - on_family,
+                                    "env_bpfo_1b1_h1_db": on_family})
+
+
+def test_a_fault_that_stands_out_wins_over_a_larger_reshaping_cause():
+    top, _ = decide([_load(200.0), _outer(MIN_SIGNATURE_DELTA_CHI2 + 1)], "1b1", 300.0)
+    assert top["name"] == "bearing_outer_race"
+
+
+def test_a_fault_under_its_threshold_leaves_it_to_the_reshaping_cause():
+    top, _ = decide([_load(200.0), _outer(MIN_SIGNATURE_DELTA_CHI2 - 1)], "1b1", 300.0)
+    assert top["name"] == "torque_mismatch"
+
+
+def test_a_fault_the_reshaping_cause_explains_as_well_does_not_stand_out():
+    # the load moves the BPFO line as much as the defect does: it is the load
+    top, _ = decide([_load(200.0, on_family=30.0), _outer(25.0)], "1b1", 300.0)
+    assert top["name"] == "torque_mismatch"
+
+
+def test_a_reshaping_cause_needs_its_share_of_the_discrepancy():
+    assert decide([_load(MIN_DELTA_CHI2 + 1)], "1b1", 10 * MIN_DELTA_CHI2)[0] is None
+    assert decide([_load(MIN_DELTA_CHI2 + 1)], "1b1", 2 * MIN_DELTA_CHI2)[0] is not None
+
+
+def test_the_sensors_bearing_is_preferred_unless_the_far_one_is_clearly_stronger():
+    near, far = _outer(40.0, "1b1"), _outer(40.0 * FAR_MARGIN * 0.95, "1b2")
+    assert decide([far, near], "1b1", 300.0)[0]["component"] == "1b1"
+    far = _outer(40.0 * FAR_MARGIN * 1.05, "1b2")
+    assert decide([far, near], "1b1", 300.0)[0]["component"] == "1b2"
+
+
+def test_a_close_runner_up_is_a_near_tie():
+    inner = _row("bearing_inner_race", {"env_bpfi_1b1_h1_db": 40.0 * NEAR_TIE + 1},
+                 "env_bpfi_1b1", "1b1")
+    top, ties = decide([_outer(40.0), inner], "1b1", 300.0)
+    assert top["name"] == "bearing_outer_race" and [t["name"] for t in ties] == [
+        "bearing_inner_race"]
+    inner = _row("bearing_inner_race", {"env_bpfi_1b1_h1_db": 40.0 * NEAR_TIE - 1},
+                 "env_bpfi_1b1", "1b1")
+    assert decide([_outer(40.0), inner], "1b1", 300.0)[1] == []
