@@ -177,8 +177,9 @@ def refine(r, nominal, nuis):
 
 
 def evidence(r, chi_of, nominal_features, names):
-    """Fill ``r["delta_chi2"]`` (evidence on the cause's signature), ``r["total"]`` (over
-    every feature) and ``r["judged_on"]`` (the signature's features) of a ranked cause.
+    """Fill ``r["per_feature"]`` (Δχ² of each feature), ``r["delta_chi2"]`` (evidence on the
+    cause's signature), ``r["total"]`` (over every feature) and ``r["judged_on"]`` (the
+    signature's features) of a ranked cause.
 
     Parameters
     ----------
@@ -194,9 +195,11 @@ def evidence(r, chi_of, nominal_features, names):
     judged = r["cause"].judged_on(names, r["component"])
     sim = r.get("features")
     r["judged_on"] = judged
-    r["per_feature"] = {k: chi_of(nominal_features, [k]) - chi_of(sim, [k]) for k in names}
-    r["total"] = chi_of(nominal_features, names) - chi_of(sim, names)
-    r["delta_chi2"] = chi_of(nominal_features, judged) - chi_of(sim, judged) if judged else 0.0
+    # χ² is a sum over features: the evidence on any set of them is a sum of these
+    r["per_feature"] = pf = {k: chi_of(nominal_features, [k]) - chi_of(sim, [k])
+                             for k in names}
+    r["total"] = sum(pf.values())
+    r["delta_chi2"] = sum(pf[k] for k in judged)
 
 
 def decide(ranked, sensor_bearing, chi_nominal):
