@@ -126,7 +126,8 @@ def _floor(freq, psd):
 
 def _lines_and_floor(freq, psd):
     """(lines, floor): the narrow lines [(frequency, amplitude)] standing
-    :data:`LINE_MIN_DB` over the running median, strongest first, and the broadband floor —
+    :data:`LINE_MIN_DB` over the running median (each at the centroid of its power),
+    strongest first, and the broadband floor —
     the running mean of the PSD with the lines' bins replaced by the median (unbiased: the
     power of a line too weak to be called stays in the broadband)."""
     df = freq[1] - freq[0]
@@ -135,24 +136,45 @@ def _lines_and_floor(freq, psd):
     thr = 10.0 ** (LINE_MIN_DB / 10.0)
     peaks = [i for i in range(2, psd.size - 2) if ratio[i] > thr and freq[i] >= 2.0
              and psd[i] >= psd[i - 1] and psd[i] >= psd[i + 1]]
-    masked = psd.copy()
-    for i in peaks:
-        masked[i - 2:i + 3] = med[i - 2:i + 3]
     k = _window_bins(freq)
+    owner = np.full(psd.size, -1)        # the line each bin belongs to
+    spans = []
+    for i in sorted(peaks, key=lambda j: -psd[j]):
+        if owner[i] >= 0:                # a local maximum within a stronger line's bins
+            continue
+        bins = _line_bins(ratio, owner, i, thr, k // 4)
+        owner[bins] = len(spans)
+        spans.append((i, bins))
+    masked = np.where(owner >= 0, med, psd)
     floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
                                    mode="valid"), 1e-300)
-    found = []
-    for i in peaks:
-        excess = float(np.sum(psd[i - 2:i + 3] - floor[i - 2:i + 3])) * df
-        if excess > 0:
-            # Hann: the line's power spreads over its main lobe; ∑ (P − floor)·df = A²/2
-            found.append((float(freq[i]), math.sqrt(2.0 * excess)))
-    found.sort(key=lambda fa: -fa[1])
     kept = []
-    for f, a in found:
-        if all(abs(f - g) > 2.5 * df for g, _ in kept):
-            kept.append((f, a))
+    for i, bins in spans:
+        over = np.maximum(psd[bins] - floor[bins], 0.0)
+        excess = float(np.sum(over)) * df
+        if excess > 0:
+            # Hann: the line's power spreads over its main lobe; ∑ (P − floor)·df = A²/2;
+            # its frequency is the centroid of that power (a wandering line's mean)
+            centre = float(np.sum(freq[bins] * over) / np.sum(over))
+            kept.append((centre, math.sqrt(2.0 * excess)))
+    kept.sort(key=lambda fa: -fa[1])
     return kept[:MAX_LINES], floor
+
+
+def _line_bins(ratio, owner, i, thr, most):
+    """Bins of the line peaking at bin ``i``: its Hann main lobe (± 2 bins) and the bins
+    beside it that still stand ``thr`` over the median — a line whose frequency wanders (a
+    speed wobble moves the k-th harmonic k times as far) or whose leakage stands over a low
+    floor spreads over more — at most ``most`` bins each side, and none that a stronger
+    line holds (``owner`` ≥ 0)."""
+    bins = [i]
+    for step in (-1, 1):
+        j = i + step
+        while (0 <= j < ratio.size and owner[j] < 0 and abs(j - i) <= most
+               and (abs(j - i) <= 2 or ratio[j] > thr)):
+            bins.append(j)
+            j += step
+    return bins
 
 
 def _refined(lines, x, fs, df):
@@ -193,6 +215,48 @@ def _model_lines(freqs, bearing):
     if bearing in freqs.bearing_names:
         return [h * freqs.bearing(bearing).bpf_hz for h in range(1, 6)]
     return []
+
+
+def _path_shape(freq, power, fs):
+    """A path's shape from a power spectrum: its root, smoothed over
+    :data:`PATH_SMOOTHING_OCTAVE`, falling as f² below :data:`HOUSING_BAND_LOW`·fs."""
+    df = freq[1] - freq[0]
+    shape = np.sqrt(np.exp(smooth_log(np.log(np.maximum(power, 1e-300)), freq,
+                                      PATH_SMOOTHING_OCTAVE)))
+    i_low = int(np.searchsorted(freq, HOUSING_BAND_LOW * fs))
+    shape[:i_low] = shape[i_low] * (np.maximum(freq[:i_low], df) / freq[i_low]) ** 2
+    return shape
+
+
+def _pins(shape, strong, lines, floor, pin_at, df, weak_family):
+    """(pins, bounds, dropped) of a path shape: the gain corrections [(Hz, factor)] the
+    model lines ``strong`` that the record shows at ``pin_at`` ask of it; those that the
+    lines it does not show allow (their amplitude 10 dB under the record's floor); and, for a
+    ``weak_family`` (a healthy bearing's ball pass, often under the floor), the pins another
+    harmonic of the family the record does not show contradicts: some other line at that frequency. A gear's mesh harmonics are the
+    strongest periodic lines of a gearbox, and a housing resonance can lift one harmonic 20 dB
+    over its neighbours (a 2 %-damped mode falls 20 dB at 20 % detuning): a missing
+    neighbour bounds the path there (a cap), it does not disown the line."""
+    pins, bounds = [], []
+    for fm, force_amp in strong:
+        j = int(round(fm / df))
+        match = [(f, a) for f, a in lines if abs(f - fm) <= 1.5 * df]
+        if match and any(_near(fm, g, df) for g in pin_at):
+            f, a = max(match, key=lambda fa: fa[1])
+            pins.append((f, a / force_amp / shape[int(round(f / df))]))
+        elif not match:
+            floor_amp = math.sqrt(2.0 * float(floor[j]) * df * 5 / 10.0)
+            bounds.append((fm, floor_amp / force_amp / shape[j]))
+    if not weak_family:
+        return pins, bounds, []
+    family = [(fb, gb) for fb, gb in bounds if any(_near(fb, g, df) for g in pin_at)]
+    dropped = [p for p in pins if any(p[1] > PIN_CONSISTENCY * gb for _, gb in family)]
+    return [p for p in pins if p not in dropped], bounds, dropped
+
+
+def _scatter(pins):
+    """Spread of the pins' gain corrections, natural-log RMS about their mean (0 for < 2)."""
+    return float(np.std(np.log([p[1] for p in pins]))) if len(pins) >= 2 else 0.0
 
 
 def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
@@ -328,39 +392,31 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     _, pf = _power_spectrum(forces, fs)
     amp_f = np.sqrt(pf * df * 2.0)                 # a line's amplitude at its bin (approx.)
 
-    # 3. the path: shape of the background (stiffness-controlled below the housing band),
-    # gain pinned by the model lines the record shows, bounded by those it does not show
-    shape = np.sqrt(np.exp(smooth_log(np.log(floor), freq, PATH_SMOOTHING_OCTAVE)))
-    f_low = HOUSING_BAND_LOW * fs
-    i_low = int(np.searchsorted(freq, f_low))
-    shape[:i_low] = shape[i_low] * (np.maximum(freq[:i_low], df) / freq[i_low]) ** 2
+    # 3. the path: its shape (that of the background, or of the background over the
+    # model's broadband force, whichever the model lines read alike), its gain pinned by the
+    # model lines the record shows and bounded by those it does not show
     force_lines, pf_floor = _lines_and_floor(freq, pf)
     strong = [(f, a) for f, a in force_lines
               if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
               * pf_floor[int(round(f / df))]]
     pin_at = _model_lines(freqs, bearing)
-    pins, bounds = [], []
-    for fm, force_amp in strong:
-        j = int(round(fm / df))
-        match = [(f, a) for f, a in lines if abs(f - fm) <= 1.5 * df]
-        if match and any(_near(fm, g, df) for g in pin_at):
-            f, a = max(match, key=lambda fa: fa[1])
-            pins.append((f, a / force_amp / shape[int(round(f / df))]))
-        elif not match:            # not in the record: 10 dB under its floor there
-            floor_amp = math.sqrt(2.0 * float(floor[j]) * df * 5 / 10.0)
-            bounds.append((fm, floor_amp / force_amp / shape[j]))
-    if bounds and pins:
-        # a record line at one harmonic of the family the path is read at, at a gain that
-        # would show another harmonic of that family the record does not show, is some other
-        # line at that frequency
-        family = [(fb, gb) for fb, gb in bounds if any(_near(fb, g, df) for g in pin_at)]
-        dropped = [p for p in pins if any(p[1] > PIN_CONSISTENCY * gb for _, gb in family)]
-        pins = [p for p in pins if p not in dropped]
-        if dropped:
-            notes.append(f"{len(dropped)} line(s) of the record at a model line's frequency "
-                         f"({', '.join(f'{p[0]:.1f}' for p in dropped[:4])} Hz) not taken as "
-                         "the model's: the gain they imply would show other harmonics of "
-                         "that family, which the record does not have")
+    readings = []
+    for forced in (False, True):
+        shape = _path_shape(freq, floor / pf_floor if forced else floor, fs)
+        pins, bounds, dropped = _pins(shape, strong, lines, floor, pin_at, df,
+                                      weak_family=not freqs.gmf_hz)
+        readings.append((len(pins), -_scatter(pins), not forced, shape, pins, bounds,
+                         dropped))
+    *_, own_shape, shape, pins, bounds, dropped = max(readings, key=lambda r: r[:3])
+    if not own_shape:
+        notes.append("path shape: the background over the model's broadband force (the "
+                     "model lines the record shows read alike through it, not through the "
+                     "background's own shape): the record's broadband is the model's force")
+    if dropped:
+        notes.append(f"{len(dropped)} line(s) of the record at a model line's frequency "
+                     f"({', '.join(f'{p[0]:.1f}' for p in dropped[:4])} Hz) not taken as "
+                     "the model's: the gain they imply would show another harmonic of that "
+                     "family, which the record does not have")
     band = (freq >= 0.05 * fs) & (freq <= 0.45 * fs)
     if pins:
         points = sorted(pins)
