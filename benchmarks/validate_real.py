@@ -168,11 +168,17 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument("--modes", nargs="+", choices=("machine", "free"),
+                    default=("machine", "free"), help="the nominal models to run")
+    ap.add_argument("--datasets", nargs="+", default=None,
+                    help="folder names under --data (default every folder with metadata)")
     ap.add_argument("--render", type=Path, default=None,
                     help="only re-render the tables from a --json file of an earlier run")
     a = ap.parse_args(argv)
-    folders = sorted(p for p in a.data.iterdir() if (p / "metadata.json").is_file())
+    folders = sorted(p for p in a.data.iterdir() if (p / "metadata.json").is_file()
+                     and (a.datasets is None or p.name in a.datasets))
     jobs, keys = jobs_of(folders)
+    jobs = [j for j in jobs if j[0] in a.modes]
     if a.render:
         results = json.loads(a.render.read_text())
     else:

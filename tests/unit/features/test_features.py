@@ -10,7 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from cmsim.features import (N_ENVELOPE_HARMONICS, N_GMF_HARMONICS, FeatureRow, extract_features,
+from cmsim.features import (N_ENVELOPE_HARMONICS, N_GMF_HARMONICS, FeatureRow, common_band,
+                            demodulation_band, extract_features, highest_fault_hz,
                             relative_features, run_features, statistics)
 from cmsim.frequencies import RigFrequencies, bearing_frequencies, rig_frequencies
 from cmsim.rig import OperatingPoint, Rig
@@ -168,3 +169,30 @@ def test_sideband_energies_read_an_amplitude_modulation_and_ignore_a_small_wobbl
         assert clean[f"sb1_fr1_k{k}_db"] == pytest.approx(expected, abs=0.3), k
         assert clean[f"sb23_fr1_k{k}_db"] < expected - 30, k
         assert wobbly[f"sb1_fr1_k{k}_db"] == pytest.approx(expected, abs=1.5), k
+
+
+def test_one_band_for_a_record_is_the_band_most_segments_give():
+    """Three segments ring a 3.5-kHz resonance at the ball pass, one is noise only: the
+    record's band is the resonance's, and a segment read in it (relative_features with
+    ``band_hz``) gives the same BPFO line as one that chose that band itself, while the
+    noise segment read in its own band does not."""
+    rpm = 1797.0
+    brg = bearing_frequencies(rpm / 60, 9, 7.94e-3, 39.04e-3)
+    f = RigFrequencies(fr1_hz=rpm / 60, bearings={"DE": brg})
+    fs = 20_000.0
+    n = int(0.5 * fs)
+    wn = 2 * np.pi * 3500.0
+    th = np.arange(int(0.01 * fs)) / fs
+    h = np.exp(-0.05 * wn * th) * np.sin(wn * th)
+    hits = np.zeros(n)
+    hits[np.round(np.arange(0.0, n / fs, 1.0 / brg.bpfo_hz) * fs).astype(int)] = 1.0
+    rng = np.random.default_rng(2)
+    ringing = [np.convolve(hits, h)[:n] + 0.2 * rng.standard_normal(n) for _ in range(3)]
+    noise = 0.3 * rng.standard_normal(n)
+    band = common_band([noise] + ringing, fs, f, ["DE"])
+    assert band == demodulation_band(ringing[0], fs, highest_fault_hz([brg]))
+    assert band[0] < 3500.0 < band[1]
+    own = relative_features(ringing[1], fs, f, ["DE"])
+    given = relative_features(ringing[1], fs, f, ["DE"], band)
+    assert given["env_bpfo_DE_h1_db"] == pytest.approx(own["env_bpfo_DE_h1_db"], abs=0.5)
+    assert given["env_bpfo_DE_h1_db"] > 10.0
