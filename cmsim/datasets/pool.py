@@ -20,10 +20,12 @@ Processes
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import multiprocessing
 import os
 import signal
+import socket
 import sys
 import threading
 import time
@@ -32,7 +34,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from cmsim.errors import ParameterError
 
 __all__ = ["run_tasks", "Interrupted", "START_METHODS", "default_start_method",
-           "check_workers", "check_start_method"]
+           "check_workers", "check_start_method", "scheduler_client"]
 
 #: Process start methods accepted by :func:`run_tasks`.
 START_METHODS = ("fork", "spawn", "forkserver")
@@ -255,21 +257,82 @@ def _terminate(pool):
         p.join(timeout=5)
 
 
-def _run_dask(fn, tasks, done, scheduler):
+def _distributed():
+    """The ``distributed`` package, or an error saying how to install it."""
     try:
-        from distributed import Client, as_completed
+        import distributed
     except ImportError:                            # pragma: no cover - optional extra
         raise ParameterError("scheduler needs dask.distributed: pip install 'cmsim[dask]'",
                              param="scheduler") from None
-    own = not isinstance(scheduler, Client)
-    if own:
-        try:
-            client = Client(scheduler, timeout=30)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ParameterError(f"scheduler {scheduler!r}: cannot connect ({exc})",
-                                 param="scheduler") from None
-    else:
-        client = scheduler
+    return distributed
+
+
+def _probe_tcp(address, timeout_s):
+    """Refuse at once a ``tcp://host:port`` where nothing listens (the client would retry
+    until its timeout); other addresses are left to the client."""
+    from distributed.comm import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError):
+        raise ParameterError(f"scheduler must be an address like tcp://host:8786, got "
+                             f"{address!r}", param="scheduler") from None
+    if scheme != "tcp":
+        return
+    try:
+        socket.create_connection((host, port), timeout=timeout_s).close()
+    except OSError as exc:
+        raise ParameterError(f"scheduler {address!r}: cannot connect, nothing answers there "
+                             f"({type(exc).__name__}: {exc}); start the Dask cluster "
+                             f"first, or give the address it prints", param="scheduler") from None
+
+
+@contextlib.contextmanager
+def scheduler_client(scheduler, timeout_s=30):
+    """The ``distributed.Client`` of ``scheduler`` while active: ``None`` for ``None``, the
+    client itself, or a client connected to the address (closed on exit).
+
+    Connecting first lets a caller refuse an unreachable cluster before it creates anything.
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client or None
+        ``"tcp://host:8786"``, a client, or ``None`` (local processes).
+    timeout_s : float
+        How long to try to connect, s.
+    """
+    if scheduler is None:
+        yield None
+        return
+    Client = _distributed().Client
+    if isinstance(scheduler, Client):
+        yield scheduler
+        return
+    if not isinstance(scheduler, str):
+        raise ParameterError(f"scheduler must be an address (tcp://host:8786) or a "
+                             f"distributed.Client, got {type(scheduler).__name__}",
+                             param="scheduler")
+    _probe_tcp(scheduler, min(timeout_s, 5.0))
+    try:
+        client = Client(scheduler, timeout=timeout_s)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ParameterError(f"scheduler {scheduler!r}: cannot connect ({exc})",
+                             param="scheduler") from None
+    try:
+        yield client
+    finally:
+        client.close()
+
+
+def _run_dask(fn, tasks, done, scheduler):
+    with scheduler_client(scheduler) as client:
+        return _run_on_client(fn, tasks, done, client)
+
+
+def _run_on_client(fn, tasks, done, client):
+    from distributed import as_completed
+
     futures = {}
     try:
         for key, args in tasks:
@@ -283,6 +346,3 @@ def _run_dask(fn, tasks, done, scheduler):
     except BaseException:
         client.cancel(list(futures))
         raise
-    finally:
-        if own:
-            client.close()
