@@ -274,12 +274,12 @@ def _probe_tcp(address, timeout_s):
 
     try:
         scheme, location = parse_address(address)
+        if scheme != "tcp":
+            return
         host, port = parse_host_port(location)
     except (ValueError, TypeError):
         raise ParameterError(f"scheduler must be an address like tcp://host:8786, got "
                              f"{address!r}", param="scheduler") from None
-    if scheme != "tcp":
-        return
     try:
         socket.create_connection((host, port), timeout=timeout_s).close()
     except OSError as exc:
