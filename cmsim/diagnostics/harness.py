@@ -216,11 +216,16 @@ class Evaluation:
 
 
 def _manifest_rows(dataset):
+    """The rows to run, the number of records that failed in the dataset itself, and the
+    ``(record_id, why)`` of those the dataset could not read (status ``"unreadable"``)."""
     man = dataset.manifest
-    if "status" in man.columns:
-        ok = man["status"].astype(str) == "ok"
-        return man[ok], int((~ok).sum())
-    return man, 0
+    if "status" not in man.columns:
+        return man, 0, []
+    status = man["status"].astype(str)
+    ok, unreadable = status == "ok", status == "unreadable"
+    why = man["error"] if "error" in man.columns else [None] * len(man)
+    bad = [(str(rid), str(w)) for rid, w, u in zip(man["record_id"], why, unreadable) if u]
+    return man[ok], int((~ok & ~unreadable).sum()), bad
 
 
 def _answer_key(rec, row, label_map):
@@ -265,8 +270,8 @@ def evaluate(dataset, algorithm, *, label_map=None, false_alarm_rate=FALSE_ALARM
     else:
         ds, ds_name = load_dataset(dataset), str(dataset)
     lmap = dict(label_map if label_map is not None else getattr(func, "label_map", {}) or {})
-    rows, skipped = _manifest_rows(ds)
-    results, unreadable = [], []
+    rows, skipped, unreadable = _manifest_rows(ds)
+    results = []
     total = len(rows)
     for i, row in enumerate(rows.to_dict("records")):
         rid = str(row["record_id"])

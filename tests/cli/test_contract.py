@@ -749,3 +749,34 @@ def test_evaluate_skips_a_damaged_record_and_counts_it(damage, files, tmp_path, 
     cap = capsys.readouterr()
     assert f"record {victim.stem} skipped" in cap.out
     assert len(cap.err.strip().splitlines()) == 1 and "warning" in cap.err
+
+
+@pytest.mark.parametrize("damage", ["truncated", "deleted"])
+def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
+    """A folder of measured recordings with one damaged: the others are scored (exit 0),
+    the damaged one is named in a warning and counted; sim-to-real, which scores a test
+    folder whole, refuses it naming the file."""
+    import shutil
+
+    from cmsim.measured import data_root
+
+    source = data_root() / "mfpt_bearing"
+    if not (source / "metadata.json").is_file():
+        pytest.skip(f"measured data not found at {source} (set CMSIM_DATA)")
+    folder = tmp_path / "mfpt"
+    shutil.copytree(source, folder)
+    victim = folder / "OR_vload3_100lb.npz"
+    if damage == "truncated":
+        victim.write_bytes(victim.read_bytes()[:5000])
+    else:
+        victim.unlink()
+    assert main(["evaluate", str(folder), "--algorithm", "envelope", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    m = res["metrics"]
+    assert (m["n_records"], m["n_scored"], m["records_unreadable"]) == (6, 6, 1)
+    assert list(res["unreadable"]) == ["OR_vload3_100lb"]
+    assert len(res["warnings"]) == 1 and "OR_vload3_100lb" in res["warnings"][0]
+    from cmsim.diagnostics.syn2real import measured_windows
+    from cmsim.errors import ParameterError
+    with pytest.raises(ParameterError, match="OR_vload3_100lb"):
+        measured_windows(folder)
