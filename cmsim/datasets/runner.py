@@ -12,8 +12,10 @@ Resuming is the same call: finished records are kept, files half-written by a ki
 while its task is retried elsewhere), a record file without a row is adopted from the row
 kept in its meta, anything else is run. A Dask scheduler is connected to before anything is
 written, and a directory the call created is removed again if the call fails before any
-record is finished: a failed start leaves nothing behind. Ctrl-C or SIGTERM stops the workers at once and raises
-:class:`~cmsim.datasets.pool.Interrupted` after the finished records are recorded. Records
+record is finished: a failed start leaves nothing behind. Ctrl-C or SIGTERM stops the
+workers at once and raises :class:`~cmsim.datasets.pool.Interrupted` after the finished
+records are recorded. A worker process that dies (killed, out of memory) costs only its
+record: Dask retries it, a local pool is started again for the unfinished records. Records
 depend only on (spec, base seed, index), so they are bit-identical on any number of workers
 and on Dask.
 
@@ -167,6 +169,10 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
         Bad arguments, a directory holding another spec or in use by another run.
     cmsim.datasets.pool.Interrupted
         On Ctrl-C or SIGTERM (finished records are kept; rerun to resume).
+    cmsim.errors.WorkersDied
+        Worker processes kept dying (a local pool whose worker died is started again for
+        the unfinished records, :data:`~cmsim.datasets.pool.POOL_RESTARTS` times; Dask
+        retries on its own); finished records are kept.
     """
     check_type("spec", spec, DatasetSpec)
     workers = check_workers(workers)
