@@ -115,3 +115,15 @@ def test_errors_keep_tracebacks_and_unreadable_records_are_counted_apart(capfd):
     assert out["records"][2]["traceback"] == failed.traceback
     assert out["unreadable"] == {"r1": "File is not a zip file"}
     assert capfd.readouterr().out == ""
+
+
+def test_output_of_the_algorithm_module_on_import_goes_to_stderr(tmp_path, capfd):
+    from cmsim.diagnostics import load_algorithm
+
+    path = tmp_path / "chatty_module.py"
+    path.write_text("import os\nprint('importing')\nos.write(1, b'fd 1 on import\\n')\n\n"
+                    "def f(signals, fs_hz, operating_point, frequencies):\n"
+                    "    return 'healthy'\n")
+    assert callable(load_algorithm(f"{path}:f"))
+    cap = capfd.readouterr()
+    assert cap.out == "" and "importing" in cap.err and "fd 1 on import" in cap.err
