@@ -8,11 +8,18 @@ from __future__ import annotations
 
 import os
 import tempfile
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["atomic_write_text", "atomic_write_bytes", "atomic_savez"]
+__all__ = ["atomic_write_text", "atomic_write_bytes", "atomic_savez", "READ_ERRORS"]
+
+#: What reading a file a user brings can raise when the file is missing, truncated, of the
+#: wrong kind or holds the wrong keys (an ``.npz`` cut short raises ``BadZipFile`` or
+#: ``EOFError``; a missing array ``KeyError``). Readers turn these into one line naming the
+#: file; anything else is a bug of cmsim.
+READ_ERRORS = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile)
 
 
 def _atomic(path, write):

@@ -12,7 +12,7 @@ import math
 import numbers
 import re
 
-__all__ = ["ParameterError", "IntegrationDiverged", "check_range", "check_choice",
+__all__ = ["ParameterError", "IntegrationDiverged", "WorkersDied", "check_range", "check_choice",
            "check_type", "format_range", "format_value"]
 
 _LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
@@ -43,6 +43,11 @@ class ParameterError(ValueError):
 
 class IntegrationDiverged(RuntimeError):
     """The time integration produced non-finite or runaway values."""
+
+
+class WorkersDied(RuntimeError):
+    """Worker processes of a dataset run kept dying (killed, out of memory) and the run
+    stopped; the records finished before are kept (re-run to resume)."""
 
 
 def format_value(value):

@@ -1,9 +1,10 @@
 """``main(argv)``: parse, run one command, print its result (text or one JSON object).
 
-Exit status: 0 success, 1 internal error (please report), 2 bad input, 3 diverged
-integration, 130 interrupted. With ``--json`` stdout holds exactly one JSON object, also on
-errors: ``{"error": message, "status": code, "option": "--top" or null}``; warnings go to
-stderr (and, with ``--json``, to the object's ``warnings`` list).
+Exit status: 0 success, 1 internal error (please report) or worker processes that kept
+dying, 2 bad input, 3 diverged integration, 130 interrupted. With ``--json`` stdout holds
+exactly one JSON object, also on errors: ``{"error": message, "status": code, "option":
+"--top" or null}``; warnings go to stderr (and, with ``--json``, to the object's
+``warnings`` list).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from cmsim.cli import (calibrate, compare, dataset, evaluate, losses, mesh_table
                        report, simulate, spectrum, sweep)
 from cmsim.cli.contract import (CLIError, Parser, check_paths, finite, options_of, subparsers,
                                 user_message)
-from cmsim.errors import IntegrationDiverged, ParameterError
+from cmsim.errors import IntegrationDiverged, ParameterError, WorkersDied
 
 __all__ = ["main", "build_parser", "COMMANDS"]
 
@@ -92,6 +93,9 @@ def main(argv=None):
         except ParameterError as exc:
             msg, option = user_message(exc, options)
             raise CLIError(msg, 2, option=option) from None
+        except WorkersDied as exc:
+            raise CLIError(f"{exc}; re-run the same command to resume (with fewer --workers "
+                           f"if memory is short)", 1) from None
         except IntegrationDiverged as exc:
             msg, option = user_message(exc, options)
             extra = {}

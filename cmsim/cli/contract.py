@@ -20,11 +20,11 @@ from __future__ import annotations
 import argparse
 import math
 import re
-import zipfile
 from pathlib import Path
 
 import numpy as np
 
+from cmsim._io import READ_ERRORS
 from cmsim.errors import ParameterError
 
 __all__ = ["CLIError", "Parser", "ranged", "subparsers", "options_of", "user_message",
@@ -224,7 +224,7 @@ def load_file(option, path, loader, what):
     except ParameterError as exc:
         detail = getattr(exc, "detail", None) or str(exc)
         raise CLIError(f"{option} {path}: {detail}", option=option) from None
-    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as exc:
+    except READ_ERRORS as exc:
         raise CLIError(f"{option} {path}: not {what} ({type(exc).__name__}: "
                        f"{' '.join(str(exc).split()) or 'unreadable'})", option=option) from None
 

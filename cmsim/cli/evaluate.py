@@ -19,7 +19,10 @@ def register(sub):
                                    "metadata.json) and report accuracy, macro-F1, the confusion "
                                    "matrix, per-class ROC AUC and detection against severity at "
                                    "5 %% false alarms. See cmsim.diagnostics for the function's "
-                                   "signature.")
+                                   "signature. What the function prints goes to stderr; what it "
+                                   "raises (sys.exit too) is that record's error, with its "
+                                   "traceback in --json and --report. Exit status 2 if no "
+                                   "record was answered.")
     p.add_argument("dir", type=Path, metavar="DIR", nargs="?", help="dataset directory")
     p.add_argument("--algorithm", metavar="MODULE:FUNCTION",
                    help="built-in (envelope, tsa, sideband), package.module:function or "
@@ -73,8 +76,31 @@ def run(args):
     out = ev.to_dict()
     out["algorithm"] = args.algorithm
     out["dataset"] = str(args.dir)
+    _check_answered(ev, args, out)
+    if ev.unreadable:
+        rid, why = ev.unreadable[0]
+        args.warn(f"{len(ev.unreadable)} of {len(dataset.manifest)} records could not be "
+                  f"read and were skipped (first: {rid}: {why})")
     out["report"] = str(write_report(ev, args.report)) if args.report else None
     return out
+
+
+def _check_answered(ev, args, out):
+    """An evaluation that scored nothing is an error (exit 2): the dataset gave no readable
+    record (DIR), or the algorithm answered none (--algorithm). With --json the error
+    object holds the evaluation, each record's error with its traceback."""
+    m = ev.metrics
+    if m["n_scored"]:
+        return
+    if not ev.records:
+        rid, why = ev.unreadable[0]
+        raise CLIError(f"DIR {args.dir}: no record could be read ({len(ev.unreadable)} "
+                       f"unreadable; first: {rid}: {why})", option="DIR",
+                       extra={"evaluation": out})
+    first = ev.records[0]
+    raise CLIError(f"--algorithm {args.algorithm} answered no record: it failed on all "
+                   f"{m['n_failed']} (first: {first.record_id}: {first.error}; every "
+                   f"traceback: --json)", option="--algorithm", extra={"evaluation": out})
 
 
 def _syn2real(args):
@@ -141,6 +167,8 @@ def text(res):
                      f"smallest severity detected {c['min_detected_severity']:.3g}")
     for rid, err in res["errors"].items():
         lines.append(f"record {rid}: {err}")
+    for rid, why in res["unreadable"].items():
+        lines.append(f"record {rid} skipped: {why}")
     if res["report"]:
         lines.append(f"wrote {res['report']}")
     return "\n".join(lines)

@@ -19,12 +19,35 @@ from pathlib import Path
 
 import numpy as np
 
+from cmsim._io import READ_ERRORS
 from cmsim.datasets.manifest import PARQUET_NAME, SPEC_NAME, read_rows
 from cmsim.errors import ParameterError
 from cmsim.frequencies import rig_frequencies
 from cmsim.rig import OperatingPoint, Rig
 
 __all__ = ["load", "Dataset", "DatasetRecord"]
+
+
+def _read_record_file(path, read):
+    """``read(z)`` of the record file ``path`` opened as ``z`` (:func:`numpy.load`); a file
+    missing, cut short or corrupt is a :class:`~cmsim.errors.ParameterError` naming it.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The record's ``.npz`` file.
+    read : callable
+        ``read(z) -> value``, e.g. ``lambda z: z["accel_1b1_y"]``.
+    """
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return read(z)
+    except READ_ERRORS as exc:
+        why = "missing" if isinstance(exc, FileNotFoundError) else \
+            f"unreadable ({type(exc).__name__}: {' '.join(str(exc).split())})"
+        raise ParameterError(f"record file {path} is {why}; make it again: cmsim dataset "
+                             f"SPEC --out {Path(path).parent.parent} --verify",
+                             param="record_file") from None
 
 
 class _LazySignals(Mapping):
@@ -36,8 +59,7 @@ class _LazySignals(Mapping):
     def __getitem__(self, name):
         if name not in self._names:
             raise KeyError(f"no channel {name!r}; available: {list(self._names)}")
-        with np.load(self._path, allow_pickle=False) as z:
-            return z[name]
+        return _read_record_file(self._path, lambda z: z[name])
 
     def __iter__(self):
         return iter(self._names)
@@ -76,8 +98,7 @@ class DatasetRecord:
     def meta(self):
         """The record's stored meta (rig, operating point, faults, answer key, timing)."""
         if self._meta is None:
-            with np.load(self._path, allow_pickle=False) as z:
-                self._meta = json.loads(str(z["meta"]))
+            self._meta = _read_record_file(self._path, lambda z: json.loads(str(z["meta"])))
         return self._meta
 
     @property
@@ -137,8 +158,9 @@ class Dataset:
         if self.spec.get("channels") is not None:
             self.channels = tuple(self.spec["channels"])
         elif len(self._ok):                # full runs (a sweep): the first record's signals
-            with np.load(self.directory / df["path"].iloc[self._ok[0]]) as z:
-                self.channels = tuple(k for k in z.files if k not in ("t", "meta", "source"))
+            self.channels = _read_record_file(
+                self.directory / df["path"].iloc[self._ok[0]],
+                lambda z: tuple(k for k in z.files if k not in ("t", "meta", "source")))
         else:
             self.channels = ()
 
@@ -212,15 +234,19 @@ class Dataset:
             raise ParameterError(f"label must be a manifest column, got {label!r}",
                                  param="label")
         chosen = self._select(records)
+        if "n_samples" in self.manifest.columns and chosen:
+            lengths = self.manifest["n_samples"].to_numpy()[chosen]
+            shortest = int(np.argmin(lengths))
+            _check_window_fits(window, int(lengths[shortest]),
+                               self.manifest["record_id"].iloc[chosen[shortest]])
         for start in range(0, len(chosen), int(batch_records)):
             xs, ys, gs = [], [], []
             for pos in chosen[start:start + int(batch_records)]:
                 rec = self._record_at(pos)
-                with np.load(rec._path, allow_pickle=False) as z:
-                    sig = np.stack([z[c] for c in channels]).astype(np.float32, copy=False)
+                sig = _read_record_file(rec._path, lambda z: np.stack([z[c] for c in channels]))
+                sig = sig.astype(np.float32, copy=False)
+                _check_window_fits(window, sig.shape[1], rec.record_id)
                 n = (sig.shape[1] - window) // hop + 1
-                if n <= 0:
-                    continue
                 idx = np.arange(window)[None, :] + hop * np.arange(n)[:, None]
                 xs.append(np.transpose(sig[:, idx], (1, 0, 2)))
                 ys.append(np.repeat(np.asarray([rec.row[label]], dtype=object), n))
@@ -278,6 +304,14 @@ def _check_window(window, hop):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
             raise ParameterError(f"{name} must be a positive integer, got {v!r}", param=name)
     return int(window), int(hop)
+
+
+def _check_window_fits(window, n_samples, record_id):
+    """A window no longer than a record: else no window would come out of it."""
+    if window > n_samples:
+        raise ParameterError(f"window must be at most the record length, {n_samples} samples "
+                             f"(record {record_id}), got {window}", param="window",
+                             allowed=f"<= {n_samples}")
 
 
 def load(directory):

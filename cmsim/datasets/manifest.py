@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cmsim._io import atomic_write_bytes, atomic_write_text
+from cmsim._io import READ_ERRORS, atomic_write_bytes, atomic_write_text
 from cmsim.errors import ParameterError
 
 __all__ = ["PARQUET_NAME", "RECORDS_DIR", "ROWS_DIR", "SPEC_NAME", "FORMAT_VERSION",
@@ -116,7 +116,7 @@ def read_rows(out_dir):
     out = Path(out_dir)
     frames = []
     if (out / PARQUET_NAME).is_file():
-        frames.append(pd.read_parquet(out / PARQUET_NAME))
+        frames.append(_read_parquet(out / PARQUET_NAME))
     side = _read_sidecars(out)
     if side:
         frames.append(pd.DataFrame.from_records(side))
@@ -125,6 +125,28 @@ def read_rows(out_dir):
     df = pd.concat(frames, ignore_index=True) if len(frames) > 1 else frames[0]
     df = df.drop_duplicates("index", keep="last").sort_values("index", kind="stable")
     return df.reset_index(drop=True)
+
+
+def _read_parquet(path):
+    """The manifest file as a DataFrame; a corrupt one is a :class:`ParameterError` naming
+    it and the fix (every finished record keeps its row in its own file, so removing the
+    manifest loses nothing: the next run adopts the records)."""
+    import pandas as pd
+    from pyarrow import ArrowException
+
+    try:
+        df = pd.read_parquet(path)
+    except READ_ERRORS + (ArrowException,) as exc:
+        detail = " ".join(str(exc).split())[:200]
+        raise ParameterError(f"{path} is corrupt ({type(exc).__name__}: {detail}); remove "
+                             f"it and re-run cmsim dataset on this directory: finished records "
+                             f"are recovered from their files", param="out") from None
+    missing = [c for c in ("record_id", "index", "status", "path") if c not in df.columns]
+    if missing:
+        raise ParameterError(f"{path} is not a cmsim manifest (no column {missing[0]!r}); "
+                             f"remove it and re-run cmsim dataset on this directory: finished "
+                             f"records are recovered from their files", param="out")
+    return df
 
 
 def _read_sidecars(out):

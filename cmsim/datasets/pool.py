@@ -20,19 +20,22 @@ Processes
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import multiprocessing
 import os
 import signal
+import socket
 import sys
 import threading
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, WorkersDied
 
-__all__ = ["run_tasks", "Interrupted", "START_METHODS", "default_start_method",
-           "check_workers", "check_start_method"]
+__all__ = ["run_tasks", "Interrupted", "POOL_RESTARTS", "START_METHODS", "default_start_method",
+           "check_workers", "check_start_method", "scheduler_client"]
 
 #: Process start methods accepted by :func:`run_tasks`.
 START_METHODS = ("fork", "spawn", "forkserver")
@@ -205,35 +208,60 @@ def run_tasks(fn, tasks, on_result, *, workers, start_method=None, scheduler=Non
                 bar.close()
 
 
+#: Times a local pool whose worker process died (killed, out of memory) is started again
+#: for the tasks it had not finished before the run stops.
+POOL_RESTARTS = 3
+
+
 def _run_local(fn, tasks, done, n_workers, method):
+    """Run the tasks on a local pool; a pool broken by a worker that died is started again
+    (at most :data:`POOL_RESTARTS` times) for the tasks not finished."""
+    pending = list(tasks)
+    for _ in range(POOL_RESTARTS + 1):
+        pending = _run_pool(fn, pending, done, n_workers, method)
+        if not pending:
+            return n_workers
+    raise WorkersDied(f"worker processes died {POOL_RESTARTS + 1} times (killed, or out of "
+                      f"memory?) with {len(pending)} tasks left; what finished is kept")
+
+
+def _run_pool(fn, tasks, done, n_workers, method):
+    """One pool over ``tasks``; returns the tasks not finished if a worker died, else []."""
     ctx = multiprocessing.get_context(method)
     pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
                                initializer=_worker_init, initargs=(os.getpid(),))
     futures, delivered = {}, set()
     try:
         for key, args in tasks:
-            futures[pool.submit(fn, *args)] = key
+            futures[pool.submit(fn, *args)] = (key, args)
         remaining = set(futures)
         while remaining:
             finished, remaining = wait(remaining, return_when=FIRST_COMPLETED)
             for fut in finished:
+                if isinstance(fut.exception(), BrokenProcessPool):
+                    continue                   # a worker died: handed over below
                 delivered.add(fut)
-                done(futures[fut], fut.result())
+                done(futures[fut][0], fut.result())
     except BaseException:
         # stop now: terminate the busy workers, then record what had already finished
         _terminate(pool)
         with _SignalsIgnored():
-            for fut, key in futures.items():
-                if fut not in delivered and fut.done() and not fut.cancelled() \
-                        and fut.exception() is None:
-                    try:
-                        done(key, fut.result())
-                    except Exception:          # pragma: no cover - best effort
-                        pass
+            _deliver_finished(futures, delivered, done)
         raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
-    return n_workers
+    return [futures[f] for f in futures if f not in delivered]
+
+
+def _deliver_finished(futures, delivered, done):
+    """Hand over the results that finished but were not delivered yet (best effort)."""
+    for fut, (key, _) in futures.items():
+        if fut not in delivered and fut.done() and not fut.cancelled() \
+                and fut.exception() is None:
+            try:
+                done(key, fut.result())
+            except Exception:                  # pragma: no cover - best effort
+                pass
 
 
 class _SignalsIgnored(_SignalHandlers):
@@ -255,34 +283,101 @@ def _terminate(pool):
         p.join(timeout=5)
 
 
-def _run_dask(fn, tasks, done, scheduler):
+def _distributed():
+    """The ``distributed`` package, or an error saying how to install it."""
     try:
-        from distributed import Client, as_completed
+        import distributed
     except ImportError:                            # pragma: no cover - optional extra
         raise ParameterError("scheduler needs dask.distributed: pip install 'cmsim[dask]'",
                              param="scheduler") from None
-    own = not isinstance(scheduler, Client)
-    if own:
-        try:
-            client = Client(scheduler, timeout=30)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise ParameterError(f"scheduler {scheduler!r}: cannot connect ({exc})",
-                                 param="scheduler") from None
-    else:
-        client = scheduler
-    futures = {}
+    return distributed
+
+
+def _probe_tcp(address, timeout_s):
+    """Refuse at once a ``tcp://host:port`` where nothing listens (the client would retry
+    until its timeout); other addresses are left to the client."""
+    from distributed.comm import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme != "tcp":
+            return
+        host, port = parse_host_port(location)
+    except (ValueError, TypeError):
+        raise ParameterError(f"scheduler must be an address like tcp://host:8786, got "
+                             f"{address!r}", param="scheduler") from None
+    try:
+        socket.create_connection((host, port), timeout=timeout_s).close()
+    except OSError as exc:
+        raise ParameterError(f"scheduler {address!r}: cannot connect, nothing answers there "
+                             f"({type(exc).__name__}: {exc}); start the Dask cluster "
+                             f"first, or give the address it prints", param="scheduler") from None
+
+
+@contextlib.contextmanager
+def scheduler_client(scheduler, timeout_s=30):
+    """The ``distributed.Client`` of ``scheduler`` while active: ``None`` for ``None``, the
+    client itself, or a client connected to the address (closed on exit).
+
+    Connecting first lets a caller refuse an unreachable cluster before it creates anything.
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client or None
+        ``"tcp://host:8786"``, a client, or ``None`` (local processes).
+    timeout_s : float
+        How long to try to connect, s.
+    """
+    if scheduler is None:
+        yield None
+        return
+    Client = _distributed().Client
+    if isinstance(scheduler, Client):
+        yield scheduler
+        return
+    if not isinstance(scheduler, str):
+        raise ParameterError(f"scheduler must be an address (tcp://host:8786) or a "
+                             f"distributed.Client, got {type(scheduler).__name__}",
+                             param="scheduler")
+    _probe_tcp(scheduler, min(timeout_s, 5.0))
+    try:
+        client = Client(scheduler, timeout=timeout_s)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ParameterError(f"scheduler {scheduler!r}: cannot connect ({exc})",
+                             param="scheduler") from None
+    try:
+        yield client
+    finally:
+        client.close()
+
+
+def _run_dask(fn, tasks, done, scheduler):
+    with scheduler_client(scheduler) as client:
+        return _run_on_client(fn, tasks, done, client)
+
+
+def _run_on_client(fn, tasks, done, client):
+    """Run the tasks on a Dask client; a task whose workers kept dying (Dask's
+    ``KilledWorker``) does not stop the others, and :class:`WorkersDied` names it at the end."""
+    from distributed import KilledWorker, as_completed
+
+    futures, lost = {}, []
     try:
         for key, args in tasks:
             futures[client.submit(fn, *args, pure=False, key=f"cmsim-{key}-{os.getpid()}-"
                                   f"{time.monotonic_ns()}")] = key
         n_workers = max(len(client.scheduler_info().get("workers", {})), 1)
         for fut in as_completed(list(futures)):
-            done(futures[fut], fut.result())
+            if isinstance(fut.exception(), KilledWorker):
+                lost.append(futures[fut])
+            else:
+                done(futures[fut], fut.result())
             fut.release()
+        if lost:
+            raise WorkersDied(f"Dask workers kept dying (killed, or out of memory?) on "
+                              f"{len(lost)} tasks ({', '.join(lost[:5])}); what finished "
+                              f"is kept")
         return n_workers
     except BaseException:
         client.cancel(list(futures))
         raise
-    finally:
-        if own:
-            client.close()

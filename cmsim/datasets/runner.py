@@ -8,9 +8,14 @@ local processes, or a Dask cluster), each worker writing its record file and its
 (:class:`~cmsim.datasets.lock.DirectoryLock`).
 
 Resuming is the same call: finished records are kept, files half-written by a killed worker
-(``.*.tmp``) are removed, a record file without a row is adopted from the row kept in its
-meta, anything else is run. Ctrl-C or SIGTERM stops the workers at once and raises
-:class:`~cmsim.datasets.pool.Interrupted` after the finished records are recorded. Records
+(``.*.tmp``) are removed (also when a run ends: a Dask worker killed mid-write leaves one
+while its task is retried elsewhere), a record file without a row is adopted from the row
+kept in its meta, anything else is run. A Dask scheduler is connected to before anything is
+written, and a directory the call created is removed again if the call fails before any
+record is finished: a failed start leaves nothing behind. Ctrl-C or SIGTERM stops the
+workers at once and raises :class:`~cmsim.datasets.pool.Interrupted` after the finished
+records are recorded. A worker process that dies (killed, out of memory) costs only its
+record: Dask retries it, a local pool is started again for the unfinished records. Records
 depend only on (spec, base seed, index), so they are bit-identical on any number of workers
 and on Dask.
 
@@ -22,15 +27,17 @@ Processes
 
 from __future__ import annotations
 
+import contextlib
+import shutil
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from cmsim.datasets.lock import DirectoryLock
-from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, consolidate,
+from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, SPEC_NAME, consolidate,
                                      done_indices, open_directory)
-from cmsim.datasets.pool import check_start_method, check_workers, run_tasks
+from cmsim.datasets.pool import check_start_method, check_workers, run_tasks, scheduler_client
 from cmsim.datasets.records import run_record
 from cmsim.datasets.spec import DatasetSpec
 from cmsim.dynamics import simulate
@@ -162,6 +169,10 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
         Bad arguments, a directory holding another spec or in use by another run.
     cmsim.datasets.pool.Interrupted
         On Ctrl-C or SIGTERM (finished records are kept; rerun to resume).
+    cmsim.errors.WorkersDied
+        Worker processes kept dying (a local pool whose worker died is started again for
+        the unfinished records, :data:`~cmsim.datasets.pool.POOL_RESTARTS` times; Dask
+        retries on its own); finished records are kept.
     """
     check_type("spec", spec, DatasetSpec)
     workers = check_workers(workers)
@@ -170,40 +181,90 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
         progress = sys.stderr.isatty()
     start = time.perf_counter()
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    with DirectoryLock(out):
-        for sub in (RECORDS_DIR, ROWS_DIR):
-            (out / sub).mkdir(exist_ok=True)
-            for tmp in (out / sub).glob(".*.tmp"):     # left by a killed worker
-                tmp.unlink(missing_ok=True)
-        kept = open_directory(spec, out, force)
-        done, adopted = done_indices(spec, out, verify)
-        adopted += kept
-        t_resume = time.perf_counter() - start
-        pending = [i for i in range(spec.n_records) if i not in done]
-        rows = []
-
-        def record(key, row):
-            rows.append(row)
-            if on_record_done is not None:
-                on_record_done(row)
-
-        n_workers, t_warm = 0, 0.0
+    with scheduler_client(scheduler) as client, _new_directory(out) as created, \
+            DirectoryLock(out):
         try:
-            if pending:
-                if scheduler is None and method == "fork":
-                    t_w = time.perf_counter()
-                    _warm_kernels(spec, pending)
-                    t_warm = time.perf_counter() - t_w
-                tasks = [(spec.record_id(i), (spec, i, str(out))) for i in pending]
-                n_workers = run_tasks(run_record, tasks, record, workers=workers,
-                                      start_method=method, scheduler=scheduler,
-                                      progress=progress, desc=spec.name, unit="rec",
-                                      postfix=lambda k, r: f"{k} {r['status']}")
-        finally:
-            t_c = time.perf_counter()
-            consolidate(out)
-            t_consolidate = time.perf_counter() - t_c
+            return _generate(spec, out, start, workers=workers, client=client,
+                             progress=progress, method=method, verify=verify, force=force,
+                             on_record_done=on_record_done)
+        except BaseException:
+            if created:
+                _remove_unfinished(out)
+            raise
+
+
+@contextlib.contextmanager
+def _new_directory(out):
+    """Create ``out`` (and its parents) while active; yield whether it is new. The
+    directories it made are removed again if the run fails and leaves them empty
+    (:func:`_remove_unfinished`)."""
+    made = [d for d in (out, *out.parents) if not d.exists()]
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        yield bool(made)
+    except BaseException:
+        for d in made:                             # innermost first
+            try:
+                d.rmdir()
+            except OSError:                        # not empty: something was finished
+                break
+        raise
+
+
+def _remove_unfinished(out):
+    """In a directory this run created and that holds no finished record (no manifest, no
+    record file), remove what the run wrote: the spec, the empty folders."""
+    if (out / PARQUET_NAME).exists() or any((out / RECORDS_DIR).glob("*.npz")) \
+            or any((out / ROWS_DIR).glob("*.json")):
+        return
+    for sub in (RECORDS_DIR, ROWS_DIR):
+        shutil.rmtree(out / sub, ignore_errors=True)
+    (out / SPEC_NAME).unlink(missing_ok=True)
+
+
+def _remove_temporary(out):
+    """Remove the ``.*.tmp`` files a killed worker left half-written."""
+    for sub in (RECORDS_DIR, ROWS_DIR):
+        for tmp in (out / sub).glob(".*.tmp"):
+            tmp.unlink(missing_ok=True)
+
+
+def _generate(spec, out, start, *, workers, client, progress, method, verify, force,
+              on_record_done):
+    """The body of :func:`generate_dataset`, under the directory lock; ``client`` is the
+    Dask client (``None``: local processes)."""
+    for sub in (RECORDS_DIR, ROWS_DIR):
+        (out / sub).mkdir(exist_ok=True)
+    _remove_temporary(out)
+    kept = open_directory(spec, out, force)
+    done, adopted = done_indices(spec, out, verify)
+    adopted += kept
+    t_resume = time.perf_counter() - start
+    pending = [i for i in range(spec.n_records) if i not in done]
+    rows = []
+
+    def record(key, row):
+        rows.append(row)
+        if on_record_done is not None:
+            on_record_done(row)
+
+    n_workers, t_warm = 0, 0.0
+    try:
+        if pending:
+            if client is None and method == "fork":
+                t_w = time.perf_counter()
+                _warm_kernels(spec, pending)
+                t_warm = time.perf_counter() - t_w
+            tasks = [(spec.record_id(i), (spec, i, str(out))) for i in pending]
+            n_workers = run_tasks(run_record, tasks, record, workers=workers,
+                                  start_method=method, scheduler=client,
+                                  progress=progress, desc=spec.name, unit="rec",
+                                  postfix=lambda k, r: f"{k} {r['status']}")
+    finally:
+        t_c = time.perf_counter()
+        consolidate(out)
+        _remove_temporary(out)             # a worker killed mid-write (Dask retries it)
+        t_consolidate = time.perf_counter() - t_c
     timing = {k: 0.0 for k in (*_TIMING_KEYS, "busy")}
     for r in rows:
         for k in _TIMING_KEYS:
@@ -216,7 +277,7 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
                           records_written=sum(r["status"] == "ok" for r in rows),
                           records_skipped=len(done), records_adopted=adopted,
                           records_failed=len(failed), workers=n_workers,
-                          runner="dask" if scheduler is not None else "local",
+                          runner="dask" if client is not None else "local",
                           start_method=method, wall_s=time.perf_counter() - start,
                           timing_s=timing,
                           failed=tuple((r["record_id"], r["error"]) for r in failed[:20]))

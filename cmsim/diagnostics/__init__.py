@@ -22,8 +22,11 @@ the dataset's ``fault_label`` values: ``"healthy"``, ``"outer_race"``, ``"inner_
 ``"ball"``, ``"tooth_crack"``, ``"tooth_spall"`` … (several faults: ``"+"``-joined sorted
 types). A function may carry a ``label_map`` attribute (true label → its class, e.g. every
 tooth fault → ``"gear"``) that the harness applies to the answer key. The function never
-sees the answer key; if it raises on a record, that record is reported with the error and
-left out of the scores, and the evaluation goes on.
+sees the answer key; if it raises on a record (``sys.exit`` included), that record is
+reported with the error and its traceback and left out of the scores, and the evaluation goes
+on. What it prints goes to stderr (:mod:`~cmsim.diagnostics.user_code`), so that
+``cmsim evaluate --json`` prints one JSON object on stdout; an evaluation in which it answered
+no record exits with status 2.
 
 Scores (:mod:`~cmsim.diagnostics.metrics`): accuracy, macro-F1, confusion matrix, per-class
 ROC AUC (one-vs-rest, from the scores), and detection against severity at a 5 % false-alarm
@@ -32,6 +35,7 @@ largest score of a non-healthy class, or 1/0 from the label alone).
 
 Modules: :mod:`~cmsim.diagnostics.diagnosis` (:class:`Diagnosis`),
 :mod:`~cmsim.diagnostics.metrics`, :mod:`~cmsim.diagnostics.harness` (:func:`evaluate`),
+:mod:`~cmsim.diagnostics.user_code` (the user's function run isolated),
 :mod:`~cmsim.diagnostics.baselines` (``envelope``, ``tsa``, ``sideband``),
 measured records of ``../shared/datasets`` come from :mod:`cmsim.measured`;
 :mod:`~cmsim.diagnostics.report` (HTML page).

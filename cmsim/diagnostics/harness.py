@@ -7,7 +7,11 @@ The algorithm is a plain function (see :mod:`cmsim.diagnostics` for its contract
 It sees a record's signals, sample rate, operating point and the rig's characteristic
 frequencies, never the answer key. :func:`evaluate` calls it once per record, catches what it
 raises (the record is reported with the error and the evaluation goes on) and scores the
-answers with :mod:`cmsim.diagnostics.metrics`.
+answers with :mod:`cmsim.diagnostics.metrics`. The user's code runs isolated
+(:mod:`cmsim.diagnostics.user_code`): what it prints goes to stderr, what it raises
+(``sys.exit`` included) is that record's error, kept with its traceback. A record the dataset
+cannot give (its file missing or corrupt) is skipped and counted, apart from the
+algorithm's errors.
 
 A dataset is anything with ``.manifest`` (a :class:`pandas.DataFrame` with ``record_id`` and,
 optionally, ``status``), ``.record(record_id)`` → a record with ``.signals``, ``.fs_hz``,
@@ -30,11 +34,13 @@ from pathlib import Path
 import numpy as np
 
 import cmsim.datasets as _datasets
+from cmsim._io import READ_ERRORS
 from cmsim.diagnostics import baselines as _baselines
 from cmsim.diagnostics.diagnosis import Diagnosis, as_diagnosis
 from cmsim.diagnostics.metrics import (FALSE_ALARM_RATE, HEALTHY, accuracy, confusion_matrix,
                                        detection_vs_severity, f1_scores, macro_f1,
                                        one_vs_rest_auc)
+from cmsim.diagnostics.user_code import UserError, call_user, output_to_stderr
 from cmsim.errors import ParameterError
 from cmsim.measured import load_measured
 
@@ -78,14 +84,17 @@ def load_algorithm(spec):
                                                           str(path))
             module = importlib.util.module_from_spec(
                 importlib.util.spec_from_loader(loader.name, loader))
-            loader.exec_module(module)
+            with output_to_stderr():
+                loader.exec_module(module)
         else:
-            module = importlib.import_module(mod_name)
+            with output_to_stderr():
+                module = importlib.import_module(mod_name)
     except ParameterError:
         raise
-    except Exception as exc:  # noqa: BLE001 - any import failure is the user's input
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - the user's input
         raise ParameterError(f"algorithm {spec!r}: cannot import {mod_name} "
-                             f"({type(exc).__name__}: {exc})", param="algorithm") from None
+                             f"({UserError.from_exception(exc).message})",
+                             param="algorithm") from None
     func = getattr(module, func_name, None)
     if not callable(func):
         raise ParameterError(f"algorithm {spec!r}: {mod_name} has no function {func_name!r}",
@@ -138,9 +147,12 @@ class RecordResult:
     scores : dict of str to float
     fault_score : float
     error : str or None
-        ``"ExceptionType: message"`` when the algorithm raised on this record.
+        ``"ExceptionType: message"`` when the algorithm raised on this record (or called
+        ``sys.exit``, or answered with something that is not a diagnosis).
     wall_s : float
         Time of the call, s.
+    traceback : str or None
+        The error's traceback, from the algorithm down.
     """
 
     record_id: str
@@ -151,12 +163,14 @@ class RecordResult:
     fault_score: float
     error: str | None
     wall_s: float
+    traceback: str | None = None
 
     def to_dict(self):
         """JSON-ready dict."""
         return {"record_id": self.record_id, "true_label": self.true_label,
                 "severity": self.severity, "label": self.label, "scores": dict(self.scores),
-                "fault_score": self.fault_score, "error": self.error, "wall_s": self.wall_s}
+                "fault_score": self.fault_score, "error": self.error, "wall_s": self.wall_s,
+                "traceback": self.traceback}
 
 
 @dataclass(frozen=True)
@@ -171,17 +185,22 @@ class Evaluation:
         Every record the algorithm was run on, in dataset order.
     metrics : dict
         ``n_records``, ``n_scored`` (answered), ``n_failed`` (raised), ``records_skipped``
-        (failed in the dataset itself), ``accuracy``, ``chance_accuracy`` (share of the most
+        (failed in the dataset itself), ``records_unreadable`` (listed in
+        :attr:`unreadable`), ``accuracy``, ``chance_accuracy`` (share of the most
         frequent true class), ``macro_f1``, ``f1`` (per class), ``confusion`` (``classes``,
         ``matrix``), ``auc`` (per class, one-vs-rest, from the scores), ``detection``
         (:func:`~cmsim.diagnostics.metrics.detection_vs_severity` on the fault score).
         Records on which the algorithm raised are left out of the scores.
+    unreadable : tuple of (str, str)
+        ``(record_id, why)`` of the records whose data could not be read (skipped; the
+        algorithm never saw them).
     """
 
     algorithm: str
     dataset: str
     records: tuple
     metrics: dict
+    unreadable: tuple = ()
 
     @property
     def errors(self):
@@ -189,17 +208,24 @@ class Evaluation:
         return {r.record_id: r.error for r in self.records if r.error is not None}
 
     def to_dict(self):
-        """JSON-ready dict (``algorithm``, ``dataset``, ``metrics``, ``errors``, ``records``)."""
+        """JSON-ready dict (``algorithm``, ``dataset``, ``metrics``, ``errors``, ``records``
+        with each error's traceback, ``unreadable``)."""
         return {"algorithm": self.algorithm, "dataset": self.dataset, "metrics": self.metrics,
-                "errors": self.errors, "records": [r.to_dict() for r in self.records]}
+                "errors": self.errors, "records": [r.to_dict() for r in self.records],
+                "unreadable": dict(self.unreadable)}
 
 
 def _manifest_rows(dataset):
+    """The rows to run, the number of records that failed in the dataset itself, and the
+    ``(record_id, why)`` of those the dataset could not read (status ``"unreadable"``)."""
     man = dataset.manifest
-    if "status" in man.columns:
-        ok = man["status"].astype(str) == "ok"
-        return man[ok], int((~ok).sum())
-    return man, 0
+    if "status" not in man.columns:
+        return man, 0, []
+    status = man["status"].astype(str)
+    ok, unreadable = status == "ok", status == "unreadable"
+    why = man["error"] if "error" in man.columns else [None] * len(man)
+    bad = [(str(rid), str(w)) for rid, w, u in zip(man["record_id"], why, unreadable) if u]
+    return man[ok], int((~ok & ~unreadable).sum()), bad
 
 
 def _answer_key(rec, row, label_map):
@@ -244,31 +270,52 @@ def evaluate(dataset, algorithm, *, label_map=None, false_alarm_rate=FALSE_ALARM
     else:
         ds, ds_name = load_dataset(dataset), str(dataset)
     lmap = dict(label_map if label_map is not None else getattr(func, "label_map", {}) or {})
-    rows, skipped = _manifest_rows(ds)
+    rows, skipped, unreadable = _manifest_rows(ds)
     results = []
     total = len(rows)
     for i, row in enumerate(rows.to_dict("records")):
         rid = str(row["record_id"])
-        rec = ds.record(row["record_id"])
-        true, sev = _answer_key(rec, row, lmap)
-        t0 = time.perf_counter()
         try:
-            d = as_diagnosis(func(dict(rec.signals), float(rec.fs_hz), rec.operating_point,
-                                  rec.frequencies))
-            res = RecordResult(rid, true, sev, d.label, d.scores, d.fault_score, None,
-                               time.perf_counter() - t0)
-        except Exception as exc:  # noqa: BLE001 - the user's code; reported per record
-            msg = f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:500]
-            res = RecordResult(rid, true, sev, None, {}, math.nan, msg,
-                               time.perf_counter() - t0)
-        results.append(res)
+            inputs, true, sev = _read_record(ds, row, lmap)
+        except READ_ERRORS as exc:          # the dataset's fault, not the algorithm's
+            unreadable.append((rid, " ".join(f"{exc}".split()) or type(exc).__name__))
+        else:
+            results.append(_run_algorithm(func, rid, inputs, true, sev))
         if progress is not None:
             progress(i + 1, total)
     return Evaluation(algorithm=name, dataset=ds_name, records=tuple(results),
-                      metrics=score(results, skipped=skipped, false_alarm_rate=false_alarm_rate))
+                      metrics=score(results, skipped=skipped, unreadable=len(unreadable),
+                                    false_alarm_rate=false_alarm_rate),
+                      unreadable=tuple(unreadable))
 
 
-def score(results, *, skipped=0, false_alarm_rate=FALSE_ALARM_RATE):
+def _read_record(ds, row, label_map):
+    """Everything the algorithm gets of one record, read before it is called, and the
+    answer key: ``((signals, fs_hz, operating_point, frequencies), true_label, severity)``."""
+    rec = ds.record(row["record_id"])
+    true, sev = _answer_key(rec, row, label_map)
+    inputs = (dict(rec.signals), float(rec.fs_hz), rec.operating_point, rec.frequencies)
+    return inputs, true, sev
+
+
+def _run_algorithm(func, rid, inputs, true, sev):
+    """The algorithm's answer on one record, its output sent to stderr and its error (with
+    the traceback) kept."""
+    t0 = time.perf_counter()
+    answer, error = call_user(func, *inputs)
+    if error is None:
+        try:
+            d = as_diagnosis(answer)
+        except (TypeError, ValueError) as exc:
+            error = UserError.from_exception(exc)
+    wall = time.perf_counter() - t0
+    if error is not None:
+        return RecordResult(rid, true, sev, None, {}, math.nan, error.message, wall,
+                            error.traceback)
+    return RecordResult(rid, true, sev, d.label, d.scores, d.fault_score, None, wall)
+
+
+def score(results, *, skipped=0, unreadable=0, false_alarm_rate=FALSE_ALARM_RATE):
     """Metrics of a list of :class:`RecordResult` (see :attr:`Evaluation.metrics`).
 
     Parameters
@@ -277,12 +324,15 @@ def score(results, *, skipped=0, false_alarm_rate=FALSE_ALARM_RATE):
         Answers with their answer key.
     skipped : int
         Records that failed in the dataset itself (reported only).
+    unreadable : int
+        Records whose data could not be read (reported only).
     false_alarm_rate : float
         α of the detection threshold.
     """
     done = [r for r in results if r.error is None]
     out = {"n_records": len(results), "n_scored": len(done),
-           "n_failed": len(results) - len(done), "records_skipped": int(skipped)}
+           "n_failed": len(results) - len(done), "records_skipped": int(skipped),
+           "records_unreadable": int(unreadable)}
     if not done:
         return {**out, "accuracy": math.nan, "chance_accuracy": math.nan, "macro_f1": math.nan,
                 "f1": {}, "confusion": {"classes": [], "matrix": []}, "auc": {},

@@ -99,6 +99,17 @@ def _fmt(v):
     return html.escape(str(v))
 
 
+def _error_cell(result):
+    """A record's error, its traceback folded under it."""
+    if not result.error:
+        return ""
+    cell = html.escape(result.error)
+    tb = result.traceback
+    if tb:
+        cell += f"<details><summary>traceback</summary><pre>{html.escape(tb)}</pre></details>"
+    return cell
+
+
 def write_report(evaluation, path):
     """Write the HTML page of ``evaluation`` to ``path`` (atomically); return the path.
 
@@ -114,7 +125,12 @@ def write_report(evaluation, path):
         f"<tr><td>{e(r.record_id)}</td><td>{e(r.true_label)}</td><td>{_fmt(r.severity)}</td>"
         f"<td>{e(str(r.label))}</td><td>{_fmt(r.fault_score)}</td>"
         f"<td>{e(', '.join(f'{k}={_fmt(v)}' for k, v in r.scores.items()))}</td>"
-        f"<td>{e(r.error or '')}</td></tr>" for r in evaluation.records)
+        f"<td>{_error_cell(r)}</td></tr>" for r in evaluation.records)
+    unreadable = "".join(f"<tr><td>{e(rid)}</td><td>{e(why)}</td></tr>"
+                         for rid, why in evaluation.unreadable)
+    if unreadable:
+        unreadable = ("<h2>Records not read (skipped)</h2><table><tr><th>record</th>"
+                      f"<th>why</th></tr>{unreadable}</table>")
     auc = "".join(f"<tr><td>{e(k)}</td><td>{_fmt(v)}</td><td>{_fmt(m['f1'].get(k, math.nan))}"
                   f"</td></tr>" for k, v in m["auc"].items())
     det = m["detection"]
@@ -134,7 +150,8 @@ def write_report(evaluation, path):
 td,th{{border:1px solid #ccc;padding:2px 6px;font-size:90%}}</style></head><body>
 <h1>{e(evaluation.algorithm)} on {e(evaluation.dataset)}</h1>
 <p>{m['n_records']} records, {m['n_scored']} answered, {m['n_failed']} raised (left out of
-the scores), {m['records_skipped']} failed in the dataset. Accuracy {_fmt(m['accuracy'])}
+the scores), {m['records_skipped']} failed in the dataset,
+{m['records_unreadable']} could not be read. Accuracy {_fmt(m['accuracy'])}
 (chance: {_fmt(m['chance_accuracy'])}), macro-F1 {_fmt(m['macro_f1'])}. Detection threshold
 {_fmt(det['threshold'])} (95th percentile of the healthy records' fault scores; false-alarm
 rate reached {_fmt(det['false_alarm_rate'])}).</p>
@@ -147,6 +164,7 @@ rate reached {_fmt(det['false_alarm_rate'])}).</p>
 {det_rows}</table>
 <h2>Records</h2><table><tr><th>record</th><th>true</th><th>severity</th><th>predicted</th>
 <th>fault score</th><th>scores</th><th>error</th></tr>{rows}</table>
+{unreadable}
 </body></html>
 """
     return atomic_write_text(Path(path), page)

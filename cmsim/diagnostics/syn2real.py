@@ -217,6 +217,8 @@ def measured_windows(folder, channel=None, window=None, hop=None, bearing=None,
         Labels from the answer key, for scoring only; the features never read them.
     """
     ds = load_measured(folder)
+    if ds.unreadable:                      # a test set is scored whole, or not at all
+        raise ParameterError(next(iter(ds.unreadable.values())), param="dataset")
     ch, key = _measured_channel(folder, bearing) if channel is None else (channel, bearing)
     parts, fs0 = [], None
     for rec in ds:

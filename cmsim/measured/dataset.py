@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cmsim._io import READ_ERRORS
 from cmsim.errors import ParameterError
 from cmsim.measured.record import read_record
 from cmsim.measured.schema import answer_key, read_metadata
@@ -56,9 +57,11 @@ class MeasuredDataset:
         Folder name.
     folder : pathlib.Path
     manifest : pandas.DataFrame
-        One row per recording: ``record_id``, ``status`` ("ok"), ``path``, ``fs_hz``,
-        ``speed_rpm``, ``radial_load_n`` (documented or inferred values), and the answer key
-        ``fault_label``, ``fault_severity`` (m or NaN) for scoring.
+        One row per recording: ``record_id``, ``status`` ("ok", or "unreadable" for a
+        recording whose file is missing or damaged, with the reason in ``error``), ``path``,
+        ``fs_hz``, ``speed_rpm``, ``radial_load_n`` (documented or inferred values), and the
+        answer key ``fault_label``, ``fault_severity`` (m or NaN) for scoring. One bad
+        recording does not make the folder unusable: the others are read.
     assumptions : list of str
         What was not documented and was inferred or assumed (e.g. the sample rate).
     """
@@ -79,18 +82,37 @@ class MeasuredDataset:
             if "file" not in r:
                 raise ParameterError(f"{folder}/metadata.json: a recording has no file",
                                      param="dataset")
-            rec = read_record(folder / r["file"])
+            try:
+                rec = read_record(folder / r["file"])
+            except READ_ERRORS as exc:     # ParameterError included: named, with the fix
+                why = " ".join(str(exc).split()) or type(exc).__name__
+                if str(r["file"]) not in why:
+                    why = f"record {folder / r['file']}: {type(exc).__name__}: {why}"
+                rows.append(_unreadable_row(r, why))
+                continue
             rid = rec.record_id
             for k, v in rec.inferred.items():
                 self.assumptions.append(f"{rid}: {k} = {v['value']:.6g} inferred ({v['how']})")
             self._records[rid] = rec
             self._answers[rid] = answer_key(r)
-            rows.append({"record_id": rid, "status": "ok", "path": r["file"],
+            rows.append({"record_id": rid, "status": "ok", "error": None, "path": r["file"],
                          "fs_hz": rec.fs_hz, "speed_rpm": rec.operating_point.speed_rpm,
                          "radial_load_n": rec.operating_point.radial_load_n,
                          "fault_label": self._answers[rid]["fault_label"],
                          "fault_severity": self._answers[rid]["fault_severity"]})
         self.manifest = pd.DataFrame(rows)
+
+    @property
+    def unreadable(self):
+        """{record_id: why} of the recordings that could not be read."""
+        bad = self.manifest[self.manifest["status"] == "unreadable"]
+        return dict(zip(bad["record_id"], bad["error"]))
+
+    def __len__(self):
+        return len(self._records)
+
+    def __iter__(self):
+        return iter(self._records.values())
 
     def record(self, record_id):
         """The :class:`~cmsim.measured.record.MeasuredRecord` of ``record_id`` (file stem) or
@@ -118,11 +140,14 @@ class MeasuredDataset:
         """
         return dict(self._answers[str(record_id)])
 
-    def __len__(self):
-        return len(self._records)
 
-    def __iter__(self):
-        return iter(self._records.values())
+def _unreadable_row(recording, why):
+    """The manifest row of a recording that could not be read (its answer key kept)."""
+    key = answer_key(recording)
+    return {"record_id": Path(recording["file"]).stem, "status": "unreadable", "error": why,
+            "path": recording["file"], "fs_hz": np.nan, "speed_rpm": np.nan,
+            "radial_load_n": np.nan, "fault_label": key["fault_label"],
+            "fault_severity": key["fault_severity"]}
 
 
 def load_measured(folder):

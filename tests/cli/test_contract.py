@@ -337,6 +337,27 @@ CATALOGUE = [
     R("compare-rig-missing", "compare {record} --rig {work}/none.toml", "--rig"),
     R("compare-rig-text", "compare {record} --rig {text}", "--rig"),
     R("compare-report-file", "compare {record} --report {text}", "--report"),
+    # ---- files, user code and the cluster (issue 26: evaluate, dataset)
+    R("evaluate-algorithm-raises-on-every-record", "evaluate {gen_ds} --algorithm "
+      "{algo}:boom", "--algorithm", "answered no record", "ValueError: nope"),
+    R("evaluate-algorithm-calls-sys-exit", "evaluate {gen_ds} --algorithm {algo}:leave",
+      "--algorithm", "answered no record", "sys.exit(1)"),
+    R("evaluate-algorithm-exits-on-import", "evaluate {gen_ds} --algorithm {algo_exit}:f",
+      "--algorithm", "SystemExit"),
+    R("evaluate-every-record-truncated", "evaluate {gen_truncated} --algorithm envelope",
+      "DIR", "no record could be read", "BadZipFile"),
+    R("evaluate-every-record-deleted", "evaluate {gen_deleted} --algorithm envelope", "DIR",
+      "no record could be read", "missing"),
+    R("evaluate-manifest-corrupt", "evaluate {gen_bad_manifest} --algorithm envelope", "DIR",
+      "manifest.parquet is corrupt", "remove it"),
+    R("evaluate-manifest-foreign", "evaluate {gen_foreign_manifest} --algorithm envelope",
+      "DIR", "manifest.parquet is not a cmsim manifest"),
+    R("dataset-resume-manifest-corrupt", "dataset {ds_spec} --out {gen_bad_manifest}", "--out",
+      "manifest.parquet is corrupt", "remove it"),
+    R("dataset-scheduler-refused", "dataset {ds_spec} --out {work}/dask --scheduler "
+      "tcp://127.0.0.1:1", "--scheduler", "cannot connect"),
+    R("dataset-scheduler-not-an-address", "dataset {ds_spec} --out {work}/dask2 --scheduler "
+      "tcp://nohost", "--scheduler", "address"),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -436,6 +457,7 @@ def files(tmp_path_factory):
                                                    '[[faults.types]]\ntype = "bogus"\n')):
         (d / f"{name}.toml").write_text(text_)
         f[name] = d / f"{name}.toml"
+    _generated_datasets(d, f)
     run = _synthetic_run(paper, ["F_1b1_loa", "F_1b1_oloa", "x_1b1", "y_1b1", "x_2b1", "y_2b1",
                                  "dte_um"])
     f["run"] = run.save(d / "run.npz")
@@ -465,6 +487,61 @@ def files(tmp_path_factory):
     f["record"] = meas / "rec.npz"
     f["root"] = d
     return f
+
+
+ALGORITHMS = """import os
+import sys
+
+
+def boom(signals, fs_hz, operating_point, frequencies):
+    raise ValueError("nope")
+
+
+def leave(signals, fs_hz, operating_point, frequencies):
+    sys.exit(1)
+
+
+CALLS = []
+
+
+def chatty(signals, fs_hz, operating_point, frequencies):
+    # prints, writes to file descriptor 1, and fails on its first record only
+    CALLS.append(1)
+    print("chatty print")
+    os.write(1, b"chatty fd 1\\n")
+    if len(CALLS) == 1:
+        raise ValueError("first record")
+    return "healthy"
+"""
+
+
+def _generated_datasets(d, f):
+    """A dataset generated from ``ds_spec`` and copies of it broken in one way each: every
+    record truncated, every record deleted, the manifest cut short, a foreign Parquet file
+    as the manifest; and the users' algorithms (issue 26)."""
+    import shutil
+
+    import pandas as pd
+
+    from cmsim.datasets import DatasetSpec, generate_dataset
+
+    gen = d / "gen"
+    generate_dataset(DatasetSpec.load(f["ds_spec"]), gen, workers=1, progress=False)
+    f["gen_ds"] = gen
+    for name in ("gen_truncated", "gen_deleted", "gen_bad_manifest", "gen_foreign_manifest"):
+        shutil.copytree(gen, d / name)
+        f[name] = d / name
+    for rec in (d / "gen_truncated" / "records").glob("*.npz"):
+        rec.write_bytes(rec.read_bytes()[:1000])
+    for rec in (d / "gen_deleted" / "records").glob("*.npz"):
+        rec.unlink()
+    manifest = d / "gen_bad_manifest" / "manifest.parquet"
+    manifest.write_bytes(manifest.read_bytes()[:300])
+    pd.DataFrame({"x": [1.0]}).to_parquet(d / "gen_foreign_manifest" / "manifest.parquet")
+    (d / "algo.py").write_text(ALGORITHMS)
+    f["algo"] = d / "algo.py"
+    (d / "algo_exit.py").write_text("import sys\nsys.exit(3)\n")
+    f["algo_exit"] = d / "algo_exit.py"
 
 
 def _argv(row, files):
@@ -627,3 +704,79 @@ def test_subprocess_exit_codes(argv, status, word, as_json):
         assert json.loads(proc.stdout)["status"] == status
     else:
         assert proc.stdout == ""
+
+
+# ---------------------------------------------------------------------- user code, files
+# (issue 26): the rows above cover the failures; these the runs that go on.
+def test_evaluate_stdout_is_one_json_object_whatever_the_algorithm_prints(files, tmp_path):
+    """The real process: the algorithm's print and its writes to descriptor 1 reach stderr;
+    its error on one record is that record's, with the traceback, in the JSON and the
+    HTML report; the other record is scored (exit 0)."""
+    html = tmp_path / "eval.html"
+    cmd = [sys.executable, "-m", "cmsim.cli", "evaluate", str(files["gen_ds"]), "--algorithm",
+           f"{files['algo']}:chatty", "--report", str(html), "--json"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    res = json.loads(proc.stdout)
+    assert "chatty print" in proc.stderr and "chatty fd 1" in proc.stderr
+    assert (res["metrics"]["n_scored"], res["metrics"]["n_failed"]) == (1, 1)
+    failed = [r for r in res["records"] if r["error"]]
+    assert failed[0]["error"] == "ValueError: first record"
+    assert "in chatty" in failed[0]["traceback"]
+    page = html.read_text()
+    assert "<details><summary>traceback</summary>" in page and "in chatty" in page
+
+
+@pytest.mark.parametrize("damage", ["truncated", "deleted"])
+def test_evaluate_skips_a_damaged_record_and_counts_it(damage, files, tmp_path, capsys):
+    import shutil
+
+    ds = tmp_path / "ds"
+    shutil.copytree(files["gen_ds"], ds)
+    victim = sorted((ds / "records").glob("*.npz"))[0]
+    if damage == "truncated":
+        victim.write_bytes(victim.read_bytes()[:1000])
+    else:
+        victim.unlink()
+    assert main(["evaluate", str(ds), "--algorithm", "envelope", "--json"]) == 0
+    cap = capsys.readouterr()
+    res = json.loads(cap.out)
+    m = res["metrics"]
+    assert (m["n_records"], m["n_scored"], m["records_unreadable"]) == (1, 1, 1)
+    assert list(res["unreadable"]) == [victim.stem]
+    assert len(res["warnings"]) == 1 and victim.stem in res["warnings"][0]
+    assert main(["evaluate", str(ds), "--algorithm", "envelope"]) == 0
+    cap = capsys.readouterr()
+    assert f"record {victim.stem} skipped" in cap.out
+    assert len(cap.err.strip().splitlines()) == 1 and "warning" in cap.err
+
+
+@pytest.mark.parametrize("damage", ["truncated", "deleted"])
+def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
+    """A folder of measured recordings with one damaged: the others are scored (exit 0),
+    the damaged one is named in a warning and counted; sim-to-real, which scores a test
+    folder whole, refuses it naming the file."""
+    import shutil
+
+    from cmsim.measured import data_root
+
+    source = data_root() / "mfpt_bearing"
+    if not (source / "metadata.json").is_file():
+        pytest.skip(f"measured data not found at {source} (set CMSIM_DATA)")
+    folder = tmp_path / "mfpt"
+    shutil.copytree(source, folder)
+    victim = folder / "OR_vload3_100lb.npz"
+    if damage == "truncated":
+        victim.write_bytes(victim.read_bytes()[:5000])
+    else:
+        victim.unlink()
+    assert main(["evaluate", str(folder), "--algorithm", "envelope", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    m = res["metrics"]
+    assert (m["n_records"], m["n_scored"], m["records_unreadable"]) == (6, 6, 1)
+    assert list(res["unreadable"]) == ["OR_vload3_100lb"]
+    assert len(res["warnings"]) == 1 and "OR_vload3_100lb" in res["warnings"][0]
+    from cmsim.diagnostics.syn2real import measured_windows
+    from cmsim.errors import ParameterError
+    with pytest.raises(ParameterError, match="OR_vload3_100lb"):
+        measured_windows(folder)

@@ -209,8 +209,11 @@ def test_cli_evaluate_user_function_json_and_report(bearing_set, tmp_path, capsy
 
 def test_cli_gear_baseline_on_bearing_rig_reports_every_record(bearing_set, tmp_path, capsys):
     folder = _write_measured(tmp_path / "m", bearing_set)
-    assert main(["evaluate", str(folder), "--algorithm", "tsa", "--json"]) == 0
-    res = json.loads(capsys.readouterr().out)
+    # nothing answered: exit 2 naming --algorithm (issue 26), every record's error kept
+    assert main(["evaluate", str(folder), "--algorithm", "tsa", "--json"]) == 2
+    err = json.loads(capsys.readouterr().out)
+    assert err["option"] == "--algorithm" and "needs a rig with gears" in err["error"]
+    res = err["evaluation"]
     assert res["metrics"]["n_failed"] == 15 and res["metrics"]["accuracy"] is None
     assert all("needs a rig with gears" in e for e in res["errors"].values())
 
