@@ -172,16 +172,45 @@ def _channel(signals, sensors, bearings, channel, name):
         raise ParameterError(f"channel {channel!r} is not in {name}; available: "
                              f"{sorted(signals)}", param="--channel",
                              allowed=", ".join(sorted(signals)))
-    x = signals[channel]
-    if x.size < MIN_SAMPLES or not np.all(np.isfinite(x)):
-        raise ParameterError(f"channel {channel!r} must hold >= {MIN_SAMPLES} finite samples, "
-                             f"got {x.size}", param="--channel")
-    return channel, x
+    return channel, _checked_samples(signals[channel], channel, name)
 
 
-def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes):
+def _checked_samples(x, channel, name):
+    """The compared channel's samples, or the one line that says what is wrong with them:
+    too few, some not finite (where the first is), or constant (nothing recorded)."""
+    if x.size < MIN_SAMPLES:
+        raise ParameterError(f"record {name}: channel {channel!r} holds {x.size} samples; "
+                             f"needs >= {MIN_SAMPLES}", param="record",
+                             allowed=f">= {MIN_SAMPLES} samples")
+    bad = ~np.isfinite(x)
+    if bad.any():
+        raise ParameterError(f"record {name}: channel {channel!r} holds {int(bad.sum())} "
+                             f"non-finite samples (NaN or inf) of {x.size}, the first at "
+                             f"sample {int(np.argmax(bad))}; cmsim does not fill gaps: repair "
+                             f"the file or cut it to a finite stretch", param="record",
+                             allowed="finite samples")
+    if np.ptp(x) == 0.0:
+        raise ParameterError(f"record {name}: channel {channel!r} is constant (every sample "
+                             f"{x[0]:g}): nothing was recorded; check the sensor, its cable "
+                             f"and the channel chosen (--channel)", param="record",
+                             allowed="a varying signal")
+    return x
+
+
+#: Largest relative difference between a file header's sample rate and metadata.json's.
+HEADER_RATE_TOLERANCE = 1e-3
+
+
+def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, path):
     """The sample rate: documented (entry, folder, file), else inferred from the signal."""
-    fs = entry.get("fs_hz", meta.get("fs_hz")) or file_rate
+    stated = entry.get("fs_hz") or meta.get("fs_hz")
+    if stated is not None and file_rate is not None \
+            and abs(float(stated) / file_rate - 1.0) > HEADER_RATE_TOLERANCE:
+        raise ParameterError(f"record {path}: its header says {file_rate:g} Hz but "
+                             f"metadata.json says fs_hz {float(stated):g} Hz; correct the one "
+                             f"that is wrong (the header is what the recorder wrote)",
+                             param="record", allowed=f"fs_hz = {file_rate:g} Hz")
+    fs = stated or file_rate
     if fs is not None:
         return float(fs)
     note_hz = sample_rate_from_note(meta.get("fs_note"))
@@ -232,13 +261,13 @@ def read_record(path, *, channel=None, rig=None):
     p = resolve_path(path)
     full = read_metadata(p.parent)
     meta = {k: full.get(k) for k in FOLDER_KEYS}
-    entry = recording_entry(full, p.name)
+    entry = recording_entry(full, p.name, p.parent / "metadata.json")
     sensors = meta.get("sensors") or {}
     geometry = meta.get("geometry") or {}
     signals, file_rate = read_signals(p, entry.get("channels"))
     if not signals:
         raise ParameterError(f"record {p} holds no 1-D channel", param="record")
-    channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, p.name)
+    channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, str(p))
     near = (sensors.get(channel) or {}).get("near")
     inferred, notes = {}, []
     rig_given = rig is not None
@@ -251,7 +280,7 @@ def read_record(path, *, channel=None, rig=None):
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
     speed_rpm = documented_speed_rpm(entry)
-    fs = _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes)
+    fs = _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, p)
     if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
         speed_rpm, how = refine_speed(x, fs, speed_rpm, teeth)
         if how is not None:
