@@ -4,7 +4,9 @@ comparison with the model need.
 :func:`read_record` turns a signal file in a folder with ``metadata.json`` into a
 :class:`MeasuredRecord`: it reads the schema's readable keys (:mod:`cmsim.measured.schema`),
 the channels (:mod:`cmsim.measured.readers`), fills in what the metadata lacks from the signal
-(:mod:`cmsim.measured.inference`: sample rate, speed) and builds the model of the record
+(:mod:`cmsim.measured.inference`: sample rate, speed), checks a stated sample rate and
+speed against the record's own lines (:mod:`cmsim.measured.consistency`) before anything
+is computed on them, and builds the model of the record
 (:mod:`cmsim.measured.model_rig`). The same record serves the diagnostics harness (signals,
 sample rate, documented operating point and characteristic frequencies) and
 :func:`cmsim.discrepancy.compare` (the compared channel, the model rig and operating point).
@@ -19,6 +21,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.frequencies import RigFrequencies, rig_frequencies
+from cmsim.measured.consistency import check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
                                       refine_speed, sample_rate_from_note)
 from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
@@ -235,6 +238,20 @@ def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, p
                          allowed="a number > 0 in metadata.json")
 
 
+def _check_against_lines(x, fs, speed_rpm, geometry, notes, path, fs_source):
+    """The stated sample rate and speed checked against the record's own lines
+    (:func:`~cmsim.measured.consistency.check_rate_and_speed`); what was checked, or that
+    nothing could be, goes to the notes."""
+    found = check_rate_and_speed(x, fs, speed_rpm, documented_frequencies(geometry, 1.0),
+                                 where=path, fs_source=fs_source)
+    if found is None:
+        notes.append("sample rate and speed not checked against the signal: no shaft or "
+                     "bearing lines stand clear of the floor")
+    else:
+        notes.append(f"sample rate and speed agree with the signal's {found.family.name} "
+                     f"lines ({found.level_db:.0f} dB over the floor)")
+
+
 def read_record(path, *, channel=None, rig=None):
     """Read a measured record (``metadata.json`` schema) into a :class:`MeasuredRecord`.
 
@@ -256,7 +273,10 @@ def read_record(path, *, channel=None, rig=None):
     Raises
     ------
     ParameterError
-        Missing file or metadata, unknown channel, no way to get the sample rate.
+        Missing file or metadata, unknown channel, no way to get the sample rate; a damaged
+        file or channel (:mod:`~cmsim.measured.readers`, too few, non-finite or constant
+        samples); a sample rate or speed its own lines contradict
+        (:func:`~cmsim.measured.consistency.check_rate_and_speed`).
     """
     p = resolve_path(path)
     full = read_metadata(p.parent)
@@ -281,6 +301,9 @@ def read_record(path, *, channel=None, rig=None):
 
     speed_rpm = documented_speed_rpm(entry)
     fs = _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, p)
+    if speed_rpm is not None:         # before anything is computed on them
+        _check_against_lines(x, fs, speed_rpm, geometry, notes, p,
+                             "the WAV header" if file_rate is not None else "fs_hz")
     if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
         speed_rpm, how = refine_speed(x, fs, speed_rpm, teeth)
         if how is not None:
