@@ -32,7 +32,7 @@ from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metad
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 
-__all__ = ["MeasuredRecord", "read_record", "record_from_run", "MIN_SAMPLES"]
+__all__ = ["MeasuredRecord", "read_record", "read_run", "record_from_run", "MIN_SAMPLES"]
 
 #: Fewest samples of the compared channel (the speed and sample-rate inference need a few
 #: hundred shaft revolutions' worth of resolution; a kurtogram needs 1024).
@@ -331,6 +331,47 @@ def read_record(path, *, channel=None, rig=None):
         record_id=p.stem, frequencies=documented_frequencies(geometry, speed_rpm / 60.0),
         operating_point=documented_operating_point(entry, speed_rpm),
         path_documented=rig_given)
+
+
+def read_run(path, *, channel=None):
+    """Any record cmsim writes or reads, as a :class:`~cmsim.run.Run` with its rig and
+    operating point: a run (``cmsim simulate``, ``cmsim sweep``), a dataset record
+    (``cmsim dataset``) or a measured recording in a folder with ``metadata.json``
+    (:func:`read_record`, with every check it makes).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file. An ``.npz`` holding a ``meta`` array is one cmsim wrote; any other file is
+        a measured recording.
+    channel : str, optional
+        Compared channel of a measured recording (default as :func:`read_record`).
+
+    Returns
+    -------
+    run : cmsim.run.Run
+    signal : str or None
+        The signal to look at by default: a measured recording's compared channel, a dataset
+        record's first channel, None for a simulated run (its caller's default).
+    """
+    p = resolve_path(path)
+    names = _npz_names(p) if p.suffix.lower() == ".npz" else set()
+    if "meta" in names:
+        run = Run.load(p)
+        run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
+        return run, (None if "t" in names else sorted(run.signals)[0])
+    rec = read_record(p, channel=channel)
+    return rec.run, rec.channel
+
+
+def _npz_names(path):
+    """Array names of an ``.npz`` (empty when unreadable: :func:`read_record` then names
+    the damage)."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return set(z.files)
+    except Exception:  # noqa: BLE001 - any failure is the reader's to report
+        return set()
 
 
 def record_from_run(run, channel, rig, op, model_signal=None, components=None,
