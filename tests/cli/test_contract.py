@@ -369,6 +369,10 @@ CATALOGUE = [
     R("spectrum-record-nan", "spectrum {rec_nan}", "RECORD", "non-finite"),
     R("spectrum-wav-header-rate", "spectrum {rec_wav_rate}", "RECORD", "48000 Hz"),
     R("spectrum-measured-signal", "spectrum {record} --signal nosuch", "--signal", "DE"),
+    R("evaluate-measured-record-nan", "evaluate {rec_nan_dir} --algorithm envelope",
+      "rec.npz", "non-finite"),
+    R("evaluate-measured-fs-text", "evaluate {rec_fs_text_dir} --algorithm envelope",
+      "metadata.json", "'12k'", numeric=True),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -539,6 +543,7 @@ def _bad_recordings(d):
         w.setframerate(48000)
         w.writeframes((x / np.abs(x).max() * 30000).astype("<i2").tobytes())
     f["rec_wav_rate"] = wav
+    f.update({f"{k}_dir": v.parent for k, v in list(f.items())})
     return f
 
 

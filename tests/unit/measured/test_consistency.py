@@ -126,3 +126,15 @@ def test_undocumented_speed_is_the_shaft_not_a_harmonic(tmp_path):
     rec = read_record(p)
     assert rec.inferred["speed_rpm"]["value"] == pytest.approx(1797.0, rel=5e-3)
     assert "1/2 of the comb's best fit" in rec.inferred["speed_rpm"]["how"]
+
+
+def test_calibrate_reports_an_inferred_speed_in_text_and_json(tmp_path, capsys):
+    """What was inferred from the signal is said in the text output as well as the JSON."""
+    p = _copy_record(tmp_path, "cwru_bearing_12k_de", "IR007_0.npz", entry=None)
+    argv = ["calibrate", str(p), "--out", str(tmp_path / "m.toml"), "--span", "0", "3"]
+    assert main(argv) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if s.startswith("inferred"))
+    assert line.startswith("inferred speed_rpm of IR007_0: 1799"), line
+    assert main(argv + ["--json"]) == 0
+    inferred = json.loads(capsys.readouterr().out)["inferred"]
+    assert inferred["IR007_0"]["speed_rpm"]["value"] == pytest.approx(1797.0, rel=5e-3)
