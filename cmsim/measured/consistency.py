@@ -2,30 +2,34 @@
 
 A sample rate wrong by a factor k scales every line of the spectrum by k; a speed wrong by k
 moves every predicted line by 1/k. Either way the lines the rig makes — shaft harmonics, the
-gear mesh comb, the bearing defect families — stand at a ratio ρ ≠ 1 of where the metadata
-puts them, while at ρ = 1 they all fit. :func:`check_rate_and_speed` finds ρ from the
-signal, family by family, and refuses a record whose families say ρ ≠ 1.
+bearing defect families — stand at a ratio ρ ≠ 1 of where the metadata puts them, while at
+ρ = 1 they all fit. :func:`check_rate_and_speed` finds ρ from the signal, family by family,
+and refuses a record whose clearest family says ρ ≠ 1.
 
 For one family (fundamental u = order × stated shaft rate, harmonics k·u) the ratio is
 decided by the lines that only one of two neighbouring fundamentals predicts
-(:func:`exclusive_contrast_db`):
+(:func:`exclusive_contrast_db`), tested in this order:
 
-* **lines below the stated ones** — a comb at u/m also predicts the lines j·u/m with j not a
-  multiple of m, first of all its own fundamental u/m (a machine's strongest shaft or defect
-  line is usually its first); if that line stands clear (:data:`CLEAR_LINE_DB`) and as high
-  as the stated lines (within :data:`SUBCOMB_MARGIN_DB`), the fundamental is u/m (the
-  stated rate is m times too high);
-* **the stated lines missing** — the stated comb predicts k·u for k not a multiple of m that a
-  comb at m·u does not; if these are :data:`MISSING_MARGIN_DB` below the lines at m·u, the
-  fundamental is m·u.
+* **the stated lines missing** — the stated comb predicts k·u for k not a multiple of m (the
+  first two: u and 3u for m = 2) that a comb at m·u does not; if these stand
+  :data:`MISSING_MARGIN_DB` below the lines at m·u and one of those stands clear
+  (:data:`CLEAR_LINE_DB`), the fundamental is m·u (the stated rate is m times too low);
+* **lines between the stated ones** — a comb at u/m also predicts j·u/m for j not a multiple
+  of m (the first two: u/2 and 3u/2); if these stand clear and as high as the stated lines
+  (within :data:`SUBCOMB_MARGIN_DB`), the fundamental is u/m (the stated rate is m times
+  too high). The missing-line test goes first because a lower comb predicts the stated
+  lines too: it must not be taken where they are absent.
 
-Steps of 2 (:data:`STEPS`) are taken until neither test moves the fundamental (4 = 2·2), within
-[1/:data:`LARGEST_FACTOR`, :data:`LARGEST_FACTOR`]. A family speaks only when its lines stand
-:data:`CLEAR_LINE_DB` over the local floor, and of those the one whose lines stand highest
-at its ratio decides (a healthy record's shaft comb, a faulty bearing's defect family in the
-envelope spectrum, a gearbox's shaft comb with its mesh modulation). A harmonic of the true fundamental always fits a
-too-high stated rate too, which is why the lines *between* the stated ones decide, never the
-stated lines alone.
+Steps of 2 (:data:`STEPS`) are taken until neither test moves the fundamental (4 = 2·2),
+within [1/:data:`LARGEST_FACTOR`, :data:`LARGEST_FACTOR`]. A family speaks only when its
+lines stand :data:`CLEAR_LINE_DB` over the local floor at its ratio, and the one whose lines
+stand highest decides (a healthy record's or a gearbox's shaft comb, a faulty bearing's
+defect family in the envelope spectrum). A harmonic of the true fundamental always fits a
+too-high stated rate too, which is why the lines *between* the stated ones decide, never
+the stated lines alone. The mesh comb is not a family of its own (:func:`line_families`).
+
+Known limit: a record whose every family is weak (below :data:`CLEAR_LINE_DB` at any ratio)
+is not checked (:func:`check_rate_and_speed` returns None and the reader notes it).
 
 Line prominence: the largest amplitude within ±:data:`LINE_TOLERANCE` of the line (the stated
 speed may be nominal, bearings slip) over the median of the surrounding ±10 % (at least 25
@@ -45,7 +49,8 @@ from cmsim.spectra.envelope import envelope_spectrum
 from cmsim.spectra.kurtogram import kurtogram
 
 __all__ = ["LineFamily", "FamilyVerdict", "line_families", "line_prominence_db",
-           "exclusive_contrast_db", "family_ratio", "lowest_fundamental", "family_verdicts", "check_rate_and_speed",
+           "exclusive_contrast_db", "family_ratio", "lowest_fundamental", "family_verdicts",
+           "check_rate_and_speed",
            "LINE_TOLERANCE", "SUBCOMB_MARGIN_DB", "MISSING_MARGIN_DB", "CLEAR_LINE_DB",
            "LARGEST_FACTOR", "STEPS"]
 
@@ -72,6 +77,7 @@ LARGEST_FACTOR = 4
 #: taken: a gear rig's 3rd shaft harmonic often stands well above the 1st and 2nd, which
 #: reads as "the stated lines are missing" at 3×.
 STEPS = (2,)
+
 
 @dataclass(frozen=True)
 class LineFamily:
