@@ -272,15 +272,24 @@ class Run:
 
     @classmethod
     def load(cls, path):
-        """Read a run written by :meth:`save` (files without ``source`` are simulated)."""
+        """Read a run written by :meth:`save`, or a dataset record (``cmsim dataset``: its
+        channels and ``meta`` without ``t``, whose times follow from ``meta["fs_hz"]`` and
+        ``meta["t0_s"]``); files without ``source`` are simulated."""
         try:
             z = np.load(path, allow_pickle=False)
         except FileNotFoundError:
             raise ParameterError(f"run file {path} does not exist") from None
         with z:
-            if "t" not in z.files or "meta" not in z.files:
+            if "meta" not in z.files:
                 raise ParameterError(f"{path} is not a cmsim run (needs arrays 't' and 'meta')")
             meta = json.loads(str(z["meta"]))
             source = str(z["source"]) if "source" in z.files else "simulated"
             signals = {k: z[k] for k in z.files if k not in _RESERVED}
-            return cls(z["t"], signals, meta, source)
+            if "t" in z.files:
+                return cls(z["t"], signals, meta, source)
+            if not signals or not isinstance(meta, dict) or not meta.get("fs_hz"):
+                raise ParameterError(f"{path} is not a cmsim run (needs arrays 't' and "
+                                     f"'meta', or channels and a meta with fs_hz)")
+            n = next(iter(signals.values())).shape[0]
+            t = float(meta.get("t0_s") or 0.0) + np.arange(n) / float(meta["fs_hz"])
+            return cls(t, signals, meta, source)

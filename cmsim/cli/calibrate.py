@@ -77,6 +77,7 @@ def run(args):
            "fs_hz": machine.fs_hz, "speed_rpm": machine.op.speed_rpm,
            "speed_wobble": machine.speed_wobble, "lines": len(machine.background.lines),
            "calibrated_on": list(machine.calibrated_on), "notes": list(machine.notes),
+           "inferred": {r.record_id: dict(r.inferred) for r in records if r.inferred},
            "fit_quality": {"worst_feature": q.get("worst_feature"),
                            "worst_z": q.get("worst_z"),
                            "chi2_per_feature": q.get("chi2_per_feature"),
@@ -102,6 +103,9 @@ def text(res):
              f"{q['n_features']} features"]
     lines += [f"calibrated on {c}" for c in res["calibrated_on"]]
     lines += [f"note: {n}" for n in res["notes"]]
+    lines += [f"inferred {k} of {record}: {v['value']:.6g} ({v['how']})"
+              for record, inferred in res.get("inferred", {}).items()
+              for k, v in inferred.items()]
     lines.append(f"wrote {res['machine']}")
     if res["report"]:
         lines.append(f"wrote {res['report']}")

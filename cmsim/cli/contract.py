@@ -39,7 +39,7 @@ PARAM_TO_DEST = {
     "clearances_m": "clearance_m", "max_freq_hz": "max_hz", "signals": "signal",
     "mesh": "mesh", "method": "method", "centres": "centres",
     "noise_rms": "sensor_noise", "fs_out_hz": "sensor_fs_hz",
-    "algorithm": "algorithm", "dataset": "dir",
+    "algorithm": "algorithm", "dataset": "dir", "record": "run",
 }
 
 #: One-word Python names the library uses in messages for what an option sets.

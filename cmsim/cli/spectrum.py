@@ -5,18 +5,25 @@ from __future__ import annotations
 from pathlib import Path
 
 from cmsim.cli.contract import load_file, ranged
+from cmsim.errors import ParameterError
 from cmsim.cli.output import save_figure
 from cmsim.rig import Range
 
 
 def register(sub):
     """Add the ``spectrum`` parser."""
-    p = sub.add_parser("spectrum", help="labelled spectrum of one signal of a run",
-                       description="Amplitude, envelope or order spectrum of a run signal, "
-                                   "with its largest peaks named k·GMF ± m·BPF ± n·fr from "
-                                   "the run's own rig and operating point.")
-    p.add_argument("run", type=Path, metavar="RUN.npz", help="run written by cmsim simulate")
-    p.add_argument("--signal", default="F_1b1_loa", help="signal name (default F_1b1_loa)")
+    p = sub.add_parser("spectrum", help="labelled spectrum of one signal of a record",
+                       description="Amplitude, envelope or order spectrum of a signal of any "
+                                   "record cmsim writes or reads (run, dataset record, "
+                                   "measured recording with its metadata.json), with its "
+                                   "largest peaks named k·GMF ± m·BPF ± n·fr from the "
+                                   "record's own rig and operating point.")
+    p.add_argument("run", type=Path, metavar="RECORD",
+                   help="a run (cmsim simulate, sweep), a dataset record (cmsim dataset) or "
+                        "a measured recording in a folder with metadata.json")
+    p.add_argument("--signal", help="signal name (default: F_1b1_loa of a simulated run, "
+                                    "the first channel of a dataset record, the compared "
+                                    "channel of a measured recording)")
     p.add_argument("--kind", default="amplitude", choices=("amplitude", "envelope", "order"),
                    help="spectrum kind")
     p.add_argument("--band-hz", type=ranged(Range(0.0, 1.0e7, unit="Hz")), nargs=2,
@@ -37,16 +44,11 @@ def register(sub):
 
 def run(args):
     """The spectrum's labelled peaks (and its figure)."""
-    from cmsim.run import Run
     from cmsim.spectra.run_spectrum import run_spectrum
 
-    def load(path):
-        run_ = Run.load(path)
-        run_.rig, run_.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
-        return run_
-
-    run_ = load_file("RUN.npz", args.run, load, "a cmsim run file (cmsim simulate --out)")
-    spec = run_spectrum(run_, args.signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
+    run_, default_signal = _read(args.run)
+    signal = args.signal or default_signal or "F_1b1_loa"
+    spec = run_spectrum(run_, signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
                         resolution_hz=args.resolution_hz, bearing=args.bearing,
                         max_peaks=args.top, threshold_db=args.threshold_db)
     out = {"run": str(args.run), "signal": spec.signal, "kind": spec.kind, "unit": spec.unit,
@@ -65,6 +67,30 @@ def run(args):
         save_figure(fig, args.plot)
         out["plot"] = str(args.plot)
     return out
+
+
+def _read(path):
+    """The record as a run (:func:`cmsim.measured.read_run`): a measured recording's error
+    names the file itself (``RECORD ...``); a cmsim file that does not load is named here."""
+    from cmsim.measured import read_run
+
+    try:
+        return read_run(path)
+    except ParameterError as exc:
+        if exc.param == "record":
+            raise
+        return load_file("RECORD", path, _raise(exc), _WHAT)
+    except Exception as exc:  # noqa: BLE001 - reported by load_file as one line
+        return load_file("RECORD", path, _raise(exc), _WHAT)
+
+
+_WHAT = "a record cmsim wrote (simulate, sweep, dataset) nor a measured recording"
+
+
+def _raise(exc):
+    def loader(path):
+        raise exc
+    return loader
 
 
 def text(res):

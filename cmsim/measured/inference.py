@@ -6,7 +6,9 @@
   ±:data:`SPEED_SEARCH_FRACTION` when the comb is clear (:data:`MIN_COMB_DB`) and its
   interpolated rate lies in that range, more than :data:`MIN_SPEED_CHANGE` away
   (:func:`refine_speed`); an undocumented one is searched
-  between 5 Hz and min(100 Hz, fs/40).
+  between 5 Hz and min(100 Hz, fs/40), and the comb found is moved to its true fundamental
+  by the lines between its own (:func:`cmsim.measured.consistency.family_ratio`: the best
+  comb of a record whose 2nd shaft harmonic and mains lines stand high is at 2×).
 * **Sample rate** (``fs_hz: null``, e.g. the SpectraQuest gearbox) — one rule,
   :func:`infer_sample_rate`: the mesh comb of the documented tooth counts is found in
   cycles per sample, and the documented input-shaft speed turns it into Hz. A prose
@@ -24,6 +26,7 @@ import re
 
 import numpy as np
 
+from cmsim.measured.consistency import lowest_fundamental
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["estimate_shaft_hz", "refine_speed", "infer_sample_rate", "sample_rate_from_note",
@@ -134,7 +137,14 @@ def refine_speed(x, fs_hz, speed_rpm, teeth=None):
     if speed_rpm is None:
         f, score = estimate_shaft_hz(x, fs_hz, lo_hz=5.0, hi_hz=min(100.0, fs_hz / 40),
                                      teeth=teeth)
-        return 60.0 * f, f"shaft-harmonic comb, {score:.1f} dB over the median level"
+        freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
+        ratio = lowest_fundamental(freq, np.log10(np.maximum(amp, 1e-300)), f, 4, lo_hz=5.0)
+        how = f"shaft-harmonic comb, {score:.1f} dB over the median level"
+        if ratio != 1.0:       # the best comb was a harmonic of the shaft's
+            f *= ratio
+            how += (f"; its fundamental is 1/{1 / ratio:g} of the comb's best fit (its lines "
+                    f"between stand as high)")
+        return 60.0 * f, how
     f0 = float(speed_rpm) / 60.0
     f, score = estimate_shaft_hz(x, fs_hz, lo_hz=(1 - SPEED_SEARCH_FRACTION) * f0,
                                  hi_hz=(1 + SPEED_SEARCH_FRACTION) * f0, teeth=teeth)

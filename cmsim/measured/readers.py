@@ -5,12 +5,15 @@ rate_hz)``: ``signals`` maps a channel name to a float64 1-D array, ``rate_hz`` 
 rate the file itself stores (WAV) or None. Types today:
 
 * ``.npz`` — one 1-D array per channel (keys = channel names; ``t``, ``meta`` and ``source``
-  of a saved :class:`~cmsim.run.Run` are skipped);
+  of a saved :class:`~cmsim.run.Run` are skipped; a column or row vector, shape (n, 1) or
+  (1, n), is read as the 1-D channel it is; any other 2-D array is refused, never dropped);
 * ``.csv`` — one column per channel, a header row of channel names;
 * ``.wav`` — one channel per WAV channel, named by ``names`` (the entry's ``channels``) when
   they match in number, else ``ch0``, ``ch1``, ...; the WAV rate is the sample rate.
 
 A new type (``.mat``, ``.uff``, ``.tdms``) is one function added to :data:`READERS`.
+:func:`read_signals` turns whatever a reader raises on a damaged file (truncated, not of its
+type) into one :class:`~cmsim.errors.ParameterError` naming the file.
 """
 
 from __future__ import annotations
@@ -29,10 +32,22 @@ __all__ = ["READERS", "read_signals", "resolve_path"]
 _NOT_CHANNELS = ("t", "meta", "source")
 
 
+def _channel_1d(path, name, a):
+    """A stored array as a 1-D channel: (n,), (n, 1) and (1, n) are one channel; any other
+    shape is refused (a silently dropped channel would let another one be compared)."""
+    a = np.asarray(a)
+    if a.ndim == 2 and 1 in a.shape:
+        a = a.reshape(-1)
+    if a.ndim != 1:
+        raise ParameterError(f"record {path}: channel {name!r} has shape {a.shape}; store "
+                             f"one 1-D array per channel (e.g. {name}_0, {name}_1, ... for "
+                             f"the columns)", param="record", allowed="1-D arrays")
+    return np.asarray(a, dtype=float)
+
+
 def _read_npz(path, names=None):
     with np.load(path, allow_pickle=False) as z:
-        return {k: np.asarray(z[k], dtype=float) for k in z.files
-                if np.ndim(z[k]) == 1 and k not in _NOT_CHANNELS}, None
+        return {k: _channel_1d(path, k, z[k]) for k in z.files if k not in _NOT_CHANNELS}, None
 
 
 def _read_csv(path, names=None):
@@ -104,11 +119,21 @@ def read_signals(path, names=None):
     Raises
     ------
     ParameterError
-        Unsupported file type.
+        Unsupported file type; a file its reader cannot read (truncated, damaged, not of
+        its type); a channel that is not 1-D.
     """
     path = Path(path)
     reader = READERS.get(path.suffix.lower())
     if reader is None:
         raise ParameterError(f"record {path}: unsupported file type {path.suffix!r}",
                              param="record", allowed=", ".join(READERS))
-    return reader(path, names)
+    try:
+        return reader(path, names)
+    except ParameterError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any reader failure is a damaged file
+        detail = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise ParameterError(f"record {path}: cannot be read as a {path.suffix} file "
+                             f"({type(exc).__name__}: {detail}); the file is truncated or "
+                             f"damaged: copy or export it again", param="record",
+                             allowed=f"a readable {path.suffix} file") from None

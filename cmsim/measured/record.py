@@ -4,7 +4,9 @@ comparison with the model need.
 :func:`read_record` turns a signal file in a folder with ``metadata.json`` into a
 :class:`MeasuredRecord`: it reads the schema's readable keys (:mod:`cmsim.measured.schema`),
 the channels (:mod:`cmsim.measured.readers`), fills in what the metadata lacks from the signal
-(:mod:`cmsim.measured.inference`: sample rate, speed) and builds the model of the record
+(:mod:`cmsim.measured.inference`: sample rate, speed), checks a stated sample rate and
+speed against the record's own lines (:mod:`cmsim.measured.consistency`) before anything
+is computed on them, and builds the model of the record
 (:mod:`cmsim.measured.model_rig`). The same record serves the diagnostics harness (signals,
 sample rate, documented operating point and characteristic frequencies) and
 :func:`cmsim.discrepancy.compare` (the compared channel, the model rig and operating point).
@@ -19,6 +21,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.frequencies import RigFrequencies, rig_frequencies
+from cmsim.measured.consistency import check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
                                       refine_speed, sample_rate_from_note)
 from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
@@ -29,7 +32,7 @@ from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metad
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 
-__all__ = ["MeasuredRecord", "read_record", "record_from_run", "MIN_SAMPLES"]
+__all__ = ["MeasuredRecord", "read_record", "read_run", "record_from_run", "MIN_SAMPLES"]
 
 #: Fewest samples of the compared channel (the speed and sample-rate inference need a few
 #: hundred shaft revolutions' worth of resolution; a kurtogram needs 1024).
@@ -172,16 +175,45 @@ def _channel(signals, sensors, bearings, channel, name):
         raise ParameterError(f"channel {channel!r} is not in {name}; available: "
                              f"{sorted(signals)}", param="--channel",
                              allowed=", ".join(sorted(signals)))
-    x = signals[channel]
-    if x.size < MIN_SAMPLES or not np.all(np.isfinite(x)):
-        raise ParameterError(f"channel {channel!r} must hold >= {MIN_SAMPLES} finite samples, "
-                             f"got {x.size}", param="--channel")
-    return channel, x
+    return channel, _checked_samples(signals[channel], channel, name)
 
 
-def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes):
+def _checked_samples(x, channel, name):
+    """The compared channel's samples, or the one line that says what is wrong with them:
+    too few, some not finite (where the first is), or constant (nothing recorded)."""
+    if x.size < MIN_SAMPLES:
+        raise ParameterError(f"record {name}: channel {channel!r} holds {x.size} samples; "
+                             f"needs >= {MIN_SAMPLES}", param="record",
+                             allowed=f">= {MIN_SAMPLES} samples")
+    bad = ~np.isfinite(x)
+    if bad.any():
+        raise ParameterError(f"record {name}: channel {channel!r} holds {int(bad.sum())} "
+                             f"non-finite samples (NaN or inf) of {x.size}, the first at "
+                             f"sample {int(np.argmax(bad))}; cmsim does not fill gaps: repair "
+                             f"the file or cut it to a finite stretch", param="record",
+                             allowed="finite samples")
+    if np.ptp(x) == 0.0:
+        raise ParameterError(f"record {name}: channel {channel!r} is constant (every sample "
+                             f"{x[0]:g}): nothing was recorded; check the sensor, its cable "
+                             f"and the channel chosen (--channel)", param="record",
+                             allowed="a varying signal")
+    return x
+
+
+#: Largest relative difference between a file header's sample rate and metadata.json's.
+HEADER_RATE_TOLERANCE = 1e-3
+
+
+def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, path):
     """The sample rate: documented (entry, folder, file), else inferred from the signal."""
-    fs = entry.get("fs_hz", meta.get("fs_hz")) or file_rate
+    stated = entry.get("fs_hz") or meta.get("fs_hz")
+    if stated is not None and file_rate is not None \
+            and abs(float(stated) / file_rate - 1.0) > HEADER_RATE_TOLERANCE:
+        raise ParameterError(f"record {path}: its header says {file_rate:g} Hz but "
+                             f"metadata.json says fs_hz {float(stated):g} Hz; correct the one "
+                             f"that is wrong (the header is what the recorder wrote)",
+                             param="record", allowed=f"fs_hz = {file_rate:g} Hz")
+    fs = stated or file_rate
     if fs is not None:
         return float(fs)
     note_hz = sample_rate_from_note(meta.get("fs_note"))
@@ -206,6 +238,20 @@ def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes):
                          allowed="a number > 0 in metadata.json")
 
 
+def _check_against_lines(x, fs, speed_rpm, geometry, notes, path, fs_source):
+    """The stated sample rate and speed checked against the record's own lines
+    (:func:`~cmsim.measured.consistency.check_rate_and_speed`); what was checked, or that
+    nothing could be, goes to the notes."""
+    found = check_rate_and_speed(x, fs, speed_rpm, documented_frequencies(geometry, 1.0),
+                                 where=path, fs_source=fs_source)
+    if found is None:
+        notes.append("sample rate and speed not checked against the signal: no shaft or "
+                     "bearing lines stand clear of the floor")
+    else:
+        notes.append(f"sample rate and speed agree with the signal's {found.family.name} "
+                     f"lines ({found.level_db:.0f} dB over the floor)")
+
+
 def read_record(path, *, channel=None, rig=None):
     """Read a measured record (``metadata.json`` schema) into a :class:`MeasuredRecord`.
 
@@ -227,18 +273,21 @@ def read_record(path, *, channel=None, rig=None):
     Raises
     ------
     ParameterError
-        Missing file or metadata, unknown channel, no way to get the sample rate.
+        Missing file or metadata, unknown channel, no way to get the sample rate; a damaged
+        file or channel (:mod:`~cmsim.measured.readers`, too few, non-finite or constant
+        samples); a sample rate or speed its own lines contradict
+        (:func:`~cmsim.measured.consistency.check_rate_and_speed`).
     """
     p = resolve_path(path)
     full = read_metadata(p.parent)
     meta = {k: full.get(k) for k in FOLDER_KEYS}
-    entry = recording_entry(full, p.name)
+    entry = recording_entry(full, p.name, p.parent / "metadata.json")
     sensors = meta.get("sensors") or {}
     geometry = meta.get("geometry") or {}
     signals, file_rate = read_signals(p, entry.get("channels"))
     if not signals:
         raise ParameterError(f"record {p} holds no 1-D channel", param="record")
-    channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, p.name)
+    channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, str(p))
     near = (sensors.get(channel) or {}).get("near")
     inferred, notes = {}, []
     rig_given = rig is not None
@@ -251,7 +300,10 @@ def read_record(path, *, channel=None, rig=None):
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
     speed_rpm = documented_speed_rpm(entry)
-    fs = _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes)
+    fs = _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, p)
+    if speed_rpm is not None:         # before anything is computed on them
+        _check_against_lines(x, fs, speed_rpm, geometry, notes, p,
+                             "the WAV header" if file_rate is not None else "fs_hz")
     if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
         speed_rpm, how = refine_speed(x, fs, speed_rpm, teeth)
         if how is not None:
@@ -279,6 +331,47 @@ def read_record(path, *, channel=None, rig=None):
         record_id=p.stem, frequencies=documented_frequencies(geometry, speed_rpm / 60.0),
         operating_point=documented_operating_point(entry, speed_rpm),
         path_documented=rig_given)
+
+
+def read_run(path, *, channel=None):
+    """Any record cmsim writes or reads, as a :class:`~cmsim.run.Run` with its rig and
+    operating point: a run (``cmsim simulate``, ``cmsim sweep``), a dataset record
+    (``cmsim dataset``) or a measured recording in a folder with ``metadata.json``
+    (:func:`read_record`, with every check it makes).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file. An ``.npz`` holding a ``meta`` array is one cmsim wrote; any other file is
+        a measured recording.
+    channel : str, optional
+        Compared channel of a measured recording (default as :func:`read_record`).
+
+    Returns
+    -------
+    run : cmsim.run.Run
+    signal : str or None
+        The signal to look at by default: a measured recording's compared channel, a dataset
+        record's first channel, None for a simulated run (its caller's default).
+    """
+    p = resolve_path(path)
+    names = _npz_names(p) if p.suffix.lower() == ".npz" else set()
+    if "meta" in names:
+        run = Run.load(p)
+        run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
+        return run, (None if "t" in names else sorted(run.signals)[0])
+    rec = read_record(p, channel=channel)
+    return rec.run, rec.channel
+
+
+def _npz_names(path):
+    """Array names of an ``.npz`` (empty when unreadable: :func:`read_record` then names
+    the damage)."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return set(z.files)
+    except Exception:  # noqa: BLE001 - any failure is the reader's to report
+        return set()
 
 
 def record_from_run(run, channel, rig, op, model_signal=None, components=None,

@@ -20,8 +20,9 @@ import math
 from pathlib import Path
 
 from cmsim.errors import ParameterError
+from cmsim.rig import RANGES
 
-__all__ = ["RECORDING_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_N", "INCH_M",
+__all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_N", "INCH_M",
            "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
            "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
            "documented_radial_load_n", "unit_scale_of"]
@@ -31,6 +32,15 @@ RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_
                   "shaft_speed_rpm_nominal", "shaft_speed_hz_nominal", "torque_nm",
                   "motor_load_hp", "radial_load_lbs", "radial_load_n", "load_percent",
                   "channels", "segment")
+
+#: Numeric keys of a recording (and the folder's ``fs_hz``) → the name of their range in
+#: :data:`cmsim.rig.RANGES`; ``null`` means undocumented, anything else must be in range.
+NUMERIC_KEYS = {"fs_hz": "record_fs_hz", "n_samples": "n_samples",
+                "shaft_speed_rpm": "speed_rpm", "shaft_speed_rpm_nominal": "speed_rpm",
+                "shaft_speed_hz": "shaft_speed_hz", "shaft_speed_hz_nominal": "shaft_speed_hz",
+                "torque_nm": "torque_nm", "motor_load_hp": "motor_load_hp",
+                "radial_load_lbs": "radial_load_lbs", "radial_load_n": "radial_load_n",
+                "load_percent": "load_percent"}
 
 #: Folder-level keys the pipeline reads (``fs_note`` only to cross-check an inferred rate).
 FOLDER_KEYS = ("fs_hz", "fs_note", "channels", "sensors", "geometry")
@@ -81,7 +91,40 @@ def read_metadata(folder):
     if not isinstance(meta, dict) or not isinstance(meta.get("recordings", []), list):
         raise ParameterError(f"{path}: not a dataset metadata file (no recordings list)",
                              param="record")
+    checked_numbers(meta, "fs_hz", path)
     return meta
+
+
+def checked_numbers(values, keys, where):
+    """``values`` with each of ``keys`` (of :data:`NUMERIC_KEYS`) that is not ``null``
+    checked against its range; a string (``"12k"``), a boolean or a value out of range is
+    one error naming the file and the key.
+
+    Parameters
+    ----------
+    values : dict
+        The folder's keys or one recording entry.
+    keys : str or sequence of str
+        Keys to check (those absent or ``null`` are undocumented, not wrong).
+    where : str or pathlib.Path
+        What to name in the message (``.../metadata.json`` or ``... recordings[2]``).
+
+    Returns
+    -------
+    dict
+        ``values`` with the checked numbers as floats (ints for an integer range).
+    """
+    out = dict(values)
+    for key in [keys] if isinstance(keys, str) else keys:
+        if out.get(key) is None:
+            continue
+        try:
+            out[key] = RANGES[NUMERIC_KEYS[key]].check(key, out[key])
+        except ParameterError as exc:
+            raise ParameterError(f"{where}: {exc}; write a plain JSON number (e.g. 12000, "
+                                 f"not \"12k\") or null when undocumented", param="record",
+                                 allowed=exc.allowed) from None
+    return out
 
 
 def is_answer_key(key):
@@ -94,7 +137,7 @@ def is_answer_key(key):
     return key in ANSWER_KEYS or key.startswith("fault")
 
 
-def recording_entry(meta, file_name):
+def recording_entry(meta, file_name, metadata_path="metadata.json"):
     """The readable keys (:data:`RECORDING_KEYS`) of the entry of ``file_name``.
 
     Parameters
@@ -103,15 +146,25 @@ def recording_entry(meta, file_name):
         Parsed ``metadata.json``.
     file_name : str
         Name of the signal file (locates the entry; it is not returned).
+    metadata_path : str or pathlib.Path
+        The ``metadata.json`` the entry comes from (named in messages).
 
     Returns
     -------
     dict
         Empty when the folder has no entry for the file.
+
+    Raises
+    ------
+    ParameterError
+        A numeric key that is neither ``null`` nor a number in its range
+        (:func:`checked_numbers`).
     """
-    for rec in meta.get("recordings") or []:
-        if rec.get("file") == file_name:
-            return {k: rec[k] for k in RECORDING_KEYS if k in rec and k != "file"}
+    for i, rec in enumerate(meta.get("recordings") or []):
+        if isinstance(rec, dict) and rec.get("file") == file_name:
+            entry = {k: rec[k] for k in RECORDING_KEYS if k in rec and k != "file"}
+            return checked_numbers(entry, [k for k in NUMERIC_KEYS if k in entry],
+                                   f"{metadata_path} recordings[{i}] ({file_name})")
     return {}
 
 

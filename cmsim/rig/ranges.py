@@ -136,4 +136,12 @@ RANGES = {
     "slip_correlation_s": Range(1.0e-5, 10.0, unit="s"),
     # housing sensors
     "sensor_noise_m_s2": Range(0.0, 1.0e6, unit="m/s^2"),
+    # what a measured recording's metadata.json states (cmsim.measured.schema); its sample
+    # rate may be below a simulation's (a slow machine logged at a few hundred Hz)
+    "record_fs_hz": Range(0.0, 1.0e7, lo_open=True, unit="Hz"),
+    "shaft_speed_hz": Range(0.0, 1.0e5 / 60.0, lo_open=True, unit="Hz"),
+    "motor_load_hp": Range(0.0, 1.0e5, unit="hp"),
+    "radial_load_lbs": Range(0.0, 2.2e6, unit="lbf"),
+    "load_percent": Range(0.0, 200.0, unit="%"),
+    "n_samples": Range(1, 1.0e12, integer=True),
 }

@@ -16,6 +16,7 @@ import json
 import math
 import subprocess
 import sys
+import wave
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -204,14 +205,14 @@ CATALOGUE = [
     R("mesh-table-out-directory", "mesh-table --torque-nm 10 --out {work}", "--out"),
     R("mesh-table-bearing-rig", "mesh-table --torque-nm 10 --rig {bearing_rig}", "--rig"),
     # ---- spectrum
-    R("spectrum-text-file", "spectrum {text}", "RUN.npz"),
-    R("spectrum-empty-file", "spectrum {empty}", "RUN.npz"),
-    R("spectrum-toml-file", "spectrum {rig_ok}", "RUN.npz"),
-    R("spectrum-directory", "spectrum {work}", "RUN.npz"),
-    R("spectrum-missing", "spectrum {work}/none.npz", "RUN.npz"),
-    R("spectrum-meta-not-json", "spectrum {bad_meta}", "RUN.npz"),
-    R("spectrum-meta-bad-rig", "spectrum {bad_rig_meta}", "RUN.npz"),
-    R("spectrum-table-file", "spectrum {tables}", "RUN.npz"),
+    R("spectrum-text-file", "spectrum {text}", "RECORD"),
+    R("spectrum-empty-file", "spectrum {empty}", "RECORD"),
+    R("spectrum-toml-file", "spectrum {rig_ok}", "RECORD"),
+    R("spectrum-directory", "spectrum {work}", "RECORD"),
+    R("spectrum-missing", "spectrum {work}/none.npz", "RECORD"),
+    R("spectrum-meta-not-json", "spectrum {bad_meta}", "RECORD"),
+    R("spectrum-meta-bad-rig", "spectrum {bad_rig_meta}", "RECORD"),
+    R("spectrum-table-file", "spectrum {tables}", "RECORD"),
     R("spectrum-signal", "spectrum {run} --signal nosuch", "--signal"),
     R("spectrum-bearing", "spectrum {run} --bearing 9z9", "--bearing"),
     R("spectrum-kind", "spectrum {run} --kind cepstrum", "--kind"),
@@ -358,6 +359,41 @@ CATALOGUE = [
       "tcp://127.0.0.1:1", "--scheduler", "cannot connect"),
     R("dataset-scheduler-not-an-address", "dataset {ds_spec} --out {work}/dask2 --scheduler "
       "tcp://nohost", "--scheduler", "address"),
+    # ---- measured recordings that are bad (issue 26: cmsim/measured/, one reader for all)
+    R("compare-record-truncated", "compare {rec_truncated}", "RECORD", "truncated",
+      "rec.npz"),
+    R("compare-metadata-fs-text", "compare {rec_fs_text}", "RECORD", "metadata.json",
+      "fs_hz", "'12k'", numeric=True),
+    R("compare-channel-2d", "compare {rec_2d}", "RECORD", "'DE'", "(24000, 2)", "1-D"),
+    R("compare-record-all-zero", "compare {rec_zero}", "RECORD", "constant", "sensor"),
+    R("compare-record-nan", "compare {rec_nan}", "RECORD", "3 non-finite samples",
+      "sample 100"),
+    R("compare-wav-header-rate", "compare {rec_wav_rate}", "RECORD", "48000 Hz",
+      "fs_hz 12000 Hz"),
+    R("calibrate-record-truncated", "calibrate {rec_truncated} --out {work}/m.toml",
+      "BASELINE", "truncated"),
+    R("calibrate-metadata-fs-text", "calibrate {rec_fs_text} --out {work}/m.toml",
+      "BASELINE", "fs_hz", "'12k'", numeric=True),
+    R("calibrate-channel-2d", "calibrate {rec_2d} --out {work}/m.toml", "BASELINE", "'DE'",
+      "1-D"),
+    R("calibrate-record-all-zero", "calibrate {rec_zero} --out {work}/m.toml", "BASELINE",
+      "constant"),
+    R("calibrate-record-nan", "calibrate {rec_nan} --out {work}/m.toml", "BASELINE",
+      "non-finite"),
+    R("calibrate-wav-header-rate", "calibrate {rec_wav_rate} --out {work}/m.toml",
+      "BASELINE", "48000 Hz"),
+    R("spectrum-record-truncated", "spectrum {rec_truncated}", "RECORD", "truncated"),
+    R("spectrum-metadata-fs-text", "spectrum {rec_fs_text}", "RECORD", "fs_hz", "'12k'",
+      numeric=True),
+    R("spectrum-channel-2d", "spectrum {rec_2d}", "RECORD", "'DE'", "1-D"),
+    R("spectrum-record-all-zero", "spectrum {rec_zero}", "RECORD", "constant"),
+    R("spectrum-record-nan", "spectrum {rec_nan}", "RECORD", "non-finite"),
+    R("spectrum-wav-header-rate", "spectrum {rec_wav_rate}", "RECORD", "48000 Hz"),
+    R("spectrum-measured-signal", "spectrum {record} --signal nosuch", "--signal", "DE"),
+    R("evaluate-measured-record-nan", "evaluate {rec_nan_dir} --algorithm envelope",
+      "rec.npz", "non-finite"),
+    R("evaluate-measured-fs-text", "evaluate {rec_fs_text_dir} --algorithm envelope",
+      "metadata.json", "'12k'", numeric=True),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -485,6 +521,7 @@ def files(tmp_path_factory):
             "n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04}}},
         "recordings": [{"file": "rec.npz", "shaft_speed_rpm": 1797.0}]}))
     f["record"] = meas / "rec.npz"
+    f.update(_bad_recordings(d / "bad_recordings"))
     f["root"] = d
     return f
 
@@ -542,6 +579,49 @@ def _generated_datasets(d, f):
     f["algo"] = d / "algo.py"
     (d / "algo_exit.py").write_text("import sys\nsys.exit(3)\n")
     f["algo_exit"] = d / "algo_exit.py"
+
+
+def _measured_folder(folder, arrays, *, fs_hz=12000.0, file="rec.npz", entry=None):
+    """A folder with one recording (``arrays``: channel -> samples, or bytes: the raw file)
+    and its metadata.json (a CWRU-like bearing rig, sensor DE near the drive end)."""
+    folder.mkdir(parents=True)
+    if isinstance(arrays, bytes):
+        (folder / file).write_bytes(arrays)
+    elif arrays is not None:
+        np.savez(folder / file, **arrays)
+    (folder / "metadata.json").write_text(json.dumps({
+        "fs_hz": fs_hz, "sensors": {"DE": {"near": "de", "direction": "radial"},
+                                    "FE": {"near": "fe", "direction": "radial"}},
+        "geometry": {"gears": None, "bearings": {
+            "de": {"n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04},
+            "fe": {"n_balls": 8, "ball_diameter_mm": 6.75, "pitch_diameter_mm": 28.5}}},
+        "recordings": [{"file": file, "shaft_speed_rpm": 1797.0, **(entry or {})}]}))
+    return folder / file
+
+
+def _bad_recordings(d):
+    """Measured recordings damaged in each way a user's file can be (issue 26): truncated,
+    a numeric metadata value written as text, a 2-D channel, all zero, a few NaN, a WAV
+    whose header rate contradicts metadata.json."""
+    x = np.random.default_rng(1).standard_normal(24000)
+    ok = _measured_folder(d / "ok", {"DE": x, "FE": x})
+    raw = ok.read_bytes()
+    with_nan = x.copy()
+    with_nan[[100, 9000, 20000]] = np.nan
+    f = {"rec_truncated": _measured_folder(d / "truncated", raw[: len(raw) // 2]),
+         "rec_fs_text": _measured_folder(d / "fs_text", {"DE": x}, entry={"fs_hz": "12k"}),
+         "rec_2d": _measured_folder(d / "two_d", {"DE": np.stack([x, x], 1), "FE": x}),
+         "rec_zero": _measured_folder(d / "zero", {"DE": np.zeros_like(x)}),
+         "rec_nan": _measured_folder(d / "nan", {"DE": with_nan})}
+    wav = _measured_folder(d / "wav", None, file="rec.wav", entry={"channels": ["DE"]})
+    with wave.open(str(wav), "wb") as w:
+        w.setnchannels(1)
+        w.setsampwidth(2)
+        w.setframerate(48000)
+        w.writeframes((x / np.abs(x).max() * 30000).astype("<i2").tobytes())
+    f["rec_wav_rate"] = wav
+    f.update({f"{k}_dir": v.parent for k, v in list(f.items())})
+    return f
 
 
 def _argv(row, files):
@@ -687,7 +767,7 @@ def test_plausibility_warning_text_and_json(capsys):
 
 @pytest.mark.parametrize("argv, status, word", [
     (["simulate", "--speed-rpm", "nan"], 2, "--speed-rpm"),
-    (["spectrum", "/"], 2, "RUN.npz"),
+    (["spectrum", "/"], 2, "RECORD"),
     (["modes", "--torque-nm", "10", "--positions", "2"], 2, "--positions"),
     (["frobnicate"], 2, "frobnicate"),
     (["sweep", "--speed-rpm", "1000", "--out", "/etc/hostname"], 2, "--out"),

@@ -105,3 +105,35 @@ def test_library_helpers(run_file):
     assert np.all(s.peaks["frequency_hz"] <= 1000.0)
     with pytest.raises(ParameterError, match="kind"):
         run_spectrum(run, "dte", kind="cepstrum")
+
+
+# ---- any record cmsim writes or reads (issue 26): dataset records, measured recordings
+def test_dataset_record(capsys, tmp_path):
+    """A record of ``cmsim dataset`` (channels and meta, no ``t``): its first channel, the
+    families of its own rig and operating point."""
+    spec = tmp_path / "ds.toml"
+    spec.write_text('[dataset]\nrecords = 1\n\n[sensor]\nchannels = ["accel_1b1_y"]\n'
+                    'duration_s = 0.05\n')
+    assert main(["dataset", str(spec), "--out", str(tmp_path / "ds"), "--json"]) == 0
+    capsys.readouterr()
+    record = next((tmp_path / "ds" / "records").glob("*.npz"))
+    status, res = cli_json(capsys, ["spectrum", str(record), "--top", "5"])
+    assert status == 0, res
+    assert res["signal"] == "accel_1b1_y" and res["unit"] == "m/s²" and res["n_peaks"] >= 1
+    assert res["families"]["GMF"] > 0
+
+
+@pytest.mark.skipif(not (__import__("cmsim.measured", fromlist=["data_root"]).data_root()
+                         / "cwru_bearing_12k_de").is_dir(), reason="shared data absent")
+def test_measured_recording(capsys):
+    """A measured recording with its metadata.json: the compared channel, its bearing's
+    families at the record's speed; the envelope spectrum finds the inner-race defect."""
+    from cmsim.measured import data_root
+    path = data_root() / "cwru_bearing_12k_de" / "IR007_0.npz"
+    status, res = cli_json(capsys, ["spectrum", str(path), "--kind", "envelope",
+                                    "--max-hz", "500", "--top", "5"])
+    assert status == 0, res
+    assert res["signal"] == "DE" and res["bearing"] == "1b1"
+    bpfi = res["families"]["BPFI"]
+    assert bpfi == pytest.approx(162.19, rel=1e-3)
+    assert any(abs(p["frequency_hz"] - bpfi) < 1.0 for p in res["peaks"]), res["peaks"]
