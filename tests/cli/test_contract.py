@@ -14,6 +14,7 @@ Run ids are ``<command>-<what>``.
 import argparse
 import json
 import math
+import re
 import subprocess
 import sys
 from dataclasses import dataclass
@@ -365,7 +366,61 @@ def _generated_rows():
     return rows
 
 
-ALL_ROWS = CATALOGUE + _generated_rows()
+# ---- inclusive maxima (issue 26, tests that catch plausible bugs): every numeric option's
+# documented maximum (the range its message states) is accepted, the next number above it
+# refused; generated over all options of all commands, so an off-by-one at any upper bound
+# (``>=`` for ``>``, a bound moved, a message that rounds it) fails.
+def _documented_maximum(allowed):
+    """``(text, closed)`` of the upper bound a range's text states (``"a number in [0, 0.3]"``
+    -> ``("0.3", True)``), or None when it states none."""
+    m = re.search(r" in [\[(][^,]+, ([^\])]+)([\])])", allowed)
+    if m:
+        return m.group(1), m.group(2) == "]"
+    m = re.search(r" (<=?) (\S+)", allowed)
+    return (m.group(2), m.group(1) == "<=") if m else None
+
+
+def _just_above(text, integer):
+    """The next value a user could type above ``text``: +1 for an integer, else the next
+    float (exact, so ``>`` and ``>=`` differ)."""
+    return str(int(text) + 1) if integer else repr(math.nextafter(float(text), math.inf))
+
+
+def _maxima(closed_only=False):
+    """(command, option, dest, nargs, allowed, maximum text, refused text) of every numeric
+    option whose range has an upper bound; the refused text is the bound itself when the
+    range excludes it, else the next value above it."""
+    out = []
+    for command, option, dest, nargs in _numeric_options():
+        sub = contract.subparsers(build_parser())[command]
+        allowed = next(a for a in sub._actions if a.dest == dest).type.allowed
+        top = _documented_maximum(allowed)
+        if top is None or (closed_only and not top[1]):
+            continue
+        text, closed = top
+        above = _just_above(text, allowed.startswith("an integer")) if closed else text
+        out.append((command, option, dest, nargs, allowed, text, above))
+    return out
+
+
+def _with_option(command, option, nargs, value):
+    """BASE of ``command`` (without ``option`` if it gives it) plus ``option value``."""
+    base = BASE[command].split()
+    n = nargs if isinstance(nargs, int) else 1
+    if option in base:
+        i = base.index(option)
+        del base[i: i + 1 + n]
+    return base + [option] + [value] * n
+
+
+def _above_maximum_rows():
+    return [Row(f"{command}{option}-above-max", tuple(_with_option(command, option, nargs,
+                                                                   above)),
+                (option, allowed, above), 2, True)
+            for command, option, _, nargs, allowed, _, above in _maxima()]
+
+
+ALL_ROWS = CATALOGUE + _generated_rows() + _above_maximum_rows()
 
 
 # ---------------------------------------------------------------------- fixtures
@@ -538,6 +593,18 @@ def test_every_option_is_validated():
                 assert (a.choices is not None or a.dest in free_text
                         or (command, a.dest) in contract.PATHS or a.dest in contract.PATHS), \
                     (command, a.dest)
+
+
+@pytest.mark.parametrize("command, option, dest, nargs, allowed, top, above",
+                         _maxima(closed_only=True),
+                         ids=[f"{c}{o}" for c, o, *_ in _maxima(closed_only=True)])
+def test_documented_maximum_is_accepted(command, option, dest, nargs, allowed, top, above):
+    """The maximum an option's range states parses to itself (parse only: no command runs);
+    its refusal just above is a row of ALL_ROWS (``<command><option>-above-max``)."""
+    argv = app._plain_negative_numbers(_with_option(command, option, nargs, top))
+    value = getattr(build_parser().parse_args(argv), dest)
+    values = value if isinstance(value, list) else [value]
+    assert values and all(v == pytest.approx(float(top), rel=1e-15) for v in values), allowed
 
 
 def test_param_names_map_to_options():
