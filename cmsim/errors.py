@@ -63,12 +63,17 @@ def format_range(lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False, uni
                  integer=False):
     """Readable allowed range: ``"in (0, 0.1] m"``, ``"> 0 kg"``, ``"<= 5"``, ``"finite"``.
 
-    An infinite bound is never printed (infinity is always rejected).
+    An infinite bound is never printed (infinity is always rejected). A bound reads as typed
+    back: ``0.3`` as ``0.3``, but 2π in full (``6.283185307179586``, not ``6.28319``, which
+    lies outside a range ending at 2π).
     """
     kind = "an integer" if integer else "a number"
 
     def num(x):
-        return str(int(x)) if integer else f"{x:g}"
+        if integer:
+            return str(int(x))
+        short = f"{x:g}"
+        return short if float(short) == float(x) else repr(float(x))
 
     if math.isinf(lo) and math.isinf(hi):
         text = f"{'an integer' if integer else 'a finite number'}"

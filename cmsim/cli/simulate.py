@@ -157,7 +157,7 @@ def run(args):
 def _losses_summary(info):
     """The ``losses`` of a run's meta for the CLI: power by source (W), total, efficiency
     (the run's power balance where there is one, else quasi-static) and the balance's
-    closure."""
+    closure, of the input power and of the losses themselves."""
     if not info:
         return None
     qs, bal = info["quasi_static"], info.get("balance")
@@ -165,6 +165,7 @@ def _losses_summary(info):
             "efficiency": bal["efficiency"] if bal else qs["efficiency"],
             "quasi_static_efficiency": qs["efficiency"],
             "closure": bal["closure"] if bal else None,
+            "closure_of_losses": bal.get("closure_of_losses") if bal else None,
             "balance_losses_w": bal["losses_w"] if bal else None}
 
 

@@ -94,6 +94,7 @@ class PowerBalance:
                 "losses_w": {k: float(x) for k, x in self.losses_w.items()},
                 "stored_rate_w": float(self.stored_rate_w),
                 "residual_w": float(self.residual_w), "closure": float(self.closure),
+                "closure_of_losses": float(self.closure_of_losses),
                 "efficiency": float(self.efficiency),
                 "loads_by_dof_w": {k: float(x) for k, x in self.loads_by_dof_w.items()},
                 "duration_s": float(self.duration_s)}

@@ -167,3 +167,25 @@ def test_cli_train_test_json(cwru_small, capsys):
     for key in ("balanced_accuracy", "per_class_recall", "macro_auroc", "confusion_matrix"):
         assert key in out
     assert sum(map(sum, out["confusion_matrix"]["matrix"])) == 21
+
+
+def _windows_of(groups):
+    """Two windows per record id of ``groups`` (contents irrelevant to the split check)."""
+    g = np.repeat(np.array(groups, dtype=object), 2)
+    return WindowSet(np.zeros((g.size, 8), np.float32), np.array(["healthy"] * g.size, object),
+                     g, np.zeros((g.size, 4)), np.full(g.size, 30.0), 12_000.0)
+
+
+@pytest.mark.parametrize("train, test, shared", [
+    (["sim-1", "sim-2", "sim-3"], ["sim-3", "real-1", "real-2"], "sim-3"),   # one of many
+    (["a"], ["a", "b", "c", "d"], "a"),                                      # all of one side
+    (["a", "b", "c", "d"], ["d"], "d"),                                      # all of the other
+])
+def test_one_shared_record_is_already_leakage(train, test, shared):
+    """A single record with windows on both sides raises, naming it, whatever else the
+    sides hold; disjoint sides pass."""
+    with pytest.raises(ParameterError, match=f"both sides.*{shared}"):
+        check_disjoint(_windows_of(train), _windows_of(test))
+    rest = [g for g in test if g != shared]
+    if rest:
+        check_disjoint(_windows_of(train), _windows_of(rest))

@@ -97,3 +97,24 @@ def test_runup_order_spectrum_has_sharp_gmf_and_ball_pass_orders(runup):
         assert abs(o[k] - bpo) <= sp.resolution_order         # ball pass where the cage puts it
         if name == "F_1b1_loa":
             assert amp > 10 * floor
+
+
+def test_ramp_loads_the_mesh_with_the_driven_inertia():
+    """Constant-acceleration ramps up and down: the mean mesh torque on gear 2 is the load
+    plus the driven side's inertia (gear 2, its bearings' nodes, the output inertia 2J2)
+    times its angular acceleration, with the sign of the acceleration (closed form: Newton on
+    the driven shaft; the output-side torsional springs only pass torque on). A constant-speed
+    run cannot see this term, and the order-spectrum test checks only frequencies."""
+    torque, ratio = 5.0, RIG.gears.driving.n_teeth / RIG.gears.driven.n_teeth
+    prof = SpeedProfile((0.0, 0.05, 0.15, 0.25), (1000.0, 1000.0, 3000.0, 1000.0))
+    run = simulate(RIG, cmsim.OperatingPoint(1000.0, torque), 0.25, profile=prof, seed=1,
+                   warmup_s=0.0, mesh="potential-energy")
+    names = run.meta["dof_names"]
+    j_driven = sum(m for name, m in zip(names, RIG.dof_masses) if name.startswith("theta_2"))
+    mesh_torque = run["Fmesh_total"] * RIG.gears.driven.base_radius_m
+    alpha_in = 2000.0 * math.pi / 30.0 / 0.1                    # rad/s², 2000 rpm in 0.1 s
+    for (a, b), sign in (((0.01, 0.05), 0.0), ((0.07, 0.15), 1.0), ((0.17, 0.25), -1.0)):
+        window = (run.t >= a) & (run.t < b)        # 20 ms after each kink: transient gone
+        expected = torque + sign * j_driven * alpha_in * ratio
+        assert mesh_torque[window].mean() == pytest.approx(expected, rel=0.01), (a, b)
+    assert j_driven * alpha_in > 0.3 * torque                 # the term is not lost in 1 %

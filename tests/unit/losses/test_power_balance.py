@@ -2,6 +2,11 @@
 
 Tier: closed form (conservation of energy): input power through the input coupling =
 output power + dissipation by source + change of stored energy, from the run's own signals.
+
+The closure is checked against the losses themselves (P_in − P_out, 2 % of the input here):
+a kernel that loses the tooth friction's sliding direction (``ff = μ·F``) leaves the
+balance's closure at 1.5 % of the input, barely over a 1 % tolerance, but at 400 % of the
+losses.
 """
 
 import json
@@ -31,8 +36,8 @@ def test_energy_balance_closes_with_every_loss_on(setup):
     loads = losses.loads()
     run = simulate(rig, op, 0.1, seed=3, warmup_s=0.1, loads=loads, friction_table=mu)
     pb = power_balance(run, loads, mu, tab)
-    assert pb.closure < 0.01                     # of the input power
     assert pb.closure_of_losses < 0.01           # of the losses themselves (P_in − P_out)
+    assert pb.closure < 0.01                     # of the input power
     # the sources carry what the loss model put in
     torque_sources = ("windage", "meshing", "bearing_viscous", "bearing_load", "oil_jet")
     assert pb.losses_w["loads"] == pytest.approx(
@@ -65,6 +70,7 @@ def test_a_run_made_with_every_loss_on_carries_its_breakdown_and_balance(setup):
     info = run.meta["losses"]
     assert info["quasi_static"]["power_w"] == pytest.approx(losses.power_w, rel=1e-9)
     bal = info["balance"]
+    assert bal["closure_of_losses"] < 0.01       # of the losses: the strong check
     assert bal["closure"] < 0.01
     assert bal["losses_w"]["loads"] == pytest.approx(
         sum(v for k, v in losses.power_w.items() if k != "tooth_friction"), rel=0.01)
@@ -83,6 +89,7 @@ def test_cli_losses_flag(tmp_path, capsys):
             "--losses", "--json"]
     assert main(argv) == 0
     res = json.loads(capsys.readouterr().out)["losses"]
+    assert res["closure_of_losses"] < 0.01
     assert 0.95 < res["efficiency"] < 1.0 and res["closure"] < 0.01
     assert res["power_w"]["tooth_friction"] > res["power_w"]["windage"] > 0
     assert main(argv + ["--friction", "0.05"]) == 2

@@ -185,3 +185,20 @@ def test_bad_inputs_name_the_parameter(call, name):
     f, a = amplitude_spectrum(np.sin(np.arange(1000) * 0.3), 1000.0)
     with pytest.raises(ParameterError, match=name):
         call(f, a)
+
+
+def test_a_simple_label_slightly_off_beats_a_complex_exact_one():
+    """GMF 100 Hz, BPF 33 Hz, fr 10 Hz, a line at 199 Hz, tolerance 1.5 Hz: 2GMF (1 Hz off,
+    |k|+|m|+|n| = 2) and 1GMF+3BPF (exact, 4) both fit; the simpler one names the line. With
+    a 0.5 Hz tolerance only 1GMF+3BPF fits, so that label is reachable and the rule, not the
+    lattice, decides."""
+    fs, seconds = 2000.0, 8.0
+    t = np.arange(int(fs * seconds)) / fs
+    f, a = amplitude_spectrum(np.sin(2 * np.pi * 199.0 * t), fs)
+    fam = {"GMF": 100.0, "BPF": 33.0, "fr": 10.0}
+    wide = label_peaks(f, a, fam, tolerance_hz=1.5)
+    r = _row(wide, "2GMF")
+    assert (r["k"], r["m"], r["n"]) == (2, 0, 0)
+    assert r["error_hz"] == pytest.approx(-1.0, abs=0.05)
+    narrow = label_peaks(f, a, fam, tolerance_hz=0.5)
+    assert (_row(narrow, "1GMF+3BPF")["k"], _row(narrow, "1GMF+3BPF")["m"]) == (1, 3)
