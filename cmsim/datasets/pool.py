@@ -314,6 +314,13 @@ def _probe_tcp(address, timeout_s):
                              f"first, or give the address it prints", param="scheduler") from None
 
 
+def check_scheduler(address, timeout_s=5.0):
+    """Refuse, before anything is computed, a scheduler address that is malformed or where
+    nothing listens (:class:`ParameterError` naming ``scheduler``)."""
+    _distributed()
+    _probe_tcp(address, timeout_s)
+
+
 @contextlib.contextmanager
 def scheduler_client(scheduler, timeout_s=30):
     """The ``distributed.Client`` of ``scheduler`` while active: ``None`` for ``None``, the
