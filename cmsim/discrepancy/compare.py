@@ -48,7 +48,7 @@ from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, fea
 from cmsim.discrepancy.ranking import (REFINE_TOP, Nuisances, decide, evidence, fit, rank,
                                        refine)
 from cmsim.errors import ParameterError
-from cmsim.features import common_band, segment_features, segments
+from cmsim.features import segment_features, segments
 from cmsim.features.relative import shape_band_edges
 
 __all__ = ["Comparison", "compare", "describe", "DEFAULT_BUDGET", "SIM_SEEDS", "VAR_SEEDS",
@@ -169,21 +169,14 @@ def describe(finding, component, parameters, ranges):
     return text
 
 
-def _prepare(record, seg_s, max_segments, one_band):
-    """(seg_s, duration, names, features per segment, band): with ``one_band`` every segment
-    is demodulated in the band most of the fit segments give (:func:`common_band`), else
-    each in its own."""
+def _prepare(record, seg_s, max_segments):
     x = record.signal
     fs = record.fs_hz
     duration = x.size / fs
     seg_s = float(seg_s) if seg_s is not None else min(0.5, duration / 4.0)
     freqs = record.model_frequencies()
-    bearings = list(record.rig.bearing_names)
-    band = None
-    if one_band:
-        fit = segments(x.size, fs, seg_s, max_segments)[0::2]
-        band = common_band([x[a:b] for a, b in fit], fs, freqs, bearings)
-    names, F = segment_features(x, fs, freqs, bearings, seg_s, max_segments, band)
+    names, F = segment_features(x, fs, freqs, list(record.rig.bearing_names), seg_s,
+                                max_segments)
     if F.shape[0] < 4:
         raise ParameterError(f"record of {duration:.3g} s gives {F.shape[0]} segments of "
                              f"{seg_s:g} s; needs >= 4", param="record")
@@ -198,7 +191,7 @@ def _prepare(record, seg_s, max_segments, one_band):
               for a, b in segments(x.size, fs, seg_s, max_segments)]
         names = names + ["level_db"]
         F = np.column_stack([F, lv])
-    return seg_s, duration, names, F, band
+    return seg_s, duration, names, F
 
 
 def _check_machine(record, machine):
@@ -252,9 +245,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         mode = "machine"
     else:
         mode = "documented" if record.path_documented else "path-free"
-    seg_s, duration, names, F, band = _prepare(record, seg_s, max_segments, one_band=False)
+    seg_s, duration, names, F = _prepare(record, seg_s, max_segments)
     ev = Evaluator(record, seg_s, seed, budget - 2 * SIM_SEEDS)   # held-out runs kept
-    ev.band_hz = band
     fit_rows, held_rows = F[0::2], F[1::2]
     meas_fit = dict(zip(names, np.nanmean(fit_rows, axis=0)))
     meas_held = dict(zip(names, np.nanmean(held_rows, axis=0)))

@@ -221,8 +221,6 @@ class Evaluator:
         self.cache = {}
         self.ref_rms = None
         self.scale = record.unit_scale
-        #: Demodulation band of the envelope features (None: each signal's band rule).
-        self.band_hz = None
 
     def _forces(self, setup, seed):
         key = (setup.dynamics_key(), seed)
@@ -263,8 +261,7 @@ class Evaluator:
             if x is None:
                 self.cache[key] = None
             else:
-                f = relative_features(x, self.record.fs_hz, self.freqs, self.bearings,
-                                      self.band_hz)
+                f = relative_features(x, self.record.fs_hz, self.freqs, self.bearings)
                 if self.scale is not None:
                     scale = self.scale if setup.machine is not None else 1.0
                     f["level_db"] = 20.0 * math.log10(max(float(np.std(x)) * scale, 1e-30)
