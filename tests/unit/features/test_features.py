@@ -53,19 +53,28 @@ def test_gmf_harmonics_and_sidebands_read_within_1_percent():
     assert row.dominant_gmf_harmonic == 1
 
 
-def test_envelope_family_at_bpfo_dominates():
-    """A measured-style record: one bearing given by name, no gears."""
+def _ball_pass_rig():
+    """(bearing frequencies, rig frequencies, fs) of a 6205 at 1797 rpm (BPFO 107.4 Hz)."""
     rpm = 1797.0
-    brg = bearing_frequencies(rpm / 60, 9, 7.94e-3, 39.04e-3)       # BPFO 107.4 Hz
-    f = RigFrequencies(fr1_hz=rpm / 60, bearings={"DE": brg})
-    fs = 20_000.0
-    n = int(2 * fs)
+    brg = bearing_frequencies(rpm / 60, 9, 7.94e-3, 39.04e-3)
+    return brg, RigFrequencies(fr1_hz=rpm / 60, bearings={"DE": brg}), 20_000.0
+
+
+def _ringing_at_bpfo(brg, fs, n):
+    """Unit impacts at the ball pass, each ringing a 3.5-kHz, 5 %-damped resonance."""
     wn = 2 * np.pi * 3500.0
     th = np.arange(int(0.01 * fs)) / fs
     h = np.exp(-0.05 * wn * th) * np.sin(wn * th)
     hits = np.zeros(n)
     hits[np.round(np.arange(0.0, n / fs, 1.0 / brg.bpfo_hz) * fs).astype(int)] = 1.0
-    x = np.convolve(hits, h)[:n] + 0.2 * np.random.default_rng(1).standard_normal(n)
+    return np.convolve(hits, h)[:n]
+
+
+def test_envelope_family_at_bpfo_dominates():
+    """A measured-style record: one bearing given by name, no gears."""
+    brg, f, fs = _ball_pass_rig()
+    n = int(2 * fs)
+    x = _ringing_at_bpfo(brg, fs, n) + 0.2 * np.random.default_rng(1).standard_normal(n)
     x *= 1.0 + 0.5 * np.cos(2 * np.pi * f.fr1_hz * np.arange(n) / fs)   # load-zone modulation
     row = extract_features(x, fs, f, bearing="DE")
     d = row.to_dict()
@@ -176,18 +185,10 @@ def test_one_band_for_a_record_is_the_band_most_segments_give():
     record's band is the resonance's, and a segment read in it (relative_features with
     ``band_hz``) gives the same BPFO line as one that chose that band itself, while the
     noise segment read in its own band does not."""
-    rpm = 1797.0
-    brg = bearing_frequencies(rpm / 60, 9, 7.94e-3, 39.04e-3)
-    f = RigFrequencies(fr1_hz=rpm / 60, bearings={"DE": brg})
-    fs = 20_000.0
+    brg, f, fs = _ball_pass_rig()
     n = int(0.5 * fs)
-    wn = 2 * np.pi * 3500.0
-    th = np.arange(int(0.01 * fs)) / fs
-    h = np.exp(-0.05 * wn * th) * np.sin(wn * th)
-    hits = np.zeros(n)
-    hits[np.round(np.arange(0.0, n / fs, 1.0 / brg.bpfo_hz) * fs).astype(int)] = 1.0
     rng = np.random.default_rng(2)
-    ringing = [np.convolve(hits, h)[:n] + 0.2 * rng.standard_normal(n) for _ in range(3)]
+    ringing = [_ringing_at_bpfo(brg, fs, n) + 0.2 * rng.standard_normal(n) for _ in range(3)]
     noise = 0.3 * rng.standard_normal(n)
     band = common_band([noise] + ringing, fs, f, ["DE"])
     assert band == demodulation_band(ringing[0], fs, highest_fault_hz([brg]))
