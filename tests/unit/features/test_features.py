@@ -183,8 +183,7 @@ def test_sideband_energies_read_an_amplitude_modulation_and_ignore_a_small_wobbl
 def test_one_band_for_a_record_is_the_band_most_segments_give():
     """Three segments ring a 3.5-kHz resonance at the ball pass, one is noise only: the
     record's band is the resonance's, and a segment read in it (relative_features with
-    ``band_hz``) gives the same BPFO line as one that chose that band itself, while the
-    noise segment read in its own band does not."""
+    ``band_hz``) gives the same BPFO line as one that chose that band itself."""
     brg, f, fs = _ball_pass_rig()
     n = int(0.5 * fs)
     rng = np.random.default_rng(2)
