@@ -92,7 +92,7 @@ def test_bad_input_exit_code_and_message(capsys, argv, word):
 
 
 def test_divergence_exit_code(capsys):
-    status = main(["simulate", "--speed-rpm", "1000", "--torque-nm", "100", "--fs-hz", "2000", "--substeps", "1",
+    status = main(["simulate", "--speed-rpm", "100", "--torque-nm", "100", "--fs-hz", "2000", "--substeps", "1",
                    "--warmup-s", "0", "--duration-s", "0.2"])
     assert status == 3
     assert "diverged" in capsys.readouterr().err

@@ -187,7 +187,7 @@ CATALOGUE = [
       "--ramp-s", numeric=True),
     R("simulate-ramp-s-alone", "simulate --speed-rpm 1000 --ramp-s 1", "--ramp-s",
       "--ramp-to-rpm"),
-    R("simulate-diverges", "simulate --speed-rpm 1000 --torque-nm 100 --fs-hz 2000 --substeps 1 "
+    R("simulate-diverges", "simulate --speed-rpm 100 --torque-nm 100 --fs-hz 2000 --substeps 1 "
       "--warmup-s 0 --duration-s 0.2", "--substeps", status=3),
     # ---- modes
     R("modes-positions", "modes --torque-nm 10 --positions 3", "--positions", numeric=True),
@@ -337,6 +337,17 @@ CATALOGUE = [
     R("compare-rig-missing", "compare {record} --rig {work}/none.toml", "--rig"),
     R("compare-rig-text", "compare {record} --rig {text}", "--rig"),
     R("compare-report-file", "compare {record} --report {text}", "--report"),
+    # ---- h1 (issue 26): inputs at the edge — step vs excitation, faults files, duplicates,
+    # ---- messages that name what the user typed
+    R("simulate-substeps-under-resolve-mesh", "simulate --speed-rpm 100000 --torque-nm 50 "
+      "--substeps 1 --duration-s 0.01", "--substeps", "GMF", "[18, 1000]", "--speed-rpm",
+      numeric=True),
+    R("simulate-fs-too-low-for-mesh", "simulate --speed-rpm 100000 --fs-hz 1000 "
+      "--duration-s 0.01", "--fs-hz", ">= 1316", numeric=True),
+    R("sweep-substeps-under-resolve-mesh", "sweep --speed-rpm 1000 100000 --substeps 1 "
+      "--out {work}/s", "--substeps", "[18, 1000]", numeric=True),
+    R("dataset-substeps-under-resolve-mesh", "dataset {ds_fast} --out {work}/d", "SPEC",
+      "simulation.substeps", "[18, 1000]", numeric=True),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -429,8 +440,11 @@ def files(tmp_path_factory):
     f["faults_gear"] = d / "faults_gear.toml"
     ds_spec = ('[dataset]\nrecords = 2\n\n[sensor]\nchannels = ["accel_1b1_y"]\n'
                'duration_s = 0.01\n')
+    ds_fast = ('[operating]\nsampling = "grid"\nspeed_rpm = [1000, 100000]\n\n[sensor]\n'
+               'channels = ["accel_1b1_y"]\nduration_s = 0.01\n\n[simulation]\nsubsteps = 1\n')
     for name, text_ in (("ds_spec", ds_spec),
                         ("ds_zero", ds_spec.replace("records = 2", "records = 0")),
+                        ("ds_fast", ds_fast),
                         ("ds_unknown_key", ds_spec.replace("channels", "chanels")),
                         ("ds_bad_fault", ds_spec + '\n[faults]\nhealthy_share = 0.5\n\n'
                                                    '[[faults.types]]\ntype = "bogus"\n')):
