@@ -8,6 +8,7 @@ default and accept the same range for the same option.
 from __future__ import annotations
 
 import re
+from functools import partial
 
 from cmsim.cli.contract import CLIError, load_file, ranged
 from cmsim.errors import ParameterError
@@ -172,13 +173,14 @@ def faults_of(args, rig):
     """The faults of the rig file's ``[[faults]]``, ``--faults FILE`` and each ``--fault``
     of ``args`` (in that order), each checked against ``rig``; bad input names the option
     that gave it."""
-    from cmsim.faults import load_faults, parse_fault
+    from cmsim.faults import first_clash, load_faults, parse_fault
 
     found = []                                    # (where, fault)
-    for option, path in (("--rig", getattr(args, "rig", None)),
-                         ("--faults", getattr(args, "faults", None))):
+    for option, path, rig_file in (("--rig", getattr(args, "rig", None), True),
+                                   ("--faults", getattr(args, "faults", None), False)):
         if path:
-            loaded = load_file(option, path, load_faults, "a TOML file with a [[faults]] list")
+            loaded = load_file(option, path, partial(load_faults, rig_file=rig_file),
+                               "a TOML file with a [[faults]] list")
             found += [(f"{option} {path}: faults[{i}] ({f.name})", f)
                       for i, f in enumerate(loaded)]
     for text in getattr(args, "fault", None) or ():
@@ -197,6 +199,11 @@ def faults_of(args, rig):
         except ParameterError as exc:
             raise CLIError(f"{where}: {' '.join(str(exc).split())}",
                            option=where.split()[0]) from None
+    clash = first_clash([f for _, f in found])
+    if clash is not None:
+        i, j, why = clash
+        raise CLIError(f"{found[j][0]} {why} {found[i][0]}; give each fault once",
+                       option=found[j][0].split()[0])
     return tuple(f for _, f in found)
 
 

@@ -580,6 +580,8 @@ def _settings(variations, fixed, rig, sampling):
                 bounds.check(name, v)
         if sampling == "grid" and dist.kind not in ("constant", "choice"):
             raise ParameterError(f"{name}: grid sampling takes a number or a list", param=name)
+        if sampling == "grid" and dist.kind == "choice":
+            Variation(name, dist.values)   # a grid axis: the sweep's check (no repeats)
         out.append((name, dist))
     if "speed_rpm" not in {n for n, _ in out}:
         raise ParameterError("speed_rpm must be varied (Variation('speed_rpm', [...])) or "

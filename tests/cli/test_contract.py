@@ -348,6 +348,33 @@ CATALOGUE = [
       "--out {work}/s", "--substeps", "[18, 1000]", numeric=True),
     R("dataset-substeps-under-resolve-mesh", "dataset {ds_fast} --out {work}/d", "SPEC",
       "simulation.substeps", "[18, 1000]", numeric=True),
+    R("simulate-faults-file-single-table", "simulate --speed-rpm 1000 --faults {faults_table}",
+      "--faults", "[fault]", "[[faults]]"),
+    R("simulate-faults-file-empty", "simulate --speed-rpm 1000 --faults {empty}", "--faults",
+      "defines no fault"),
+    R("simulate-faults-file-empty-list", "simulate --speed-rpm 1000 --faults {faults_none}",
+      "--faults", "defines no fault"),
+    R("simulate-faults-file-unknown-key", "simulate --speed-rpm 1000 --faults {faults_unknown}",
+      "--faults", "'severity'"),
+    R("sweep-faults-file-single-table", "sweep --speed-rpm 1000 --faults {faults_table} "
+      "--out {work}/s", "--faults", "[fault]"),
+    R("simulate-fault-repeated-key", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3,size_m=2e-3,depth_m=1e-4", "--fault", "size_m",
+      "twice"),
+    R("simulate-fault-twice", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4", "--fault", "same fault"),
+    R("simulate-two-cracks-one-tooth", "simulate --speed-rpm 1000 --fault "
+      "tooth_crack:gear=1,depth_m=1e-3 --fault tooth_crack:gear=1,depth_m=5e-4", "--fault",
+      "tooth 0 of gear 1"),
+    R("simulate-eccentricity-option-and-file", "simulate --speed-rpm 1000 --faults "
+      "{faults_ecc} --fault eccentricity:gear=1,amplitude_m=2e-5", "--fault", "--faults",
+      "eccentricity of gear 1"),
+    R("sweep-fault-twice", "sweep --speed-rpm 1000 --fault wear:bearing=1b1,"
+      "clearance_growth_m=1e-5 --fault wear:bearing=1b1,clearance_growth_m=1e-5 "
+      "--out {work}/s", "--fault", "same fault"),
+    R("dataset-grid-repeated-value", "dataset {ds_grid_repeat} --out {work}/d", "SPEC",
+      "operating.speed_rpm", "repeat"),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -438,6 +465,16 @@ def files(tmp_path_factory):
     (d / "faults_gear.toml").write_text(
         '[[faults]]\ntype = "inner_race"\nbearing = "2b1"\nsize_m = 5e-4\ndepth_m = 1e-4\n')
     f["faults_gear"] = d / "faults_gear.toml"
+    for name, text_ in (
+            ("faults_table", '[fault]\ntype = "ball"\nbearing = "1b1"\nsize_m = 5e-4\n'
+                             'depth_m = 1e-4\n'),
+            ("faults_none", "faults = []\n"),
+            ("faults_unknown", 'severity = 2\n[[faults]]\ntype = "wear"\nbearing = "1b1"\n'
+                               'clearance_growth_m = 1e-5\n'),
+            ("faults_ecc", '[[faults]]\ntype = "eccentricity"\ngear = 1\n'
+                           'amplitude_m = 1e-5\n')):
+        (d / f"{name}.toml").write_text(text_)
+        f[name] = d / f"{name}.toml"
     ds_spec = ('[dataset]\nrecords = 2\n\n[sensor]\nchannels = ["accel_1b1_y"]\n'
                'duration_s = 0.01\n')
     ds_fast = ('[operating]\nsampling = "grid"\nspeed_rpm = [1000, 100000]\n\n[sensor]\n'
@@ -445,6 +482,8 @@ def files(tmp_path_factory):
     for name, text_ in (("ds_spec", ds_spec),
                         ("ds_zero", ds_spec.replace("records = 2", "records = 0")),
                         ("ds_fast", ds_fast),
+                        ("ds_grid_repeat", ds_fast.replace("[1000, 100000]", "[1000, 1000.0]")
+                         .replace("substeps = 1", "substeps = 3")),
                         ("ds_unknown_key", ds_spec.replace("channels", "chanels")),
                         ("ds_bad_fault", ds_spec + '\n[faults]\nhealthy_share = 0.5\n\n'
                                                    '[[faults.types]]\ntype = "bogus"\n')):
