@@ -134,3 +134,25 @@ def test_bearing_rig_sweep_radial_load_and_report(capsys, tmp_path):
     assert run.meta["operating_point"]["radial_load_n"] == pytest.approx(500.0)
     status, res = run_json(capsys, ["report", str(out)])
     assert status == 0 and "dte_um" not in " ".join(res["figures"])
+
+
+def test_report_lists_the_grid_points_a_sweep_could_not_run(capsys, tmp_path):
+    """Issue 26: 20000 N m diverges (the sweep exits 3); the report of the sweep then lists
+    that grid point — in its JSON, on stderr, in the text and in the page's "Runs" — instead
+    of reading as a sweep of one run."""
+    out = tmp_path / "sw"
+    status, _ = run_json(capsys, ["sweep", "--speed-rpm", "1000", "--torque-nm", "10", "20000",
+                                  "--duration-s", "0.02", "--warmup-s", "0.01",
+                                  "--workers", "1", "--out", str(out)])
+    assert status == 3
+    status, res = run_json(capsys, ["report", str(out)])
+    assert status == 0 and res["n_runs"] == 1 and res["n_failed"] == 1
+    (failed,) = res["failed"]
+    assert failed["torque_nm"] == 20000.0 and "diverged" in failed["error"]
+    assert "20000Nm" in res["warnings"][0] and "1 of 2 grid points failed" in res["warnings"][0]
+    page = (out / "report.html").read_text()
+    assert "1 of 2 grid points failed" in page and "Failed grid points" in page
+    assert main(["report", str(out)]) == 0
+    cap = capsys.readouterr()
+    assert "1 failed grid points listed (001_n1000rpm_T20000Nm)" in cap.out
+    assert "warning: 1 of 2 grid points failed" in cap.err

@@ -24,6 +24,7 @@ import pytest
 
 import cmsim
 from cmsim.cli import app, build_parser, contract, main
+from cmsim.datasets.manifest import write_row
 from cmsim.rig import Rig
 from cmsim.run import Run
 
@@ -375,6 +376,8 @@ CATALOGUE = [
       "--out {work}/s", "--fault", "same fault"),
     R("dataset-grid-repeated-value", "dataset {ds_grid_repeat} --out {work}/d", "SPEC",
       "operating.speed_rpm", "repeat"),
+    R("report-only-failed-runs", "report {failed_sweep}", "DIR", "no finished runs",
+      "1 failed", "T20000Nm"),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -507,6 +510,12 @@ def files(tmp_path_factory):
     raw[len(raw) // 2: len(raw) // 2 + 64] = b"\0" * 64
     (corrupt / "runs" / "r0.npz").write_bytes(bytes(raw))
     f["corrupt_sweep"] = corrupt
+    failed = d / "failed_sweep"                    # a sweep whose one grid point failed
+    (failed / "records").mkdir(parents=True)
+    write_row(failed, {"index": 0, "record_id": "000_n1000rpm_T20000Nm", "status": "failed",
+                       "speed_rpm": 1000.0, "torque_nm": 20000.0, "path": None,
+                       "error": "IntegrationDiverged: the integration diverged"})
+    f["failed_sweep"] = failed
     meas = d / "measured"                          # a measured record (cmsim compare)
     meas.mkdir()
     np.savez(meas / "rec.npz", DE=np.random.default_rng(0).standard_normal(24000))
