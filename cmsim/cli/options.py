@@ -8,6 +8,7 @@ default and accept the same range for the same option.
 from __future__ import annotations
 
 import re
+import sys
 from functools import partial
 
 from cmsim.cli.contract import CLIError, load_file, ranged
@@ -148,13 +149,17 @@ def mesh_argument(args, rig, torques_nm=()):
     return tables if args.table_torque_nm is None else tables.at(args.table_torque_nm)
 
 
-def prepare_tables(args, rig, mesh):
-    """Build (or load) the hybrid mesh tables of ``rig`` once when ``mesh`` asks for them,
-    with a progress bar on stderr unless ``args.json``, before a run or the workers of a
-    sweep read them from the cache."""
+def prepare_tables(args, rig, mesh, torques_nm=()):
+    """Build (or load) the hybrid mesh tables of ``rig`` once when ``mesh`` asks for them —
+    the set and the table of each of ``torques_nm`` above it — before a run or the workers
+    of a sweep read them from the cache, so a torque the tables cannot take is refused here,
+    once. A progress bar shows on a terminal's stderr (never with ``args.json``)."""
     if mesh == "hybrid-tables" and rig.gears is not None:
-        from cmsim.dynamics.tooth_contact import hybrid_table_set
-        hybrid_table_set(rig, progress=False if args.json else None)
+        from cmsim.dynamics.tooth_contact import hybrid_table_set, resolve_mesh
+        progress = None if not args.json and sys.stderr.isatty() else False
+        hybrid_table_set(rig, progress=progress)
+        for torque in torques_nm:
+            resolve_mesh(rig, mesh, torque, progress=progress)
 
 
 # ---------------------------------------------------------------------- faults

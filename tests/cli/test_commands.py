@@ -156,3 +156,28 @@ def test_report_lists_the_grid_points_a_sweep_could_not_run(capsys, tmp_path):
     cap = capsys.readouterr()
     assert "1 failed grid points listed (001_n1000rpm_T20000Nm)" in cap.out
     assert "warning: 1 of 2 grid points failed" in cap.err
+
+
+def test_no_help_text_shows_a_doubled_percent_sign():
+    """argparse %-formats help strings but prints a parser's description as written: "5 %%"
+    showed in ``cmsim evaluate --help`` (issue 26)."""
+    from cmsim.cli import build_parser
+    from cmsim.cli.contract import subparsers
+    for command, sub in subparsers(build_parser()).items():
+        assert "%%" not in sub.format_help(), command
+
+
+def test_evaluate_text_says_when_a_class_was_never_detected():
+    """A fault class none of whose records beat the threshold has no smallest detected
+    severity (NaN): the text says so instead of "smallest severity detected nan"."""
+    from cmsim.cli.evaluate import text
+    res = {"algorithm": "envelope", "dataset": "d", "errors": {}, "report": None, "metrics": {
+        "n_scored": 4, "n_records": 4, "n_failed": 0, "accuracy": 0.5, "chance_accuracy": 0.5,
+        "macro_f1": 0.4, "auc": {},
+        "detection": {"threshold": 0.3, "classes": {
+            "outer_race": {"detection_rate_all": 0.0, "min_detected_severity": float("nan")},
+            "ball": {"detection_rate_all": 0.5, "min_detected_severity": 2e-4}}}}}
+    out = text(res)
+    assert "nan" not in out
+    assert "outer_race: detected 0.00 at 5 % false alarms, no record detected" in out
+    assert "ball: detected 0.50 at 5 % false alarms, smallest severity detected 0.0002" in out

@@ -378,6 +378,17 @@ CATALOGUE = [
       "operating.speed_rpm", "repeat"),
     R("report-only-failed-runs", "report {failed_sweep}", "DIR", "no finished runs",
       "1 failed", "T20000Nm"),
+    R("simulate-torque-moves-centres", "simulate --speed-rpm 1000 --torque-nm 1e5 "
+      "--duration-s 0.01", "--torque-nm", "gear centres", "<= about", numeric=True),
+    R("sweep-torque-moves-centres", "sweep --speed-rpm 1000 --torque-nm 10 1e5 "
+      "--out {work}/s", "--torque-nm", "gear centres", "<= about", numeric=True),
+    R("simulate-torque-at-max-diverges", "simulate --speed-rpm 1000 --torque-nm 1e6 "
+      "--duration-s 0.01", "diverged", status=3),
+    R("simulate-sensor-fs-not-a-fraction", "simulate --speed-rpm 1000 --sensor-fs-hz 1234.567 "
+      "--duration-s 0.01", "--sensor-fs-hz = 1234.57 Hz", "--fs-hz = 75000 Hz"),
+    R("simulate-ramp-starts-after-record", "simulate --speed-rpm 1000 --ramp-to-rpm 2000 "
+      "--ramp-start-s 5 --duration-s 0.01", "--ramp-start-s", "[0, 0.06)", numeric=True),
+    R("modes-torque-zero", "modes --torque-nm 0", "--torque-nm", "> 0 N m", numeric=True),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -563,6 +574,8 @@ def test_bad_input(row, as_json, files, capsys):
         obj = json.loads(cap.out)
         assert isinstance(obj, dict) and obj["status"] == row.status
         assert obj["error"] in lines[0]
+        if row.argv and row.argv[0] in BASE:        # issue 26: never "option": null
+            assert obj["option"] and obj["option"] in obj["error"], obj
     else:
         assert cap.out == ""
     assert _tree(files["root"]) == before
