@@ -88,8 +88,9 @@ def add_sampling_options(p, *, seed_help="seed of every random draw of the run")
                         f"{s.warmup_s:g})")
     p.add_argument("--substeps", type=number("substeps"), default=s.substeps,
                    help="integration steps per output sample (default: the fewest giving "
-                        ">= 4.7 steps per period of the highest mode; 1 at 75 kHz on the "
-                        "paper rig, 3 at 25.6 kHz)")
+                        ">= 4.7 steps per period of the highest mode and of 6 harmonics of "
+                        "the mesh or ball passes; 1 at 75 kHz on the paper rig at 1000 rpm, 3 "
+                        "at 25.6 kHz; a value that does not resolve the mesh is refused)")
     p.add_argument("--seed", type=number("seed"), default=s.seed,
                    help=f"{seed_help} (default {s.seed}; recorded in the run)")
 

@@ -444,25 +444,20 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     if substeps is None:
         substeps = integration_substeps(fs_hz, excitation, f_max)
     stats = {}
-    aa = None
     if on_start is not None:
         on_start(warmup_s + duration_s)
-    if substeps == 1:
-        n_warm = int(round(warmup_s * fs_hz))
-        report = None if progress is None else (lambda done, total: progress(done * dt,
-                                                                             total * dt))
-        states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
-                                       report)
-        states, diag = states[n_warm:, :n], diag[n_warm:]
-    else:
-        aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
-        # the centred filter needs half its length of integration before the first sample
-        n_warm = max(int(round(warmup_s * fs_hz)),
-                     math.ceil(aa.half_length / substeps))
-        report = None if progress is None else (lambda done, total: progress(
-            done * dt / substeps, total * dt / substeps))
-        states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme,
-                                                  stats, report, q_cols, d_cols)
+    try:
+        states, diag, wall, n_warm, aa = _integrate_run(
+            model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress, q_cols,
+            d_cols)
+    except IntegrationDiverged as exc:
+        if not start_method.endswith("(no equilibrium found)"):
+            raise
+        loads = (f"torque_nm = {op.torque_nm:g} N m" if rig.gears is not None
+                 else f"radial_load_n = {op.radial_load_n:g} N")
+        raise IntegrationDiverged(f"no static equilibrium at {loads} (the rig may not carry "
+                                  f"it), and the run from the nominal geometry diverged: "
+                                  f"{exc}") from None
     t = (n_warm + np.arange(n_rec)) * dt
     signals = _signals(model, t, states, diag, kprof)
     if wanted is not None:
@@ -506,6 +501,27 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
             run, loads, friction_table, model.mesh_table).to_dict()
         run = run.with_meta(losses=info)
     return run
+
+
+def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress,
+                   q_cols, d_cols):
+    """The run's integration: ``(states, diag, wall_s, n_warm, anti_alias)`` of the recorded
+    samples, directly at ``fs_hz`` (one step per sample) or through the anti-alias filter."""
+    if substeps == 1:
+        n_warm = int(round(warmup_s * fs_hz))
+        report = None if progress is None else (lambda done, total: progress(done * dt,
+                                                                             total * dt))
+        states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
+                                       report)
+        return states[n_warm:, :model.n_dof], diag[n_warm:], wall, n_warm, None
+    aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
+    # the centred filter needs half its length of integration before the first sample
+    n_warm = max(int(round(warmup_s * fs_hz)), math.ceil(aa.half_length / substeps))
+    report = None if progress is None else (lambda done, total: progress(
+        done * dt / substeps, total * dt / substeps))
+    states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme, stats,
+                                              report, q_cols, d_cols)
+    return states, diag, wall, n_warm, aa
 
 
 def _signals(model, t, states, diag, kprof=None):

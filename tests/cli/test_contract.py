@@ -383,7 +383,7 @@ CATALOGUE = [
     R("sweep-torque-moves-centres", "sweep --speed-rpm 1000 --torque-nm 10 1e5 "
       "--out {work}/s", "--torque-nm", "gear centres", "<= about", numeric=True),
     R("simulate-torque-at-max-diverges", "simulate --speed-rpm 1000 --torque-nm 1e6 "
-      "--duration-s 0.01", "diverged", status=3),
+      "--duration-s 0.01", "--torque-nm", "no static equilibrium", "diverged", status=3),
     R("simulate-sensor-fs-not-a-fraction", "simulate --speed-rpm 1000 --sensor-fs-hz 1234.567 "
       "--duration-s 0.01", "--sensor-fs-hz = 1234.57 Hz", "--fs-hz = 75000 Hz"),
     R("simulate-ramp-starts-after-record", "simulate --speed-rpm 1000 --ramp-to-rpm 2000 "
