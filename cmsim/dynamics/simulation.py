@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 
 import cmsim
-from cmsim.dynamics._rhs_kernels import PR_OMEGA, PR_THETA, integrate_jit, make_integrator_buffers, make_work
+from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
+                                         make_integrator_buffers, make_work)
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
