@@ -55,7 +55,8 @@ from cmsim.spectra.labels import label_peaks
 from cmsim.spectra.run_spectrum import signal_bearing, signal_unit
 from cmsim.spectra.waterfall import plot_family_waterfall, plot_harmonic_trend
 
-__all__ = ["ReportResult", "build_report", "sweep_run_files", "DEFAULT_SIGNALS", "SWEEP_AXES"]
+__all__ = ["ReportResult", "build_report", "sweep_run_files", "sweep_failures", "DEFAULT_SIGNALS",
+           "SWEEP_AXES"]
 
 #: Signals whose spectra are drawn as waterfalls by default.
 DEFAULT_SIGNALS = ("dte_um", "F_1b1_loa", "F_1b1_oloa")
@@ -93,6 +94,9 @@ class ReportResult:
     timing_s : dict of str to float
         ``load``, ``spectra``, ``plot``, ``write``, ``total`` (report generation, s) and
         ``integration`` (sum of the runs' ``meta["wall_s"]``, the simulation that made them).
+    failed : tuple of dict
+        The sweep's grid points that have no run (:func:`sweep_failures`): ``name``, their
+        settings and ``error``.
     """
 
     html: str
@@ -101,11 +105,13 @@ class ReportResult:
     sweep_axis: str
     dominant_signal: str | None
     timing_s: dict
+    failed: tuple = ()
 
     def to_dict(self):
         """JSON-ready dict (timings flattened as ``<key>_s``)."""
         out = {"html": self.html, "figures": list(self.figures), "runs": list(self.runs),
-               "n_runs": len(self.runs), "sweep_axis": self.sweep_axis,
+               "n_runs": len(self.runs), "failed": list(self.failed),
+               "n_failed": len(self.failed), "sweep_axis": self.sweep_axis,
                "dominant_signal": self.dominant_signal}
         out.update({f"{k}_s": v for k, v in self.timing_s.items()})
         return out
@@ -129,8 +135,44 @@ def sweep_run_files(sweep_dir):
     else:
         files = sorted((d / RECORDS_DIR).glob("*.npz")) or sorted((d / _RUNS_DIR).glob("*.npz"))
     if not files:
-        raise ParameterError(f"{d} holds no finished runs (expected {d / RECORDS_DIR}/*.npz)")
+        failed = sweep_failures(d)
+        why = (f"; {len(failed)} failed: " + "; ".join(f"{f['name']}: {f['error']}"
+                                                         for f in failed)) if failed else ""
+        raise ParameterError(f"{d} holds no finished runs (expected {d / RECORDS_DIR}/*.npz)"
+                             f"{why}")
     return files
+
+
+#: Manifest columns of the settings a failed grid point is listed with.
+_FAILED_SETTINGS = ("speed_rpm", "torque_nm", "friction", "clearance_m", "radial_load_n")
+
+
+def sweep_failures(sweep_dir):
+    """The grid points of a sweep that failed (their manifest rows with status ``failed``).
+
+    Parameters
+    ----------
+    sweep_dir : str or path-like
+        The sweep directory.
+
+    Returns
+    -------
+    list of dict
+        Per failed point, in index order: ``name`` (record id), the settings of
+        :data:`_FAILED_SETTINGS` it has, and ``error`` (one line); empty without a manifest.
+    """
+    d = Path(sweep_dir)
+    rows = read_rows(d) if (d / RECORDS_DIR).is_dir() else None
+    if rows is None:
+        return []
+    out = []
+    for row in rows[rows["status"] == "failed"].to_dict("records"):
+        point = {"name": str(row["record_id"])}
+        point.update({k: float(row[k]) for k in _FAILED_SETTINGS
+                      if k in row and row[k] is not None and row[k] == row[k]})
+        point["error"] = " ".join(str(row.get("error") or "unknown error").split())
+        out.append(point)
+    return out
 
 
 # ---------------------------------------------------------------------- per-run digest
@@ -419,8 +461,9 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
                      "clearance_m": d["clearance_m"], "seed": d["seed"],
                      "dominant_gmf_harmonic": k, "dominant_gmf_amplitude": a,
                      "load_s": d["load_s"], "spectra_s": d["spectra_s"]})
+    failed = sweep_failures(out_dir)
     page = _html_page(out_dir, digests, runs, axis, signals, dom_signal, sections, top_n,
-                      f_show, in_orders)
+                      f_show, in_orders, failed)
     html_path = out_dir / "report.html"
     atomic_write_text(html_path, page)
     end = time.perf_counter()
@@ -429,7 +472,8 @@ def build_report(sweep_dir, signals=DEFAULT_SIGNALS, *, top_n=8, max_freq_hz=Non
               "plot": t_plot1 - t_plot0, "write": end - t_plot1, "total": end - start,
               "integration": sum(d["integration_s"] for d in digests)}
     return ReportResult(html=str(html_path), figures=tuple(figures), runs=tuple(runs),
-                        sweep_axis=axis, dominant_signal=dom_signal, timing_s=timing)
+                        sweep_axis=axis, dominant_signal=dom_signal, timing_s=timing,
+                        failed=tuple(failed))
 
 
 def _group_section(gi, fixed, members, axis, in_orders, signals, dom_signal, f_show, dyn,
@@ -535,14 +579,27 @@ def _losses_section(digests, emit):
         "</figure>", table])
 
 
+def _failed_section(failed):
+    """HTML of the grid points without a run (nothing when every point ran)."""
+    if not failed:
+        return []
+    columns = [k for k in _FAILED_SETTINGS if any(k in f for f in failed)]
+    rows = [(html.escape(f["name"]), *(_fmt(f.get(k), "g") for k in columns),
+             html.escape(f["error"])) for f in failed]
+    return ["<h2>Failed grid points (no run, left out of every figure and table)</h2>",
+            _table(["run", *columns, "error"], rows, left=(0, len(columns) + 1))]
+
+
 def _html_page(out_dir, digests, runs, axis, signals, dom_signal, sections, top_n, f_show,
-               in_orders):
+               in_orders, failed=()):
     d0 = digests[0]
     values = sorted({d[axis] for d in digests})
     speeds = sorted({d["speed_rpm"] for d in digests})
+    missing = (f"; {len(failed)} of {len(digests) + len(failed)} grid points failed: "
+               + ", ".join(html.escape(f["name"]) for f in failed)) if failed else ""
     head = [("Rig", html.escape(d0["rig_name"])),
             ("Runs", f"{len(digests)} (files in <code>"
-                     f"{html.escape(d0['file'].split('/')[0])}/</code>)"),
+                     f"{html.escape(d0['file'].split('/')[0])}/</code>){missing}"),
             ("Sweep parameter", f"{html.escape(SWEEP_AXES[axis])}: "
                                 f"{', '.join(f'{v:g}' for v in values)}"),
             ("Speed", ", ".join(f"{s:g} rpm" for s in speeds)),
@@ -560,7 +617,8 @@ def _html_page(out_dir, digests, runs, axis, signals, dom_signal, sections, top_
              "Fernandez-del-Rincon et al.). Every figure and table below is computed from the "
              "run files alone; regenerate with <code>cmsim report "
              f"{html.escape(out_dir.name)}</code>.</p>",
-             "<dl>" + "".join(f"<dt>{k}</dt><dd>{v}</dd>" for k, v in head) + "</dl>"]
+             "<dl>" + "".join(f"<dt>{k}</dt><dd>{v}</dd>" for k, v in head) + "</dl>",
+             *_failed_section(failed)]
     if dom_signal:
         rows = [(r["name"], _fmt(r["speed_rpm"], "g"), _fmt(r["torque_nm"], "g"),
                  _fmt(r["friction"], "g"), _fmt(r["clearance_m"] * 1e6, "g"), r["seed"],

@@ -207,8 +207,8 @@ def decimate(x, fs_hz, fs_out_hz):
     up, down = ratio.numerator, ratio.denominator
     if abs(up * fs / down - fs_out) > 1e-9 * fs_out:
         raise ParameterError(
-            f"sensor fs_hz = {fs_out:g} Hz is not a fraction up/down (down <= "
-            f"{MAX_RATIO_DENOMINATOR}) of the run's {fs:g} Hz", param="fs_hz",
+            f"fs_out_hz = {fs_out:g} Hz (the sensor rate) is not a fraction up/down (down <= "
+            f"{MAX_RATIO_DENOMINATOR}) of the run's fs_hz = {fs:g} Hz", param="fs_out_hz",
             allowed=f"{fs:g}·up/down Hz")
     if up == down:
         return x.copy(), 0.0, {"method": "none", "up": 1, "down": 1}
@@ -299,7 +299,8 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     noise_rms : float
         RMS of white Gaussian sensor noise at the sensor rate, m/s² (>= 0).
     fs_hz : float, optional
-        Sensor sample rate, Hz (<= the run's rate); default the run's own rate.
+        Sensor sample rate, Hz (<= the run's rate); default the run's own rate. Errors about
+        it name it ``fs_out_hz`` (as :func:`decimate` does), not the run's ``fs_hz``.
     seed : int, optional
         Seed of the noise generator; default the run's ``meta["seed"]`` (else 0).
     bearings : sequence of str, optional
@@ -326,8 +327,8 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
         raise ParameterError(f"run must be a cmsim Run, got {type(run).__name__}", param="run")
     noise = check_range("noise_rms", noise_rms, 0.0, unit="m/s^2")
     fs_in = run.fs_hz
-    fs_out = fs_in if fs_hz is None else check_range("fs_hz", fs_hz, 0.0, lo_open=True,
-                                                     unit="Hz")
+    fs_out = fs_in if fs_hz is None else check_range("fs_out_hz", fs_hz, 0.0, lo_open=True,
+                                                     unit="Hz (the sensor rate)")
     if path is None:
         rig = run.rig
         path = rig.housing if rig is not None else HousingPath()
@@ -371,7 +372,13 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
             signals[name] = signals[name] + noise * rng.standard_normal(t.size)
     tacho_meta = None
     if "theta_1b1" in signals:
-        signals["tacho"] = tacho_signal(signals["theta_1b1"])
+        try:
+            signals["tacho"] = tacho_signal(signals["theta_1b1"])
+        except ParameterError as exc:      # the rate named is the tacho's: the sensor's
+            if fs_out == fs_in:
+                raise
+            raise ParameterError(str(exc).replace("the sensor fs_hz", "fs_out_hz (the "
+                                                  "sensor rate)"), param="fs_out_hz") from None
         tacho_meta = {"from": "theta_1b1", "level_v": TACHO_LEVEL_V,
                       "pulse_width_rad": TACHO_PULSE_WIDTH_RAD, "pulses_per_rev": 1}
     sensor = {"housing": {k: list(v) for k, v in dataclasses.asdict(path).items()},

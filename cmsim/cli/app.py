@@ -19,8 +19,8 @@ import numpy as np
 
 from cmsim.cli import (calibrate, compare, dataset, evaluate, losses, mesh_table, modes,
                        report, simulate, spectrum, sweep)
-from cmsim.cli.contract import (CLIError, Parser, check_paths, finite, options_of, subparsers,
-                                user_message)
+from cmsim.cli.contract import (CLIError, Parser, check_paths, finite, option_named_in,
+                                options_of, subparsers, user_message)
 from cmsim.errors import IntegrationDiverged, ParameterError, WorkersDied
 
 __all__ = ["main", "build_parser", "COMMANDS"]
@@ -126,8 +126,10 @@ def main(argv=None):
 
 def _fail(parser, args, message, status, option=None, extra=None):
     message = " ".join(str(message).split())
-    prog = f"cmsim {args.command}" if getattr(args, "command", None) in subparsers(parser) \
-        else "cmsim"
+    command = getattr(args, "command", None)
+    prog = f"cmsim {command}" if command in subparsers(parser) else "cmsim"
+    if option is None and status in (2, 3):     # bad input or a diverged run: name the option
+        option = option_named_in(message, options_of(parser, command))
     print(f"{prog}: error: {message}", file=sys.stderr)
     if getattr(args, "json", False):
         out = {"error": message, "status": status, "option": option, **(extra or {})}

@@ -28,7 +28,7 @@ from cmsim._io import READ_ERRORS
 from cmsim.errors import ParameterError
 
 __all__ = ["CLIError", "Parser", "ranged", "subparsers", "options_of", "user_message",
-           "check_paths", "load_file", "finite", "PATHS", "PARAM_TO_DEST"]
+           "option_named_in", "check_paths", "load_file", "finite", "PATHS", "PARAM_TO_DEST"]
 
 #: Python names used by the library -> dest of the option that sets them.
 PARAM_TO_DEST = {
@@ -88,7 +88,7 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         """Raise :class:`CLIError` with argparse's ``message`` (never exit)."""
-        m = re.search(r"argument ([^\s:]+)", message)
+        m = re.search(r"(?:argument|unrecognized arguments:|required:) ([^\s:,]+)", message)
         raise CLIError(f"{message} (see {self.prog} --help)", 2,
                        option=m.group(1).split("/")[-1] if m else None)
 
@@ -167,7 +167,29 @@ def user_message(exc, options):
             msg = re.sub(rf"(?<![\w.\[\-]){re.escape(name)}(?![\w\[])", opt, msg)
     if option is not None and option not in msg:
         msg = f"{option}: {msg}"
-    return msg, option
+    return msg, option or option_named_in(msg, options)
+
+
+def option_named_in(message, options):
+    """The option (as typed) a message names first, or None: what an error is about when
+    the library could not say (a derived value out of range, a run that diverged).
+
+    Parameters
+    ----------
+    message : str
+        The message, its Python names already replaced by the options.
+    options : dict
+        {dest: option} of the command (:func:`options_of`).
+
+    Examples
+    --------
+    >>> option_named_in("diverged; use --substeps > 1 or a higher --fs-hz",
+    ...                 {"fs_hz": "--fs-hz", "substeps": "--substeps"})
+    '--substeps'
+    """
+    found = [(m.start(), opt) for opt in set(options.values()) if opt != "--json"
+             for m in [re.search(rf"(?<![\w\-]){re.escape(opt)}(?![\w\-])", message)] if m]
+    return min(found)[1] if found else None
 
 
 def check_paths(args, command, options):

@@ -18,7 +18,7 @@ def register(sub):
                                    "(cmsim dataset --out, or a folder of measured records with "
                                    "metadata.json) and report accuracy, macro-F1, the confusion "
                                    "matrix, per-class ROC AUC and detection against severity at "
-                                   "5 %% false alarms. See cmsim.diagnostics for the function's "
+                                   "5 % false alarms. See cmsim.diagnostics for the function's "
                                    "signature. What the function prints goes to stderr; what it "
                                    "raises (sys.exit too) is that record's error, with its "
                                    "traceback in --json and --report. Exit status 2 if no "
@@ -147,6 +147,11 @@ def _text_syn2real(res):
     return "\n".join(lines)
 
 
+def _number(value):
+    """True for a finite number (a metric that exists: not None, not NaN)."""
+    return isinstance(value, (int, float)) and value == value and abs(value) != float("inf")
+
+
 def text(res):
     """The scores in words."""
     if "classifier" in res:
@@ -163,8 +168,10 @@ def text(res):
     if m["n_scored"] and det["threshold"] is None or det["threshold"] != det["threshold"]:
         lines.append("no healthy record answered: detection against severity not scored")
     for cls, c in det["classes"].items() if det["threshold"] == det["threshold"] else ():
+        least = c["min_detected_severity"]
         lines.append(f"{cls}: detected {c['detection_rate_all']:.2f} at 5 % false alarms, "
-                     f"smallest severity detected {c['min_detected_severity']:.3g}")
+                     + (f"smallest severity detected {least:.3g}" if _number(least)
+                        else "no record detected"))
     for rid, err in res["errors"].items():
         lines.append(f"record {rid}: {err}")
     for rid, why in res["unreadable"].items():

@@ -8,6 +8,8 @@ default and accept the same range for the same option.
 from __future__ import annotations
 
 import re
+import sys
+from functools import partial
 
 from cmsim.cli.contract import CLIError, load_file, ranged
 from cmsim.errors import ParameterError
@@ -86,8 +88,9 @@ def add_sampling_options(p, *, seed_help="seed of every random draw of the run")
                         f"{s.warmup_s:g})")
     p.add_argument("--substeps", type=number("substeps"), default=s.substeps,
                    help="integration steps per output sample (default: the fewest giving "
-                        ">= 4.7 steps per period of the highest mode; 1 at 75 kHz on the "
-                        "paper rig, 3 at 25.6 kHz)")
+                        ">= 4.7 steps per period of the highest mode and of 6 harmonics of "
+                        "the mesh or ball passes; 1 at 75 kHz on the paper rig at 1000 rpm, 3 "
+                        "at 25.6 kHz; a value that does not resolve the mesh is refused)")
     p.add_argument("--seed", type=number("seed"), default=s.seed,
                    help=f"{seed_help} (default {s.seed}; recorded in the run)")
 
@@ -147,13 +150,17 @@ def mesh_argument(args, rig, torques_nm=()):
     return tables if args.table_torque_nm is None else tables.at(args.table_torque_nm)
 
 
-def prepare_tables(args, rig, mesh):
-    """Build (or load) the hybrid mesh tables of ``rig`` once when ``mesh`` asks for them,
-    with a progress bar on stderr unless ``args.json``, before a run or the workers of a
-    sweep read them from the cache."""
+def prepare_tables(args, rig, mesh, torques_nm=()):
+    """Build (or load) the hybrid mesh tables of ``rig`` once when ``mesh`` asks for them —
+    the set and the table of each of ``torques_nm`` above it — before a run or the workers
+    of a sweep read them from the cache, so a torque the tables cannot take is refused here,
+    once. A progress bar shows on a terminal's stderr (never with ``args.json``)."""
     if mesh == "hybrid-tables" and rig.gears is not None:
-        from cmsim.dynamics.tooth_contact import hybrid_table_set
-        hybrid_table_set(rig, progress=False if args.json else None)
+        from cmsim.dynamics.tooth_contact import hybrid_table_set, resolve_mesh
+        progress = None if not args.json and sys.stderr.isatty() else False
+        hybrid_table_set(rig, progress=progress)
+        for torque in torques_nm:
+            resolve_mesh(rig, mesh, torque, progress=progress)
 
 
 # ---------------------------------------------------------------------- faults
@@ -172,13 +179,14 @@ def faults_of(args, rig):
     """The faults of the rig file's ``[[faults]]``, ``--faults FILE`` and each ``--fault``
     of ``args`` (in that order), each checked against ``rig``; bad input names the option
     that gave it."""
-    from cmsim.faults import load_faults, parse_fault
+    from cmsim.faults import first_clash, load_faults, parse_fault
 
     found = []                                    # (where, fault)
-    for option, path in (("--rig", getattr(args, "rig", None)),
-                         ("--faults", getattr(args, "faults", None))):
+    for option, path, rig_file in (("--rig", getattr(args, "rig", None), True),
+                                   ("--faults", getattr(args, "faults", None), False)):
         if path:
-            loaded = load_file(option, path, load_faults, "a TOML file with a [[faults]] list")
+            loaded = load_file(option, path, partial(load_faults, rig_file=rig_file),
+                               "a TOML file with a [[faults]] list")
             found += [(f"{option} {path}: faults[{i}] ({f.name})", f)
                       for i, f in enumerate(loaded)]
     for text in getattr(args, "fault", None) or ():
@@ -197,6 +205,11 @@ def faults_of(args, rig):
         except ParameterError as exc:
             raise CLIError(f"{where}: {' '.join(str(exc).split())}",
                            option=where.split()[0]) from None
+    clash = first_clash([f for _, f in found])
+    if clash is not None:
+        i, j, why = clash
+        raise CLIError(f"{found[j][0]} {why} {found[i][0]}; give each fault once",
+                       option=found[j][0].split()[0])
     return tuple(f for _, f in found)
 
 

@@ -37,13 +37,21 @@ def run(args):
         if exc.param is None:  # about the directory or its runs
             raise CLIError(f"DIR {args.dir}: {exc}", option="DIR") from None
         raise
-    return res.to_dict()
+    out = res.to_dict()
+    if out["failed"]:
+        args.warn(f"{out['n_failed']} of {out['n_runs'] + out['n_failed']} grid points failed "
+                  f"and are not in the report: " + "; ".join(
+                      f"{f['name']} ({f['error']})" for f in out["failed"]))
+    return out
 
 
 def text(res):
     """What was written and how long it took."""
     lines = [f"wrote {res['html']} with {len(res['figures'])} figures "
              f"({', '.join(res['figures'])})",
+             f"runs {res['n_runs']}" + (f", {res['n_failed']} failed grid points listed "
+                                        f"({', '.join(f['name'] for f in res['failed'])})"
+                                        if res["n_failed"] else ""),
              f"report {res['total_s']:.2f} s: load {res['load_s']:.2f} s, spectra "
              f"{res['spectra_s']:.2f} s, plots {res['plot_s']:.2f} s, html {res['write_s']:.2f} s"]
     if res["dominant_signal"]:

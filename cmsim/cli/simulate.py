@@ -71,9 +71,11 @@ def _speed_profile(args):
                            "--ramp-to-rpm too", option="--ramp-s")
         return None
     from cmsim.dynamics.profiles import SpeedProfile
-    start_s = args.ramp_start_s or 0.0
-    ramp_s = args.ramp_s if args.ramp_s is not None else max(
-        args.warmup_s + args.duration_s - start_s, 1e-3)
+    end_s = args.warmup_s + args.duration_s
+    start_s = Range(0.0, end_s, hi_open=True,
+                    unit="s (the ramp starts before the record ends: warmup_s + duration_s)"
+                    ).check("ramp_start_s", args.ramp_start_s or 0.0)
+    ramp_s = args.ramp_s if args.ramp_s is not None else max(end_s - start_s, 1e-3)
     return SpeedProfile.ramp(args.speed_rpm, args.ramp_to_rpm, ramp_s, start_s=start_s)
 
 
@@ -108,7 +110,7 @@ def run(args):
     profile = _speed_profile(args)
     mesh = mesh_argument(args, rig, [op.torque_nm])
     check_losses_options(args)
-    prepare_tables(args, rig, mesh)
+    prepare_tables(args, rig, mesh, [op.torque_nm])
     if args.sensor_fs_hz is not None and args.sensor_fs_hz > args.fs_hz:
         raise CLIError(f"--sensor-fs-hz {args.sensor_fs_hz:g} must be <= --fs-hz "
                        f"{args.fs_hz:g}", option="--sensor-fs-hz")

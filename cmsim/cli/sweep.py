@@ -63,7 +63,7 @@ def run(args):
                                                  args.radial_load_n or 0.0))
     mesh = mesh_argument(args, rig, torques or ())
     check_losses_options(args)
-    prepare_tables(args, rig, mesh)                 # once, before the workers start
+    prepare_tables(args, rig, mesh, torques or ())  # once, before the workers start
     axes = [("speed_rpm", args.speed_rpm), ("torque_nm", torques), ("friction", args.friction),
             ("clearance_m", args.clearance_m)]
     spec = DatasetSpec([Variation(n, v) for n, v in axes if v],

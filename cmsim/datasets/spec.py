@@ -51,6 +51,7 @@ from cmsim.datasets.spec_toml import (check_channels, read_toml, setting_range, 
                                       toml_keywords)
 from cmsim.datasets.variation import (OPERATING_POINT_FIELDS, Variation, _check_value,
                                       apply_rig_setting, setting_kind, value_token)
+from cmsim.dynamics.step import fastest_excitation, integration_substeps
 from cmsim.dynamics.tooth_contact import MESH_CHOICES
 from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.faults import FAULT_TYPES, check_faults
@@ -454,7 +455,8 @@ class DatasetSpec:
 
     def _check_records(self):
         """Every grid point (or the first records drawn) builds a valid rig, operating point
-        and model faults."""
+        and model faults, and its fastest excitation is resolved by the spec's sampling
+        (:func:`cmsim.dynamics.step.integration_substeps`: the step a run takes)."""
         if self.sampling == "grid":
             indices = range(0, min(self.n_records, self.n_points * self.repeats),
                             self.repeats)
@@ -463,8 +465,12 @@ class DatasetSpec:
         for i in indices:
             plan = self.record(i)
             try:
-                check_faults(self.record_rig(plan), self.faults)
-                self.record_operating_point(plan)
+                rig = self.record_rig(plan)
+                check_faults(rig, self.faults)
+                op = self.record_operating_point(plan)
+                ratio = plan.params["end_speed_rpm"] / op.speed_rpm
+                integration_substeps(self.fs_hz, fastest_excitation(rig, op, ratio),
+                                     substeps=self.substeps)
             except ParameterError as exc:
                 raise ParameterError(f"record {plan.record_id}: {exc}",
                                      param=getattr(exc, "param", None)) from None
@@ -574,6 +580,8 @@ def _settings(variations, fixed, rig, sampling):
                 bounds.check(name, v)
         if sampling == "grid" and dist.kind not in ("constant", "choice"):
             raise ParameterError(f"{name}: grid sampling takes a number or a list", param=name)
+        if sampling == "grid" and dist.kind == "choice":
+            Variation(name, dist.values)   # a grid axis: the sweep's check (no repeats)
         out.append((name, dist))
     if "speed_rpm" not in {n for n, _ in out}:
         raise ParameterError("speed_rpm must be varied (Variation('speed_rpm', [...])) or "

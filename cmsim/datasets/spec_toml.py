@@ -25,7 +25,8 @@ checked, and a bad spec is refused before any work with a message naming the key
     [sensor]       channels (accel_<bearing>_<x|y>, tacho, F_<bearing>_<x|y|loa|oloa>, dte,
                    dte_um, Fmesh_total; or "all": the simulated run in full, as a sweep
                    keeps it), fs_hz (output rate; the integration step is chosen from the
-                   model's highest mode and the output is anti-alias decimated), duration_s,
+                   model's highest mode and fastest excitation, and the output is anti-alias
+                   decimated), duration_s,
                    warmup_s (simulated and dropped); the defaults are cmsim.rig.SAMPLING's
                    (75 kHz, 1 s, 0.05 s), as for simulate and sweep
     [simulation]   mesh (tooth contact model name), substeps (integration steps per sample;

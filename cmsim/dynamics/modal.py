@@ -134,6 +134,21 @@ def highest_frequency_hz(model, q, t=0.0):
     return float(math.sqrt(max(eig[-1], 0.0)) / (2.0 * math.pi))
 
 
+def _check_loaded(rig, op):
+    """Refuse an unloaded operating point: it has no unique static state to linearise about
+    (the gears turn freely within the backlash, bearings with clearance carry nothing)."""
+    why = ("an unloaded rig has no unique static state to linearise about (the gears turn "
+           "freely within the backlash and the bearings carry nothing); a run (simulate) "
+           "starts there from the nominal geometry")
+    if rig.gears is not None and op.torque_nm <= 0.0 and op.radial_load_n <= 0.0:
+        raise ParameterError(f"torque_nm must be > 0 N m for a modal analysis, got "
+                             f"{op.torque_nm:g}: {why}", param="torque_nm", allowed="> 0 N m")
+    if rig.gears is None and op.radial_load_n <= 0.0:
+        raise ParameterError(f"radial_load_n must be > 0 N for a modal analysis of a rig "
+                             f"without gears, got {op.radial_load_n:g}: {why}",
+                             param="radial_load_n", allowed="> 0 N")
+
+
 def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     """Natural frequencies and mode types of ``rig`` at ``op``.
 
@@ -151,12 +166,20 @@ def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     Returns
     -------
     ModalResult
+
+    Raises
+    ------
+    ParameterError
+        An unloaded operating point (no torque on a gear rig, no radial load on a rig
+        without gears): there is no unique static state to linearise about. Light loads
+        are reached by continuation from a firmly loaded state.
     """
     if not isinstance(n_positions, (int, np.integer)) or n_positions < 4:
         raise ParameterError(f"n_positions must be an integer >= 4, got {n_positions!r}")
+    _check_loaded(rig, op)
     model = build_model(rig, op, resolve_mesh(rig, mesh, op.torque_nm))
     times = _bearing_cycle_times(model, n_positions)
-    states = quasi_static_orbit(model, times)
+    states = quasi_static_orbit(model, times, light_load=True)
     k_brg = _averaged_bearing_stiffness(model, states, times)
     k_mean = 0.0 if rig.gears is None else model.mesh_table.mean_mesh_stiffness(rig.gears)
     eigvals, shapes = scipy.linalg.eigh(_linearised_stiffness(model, k_brg, k_mean),

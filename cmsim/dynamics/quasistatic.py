@@ -17,20 +17,23 @@ from scipy.optimize import root
 from cmsim.bearings.hertz import bearing_contact_stiffness
 from cmsim.errors import IntegrationDiverged
 
-__all__ = ["quasi_static_state", "quasi_static_orbit", "initial_state"]
+__all__ = ["quasi_static_state", "quasi_static_orbit", "continued_state", "initial_state"]
 
 #: Relative loads of the continuation that reaches a light load from a firmly loaded state.
 CONTINUATION_FACTORS = (64.0, 16.0, 4.0, 2.0, 1.0)
 
 
-def _scales(model):
+def _scales(model, load_factor=1.0):
+    """Scales of the unknowns and residuals, and the reference load f_ref (N), of ``model``
+    with its loads multiplied by ``load_factor`` (:func:`_with_load_scaled`)."""
     rig, op = model.rig, model.op
+    torque_nm, radial_load_n = op.torque_nm * load_factor, op.radial_load_n * load_factor
     if rig.gears is not None:
         rb = rig.gears.driving.base_radius_m
-        f_ref = max(op.torque_nm / rb, op.radial_load_n, 1.0)
+        f_ref = max(torque_nm / rb, radial_load_n, 1.0)
         length = rb
     else:
-        f_ref = max(op.radial_load_n, 1.0)
+        f_ref = max(radial_load_n, 1.0)
         length = 0.05
     rot = np.array([d.startswith("theta") for d in model.dof_names])
     q_scale = np.where(rot, 1e-4, 1e-5)
@@ -70,7 +73,7 @@ def _linear_guess(model, f_ref):
     return q
 
 
-def quasi_static_state(model, t=0.0, q_guess=None, tol=1e-9):
+def quasi_static_state(model, t=0.0, q_guess=None, tol=1e-9, *, load_factor=1.0):
     """DOF deviations ``q`` (shape (n,)) in static equilibrium at time ``t``.
 
     Parameters
@@ -82,13 +85,16 @@ def quasi_static_state(model, t=0.0, q_guess=None, tol=1e-9):
         Starting point (e.g. the solution at a neighbouring instant).
     tol : float
         Required max |residual| relative to the reference load.
+    load_factor : float
+        The factor by which ``model``'s loads were multiplied (:func:`_with_load_scaled`):
+        sets the reference load; the operating point keeps the user's values.
 
     Raises
     ------
     IntegrationDiverged
         If no equilibrium is found (e.g. a rig that cannot carry the load).
     """
-    q_scale, f_scale, f_ref = _scales(model)
+    q_scale, f_scale, f_ref = _scales(model, load_factor)
     x0 = (_linear_guess(model, f_ref) if q_guess is None else np.asarray(q_guess)) / q_scale
 
     def fun(x):
@@ -104,28 +110,71 @@ def quasi_static_state(model, t=0.0, q_guess=None, tol=1e-9):
             break
         x0 = sol.x
     if best[1] > 1e3 * tol:
+        loads = (["torque_nm"] if model.rig.gears is not None else []) + (
+            ["radial_load_n"] if model.rig.gears is None or model.op.radial_load_n > 0 else [])
         raise IntegrationDiverged(
             f"no quasi-static equilibrium at t = {t:g} s (max relative residual {best[1]:.2e}); "
-            "check torque_nm, radial_load_n and clearance_m")
+            f"check {', '.join(loads)} and clearance_m")
     return best[0] * q_scale
 
 
-def quasi_static_orbit(model, times_s):
-    """Quasi-static states at several instants (continuation), shape (len(times_s), n)."""
+def quasi_static_orbit(model, times_s, *, light_load=False):
+    """Quasi-static states at several instants (continuation), shape (len(times_s), n).
+
+    With ``light_load`` an instant whose equilibrium the direct solve misses is followed
+    down from a firmly loaded state (:func:`continued_state`), as the start of a run is.
+    """
     out = np.empty((len(times_s), model.n_dof))
     q = None
     for i, t in enumerate(times_s):
-        q = quasi_static_state(model, t, q_guess=q)
+        try:
+            q = quasi_static_state(model, t, q_guess=q)
+        except IntegrationDiverged:
+            if not light_load:
+                raise
+            q = continued_state(model, t, q_guess=q)
         out[i] = q
     return out
 
 
+def continued_state(model, t=0.0, q_guess=None):
+    """Equilibrium at a light load, followed down from :data:`CONTINUATION_FACTORS` times it.
+
+    At light loads the Hertzian contacts barely close (their stiffness vanishes at first
+    touch, so Newton's method may stall); each step is accepted within a force residual of
+    1e-5 of the reference load.
+
+    Parameters
+    ----------
+    model : DynamicModel
+    t : float
+        Instant (sets the cage and mesh positions), s.
+    q_guess : ndarray, optional
+        Starting point of the first (most loaded) step.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        DOF deviations in equilibrium at the model's load.
+
+    Raises
+    ------
+    IntegrationDiverged
+        If a step finds no equilibrium.
+    """
+    q = q_guess
+    for factor in CONTINUATION_FACTORS:
+        q = quasi_static_state(_with_load_scaled(model, factor), t, q_guess=q, tol=1e-5,
+                               load_factor=factor)
+    return q
+
+
 def _with_load_scaled(model, factor):
-    """The same model with its external loads multiplied by ``factor``."""
+    """The same model with its external loads multiplied by ``factor`` (a step of the
+    continuation: its operating point stays the user's, which may already be at the top of
+    its range; :func:`quasi_static_state` takes the factor as ``load_factor``)."""
     force = model.force * factor
-    return replace(model, force=force, kernel_params=model.kernel_params._replace(fext=force),
-                   op=replace(model.op, torque_nm=model.op.torque_nm * factor,
-                              radial_load_n=model.op.radial_load_n * factor))
+    return replace(model, force=force, kernel_params=model.kernel_params._replace(fext=force))
 
 
 def initial_state(model, t=0.0):
@@ -151,10 +200,7 @@ def initial_state(model, t=0.0):
         return quasi_static_state(model, t), "quasi-static"
     except IntegrationDiverged:
         pass
-    q = None
     try:
-        for factor in CONTINUATION_FACTORS:
-            q = quasi_static_state(_with_load_scaled(model, factor), t, q_guess=q, tol=1e-5)
-        return q, "continuation"
+        return continued_state(model, t), "continuation"
     except IntegrationDiverged:
         return np.zeros(model.n_dof), "nominal geometry (no equilibrium found)"

@@ -12,13 +12,16 @@ from pathlib import Path
 import numpy as np
 
 import cmsim
-from cmsim.dynamics._rhs_kernels import PR_THETA, integrate_jit, make_integrator_buffers, make_work
+from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
+                                         make_integrator_buffers, make_work)
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
+from cmsim.dynamics.step import (STEPS_PER_PERIOD, fastest_excitation,
+                                 integration_substeps)
 from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.errors import IntegrationDiverged, ParameterError, check_choice, check_range, check_type
 from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
@@ -30,11 +33,6 @@ from cmsim.run import Run
 
 __all__ = ["simulate", "integrate", "check_memory", "kernels_cached",
            "MAX_ROTATION_DEVIATION_RAD",           "STEPS_PER_PERIOD", "MAX_OUTPUT_BYTES"]
-
-#: Integration steps per period of the highest natural frequency when the step is chosen
-#: automatically: ω_max·h <= 2π/4.7 = 1.34, 77 % of ode3's stability limit √3 on the
-#: imaginary axis (the paper's 75 kHz for its rig's 15.94 kHz mode 19).
-STEPS_PER_PERIOD = 4.7
 
 #: Largest output a run may hold in memory, bytes (signals as float64); longer runs are
 #: refused with the duration that fits.
@@ -295,13 +293,17 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     rotation), integrates ``warmup_s`` to let the start transient decay, then records
     ``duration_s`` at ``fs_hz``.
 
-    The integration step is ``1/(fs_hz·substeps)``. By default ``substeps`` is the smallest
-    integer that gives at least :data:`STEPS_PER_PERIOD` steps per period of the model's
-    highest natural frequency (linearised at the start; 15.9 kHz for the paper's rig, so
-    75 kHz as in the paper). With ``substeps > 1`` the states and forces pass through an
-    anti-alias FIR (:class:`~cmsim.dynamics.decimation.AntiAliasFilter`: flat to 0.8 ×
-    Nyquist, ≥ 80 dB down from Nyquist on) before every ``substeps``-th sample is kept, as
-    an acquisition system does: nothing above the output Nyquist frequency aliases.
+    The integration step is ``1/(fs_hz·substeps)`` (the rule: :mod:`cmsim.dynamics.step`). By
+    default ``substeps`` is the smallest integer that gives at least :data:`STEPS_PER_PERIOD`
+    steps per period of the model's highest natural frequency (linearised at the start;
+    15.9 kHz for the paper's rig, so 75 kHz as in the paper) and of each of the first
+    :data:`~cmsim.dynamics.step.RESOLVED_HARMONICS` harmonics of the fastest excitation (the
+    gear mesh or a ball pass, at the fastest speed of the run); a ``substeps`` given that
+    does not resolve the excitation is refused. With ``substeps > 1`` the states and forces
+    pass through an anti-alias FIR (:class:`~cmsim.dynamics.decimation.AntiAliasFilter`:
+    flat to 0.8 × Nyquist, ≥ 80 dB down from Nyquist on) before every ``substeps``-th
+    sample is kept, as an acquisition system does: nothing above the output Nyquist
+    frequency aliases (a mesh faster than it is filtered out, not folded back).
 
     Parameters
     ----------
@@ -313,8 +315,8 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     fs_hz : float
         Output sample rate, Hz (the paper: 75 kHz).
     substeps : int, optional
-        Integration steps per output sample (default: chosen from the highest mode, see
-        above; 1 = the paper's fixed step 1/fs, no filter).
+        Integration steps per output sample (default: chosen from the highest mode and the
+        fastest excitation, see above; 1 = the paper's fixed step 1/fs, no filter).
     scheme : str
         ``"ode3"`` (Bogacki-Shampine, default), ``"rk4"`` or ``"heun"``.
     mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
@@ -409,6 +411,10 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
         kprof = kernel_profile(profile, op.torque_nm, warmup_s + duration_s + 0.1,
                                PROFILE_STEP_S, speed_factor=speed_factor,
                                torque_factor=torque_factor)
+    excitation = fastest_excitation(rig, op, 1.0 if kprof is None else
+                                    float(np.max(kprof.table[:, PR_OMEGA])) / op.omega_rad_s)
+    if substeps is not None:
+        substeps = integration_substeps(fs_hz, excitation, substeps=substeps)
     loss_inputs = None
     if losses is not None and losses is not False:
         if loads is not None or friction_table is not None:
@@ -437,27 +443,22 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
                              f"fs_hz = {fs_hz:g}")
     f_max = highest_frequency_hz(model, q0)
     if substeps is None:
-        substeps = max(1, math.ceil(STEPS_PER_PERIOD * f_max / fs_hz - 1e-9))
+        substeps = integration_substeps(fs_hz, excitation, f_max)
     stats = {}
-    aa = None
     if on_start is not None:
         on_start(warmup_s + duration_s)
-    if substeps == 1:
-        n_warm = int(round(warmup_s * fs_hz))
-        report = None if progress is None else (lambda done, total: progress(done * dt,
-                                                                             total * dt))
-        states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
-                                       report)
-        states, diag = states[n_warm:, :n], diag[n_warm:]
-    else:
-        aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
-        # the centred filter needs half its length of integration before the first sample
-        n_warm = max(int(round(warmup_s * fs_hz)),
-                     math.ceil(aa.half_length / substeps))
-        report = None if progress is None else (lambda done, total: progress(
-            done * dt / substeps, total * dt / substeps))
-        states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme,
-                                                  stats, report, q_cols, d_cols)
+    try:
+        states, diag, wall, n_warm, aa = _integrate_run(
+            model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress, q_cols,
+            d_cols)
+    except IntegrationDiverged as exc:
+        if not start_method.endswith("(no equilibrium found)"):
+            raise
+        loads = (f"torque_nm = {op.torque_nm:g} N m" if rig.gears is not None
+                 else f"radial_load_n = {op.radial_load_n:g} N")
+        raise IntegrationDiverged(f"no static equilibrium at {loads} (the rig may not carry "
+                                  f"it), and the run from the nominal geometry diverged: "
+                                  f"{exc}") from None
     t = (n_warm + np.arange(n_rec)) * dt
     signals = _signals(model, t, states, diag, kprof)
     if wanted is not None:
@@ -470,6 +471,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
                             "radial_load_angle_rad": op.radial_load_angle_rad},
         "fs_hz": fs_hz, "substeps": int(substeps), "scheme": scheme,
         "integration_fs_hz": fs_hz * substeps, "highest_mode_hz": f_max,
+        "fastest_excitation": {"name": excitation.name, "hz": excitation.hz},
         "anti_alias": None if aa is None else aa.to_dict(), "warmup_s": n_warm / fs_hz,
         "duration_s": n_rec / fs_hz, "seed": int(seed),
         "cage_phases_rad": [float(x) for x in model.cage_phases_rad],
@@ -500,6 +502,27 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
             run, loads, friction_table, model.mesh_table).to_dict()
         run = run.with_meta(losses=info)
     return run
+
+
+def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress,
+                   q_cols, d_cols):
+    """The run's integration: ``(states, diag, wall_s, n_warm, anti_alias)`` of the recorded
+    samples, directly at ``fs_hz`` (one step per sample) or through the anti-alias filter."""
+    if substeps == 1:
+        n_warm = int(round(warmup_s * fs_hz))
+        report = None if progress is None else (lambda done, total: progress(done * dt,
+                                                                             total * dt))
+        states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
+                                       report)
+        return states[n_warm:, :model.n_dof], diag[n_warm:], wall, n_warm, None
+    aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
+    # the centred filter needs half its length of integration before the first sample
+    n_warm = max(int(round(warmup_s * fs_hz)), math.ceil(aa.half_length / substeps))
+    report = None if progress is None else (lambda done, total: progress(
+        done * dt / substeps, total * dt / substeps))
+    states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme, stats,
+                                              report, q_cols, d_cols)
+    return states, diag, wall, n_warm, aa
 
 
 def _signals(model, t, states, diag, kprof=None):

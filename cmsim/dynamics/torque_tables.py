@@ -37,7 +37,7 @@ from cmsim.dynamics.model import build_model
 from cmsim.dynamics.quasistatic import quasi_static_orbit, quasi_static_state
 from cmsim.errors import IntegrationDiverged, ParameterError, check_choice, check_range
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
-from cmsim.mesh_stiffness.mesh_cycle import hybrid_mesh_table, mesh_cycle
+from cmsim.mesh_stiffness.mesh_cycle import MAX_CENTRE_OFFSET_M, hybrid_mesh_table, mesh_cycle
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
 from cmsim.rig import OperatingPoint
@@ -46,6 +46,20 @@ __all__ = ["torque_tables", "TABLE_METHODS"]
 
 #: Methods :func:`torque_tables` can use.
 TABLE_METHODS = ("hybrid", "potential-energy")
+
+
+def _check_centres_carry(torque_nm, centre1_m, centre2_m):
+    """Refuse a torque that pushes a gear centre beyond :data:`MAX_CENTRE_OFFSET_M` (the
+    contact geometry's limit), naming the torque (``torques_nm``), not the centres."""
+    offset = float(np.max(np.abs(np.concatenate([centre1_m, centre2_m]))))
+    if offset > MAX_CENTRE_OFFSET_M:
+        most = torque_nm * MAX_CENTRE_OFFSET_M / offset        # the offsets grow with load
+        raise ParameterError(
+            f"torques_nm = {torque_nm:g} N m moves the gear centres {offset * 1e3:.3g} mm off "
+            f"their nominal positions, and the tooth contact holds within "
+            f"±{MAX_CENTRE_OFFSET_M * 1e3:g} mm: on this rig's shafts and bearings the torque "
+            f"must be <= about {most:.3g} N m", param="torques_nm",
+            allowed=f"<= about {most:.3g} N m")
 
 
 def torque_tables(rig, torques_nm, method="hybrid", *, mesh_model=None, speed_rpm=1000.0,
@@ -125,6 +139,7 @@ def torque_tables(rig, torques_nm, method="hybrid", *, mesh_model=None, speed_rp
                 # then sit within a bearing clearance of nominal, which moves the pair
                 # stiffness by far less than the torque does
                 placed = "nominal (orbit not found)"
+        _check_centres_carry(q, c1, c2)
         cycle = mesh_cycle(mesh_model, q * ratio, c1, c2, n_steps=n_steps, n_points=n_points)
         k_mesh = cycle.mesh_stiffness_n_per_m
         meta = dict(cycle.table.meta, mean_mesh_stiffness_n_per_m=float(np.mean(k_mesh)))

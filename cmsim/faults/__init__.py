@@ -11,7 +11,7 @@ See :mod:`cmsim.faults.base` (registry, parsing), :mod:`~cmsim.faults.bearing`,
 """
 
 from cmsim.faults.base import (FAULT_TYPES, Fault, fault_from_dict, faults_to_toml_list,
-                               load_faults, parse_fault)
+                               first_clash, load_faults, parse_fault)
 from cmsim.faults.bearing import (NO_SLIP, BallDefect, BearingWear, InnerRaceDefect,
                                   OffSizeBall, OuterRaceDefect, RollingSlip)
 from cmsim.faults.compile import (FaultArrays, check_faults, compile_faults, fault_frequencies,
@@ -21,7 +21,7 @@ from cmsim.faults.gear import (Eccentricity, ProfileError, ToothBreakage, ToothC
 from cmsim.faults.operating import SpeedFluctuation, TorqueRipple
 
 __all__ = [
-    "FAULT_TYPES", "Fault", "fault_from_dict", "faults_to_toml_list", "load_faults",
+    "FAULT_TYPES", "Fault", "fault_from_dict", "faults_to_toml_list", "first_clash", "load_faults",
     "parse_fault", "BallDefect", "BearingWear", "InnerRaceDefect", "OffSizeBall",
     "OuterRaceDefect", "RollingSlip", "NO_SLIP", "FaultArrays", "check_faults", "compile_faults",
     "fault_frequencies", "operating_modulation", "rig_with_faults", "slip_from_faults",

@@ -31,7 +31,7 @@ from pathlib import Path
 from cmsim.errors import ParameterError, check_range
 
 __all__ = ["Fault", "FAULT_TYPES", "register", "fault_from_dict", "parse_fault",
-           "load_faults", "faults_to_toml_list", "check_bearing", "check_gear"]
+           "load_faults", "faults_to_toml_list", "first_clash", "check_bearing", "check_gear"]
 
 #: Registered catalogue entries, ``name -> class`` (filled by :func:`register`).
 FAULT_TYPES: dict = {}
@@ -53,6 +53,13 @@ class Fault:
     def label(self):
         """Short human/ML label, e.g. ``"outer_race@1b1 size=1.0mm depth=0.1mm"``."""
         raise NotImplementedError
+
+    @property
+    def site(self):
+        """Where the fault sits when only one of its kind can sit there, as words
+        (``"tooth_crack on tooth 3 of gear 1"``), else ``None``: two faults of one model on
+        the same site are refused (:func:`first_clash`), as are two equal faults."""
+        return None
 
     def validate(self, rig):
         """Check the fault against ``rig`` (component exists, defect fits); return ``self``.
@@ -201,22 +208,38 @@ def parse_fault(text):
         if not eq or not key.strip():
             raise ParameterError(f"fault parameter {item!r} must read key=value",
                                  param="fault", allowed="key=value")
-        data[key.strip()] = value.strip()
+        key = key.strip()
+        if key in data:
+            raise ParameterError(f"{key} is given twice ({data[key]} and {value.strip()}); "
+                                 "give each parameter once", param=key)
+        data[key] = value.strip()
     return fault_from_dict(data)
 
 
-def load_faults(source):
+def load_faults(source, *, rig_file=False):
     """Faults from a TOML file or an already-parsed mapping holding a ``[[faults]]`` list.
 
     Parameters
     ----------
     source : str, Path or dict
-        Path of a TOML file (a rig file or a faults file), or its parsed content.
+        Path of a TOML file, or its parsed content.
+    rig_file : bool
+        ``False`` (default): a faults file, which holds a non-empty ``[[faults]]`` list and
+        nothing else — a file that defines no fault (empty, or ``[fault]`` for
+        ``[[faults]]``) or has keys it does not know is refused, not read as "healthy".
+        ``True``: a rig file, whose other tables are the rig's (:meth:`cmsim.rig.Rig.load`
+        checks them) and whose ``[[faults]]`` list is optional.
 
     Returns
     -------
     tuple of Fault
-        In file order; empty if the file has no ``faults`` list.
+        In file order (empty only for a rig file without a ``faults`` list).
+
+    Raises
+    ------
+    ParameterError
+        An unreadable file, an unknown key (named), no fault in a faults file, or a bad
+        entry (``faults[i]: ...``).
     """
     if isinstance(source, dict):
         data = source
@@ -230,9 +253,13 @@ def load_faults(source):
         except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
             raise ParameterError(f"faults file {path} cannot be read as TOML: {exc}",
                                  param="faults") from None
+    if not rig_file:
+        _check_faults_file_keys(data)
     items = data.get("faults", [])
     if not isinstance(items, list):
         raise ParameterError("faults must be a list of tables ([[faults]])", param="faults")
+    if not items and not rig_file:
+        raise ParameterError(f"defines no fault: {_FAULTS_FILE_FORM}", param="faults")
     out = []
     for i, item in enumerate(items):
         try:
@@ -241,6 +268,49 @@ def load_faults(source):
             raise ParameterError(f"faults[{i}]: {exc}", param=exc.param,
                                  allowed=exc.allowed) from None
     return tuple(out)
+
+
+#: What a faults file holds, for its error messages.
+_FAULTS_FILE_FORM = ('a faults file holds [[faults]] tables, each with type = "<name>" and '
+                     "the fault's fields")
+
+
+def _check_faults_file_keys(data):
+    """Refuse any top-level key of a faults file but ``faults``, naming it (``[fault]``)."""
+    for key, value in data.items():
+        if key != "faults":
+            what = f"table [{key}]" if isinstance(value, dict) else f"key {key!r}"
+            hint = " (write [[faults]])" if key in ("fault", "Faults", "FAULTS") else ""
+            raise ParameterError(f"unknown {what}{hint}; {_FAULTS_FILE_FORM}", param=key,
+                                 allowed="faults")
+
+
+def first_clash(faults):
+    """The first two of ``faults`` that cannot both be in one model, or ``None``.
+
+    Two equal faults (the same fault given twice) clash, and so do two on the same
+    :attr:`Fault.site` (two cracks on one tooth, two eccentricities of one gear): the
+    model would silently keep the last or pile them up into something nobody described.
+
+    Parameters
+    ----------
+    faults : sequence of Fault
+
+    Returns
+    -------
+    tuple (int, int, str) or None
+        Indices ``(i, j)``, ``i < j``, and why they clash, in words.
+    """
+    seen = {}
+    for j, f in enumerate(faults):
+        for key, why in ((("same", f), "is the same fault as"),
+                         (("site", f.site), f"is a second {f.site} beside")):
+            if key[1] is None:
+                continue
+            if key in seen:
+                return seen[key], j, why
+            seen[key] = j
+    return None
 
 
 def faults_to_toml_list(faults):

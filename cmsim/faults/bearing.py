@@ -232,6 +232,11 @@ class _RaceDefect(_LocalizedDefect):
     def label(self):
         return f"{self.name}@{self.bearing} size={mm(self.size_m)} depth={mm(self.depth_m)}"
 
+    @property
+    def site(self):
+        where = "the load zone" if self.angle_rad is None else f"{self.angle_rad:g} rad"
+        return f"{self.name} defect at {where} of bearing {self.bearing}"
+
     def race_radius_m(self, brg):
         raise NotImplementedError
 
@@ -368,6 +373,10 @@ class BallDefect(_LocalizedDefect):
         return (f"ball@{self.bearing}#{self.ball} size={mm(self.size_m)} "
                 f"depth={mm(self.depth_m)}")
 
+    @property
+    def site(self):
+        return f"ball defect on ball {self.ball} of bearing {self.bearing}"
+
     def validate(self, rig):
         brg = rig.bearings[check_bearing(rig, self.bearing)]
         check_range("size_m", self.size_m, 0.0, brg.ball_diameter_m, lo_open=True,
@@ -428,6 +437,10 @@ class BearingWear(Fault):
     def label(self):
         return f"wear@{self.bearing} +{1e6 * self.clearance_growth_m:.3g}um"
 
+    @property
+    def site(self):
+        return f"wear of bearing {self.bearing}"
+
     def validate(self, rig):
         brg = rig.bearings[check_bearing(rig, self.bearing)]
         check_range("clearance_growth_m", self.clearance_growth_m, 0.0,
@@ -465,6 +478,10 @@ class OffSizeBall(Fault):
     @property
     def label(self):
         return f"off_size_ball@{self.bearing}#{self.ball} {1e6 * self.diameter_excess_m:+.3g}um"
+
+    @property
+    def site(self):
+        return f"off_size_ball on ball {self.ball} of bearing {self.bearing}"
 
     def validate(self, rig):
         brg = rig.bearings[check_bearing(rig, self.bearing)]
@@ -519,6 +536,10 @@ class RollingSlip(Fault):
     def label(self):
         return (f"rolling_slip cage={100 * self.cage_speed_rms:.3g}% "
                 f"ball={1e3 * self.ball_rms_rad:.3g}mrad")
+
+    @property
+    def site(self):
+        return "rolling_slip (one per run)"
 
 
 #: Rolling without slip (the paper's runs but §6.2.1): what a run without ``slip`` uses.

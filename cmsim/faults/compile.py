@@ -23,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.faults.base import Fault, check_bearing
+from cmsim.faults.base import Fault, check_bearing, first_clash
 from cmsim.faults.bearing import (BallDefect, BearingWear, InnerRaceDefect, OffSizeBall,
                                   OuterRaceDefect, RollingSlip)
 from cmsim.faults.crack import crack_stiffness_factor
@@ -137,6 +137,11 @@ def check_faults(rig, faults):
             raise ParameterError(f"faults[{i}] must be a Fault (see cmsim.faults), got "
                                  f"{type(f).__name__}", param="faults")
         f.validate(rig)
+    clash = first_clash(faults)
+    if clash is not None:
+        i, j, why = clash
+        raise ParameterError(f"faults[{j}] ({faults[j].label}) {why} faults[{i}] "
+                             f"({faults[i].label}); give each fault once", param="faults")
     checked = CheckedFaults(faults)
     checked.rig = rig
     return checked

@@ -98,6 +98,10 @@ class Eccentricity(Fault):
     def label(self):
         return f"eccentricity@G{self.gear} e={1e6 * self.amplitude_m:.3g}um"
 
+    @property
+    def site(self):
+        return f"eccentricity of gear {self.gear}"
+
     def validate(self, rig):
         g = check_gear(rig, self.gear)
         check_range("amplitude_m", self.amplitude_m, 0.0, 0.25 * g.module_m, lo_open=True,
@@ -147,6 +151,10 @@ class ToothCrack(_ToothFault):
     def label(self):
         return (f"tooth_crack@G{self.gear}#{self.tooth} depth={mm(self.depth_m)} "
                 f"angle={math.degrees(self.angle_rad):.3g}deg")
+
+    @property
+    def site(self):
+        return f"tooth_crack on tooth {self.tooth} of gear {self.gear}"
 
     def validate(self, rig):
         g = self._check_tooth(rig)
@@ -257,6 +265,10 @@ class ToothBreakage(_ToothFault):
     def label(self):
         return f"tooth_breakage@G{self.gear}#{self.tooth} lost={mm(self.lost_height_m)}"
 
+    @property
+    def site(self):
+        return f"tooth_breakage on tooth {self.tooth} of gear {self.gear}"
+
     def validate(self, rig):
         g = self._check_tooth(rig)
         h = g.tip_radius_m - g.root_radius_m
@@ -313,6 +325,10 @@ class ProfileError(Fault):
         if self.tip_relief_m > 0:
             parts.append(f"tip_relief={1e6 * self.tip_relief_m:.3g}um")
         return " ".join(parts)
+
+    @property
+    def site(self):
+        return f"profile_error of gear {self.gear} (it covers every tooth: give one)"
 
     def relief_start_radius_m(self, g):
         """Radius where the tip relief starts, m."""

@@ -46,7 +46,7 @@ from cmsim.mesh_stiffness.hybrid import HybridMeshModel, work_size
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
 __all__ = ["QuasiStaticMesh", "MeshCycle", "quasi_static_mesh", "mesh_cycle",
-           "hybrid_mesh_table", "slot_contacts"]
+           "hybrid_mesh_table", "slot_contacts", "MAX_CENTRE_OFFSET_M"]
 
 #: A pair counts as loaded above this fraction of the total normal force.
 LOADED_FRACTION = 1e-9
@@ -157,10 +157,15 @@ class _Evaluator:
         return c, rho1, rho2, force, arm
 
 
+#: Largest offset of a gear centre from its nominal position the contact geometry takes, m.
+MAX_CENTRE_OFFSET_M = 1e-3
+
+
 def _check_offset(name, value):
     v = np.asarray(value, dtype=float).reshape(-1)
-    if v.size != 2 or not np.all(np.isfinite(v)) or np.max(np.abs(v)) > 1e-3:
-        raise ParameterError(f"{name} must be two finite offsets within ±1 mm, got {value!r}")
+    if v.size != 2 or not np.all(np.isfinite(v)) or np.max(np.abs(v)) > MAX_CENTRE_OFFSET_M:
+        raise ParameterError(f"{name} must be two finite offsets within "
+                             f"±{MAX_CENTRE_OFFSET_M * 1e3:g} mm, got {value!r}", param=name)
     return (float(v[0]), float(v[1]))
 
 

@@ -3,7 +3,8 @@
 :data:`SAMPLING` holds the one set of defaults that :func:`cmsim.dynamics.simulate`, the
 command line (``simulate``, ``sweep``) and dataset specs share, so the same option means
 the same thing everywhere: one second recorded at the paper's 75 kHz after a 50 ms warm-up,
-the integration step chosen from the model's highest mode, and seed 0 (runs are
+the integration step chosen from the model's highest mode and fastest excitation
+(:mod:`cmsim.dynamics.step`), and seed 0 (runs are
 reproducible by default; give another seed for another realisation of the random parts).
 """
 
@@ -30,7 +31,8 @@ class Sampling:
         Simulated time discarded before recording, s.
     substeps : int or None
         Integration steps per output sample; ``None`` = the fewest giving at least 4.7 steps
-        per period of the model's highest mode (then the output is anti-alias filtered).
+        per period of the model's highest mode and of 6 harmonics of its fastest excitation
+        (:mod:`cmsim.dynamics.step`; then the output is anti-alias filtered).
     seed : int
         Seed of every random draw of the run (cage phases, slip, sensor noise).
     """

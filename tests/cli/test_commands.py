@@ -92,7 +92,7 @@ def test_bad_input_exit_code_and_message(capsys, argv, word):
 
 
 def test_divergence_exit_code(capsys):
-    status = main(["simulate", "--speed-rpm", "1000", "--torque-nm", "100", "--fs-hz", "2000", "--substeps", "1",
+    status = main(["simulate", "--speed-rpm", "100", "--torque-nm", "100", "--fs-hz", "2000", "--substeps", "1",
                    "--warmup-s", "0", "--duration-s", "0.2"])
     assert status == 3
     assert "diverged" in capsys.readouterr().err
@@ -134,3 +134,50 @@ def test_bearing_rig_sweep_radial_load_and_report(capsys, tmp_path):
     assert run.meta["operating_point"]["radial_load_n"] == pytest.approx(500.0)
     status, res = run_json(capsys, ["report", str(out)])
     assert status == 0 and "dte_um" not in " ".join(res["figures"])
+
+
+def test_report_lists_the_grid_points_a_sweep_could_not_run(capsys, tmp_path):
+    """Issue 26: 20000 N m diverges (the sweep exits 3); the report of the sweep then lists
+    that grid point — in its JSON, on stderr, in the text and in the page's "Runs" — instead
+    of reading as a sweep of one run."""
+    out = tmp_path / "sw"
+    status, _ = run_json(capsys, ["sweep", "--speed-rpm", "1000", "--torque-nm", "10", "20000",
+                                  "--duration-s", "0.02", "--warmup-s", "0.01",
+                                  "--workers", "1", "--out", str(out)])
+    assert status == 3
+    status, res = run_json(capsys, ["report", str(out)])
+    assert status == 0 and res["n_runs"] == 1 and res["n_failed"] == 1
+    (failed,) = res["failed"]
+    assert failed["torque_nm"] == 20000.0 and "diverged" in failed["error"]
+    assert "20000Nm" in res["warnings"][0] and "1 of 2 grid points failed" in res["warnings"][0]
+    page = (out / "report.html").read_text()
+    assert "1 of 2 grid points failed" in page and "Failed grid points" in page
+    assert main(["report", str(out)]) == 0
+    cap = capsys.readouterr()
+    assert "1 failed grid points listed (001_n1000rpm_T20000Nm)" in cap.out
+    assert "warning: 1 of 2 grid points failed" in cap.err
+
+
+def test_no_help_text_shows_a_doubled_percent_sign():
+    """argparse %-formats help strings but prints a parser's description as written: "5 %%"
+    showed in ``cmsim evaluate --help`` (issue 26)."""
+    from cmsim.cli import build_parser
+    from cmsim.cli.contract import subparsers
+    for command, sub in subparsers(build_parser()).items():
+        assert "%%" not in sub.format_help(), command
+
+
+def test_evaluate_text_says_when_a_class_was_never_detected():
+    """A fault class none of whose records beat the threshold has no smallest detected
+    severity (NaN): the text says so instead of "smallest severity detected nan"."""
+    from cmsim.cli.evaluate import text
+    res = {"algorithm": "envelope", "dataset": "d", "errors": {}, "report": None, "metrics": {
+        "n_scored": 4, "n_records": 4, "n_failed": 0, "accuracy": 0.5, "chance_accuracy": 0.5,
+        "macro_f1": 0.4, "auc": {},
+        "detection": {"threshold": 0.3, "classes": {
+            "outer_race": {"detection_rate_all": 0.0, "min_detected_severity": float("nan")},
+            "ball": {"detection_rate_all": 0.5, "min_detected_severity": 2e-4}}}}}
+    out = text(res)
+    assert "nan" not in out
+    assert "outer_race: detected 0.00 at 5 % false alarms, no record detected" in out
+    assert "ball: detected 0.50 at 5 % false alarms, smallest severity detected 0.0002" in out

@@ -28,6 +28,7 @@ import pytest
 
 import cmsim
 from cmsim.cli import app, build_parser, contract, main
+from cmsim.datasets.manifest import write_row
 from cmsim.rig import Rig
 from cmsim.run import Run
 
@@ -191,7 +192,7 @@ CATALOGUE = [
       "--ramp-s", numeric=True),
     R("simulate-ramp-s-alone", "simulate --speed-rpm 1000 --ramp-s 1", "--ramp-s",
       "--ramp-to-rpm"),
-    R("simulate-diverges", "simulate --speed-rpm 1000 --torque-nm 100 --fs-hz 2000 --substeps 1 "
+    R("simulate-diverges", "simulate --speed-rpm 100 --torque-nm 100 --fs-hz 2000 --substeps 1 "
       "--warmup-s 0 --duration-s 0.2", "--substeps", status=3),
     # ---- modes
     R("modes-positions", "modes --torque-nm 10 --positions 3", "--positions", numeric=True),
@@ -397,6 +398,57 @@ CATALOGUE = [
       "rec.npz", "non-finite"),
     R("evaluate-measured-fs-text", "evaluate {rec_fs_text_dir} --algorithm envelope",
       "metadata.json", "'12k'", numeric=True),
+    # ---- h1 (issue 26): inputs at the edge — step vs excitation, faults files, duplicates,
+    # ---- messages that name what the user typed
+    R("simulate-substeps-under-resolve-mesh", "simulate --speed-rpm 100000 --torque-nm 50 "
+      "--substeps 1 --duration-s 0.01", "--substeps", "GMF", "[18, 1000]", "--speed-rpm",
+      numeric=True),
+    R("simulate-fs-too-low-for-mesh", "simulate --speed-rpm 100000 --fs-hz 1000 "
+      "--duration-s 0.01", "--fs-hz", ">= 1316", numeric=True),
+    R("sweep-substeps-under-resolve-mesh", "sweep --speed-rpm 1000 100000 --substeps 1 "
+      "--out {work}/s", "--substeps", "[18, 1000]", numeric=True),
+    R("dataset-substeps-under-resolve-mesh", "dataset {ds_fast} --out {work}/d", "SPEC",
+      "simulation.substeps", "[18, 1000]", numeric=True),
+    R("simulate-faults-file-single-table", "simulate --speed-rpm 1000 --faults {faults_table}",
+      "--faults", "[fault]", "[[faults]]"),
+    R("simulate-faults-file-empty", "simulate --speed-rpm 1000 --faults {empty}", "--faults",
+      "defines no fault"),
+    R("simulate-faults-file-empty-list", "simulate --speed-rpm 1000 --faults {faults_none}",
+      "--faults", "defines no fault"),
+    R("simulate-faults-file-unknown-key", "simulate --speed-rpm 1000 --faults {faults_unknown}",
+      "--faults", "'severity'"),
+    R("sweep-faults-file-single-table", "sweep --speed-rpm 1000 --faults {faults_table} "
+      "--out {work}/s", "--faults", "[fault]"),
+    R("simulate-fault-repeated-key", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3,size_m=2e-3,depth_m=1e-4", "--fault", "size_m",
+      "twice"),
+    R("simulate-fault-twice", "simulate --speed-rpm 1000 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4 --fault "
+      "outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4", "--fault", "same fault"),
+    R("simulate-two-cracks-one-tooth", "simulate --speed-rpm 1000 --fault "
+      "tooth_crack:gear=1,depth_m=1e-3 --fault tooth_crack:gear=1,depth_m=5e-4", "--fault",
+      "tooth 0 of gear 1"),
+    R("simulate-eccentricity-option-and-file", "simulate --speed-rpm 1000 --faults "
+      "{faults_ecc} --fault eccentricity:gear=1,amplitude_m=2e-5", "--fault", "--faults",
+      "eccentricity of gear 1"),
+    R("sweep-fault-twice", "sweep --speed-rpm 1000 --fault wear:bearing=1b1,"
+      "clearance_growth_m=1e-5 --fault wear:bearing=1b1,clearance_growth_m=1e-5 "
+      "--out {work}/s", "--fault", "same fault"),
+    R("dataset-grid-repeated-value", "dataset {ds_grid_repeat} --out {work}/d", "SPEC",
+      "operating.speed_rpm", "repeat"),
+    R("report-only-failed-runs", "report {failed_sweep}", "DIR", "no finished runs",
+      "1 failed", "T20000Nm"),
+    R("simulate-torque-moves-centres", "simulate --speed-rpm 1000 --torque-nm 1e5 "
+      "--duration-s 0.01", "--torque-nm", "gear centres", "<= about", numeric=True),
+    R("sweep-torque-moves-centres", "sweep --speed-rpm 1000 --torque-nm 10 1e5 "
+      "--out {work}/s", "--torque-nm", "gear centres", "<= about", numeric=True),
+    R("simulate-torque-at-max-diverges", "simulate --speed-rpm 1000 --torque-nm 1e6 "
+      "--duration-s 0.01", "--torque-nm", "no static equilibrium", "diverged", status=3),
+    R("simulate-sensor-fs-not-a-fraction", "simulate --speed-rpm 1000 --sensor-fs-hz 1234.567 "
+      "--duration-s 0.01", "--sensor-fs-hz = 1234.57 Hz", "--fs-hz = 75000 Hz"),
+    R("simulate-ramp-starts-after-record", "simulate --speed-rpm 1000 --ramp-to-rpm 2000 "
+      "--ramp-start-s 5 --duration-s 0.01", "--ramp-start-s", "[0, 0.06)", numeric=True),
+    R("modes-torque-zero", "modes --torque-nm 0", "--torque-nm", "> 0 N m", numeric=True),
     # ---- no command
     R("cmsim-no-command", "", "command"),
     R("cmsim-unknown-command", "frobnicate", "frobnicate"),
@@ -541,10 +593,25 @@ def files(tmp_path_factory):
     (d / "faults_gear.toml").write_text(
         '[[faults]]\ntype = "inner_race"\nbearing = "2b1"\nsize_m = 5e-4\ndepth_m = 1e-4\n')
     f["faults_gear"] = d / "faults_gear.toml"
+    for name, text_ in (
+            ("faults_table", '[fault]\ntype = "ball"\nbearing = "1b1"\nsize_m = 5e-4\n'
+                             'depth_m = 1e-4\n'),
+            ("faults_none", "faults = []\n"),
+            ("faults_unknown", 'severity = 2\n[[faults]]\ntype = "wear"\nbearing = "1b1"\n'
+                               'clearance_growth_m = 1e-5\n'),
+            ("faults_ecc", '[[faults]]\ntype = "eccentricity"\ngear = 1\n'
+                           'amplitude_m = 1e-5\n')):
+        (d / f"{name}.toml").write_text(text_)
+        f[name] = d / f"{name}.toml"
     ds_spec = ('[dataset]\nrecords = 2\n\n[sensor]\nchannels = ["accel_1b1_y"]\n'
                'duration_s = 0.01\n')
+    ds_fast = ('[operating]\nsampling = "grid"\nspeed_rpm = [1000, 100000]\n\n[sensor]\n'
+               'channels = ["accel_1b1_y"]\nduration_s = 0.01\n\n[simulation]\nsubsteps = 1\n')
     for name, text_ in (("ds_spec", ds_spec),
                         ("ds_zero", ds_spec.replace("records = 2", "records = 0")),
+                        ("ds_fast", ds_fast),
+                        ("ds_grid_repeat", ds_fast.replace("[1000, 100000]", "[1000, 1000.0]")
+                         .replace("substeps = 1", "substeps = 3")),
                         ("ds_unknown_key", ds_spec.replace("channels", "chanels")),
                         ("ds_bad_fault", ds_spec + '\n[faults]\nhealthy_share = 0.5\n\n'
                                                    '[[faults.types]]\ntype = "bogus"\n')):
@@ -569,6 +636,12 @@ def files(tmp_path_factory):
     raw[len(raw) // 2: len(raw) // 2 + 64] = b"\0" * 64
     (corrupt / "runs" / "r0.npz").write_bytes(bytes(raw))
     f["corrupt_sweep"] = corrupt
+    failed = d / "failed_sweep"                    # a sweep whose one grid point failed
+    (failed / "records").mkdir(parents=True)
+    write_row(failed, {"index": 0, "record_id": "000_n1000rpm_T20000Nm", "status": "failed",
+                       "speed_rpm": 1000.0, "torque_nm": 20000.0, "path": None,
+                       "error": "IntegrationDiverged: the integration diverged"})
+    f["failed_sweep"] = failed
     meas = d / "measured"                          # a measured record (cmsim compare)
     meas.mkdir()
     np.savez(meas / "rec.npz", DE=np.random.default_rng(0).standard_normal(24000))
@@ -737,6 +810,8 @@ def test_bad_input(row, as_json, files, capsys, cold_numba_cache):
         obj = json.loads(cap.out)
         assert isinstance(obj, dict) and obj["status"] == row.status
         assert obj["error"] in line
+        if row.argv and row.argv[0] in BASE:        # issue 26: never "option": null
+            assert obj["option"] and obj["option"] in obj["error"], obj
     else:
         assert cap.out == ""
     assert _tree(files["root"]) == before

@@ -16,6 +16,7 @@ import pytest
 from cmsim.dynamics.model import build_model
 from cmsim.errors import ParameterError
 from cmsim.faults import (FAULT_TYPES, BallDefect, OuterRaceDefect, RollingSlip, ToothCrack,
+                          ToothSpall,
                           compile_faults, fault_frequencies, fault_from_dict, load_faults,
                           operating_modulation, parse_fault, rig_with_faults, slip_from_faults)
 from cmsim.faults.bearing import (BearingWear, ball_drop_m, defect_profile, track_share,
@@ -115,6 +116,64 @@ def test_bad_input_refused_naming_parameter(text, param, rig):
         parse_fault(text).validate(rig)
     assert err.value.param == param
     assert param in str(err.value)
+
+
+def test_a_repeated_key_is_refused_not_the_last_one_kept():
+    with pytest.raises(ParameterError, match="size_m is given twice") as err:
+        parse_fault("outer_race:bearing=1b1,size_m=1e-3,size_m=2e-3,depth_m=1e-4")
+    assert err.value.param == "size_m"
+
+
+@pytest.mark.parametrize("first, second, words", [
+    ("outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4",
+     "outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4", "same fault"),
+    ("tooth_crack:gear=1,depth_mm=1,tooth=3", "tooth_crack:gear=1,depth_mm=2,tooth=3",
+     "tooth 3 of gear 1"),
+    ("tooth_breakage:gear=2,lost_height_mm=1", "tooth_breakage:gear=2,lost_height_mm=2",
+     "tooth 0 of gear 2"),
+    ("eccentricity:gear=1,amplitude_m=2e-5", "eccentricity:gear=1,amplitude_m=1e-5",
+     "eccentricity of gear 1"),
+    ("wear:bearing=1b1,clearance_growth_m=1e-5", "wear:bearing=1b1,clearance_growth_m=2e-5",
+     "wear of bearing 1b1"),
+    ("inner_race:bearing=1b1,size_m=1e-3,depth_m=1e-4",
+     "inner_race:bearing=1b1,size_m=2e-3,depth_m=1e-4", "bearing 1b1"),
+    ("rolling_slip:cage_speed_rms=0.01", "rolling_slip:cage_speed_rms=0.02", "rolling_slip"),
+])
+def test_two_faults_on_one_site_are_refused(first, second, words, rig):
+    """The model would keep the last eccentricity, multiply two cracks of one tooth or add
+    two wears of one bearing: nobody described that fault, so it is refused."""
+    faults = [parse_fault(first), parse_fault(second)]
+    with pytest.raises(ParameterError, match="faults\\[1\\]") as err:
+        check_faults(rig, faults)
+    assert words in str(err.value) and err.value.param == "faults"
+
+
+def test_distinct_sites_and_summed_modulations_stay_allowed(rig):
+    check_faults(rig, [parse_fault("tooth_crack:gear=1,depth_mm=1,tooth=3"),
+                       parse_fault("tooth_crack:gear=1,depth_mm=1,tooth=4"),
+                       parse_fault("tooth_crack:gear=2,depth_mm=1,tooth=3"),
+                       parse_fault("outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4"),
+                       parse_fault("outer_race:bearing=1b1,size_m=1e-3,depth_m=1e-4,"
+                                   "angle_rad=1"),
+                       parse_fault("speed_fluctuation:relative_amplitude=0.01,frequency_hz=5"),
+                       parse_fault("speed_fluctuation:relative_amplitude=0.01,frequency_hz=9")])
+
+
+@pytest.mark.parametrize("text, words", [
+    ('[fault]\ntype = "ball"\nbearing = "1b1"\nsize_m = 5e-4\ndepth_m = 1e-4\n',
+     "[fault] (write [[faults]])"),
+    ("", "defines no fault"),
+    ("faults = []\n", "defines no fault"),
+    ('severity = 2\n[[faults]]\ntype = "wear"\nbearing = "1b1"\nclearance_growth_m = 1e-5\n',
+     "'severity'"),
+])
+def test_a_faults_file_that_defines_no_fault_or_unknown_keys_is_refused(text, words, tmp_path):
+    """Read as a healthy run before: ``[fault]`` for ``[[faults]]``, an empty file."""
+    path = tmp_path / "f.toml"
+    path.write_text(text)
+    with pytest.raises(ParameterError) as err:
+        load_faults(path)
+    assert words in str(err.value)
 
 
 def test_gear_fault_on_gearless_rig_refused(cwru):
@@ -280,9 +339,12 @@ def test_gear_fault_frequencies(rig):
     pair = replace(rig.gears, driven=replace(rig.gears.driven, n_teeth=37))
     rig = replace(rig, gears=pair)
     op = OperatingPoint(speed_rpm=1000.0, torque_nm=10.0)
-    key = fault_frequencies(rig, op, [ToothCrack(gear=2, depth_m=1e-3),
+    # two spalls of one tooth that differ only in their face share: distinct faults with
+    # one label (the same fault twice is refused: test_two_faults_on_one_site_are_refused)
+    key = fault_frequencies(rig, op, [ToothSpall(gear=2, width_m=1e-3, depth_m=2e-5),
                                       ToothCrack(gear=1, depth_m=1e-3),
-                                      ToothCrack(gear=2, depth_m=1e-3)])
+                                      ToothSpall(gear=2, width_m=1e-3, depth_m=2e-5,
+                                                 face_fraction=0.5)])
     driven, driving, again = key.values()
     fr1 = 1000 / 60
     assert driven["gmf_hz"] == driving["gmf_hz"] == pytest.approx(28 * fr1, rel=1e-12)
@@ -297,7 +359,7 @@ def test_rig_toml_with_faults(tmp_path, rig):
     path = tmp_path / "rig.toml"
     rig.save(path, faults=faults)
     assert Rig.load(path) == rig
-    assert load_faults(path) == faults
+    assert load_faults(path, rig_file=True) == faults
 
 
 def test_ball_track_share_closed_form():
