@@ -48,7 +48,8 @@ from cmsim.errors import ParameterError, check_range
 from cmsim.rig import HousingPath
 from cmsim.run import Run
 
-__all__ = ["housing_sos", "housing_acceleration", "decimate", "tacho_signal", "add_sensors",
+__all__ = ["housing_sos", "housing_acceleration", "decimate", "sensor_rate_ratio",
+           "tacho_signal", "add_sensors",
            "TACHO_LEVEL_V", "TACHO_PULSE_WIDTH_RAD", "ANTI_ALIAS_DB", "ANTI_ALIAS_PASSBAND",
            "STEPS_PER_MODE_PERIOD"]
 
@@ -170,6 +171,28 @@ def _kaiser_lowpass(fs_hz, fs_out_hz):
     return firwin(numtaps, cutoff, window=("kaiser", beta), fs=fs_hz)
 
 
+def sensor_rate_ratio(fs_hz, fs_out_hz):
+    """(fs, fs_out, up, down): a sensor rate checked against the run's, fs_out = fs·up/down
+    with down <= :data:`MAX_RATIO_DENOMINATOR` (checkable before a run is made).
+
+    Raises
+    ------
+    ParameterError
+        If fs_out_hz > fs_hz or the ratio is not such a fraction.
+    """
+    fs = check_range("fs_hz", fs_hz, 0.0, lo_open=True, unit="Hz")
+    fs_out = check_range("fs_out_hz", fs_out_hz, 0.0, fs, lo_open=True,
+                         unit="Hz (at most the run's sample rate)")
+    ratio = Fraction(fs_out / fs).limit_denominator(MAX_RATIO_DENOMINATOR)
+    up, down = ratio.numerator, ratio.denominator
+    if abs(up * fs / down - fs_out) > 1e-9 * fs_out:
+        raise ParameterError(
+            f"fs_out_hz = {fs_out:g} Hz (the sensor rate) is not a fraction up/down (down <= "
+            f"{MAX_RATIO_DENOMINATOR}) of the run's fs_hz = {fs:g} Hz", param="fs_out_hz",
+            allowed=f"{fs:g}·up/down Hz")
+    return fs, fs_out, up, down
+
+
 def decimate(x, fs_hz, fs_out_hz):
     """Low-pass and resample the columns of ``x`` to a lower sensor sample rate.
 
@@ -199,17 +222,8 @@ def decimate(x, fs_hz, fs_out_hz):
         If fs_out_hz > fs_hz, the ratio is not such a fraction, or the record is shorter than
         the filter.
     """
-    fs = check_range("fs_hz", fs_hz, 0.0, lo_open=True, unit="Hz")
-    fs_out = check_range("fs_out_hz", fs_out_hz, 0.0, fs, lo_open=True,
-                         unit="Hz (at most the run's sample rate)")
+    fs, fs_out, up, down = sensor_rate_ratio(fs_hz, fs_out_hz)
     x = np.asarray(x, dtype=float)
-    ratio = Fraction(fs_out / fs).limit_denominator(MAX_RATIO_DENOMINATOR)
-    up, down = ratio.numerator, ratio.denominator
-    if abs(up * fs / down - fs_out) > 1e-9 * fs_out:
-        raise ParameterError(
-            f"fs_out_hz = {fs_out:g} Hz (the sensor rate) is not a fraction up/down (down <= "
-            f"{MAX_RATIO_DENOMINATOR}) of the run's fs_hz = {fs:g} Hz", param="fs_out_hz",
-            allowed=f"{fs:g}·up/down Hz")
     if up == down:
         return x.copy(), 0.0, {"method": "none", "up": 1, "down": 1}
     if up == 1:

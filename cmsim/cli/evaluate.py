@@ -165,7 +165,7 @@ def text(res):
         lines.append("ROC AUC: " + ", ".join(
             f"{k} {v:.3f}" for k, v in m["auc"].items() if v == v))
     det = m["detection"]
-    if m["n_scored"] and det["threshold"] is None or det["threshold"] != det["threshold"]:
+    if m["n_scored"] and (det["threshold"] is None or det["threshold"] != det["threshold"]):
         lines.append("no healthy record answered: detection against severity not scored")
     for cls, c in det["classes"].items() if det["threshold"] == det["threshold"] else ():
         least = c["min_detected_severity"]

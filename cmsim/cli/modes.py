@@ -25,9 +25,10 @@ def register(sub):
 
 def run(args):
     """Modal analysis at the operating point."""
-    from cmsim.dynamics.modal import modal_analysis
+    from cmsim.dynamics.modal import check_loaded, modal_analysis
 
     rig, op, (table, model) = resolved_setup(args)
+    check_loaded(rig, op)                  # bad input is refused before the compile notice
     args.notice_compile()
     res = modal_analysis(rig, op, model if model is not None else table,
                          n_positions=args.positions)

@@ -71,7 +71,7 @@ def _speed_profile(args):
                            "--ramp-to-rpm too", option="--ramp-s")
         return None
     from cmsim.dynamics.profiles import SpeedProfile
-    end_s = args.warmup_s + args.duration_s
+    end_s = round(args.warmup_s + args.duration_s, 12)    # no 0.060000000000000005
     start_s = Range(0.0, end_s, hi_open=True,
                     unit="s (the ramp starts before the record ends: warmup_s + duration_s)"
                     ).check("ramp_start_s", args.ramp_start_s or 0.0)
@@ -111,9 +111,12 @@ def run(args):
     mesh = mesh_argument(args, rig, [op.torque_nm])
     check_losses_options(args)
     prepare_tables(args, rig, mesh, [op.torque_nm])
-    if args.sensor_fs_hz is not None and args.sensor_fs_hz > args.fs_hz:
-        raise CLIError(f"--sensor-fs-hz {args.sensor_fs_hz:g} must be <= --fs-hz "
-                       f"{args.fs_hz:g}", option="--sensor-fs-hz")
+    if args.sensor_fs_hz is not None:
+        if args.sensor_fs_hz > args.fs_hz:
+            raise CLIError(f"--sensor-fs-hz {args.sensor_fs_hz:g} must be <= --fs-hz "
+                           f"{args.fs_hz:g}", option="--sensor-fs-hz")
+        from cmsim.sensors import sensor_rate_ratio
+        sensor_rate_ratio(args.fs_hz, args.sensor_fs_hz)     # refused before the run
     slip = RollingSlip(cage_speed_rms=args.cage_slip, ball_rms_rad=args.ball_jitter_rad,
                        correlation_s=args.slip_correlation_s)
     bar = None

@@ -29,7 +29,7 @@ from cmsim.dynamics.quasistatic import quasi_static_orbit
 from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.errors import ParameterError
 
-__all__ = ["ModalResult", "modal_analysis", "MODE_TYPES"]
+__all__ = ["ModalResult", "modal_analysis", "check_loaded", "MODE_TYPES"]
 
 #: Mode types of the paper: rotational, translational, mixed.
 MODE_TYPES = ("R", "T", "R-T")
@@ -134,7 +134,7 @@ def highest_frequency_hz(model, q, t=0.0):
     return float(math.sqrt(max(eig[-1], 0.0)) / (2.0 * math.pi))
 
 
-def _check_loaded(rig, op):
+def check_loaded(rig, op):
     """Refuse an unloaded operating point: it has no unique static state to linearise about
     (the gears turn freely within the backlash, bearings with clearance carry nothing)."""
     why = ("an unloaded rig has no unique static state to linearise about (the gears turn "
@@ -176,7 +176,7 @@ def modal_analysis(rig, op, mesh=None, *, n_positions=24):
     """
     if not isinstance(n_positions, (int, np.integer)) or n_positions < 4:
         raise ParameterError(f"n_positions must be an integer >= 4, got {n_positions!r}")
-    _check_loaded(rig, op)
+    check_loaded(rig, op)
     model = build_model(rig, op, resolve_mesh(rig, mesh, op.torque_nm))
     times = _bearing_cycle_times(model, n_positions)
     states = quasi_static_orbit(model, times, light_load=True)

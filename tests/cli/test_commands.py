@@ -171,7 +171,8 @@ def test_evaluate_text_says_when_a_class_was_never_detected():
     """A fault class none of whose records beat the threshold has no smallest detected
     severity (NaN): the text says so instead of "smallest severity detected nan"."""
     from cmsim.cli.evaluate import text
-    res = {"algorithm": "envelope", "dataset": "d", "errors": {}, "report": None, "metrics": {
+    res = {"algorithm": "envelope", "dataset": "d", "errors": {}, "unreadable": {},
+           "report": None, "metrics": {
         "n_scored": 4, "n_records": 4, "n_failed": 0, "accuracy": 0.5, "chance_accuracy": 0.5,
         "macro_f1": 0.4, "auc": {},
         "detection": {"threshold": 0.3, "classes": {
