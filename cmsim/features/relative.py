@@ -19,13 +19,12 @@ from cmsim.errors import ParameterError
 from cmsim.features.absolute import extract_features, statistics
 from cmsim.features.envelope import (band_excess, demodulated_spectrum, envelope_lines,
                                      line_amplitudes)
-from cmsim.features.lines import (SLIP_TOLERANCE, demodulation_band, highest_fault_hz,
-                                  line_amplitude)
+from cmsim.features.lines import SLIP_TOLERANCE, line_amplitude
 from cmsim.features.sidebands import sideband_energies
 from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
-__all__ = ["relative_features", "segment_features", "segments", "common_band",
+__all__ = ["relative_features", "segment_features", "segments",
            "N_SHAPE_BANDS", "shape_band_edges", "N_RELATIVE_GMF_HARMONICS"]
 
 #: Bands of the spectral-shape columns (3 log-spaced up to 0.05·fs, then linear to fs/2).
@@ -73,7 +72,7 @@ def _shape_bands(freq, power, fs, df):
         for i in range(len(edges) - 1)}
 
 
-def relative_features(signal, fs_hz, freqs, bearings=None, band_hz=None):
+def relative_features(signal, fs_hz, freqs, bearings=None):
     """Scale-free features of a segment (see the module docstring).
 
     * ``kurtosis_log``, ``crest_log``: natural log of the kurtosis and crest factor;
@@ -106,11 +105,6 @@ def relative_features(signal, fs_hz, freqs, bearings=None, band_hz=None):
         Frequencies of the rig at the record's speed.
     bearings : sequence of str, optional
         Bearings whose families are read (default all of ``freqs``).
-    band_hz : tuple of float, optional
-        Demodulation band (lo, hi), Hz, of the envelope features (default: the band rule's
-        for this segment; a calibration reads a baseline and its twin in the baseline's
-        band, :func:`common_band`).
-
     Returns
     -------
     dict of str to float
@@ -140,7 +134,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None, band_hz=None):
         out[f"raw_bpfo_{b}_band_db"] = _db_power(band_excess(freq, amp, bf.bpfo_hz, floor,
                                                              tol))
     if bfs:
-        (ef, ea), _ = demodulated_spectrum(x, fs, bfs.values(), band_hz)
+        (ef, ea), _ = demodulated_spectrum(x, fs, bfs.values())
         top_e = max(bf.bpfi_hz for bf in bfs.values())
         esel = (ef >= 0.5 * fr) & (ef <= 4.0 * top_e)
         efloor = float(np.median(ea[esel])) if np.any(esel) else 1.0
@@ -229,39 +223,3 @@ def segment_features(x, fs_hz, freqs, bearings, seg_s, max_segments=None):
     names = list(rows[0])
     return names, np.array([[r[k] for k in names] for r in rows], dtype=float)
 
-
-def common_band(segs, fs_hz, freqs, bearings):
-    """The demodulation band of a record: the band rule's band that most of its segments
-    give (the first of them on a tie), Hz.
-
-    A healthy baseline and its twin are demodulated in this one band: the band rule
-    run on each signal apart picks, on a signal of deterministic lines over noise, whichever
-    band a few lines' beating makes most impulsive, and a model whose lines stand a little
-    differently is then read in another band than the record (measured: the baseline of a
-    gearbox chose 2.46-2.86 kHz on all of its segments, its calibrated twin four different
-    bands on four seeds). A comparison with a fault record does not: there each signal is
-    read in its own band, where the fault's impacts ring in it, so that a model whose path
-    puts that resonance a little elsewhere still shows them (measured: read in the record's
-    band, three CWRU drive-end faults out of four were named as another race or the ball).
-
-    Parameters
-    ----------
-    segs : sequence of numpy.ndarray
-        Segments of the record.
-    fs_hz : float
-        Sample rate, Hz.
-    freqs : cmsim.frequencies.RigFrequencies
-        Frequencies of the rig at the record's speed.
-    bearings : sequence of str
-        Bearings whose families are read.
-
-    Returns
-    -------
-    (float, float)
-    """
-    top = highest_fault_hz([freqs.bearing(b) for b in bearings])
-    bands = [demodulation_band(np.asarray(x, dtype=float) - np.mean(x), fs_hz, top)
-             for x in segs]
-    if not bands:
-        raise ParameterError("no segment to choose a demodulation band on", param="record")
-    return max(bands, key=bands.count)

@@ -33,9 +33,7 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    order of the input or output shaft when it sits on one (so it follows the speed), else
    at its frequency (the mains, other machines).
 5. **Spread and fit quality.** :func:`cmsim.features.relative_features` of every baseline
-   segment (all demodulated in the band most fit segments give, the twin's too:
-   :func:`cmsim.features.common_band`) give each feature's mean and segment-to-segment
-   spread; the twin (model force →
+   segment give each feature's mean and segment-to-segment spread; the twin (model force →
    path + background, :data:`N_TWIN_SEEDS` new seeds, a segment each) is compared with the
    held-out segments feature by feature: z = (twin − baseline) / spread, and, since one
    record is one realisation of the model's random parts (cage phases, slip) while the twin
@@ -61,7 +59,7 @@ import numpy as np
 from scipy.ndimage import median_filter
 
 from cmsim.errors import ParameterError
-from cmsim.features import common_band, relative_features
+from cmsim.features import relative_features
 from cmsim.features.relative import segments
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine.background import Background, BackgroundLine
@@ -261,7 +259,7 @@ def _scatter(pins):
     return float(np.std(np.log([p[1] for p in pins]))) if len(pins) >= 2 else 0.0
 
 
-def feature_rows(segs, fs_hz, freqs, bearings, unit_scale, band_hz=None):
+def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
     """Features of each segment: :func:`cmsim.features.relative_features`, plus ``level_db``
     (dB re 1 m/s²) when the unit is known; ``(names, array (n_segments, n_features))``.
 
@@ -277,12 +275,10 @@ def feature_rows(segs, fs_hz, freqs, bearings, unit_scale, band_hz=None):
         Bearings whose families are read.
     unit_scale : float or None
         Sensor unit → m/s² (None: no ``level_db``).
-    band_hz : tuple of float, optional
-        Demodulation band of every segment (default: each its own).
     """
     rows = []
     for x in segs:
-        f = relative_features(x, fs_hz, freqs, bearings, band_hz)
+        f = relative_features(x, fs_hz, freqs, bearings)
         if unit_scale is not None:
             f["level_db"] = 20.0 * math.log10(max(float(np.std(x)) * unit_scale, 1e-30))
         rows.append(f)
@@ -489,8 +485,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
 
     # 5. the baseline's spread and the twin on the held-out segments
     bearings = list(rig.bearing_names)
-    band = common_band(fit, fs, freqs, bearings)     # baseline and twin read alike
-    names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale, band)
+    names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale)
     # a feature a segment cannot read (a line beyond its resolution) is NaN there; one no
     # two segments read has no spread and is left out
     seen = np.sum(np.isfinite(all_rows), axis=0) >= 2
@@ -502,7 +497,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
         force, edge, n = model_force(rig, op, ref.model_signal, fs, seg_s,
                                      seed + 1 + 7777 * (s + n_seeds))
         twin.append(machine.sensor_signal(force, edge, n, seed + 31 * s))
-    _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale, band)
+    _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale)
     z, z_model = {}, {}
     for i, k in enumerate(names):
         if k in spread and spread[k][1] > 0:
@@ -522,6 +517,5 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
                "chi2_per_feature_with_model_spread":
                    float(np.mean([v * v for v in z_model.values()])) if z_model else 0.0,
                "n_features": len(z), "held_out_segments": len(held),
-               "demodulation_band_hz": [float(band[0]), float(band[1])],
                "twin_segments": int(twin_rows.shape[0])}
     return replace(machine, spread=spread, fit_quality=quality)

@@ -10,8 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from cmsim.features import (N_ENVELOPE_HARMONICS, N_GMF_HARMONICS, FeatureRow, common_band,
-                            demodulation_band, extract_features, highest_fault_hz,
+from cmsim.features import (N_ENVELOPE_HARMONICS, N_GMF_HARMONICS, FeatureRow, extract_features,
                             relative_features, run_features, statistics)
 from cmsim.frequencies import RigFrequencies, bearing_frequencies, rig_frequencies
 from cmsim.rig import OperatingPoint, Rig
@@ -179,20 +178,3 @@ def test_sideband_energies_read_an_amplitude_modulation_and_ignore_a_small_wobbl
         assert clean[f"sb23_fr1_k{k}_db"] < expected - 30, k
         assert wobbly[f"sb1_fr1_k{k}_db"] == pytest.approx(expected, abs=1.5), k
 
-
-def test_one_band_for_a_record_is_the_band_most_segments_give():
-    """Three segments ring a 3.5-kHz resonance at the ball pass, one is noise only: the
-    record's band is the resonance's, and a segment read in it (relative_features with
-    ``band_hz``) gives the same BPFO line as one that chose that band itself."""
-    brg, f, fs = _ball_pass_rig()
-    n = int(0.5 * fs)
-    rng = np.random.default_rng(2)
-    ringing = [_ringing_at_bpfo(brg, fs, n) + 0.2 * rng.standard_normal(n) for _ in range(3)]
-    noise = 0.3 * rng.standard_normal(n)
-    band = common_band([noise] + ringing, fs, f, ["DE"])
-    assert band == demodulation_band(ringing[0], fs, highest_fault_hz([brg]))
-    assert band[0] < 3500.0 < band[1]
-    own = relative_features(ringing[1], fs, f, ["DE"])
-    given = relative_features(ringing[1], fs, f, ["DE"], band)
-    assert given["env_bpfo_DE_h1_db"] == pytest.approx(own["env_bpfo_DE_h1_db"], abs=0.5)
-    assert given["env_bpfo_DE_h1_db"] > 10.0
