@@ -24,8 +24,9 @@ from cmsim.features.sidebands import sideband_energies
 from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
-__all__ = ["relative_features", "segment_features", "segments",
-           "N_SHAPE_BANDS", "shape_band_edges", "N_RELATIVE_GMF_HARMONICS"]
+__all__ = ["relative_features", "segment_features", "segments", "N_SHAPE_BANDS",
+           "shape_band_edges",
+           "N_RELATIVE_GMF_HARMONICS"]
 
 #: Bands of the spectral-shape columns (3 log-spaced up to 0.05·fs, then linear to fs/2).
 N_SHAPE_BANDS = 12
@@ -105,6 +106,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
         Frequencies of the rig at the record's speed.
     bearings : sequence of str, optional
         Bearings whose families are read (default all of ``freqs``).
+
     Returns
     -------
     dict of str to float
@@ -222,4 +224,3 @@ def segment_features(x, fs_hz, freqs, bearings, seg_s, max_segments=None):
         raise ParameterError(f"record shorter than one {seg_s:g}-s segment", param="RECORD")
     names = list(rows[0])
     return names, np.array([[r[k] for k in names] for r in rows], dtype=float)
-
