@@ -64,7 +64,8 @@ def _notice_compile(args):
     from cmsim.dynamics.simulation import kernels_cached
 
     if not args.json and not args._compile_noticed and not kernels_cached():
-        print("cmsim: compiling numba kernels (first run only, about 30 s)...", file=sys.stderr)
+        print("cmsim: compiling numba kernels (first run only: 1-3 min on 2 cores; later "
+              "runs load them from the cache)...", file=sys.stderr)
     args._compile_noticed = True
 
 

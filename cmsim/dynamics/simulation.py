@@ -249,7 +249,7 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
 
 def kernels_cached():
     """True when the integration kernel has an up-to-date numba cache (the first run of a
-    fresh install compiles it, about 30 s); False when it will compile or cannot tell."""
+    fresh install compiles it, 1-3 min on 2 cores); False when it will compile or cannot tell."""
     source = Path(sys.modules[integrate_jit.__module__].__file__)
     # numba writes its cache to $NUMBA_CACHE_DIR when set, else beside the source
     places = [Path(os.environ["NUMBA_CACHE_DIR"]) if os.environ.get("NUMBA_CACHE_DIR")

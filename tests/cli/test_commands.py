@@ -182,3 +182,22 @@ def test_evaluate_text_says_when_a_class_was_never_detected():
     assert "nan" not in out
     assert "outer_race: detected 0.00 at 5 % false alarms, no record detected" in out
     assert "ball: detected 0.50 at 5 % false alarms, smallest severity detected 0.0002" in out
+
+
+def test_simulate_announces_the_compile_before_it_compiles(monkeypatch, capsys):
+    """On a cold numba cache the notice is on stderr before simulate() is entered (simulate
+    compiles its kernels before it reports its start, so a notice printed from the start
+    callback came after a silent 1-3 min compile)."""
+    import cmsim.dynamics
+    import cmsim.dynamics.simulation
+
+    seen = []
+
+    def fake_simulate(*args, **kwargs):
+        seen.append(capsys.readouterr().err)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cmsim.dynamics.simulation, "kernels_cached", lambda: False)
+    monkeypatch.setattr(cmsim.dynamics, "simulate", fake_simulate)
+    main(["simulate", "--speed-rpm", "1000", "--duration-s", "0.01"])
+    assert seen and "compiling numba kernels" in seen[0]
