@@ -121,10 +121,9 @@ def run(args):
                        correlation_s=args.slip_correlation_s)
     bar = None
 
-    args.notice_compile()             # simulate() compiles before it reports its start
-
     def started(total_s):
         nonlocal bar
+        args.notice_compile()
         if not args.json and total_s > LONG_RUN_S:
             from tqdm import tqdm
             bar = tqdm(total=round(total_s, 3), unit="sim s", desc="cmsim simulate",

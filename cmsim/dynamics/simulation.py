@@ -427,7 +427,6 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
         loads, friction_table = loss_inputs.loads, loss_inputs.friction_table
     else:
         contact = resolve_mesh(rig_with_faults(rig, faults), mesh, op.torque_nm)
-    compile_s = _compile_seconds()
     model = build_model(rig, op, contact, slip=slip, duration_s=warmup_s + duration_s,
                         seed=int(rng.integers(2 ** 31)), cage_phases_rad=cage_phases_rad,
                         profile=kprof, faults=faults, loads=loads,
@@ -447,6 +446,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     stats = {}
     if on_start is not None:
         on_start(warmup_s + duration_s)
+    compile_s = _compile_seconds()      # after on_start: a front end announces the compile
     try:
         states, diag, wall, n_warm, aa = _integrate_run(
             model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress, q_cols,
