@@ -97,7 +97,9 @@ BROADBAND_SHARE = 0.5
 #: frequency to tell the speed wobble (20 dB: the noise then adds under 0.5 % of the line's
 #: phase wander).
 WOBBLE_MIN_SNR = 100.0
-#: Relative tolerance of a line's frequency against a shaft order or a model line.
+#: Relative tolerance of a line's frequency against a shaft order or a model line, and how
+#: far a line may wander from its mean (a speed wobble moves every line in proportion to
+#: its frequency: ±9 Hz at 2.3 kHz, within the Hann main lobe below 1 kHz at 2-Hz bins).
 LINE_TOLERANCE = 0.004
 #: Lower edge of a housing's resonant band, as a share of the sample rate: below it the
 #: path is taken stiffness-controlled (accelerance ∝ f², the ω²/k of a structure below its
@@ -126,8 +128,7 @@ def _floor(freq, psd):
 
 def _lines_and_floor(freq, psd):
     """(lines, floor): the narrow lines [(frequency, amplitude)] standing
-    :data:`LINE_MIN_DB` over the running median (each at the centroid of its power),
-    strongest first, and the broadband floor —
+    :data:`LINE_MIN_DB` over the running median, strongest first, and the broadband floor —
     the running mean of the PSD with the lines' bins replaced by the median (unbiased: the
     power of a line too weak to be called stays in the broadband)."""
     df = freq[1] - freq[0]
@@ -142,7 +143,8 @@ def _lines_and_floor(freq, psd):
     for i in sorted(peaks, key=lambda j: -psd[j]):
         if owner[i] >= 0:                # a local maximum within a stronger line's bins
             continue
-        bins = _line_bins(ratio, owner, i, thr, k // 4)
+        bins = _line_bins(ratio, owner, i, thr,
+                          max(2, math.ceil(LINE_TOLERANCE * freq[i] / df)))
         owner[bins] = len(spans)
         spans.append((i, bins))
     masked = np.where(owner >= 0, med, psd)
@@ -153,10 +155,8 @@ def _lines_and_floor(freq, psd):
         over = np.maximum(psd[bins] - floor[bins], 0.0)
         excess = float(np.sum(over)) * df
         if excess > 0:
-            # Hann: the line's power spreads over its main lobe; ∑ (P − floor)·df = A²/2;
-            # its frequency is the centroid of that power (a wandering line's mean)
-            centre = float(np.sum(freq[bins] * over) / np.sum(over))
-            kept.append((centre, math.sqrt(2.0 * excess)))
+            # Hann: the line's power spreads over its main lobe; ∑ (P − floor)·df = A²/2
+            kept.append((float(freq[i]), math.sqrt(2.0 * excess)))
     kept.sort(key=lambda fa: -fa[1])
     return kept[:MAX_LINES], floor
 
@@ -165,8 +165,9 @@ def _line_bins(ratio, owner, i, thr, most):
     """Bins of the line peaking at bin ``i``: its Hann main lobe (± 2 bins) and the bins
     beside it that still stand ``thr`` over the median — a line whose frequency wanders (a
     speed wobble moves the k-th harmonic k times as far) or whose leakage stands over a low
-    floor spreads over more — at most ``most`` bins each side, and none that a stronger
-    line holds (``owner`` ≥ 0)."""
+    floor spreads over more — at most ``most`` bins each side (as far as
+    :data:`LINE_TOLERANCE` reaches: a wobble moves a line in proportion to its frequency),
+    and none that a stronger line holds (``owner`` ≥ 0)."""
     bins = [i]
     for step in (-1, 1):
         j = i + step
@@ -240,7 +241,7 @@ def _pins(shape, strong, lines, floor, pin_at, df, weak_family):
     pins, bounds = [], []
     for fm, force_amp in strong:
         j = int(round(fm / df))
-        match = [(f, a) for f, a in lines if abs(f - fm) <= 1.5 * df]
+        match = [(f, a) for f, a in lines if _near(f, fm, df)]
         if match and any(_near(fm, g, df) for g in pin_at):
             f, a = max(match, key=lambda fa: fa[1])
             pins.append((f, a / force_amp / shape[int(round(f / df))]))
