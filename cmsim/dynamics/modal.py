@@ -136,7 +136,18 @@ def highest_frequency_hz(model, q, t=0.0):
 
 def check_loaded(rig, op):
     """Refuse an unloaded operating point: it has no unique static state to linearise about
-    (the gears turn freely within the backlash, bearings with clearance carry nothing)."""
+    (the gears turn freely within the backlash, bearings with clearance carry nothing).
+
+    Parameters
+    ----------
+    rig : Rig
+    op : OperatingPoint
+
+    Raises
+    ------
+    ParameterError
+        No torque on a geared rig, or no radial load on a rig without gears.
+    """
     why = ("an unloaded rig has no unique static state to linearise about (the gears turn "
            "freely within the backlash and the bearings carry nothing); a run (simulate) "
            "starts there from the nominal geometry")

@@ -50,7 +50,7 @@ from cmsim.spectra.kurtogram import kurtogram
 
 __all__ = ["LineFamily", "FamilyVerdict", "line_families", "line_prominence_db",
            "exclusive_contrast_db", "family_ratio", "lowest_fundamental", "family_verdicts",
-           "check_rate_and_speed",
+           "check_rate_and_speed", "REFUSE_LINE_DB",
            "LINE_TOLERANCE", "SUBCOMB_MARGIN_DB", "MISSING_MARGIN_DB", "CLEAR_LINE_DB",
            "LARGEST_FACTOR", "STEPS"]
 
@@ -69,6 +69,13 @@ MISSING_MARGIN_DB = 5.5
 #: Least prominence, dB over the local floor, of a family's lines for it to speak (the
 #: largest of ~40 bins of pure noise stands about 7 dB over their median).
 CLEAR_LINE_DB = 15.0
+
+#: Least prominence, dB, of the deciding family for a record to be refused: between
+#: CLEAR_LINE_DB and this a family at another ratio leaves the check undecided. A faulty
+#: ball's cage-modulated comb put a simulated 0.4-s ball-fault record's BPFO family at
+#: 1/2 × 17 dB over its floor (a valid record refused); the weakest doctored real record
+#: that must be refused stands 20.3 dB (MFPT IR_vload4 at fs × 2).
+REFUSE_LINE_DB = 20.0
 
 #: Largest factor between the stated and the found fundamental that is tested.
 LARGEST_FACTOR = 4
@@ -359,7 +366,8 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     -------
     FamilyVerdict or None
         The deciding family (ratio 1), or None when no family's lines stand clear (nothing
-        to check against).
+        to check against) or the clearest, at another ratio, stands under
+        :data:`REFUSE_LINE_DB` (undecided).
 
     Raises
     ------
@@ -375,6 +383,8 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     rho = best.ratio
     if rho == 1.0:
         return best
+    if best.level_db < REFUSE_LINE_DB:          # too weak a family to refuse a record on
+        return None
     ratio = f"{rho:g}" if rho >= 1 else f"1/{1 / rho:g}"
     raise ParameterError(
         f"record {where}: its {best.family.name} lines stand at {ratio} x where {fs_source} "

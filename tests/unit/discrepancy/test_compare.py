@@ -44,9 +44,15 @@ def _write_dataset(folder, x, fs, *, name="rec.npz", extra=None, speed_rpm=1797.
     meta = {"fs_hz": fs if fs_in_meta else None,
             "channels": {"DE": "drive end"},
             "sensors": {"DE": {"near": "drive_end", "direction": "radial", "unit": "g"}},
-            "geometry": {"gears": None, "bearings": {"drive_end": {
-                "n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04,
-                "contact_angle_deg": 0.0, "shaft": "input"}}},
+            # the rig the records are made on (cwru_like_rig): both its bearings, so that
+            # the reader's rate/speed check sees every family the signal holds
+            "geometry": {"gears": None, "bearings": {
+                "drive_end": {"n_balls": 9, "ball_diameter_mm": 7.94,
+                              "pitch_diameter_mm": 39.04, "contact_angle_deg": 0.0,
+                              "shaft": "input"},
+                "fan_end": {"n_balls": 8, "ball_diameter_mm": 6.75,
+                            "pitch_diameter_mm": 28.5, "contact_angle_deg": 0.0,
+                            "shaft": "input"}}},
             "recordings": [rec]}
     (folder / "metadata.json").write_text(json.dumps(meta))
     return folder / name
