@@ -18,7 +18,8 @@ from cmsim.rig.plausibility import load_warnings
 
 __all__ = ["number", "add_rig_options", "load_rig", "add_sampling_options", "add_mesh_options",
            "mesh_argument", "prepare_tables", "add_fault_options", "faults_of", "add_losses_option",
-           "check_losses_options", "resolved_setup", "operating_point", "operating_warnings", "FAULT_NAMES"]
+           "check_losses_options", "resolved_setup", "operating_point", "operating_warnings",
+           "FAULT_NAMES"]
 
 #: The catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
 #: pulls in the mesh-stiffness stack; tests check the two agree).

@@ -26,7 +26,12 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    (a healthy ball bearing's ball pass is usually below the floor) the gain is that of the
    rig's nominal housing path averaged over 0.05-0.45·fs, lowered if that would show a model
    line the record does not, and the machine file says so: fault sizes read through such a
-   path carry that uncertainty.
+   path carry that uncertainty. Where the background is not the path's (white sensor noise
+   under a model's lines) the pins read alike through the background *over the model's
+   broadband force* instead: of the two shapes, the one that keeps more pins with less
+   scatter is taken (the background's on a tie). A gearbox's mesh harmonics are always the
+   model's lines; a healthy bearing's ball-pass line is disowned when the gain it implies
+   would show another harmonic the record lacks (:func:`_pins`).
 4. **Background.** The coloured noise is B(f) less what the model's broadband force puts
    there through the path (at least 10 % of B); the lines are the measured lines less what
    the model's own lines put there through the path (powers subtracted), each filed as an
@@ -234,10 +239,11 @@ def _pins(shape, strong, lines, floor, pin_at, df, weak_family):
     model lines ``strong`` that the record shows at ``pin_at`` ask of it; those that the
     lines it does not show allow (their amplitude 10 dB under the record's floor); and, for a
     ``weak_family`` (a healthy bearing's ball pass, often under the floor), the pins another
-    harmonic of the family the record does not show contradicts: some other line at that frequency. A gear's mesh harmonics are the
-    strongest periodic lines of a gearbox, and a housing resonance can lift one harmonic 20 dB
-    over its neighbours (a 2 %-damped mode falls 20 dB at 20 % detuning): a missing
-    neighbour bounds the path there (a cap), it does not disown the line."""
+    harmonic of the family the record does not show contradicts: some other line at that
+    frequency. A gear's mesh harmonics are the strongest periodic lines of a gearbox, and a
+    housing resonance can lift one harmonic 20 dB over its neighbours (a 2 %-damped mode
+    falls 20 dB at 20 % detuning): a missing neighbour bounds the path there (a cap), it
+    does not disown the line."""
     pins, bounds = [], []
     for fm, force_amp in strong:
         j = int(round(fm / df))
