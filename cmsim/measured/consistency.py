@@ -367,7 +367,12 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     FamilyVerdict or None
         The deciding family (ratio 1), or None when no family's lines stand clear (nothing
         to check against) or the clearest, at another ratio, stands under
-        :data:`REFUSE_LINE_DB` (undecided).
+        :data:`REFUSE_LINE_DB` or is a bearing family no other family agrees with
+        (undecided): the harmonics of a strong defect family, on a bearing the metadata may
+        not even name, can fall on another family's at a ratio 2^k (an outer race's 6th
+        BPFO harmonic lies within 1 % of 4 × BPFI on a 6205; the independent angle-domain
+        generator's valid records read BPFI at 4 ×), while a wrong rate or speed moves the
+        shaft comb too.
 
     Raises
     ------
@@ -385,6 +390,8 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
         return best
     if best.level_db < REFUSE_LINE_DB:          # too weak a family to refuse a record on
         return None
+    if best.family.envelope and not any(v is not best and v.ratio == rho for v in verdicts):
+        return None                # one bearing family alone, no second one agrees: undecided
     ratio = f"{rho:g}" if rho >= 1 else f"1/{1 / rho:g}"
     raise ParameterError(
         f"record {where}: its {best.family.name} lines stand at {ratio} x where {fs_source} "
