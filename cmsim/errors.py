@@ -12,8 +12,8 @@ import math
 import numbers
 import re
 
-__all__ = ["ParameterError", "IntegrationDiverged", "WorkersDied", "check_range", "check_choice",
-           "check_type", "format_range", "format_value"]
+__all__ = ["ParameterError", "IntegrationDiverged", "WorkersDied", "check_range", "within",
+           "check_choice", "check_type", "format_range", "format_value"]
 
 _LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
 
@@ -87,6 +87,32 @@ def format_range(lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False, uni
     return text + (f" {unit}" if unit else "")
 
 
+def within(v, lo, hi, *, lo_open=False, hi_open=False):
+    """THE range rule: ``v`` (a float) is finite and within [lo, hi], a bound excluded when
+    open (:func:`check_range` and :meth:`cmsim.rig.Range.contains` both apply it).
+
+    Parameters
+    ----------
+    v : float
+        The value.
+    lo, hi : float
+        The bounds.
+    lo_open, hi_open : bool
+        Whether a bound itself is excluded.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> within(1.0, 0.0, 1.0), within(1.0, 0.0, 1.0, hi_open=True)
+    (True, False)
+    """
+    return math.isfinite(v) and not (v < lo or v > hi or (lo_open and v == lo)
+                                     or (hi_open and v == hi))
+
+
 def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False,
                 unit=""):
     """Return ``float(value)`` or raise :class:`ParameterError` naming ``name``.
@@ -123,8 +149,7 @@ def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_ope
     except (TypeError, ValueError):
         raise ParameterError(f"{name} must be {allowed}, got {format_value(value)}",
                              param=name, allowed=allowed) from None
-    if (not math.isfinite(v) or v < lo or v > hi or (lo_open and v == lo)
-            or (hi_open and v == hi)):
+    if not within(v, lo, hi, lo_open=lo_open, hi_open=hi_open):
         raise ParameterError(f"{name} must be {allowed}, got {format_value(v)}", param=name,
                              allowed=allowed)
     return v

@@ -26,7 +26,7 @@ import math
 import numbers
 from dataclasses import dataclass
 
-from cmsim.errors import ParameterError, check_range, format_range, format_value
+from cmsim.errors import ParameterError, check_range, format_range, format_value, within
 
 __all__ = ["Range", "RANGES", "MAX_TEETH", "MAX_MASS_KG", "MAX_INERTIA_KG_M2",
            "MAX_DAMPING_N_S_PER_M", "MAX_CONTACT_STIFFNESS", "MAX_TRANSLATIONAL_STIFFNESS",
@@ -84,10 +84,9 @@ class Range:
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             return False
         v = float(value)
-        if not math.isfinite(v) or (self.integer and v != int(v)):
+        if self.integer and math.isfinite(v) and v != int(v):
             return False
-        return not (v < self.lo or v > self.hi or (self.lo_open and v == self.lo)
-                    or (self.hi_open and v == self.hi))
+        return within(v, self.lo, self.hi, lo_open=self.lo_open, hi_open=self.hi_open)
 
     def check(self, name, value):
         """``value`` as a float (an int for an integer range), or a
