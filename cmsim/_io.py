@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["atomic_write_text", "atomic_write_bytes", "atomic_savez", "READ_ERRORS"]
+__all__ = ["atomic_write", "atomic_write_text", "atomic_write_bytes", "atomic_savez",
+           "READ_ERRORS"]
 
 #: What reading a file a user brings can raise when the file is missing, truncated, of the
 #: wrong kind or holds the wrong keys (an ``.npz`` cut short raises ``BadZipFile`` or
@@ -47,6 +48,13 @@ def _umask():
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
+
+
+def atomic_write(path, write):
+    """``write(fh)`` into a temporary file beside ``path`` (``fh`` a binary file object),
+    renamed to ``path`` only when ``write`` returns: a writer streaming many parts (Parquet
+    row groups) leaves nothing behind when interrupted; return the path."""
+    return _atomic(path, write)
 
 
 def atomic_write_bytes(path, data):

@@ -53,7 +53,8 @@ from cmsim._io import atomic_savez
 from cmsim.errors import ParameterError, check_choice
 from cmsim.rig import OperatingPoint, Rig
 
-__all__ = ["Run", "SignalInfo", "signal_info", "SOURCES", "SIGNAL_QUANTITIES"]
+__all__ = ["Run", "SignalInfo", "signal_info", "is_measurable", "SOURCES", "SIGNAL_QUANTITIES",
+           "MEASURABLE_QUANTITIES"]
 
 #: Where a run's signals come from.
 SOURCES = ("simulated", "measured")
@@ -61,6 +62,11 @@ SOURCES = ("simulated", "measured")
 #: Physical quantities of :attr:`SignalInfo.quantity`.
 SIGNAL_QUANTITIES = ("transmission_error", "force", "displacement", "rotation",
                      "acceleration", "tacho")
+
+#: Quantities a real machine's sensors give (accelerometers on the housings, a once-per-rev
+#: tacho); the others (transmission error, bearing and mesh forces, displacements, rotations)
+#: exist in the model only, so ML defaults leave them out (:func:`is_measurable`).
+MEASURABLE_QUANTITIES = ("acceleration", "tacho")
 
 #: Array names of a saved run that are not signals.
 _RESERVED = ("t", "meta", "source")
@@ -139,6 +145,31 @@ def signal_info(name):
                               None if direction is None else direction.format(**groups))
     raise ParameterError(f"signal name {name!r} is not in the run schema; allowed patterns: "
                          + ", ".join(p for p, *_ in _SCHEMA))
+
+
+def is_measurable(name):
+    """Whether a real machine could measure the signal ``name``: an acceleration or the tacho
+    (:data:`MEASURABLE_QUANTITIES`), or a name outside the schema (a calibrated machine's own
+    sensor channel, e.g. ``"DE"``). DTE, forces, displacements and rotations are simulated only.
+
+    Parameters
+    ----------
+    name : str
+        A signal or channel name.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> [is_measurable(n) for n in ("accel_1b1_y", "tacho", "dte_um", "F_1b1_loa", "DE")]
+    [True, True, False, False, True]
+    """
+    try:
+        return signal_info(name).quantity in MEASURABLE_QUANTITIES
+    except ParameterError:
+        return True
 
 
 @dataclass(frozen=True)

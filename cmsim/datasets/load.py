@@ -3,11 +3,16 @@
 >>> ds = load("out/ci")                                          # doctest: +SKIP
 >>> ds.manifest.groupby("fault_label").size()                    # doctest: +SKIP
 >>> X, y, groups = ds.to_arrays(["accel_1b1_y"], window=2048)    # doctest: +SKIP
+>>> ds.to_parquet("windows.parquet", window=2048)                # doctest: +SKIP
 
 Signals are read only when asked for (a record's file is opened when one of its signals is
 accessed), so a dataset larger than memory can be explored from a notebook; for training,
 :meth:`Dataset.iter_arrays` yields fixed-size batches of windows, and :meth:`Dataset.to_arrays`
-takes a subset of records.
+takes a subset of records; :meth:`Dataset.to_parquet` writes the same windows as one Parquet
+table (:mod:`cmsim.datasets.windows`) and :class:`cmsim.datasets.torch_windows.WindowDataset`
+serves them to a PyTorch ``DataLoader``. All of them cut records through
+:meth:`Dataset.record_windows` and default to the channels a real machine could measure
+(:meth:`Dataset.to_arrays`).
 """
 
 from __future__ import annotations
@@ -24,8 +29,9 @@ from cmsim.datasets.manifest import PARQUET_NAME, SPEC_NAME, read_rows
 from cmsim.errors import ParameterError
 from cmsim.frequencies import rig_frequencies
 from cmsim.rig import OperatingPoint, Rig
+from cmsim.run import is_measurable
 
-__all__ = ["load", "Dataset", "DatasetRecord"]
+__all__ = ["load", "Dataset", "DatasetRecord", "window_starts"]
 
 
 def _read_record_file(path, read):
@@ -212,13 +218,13 @@ class Dataset:
         return out
 
     def iter_arrays(self, channels=None, window=2048, hop=None, label="fault_label",
-                    records=None, batch_records=64):
+                    records=None, batch_records=64, include_simulated=False):
         """Yield ``(X, y, groups)`` batches of windows, ``batch_records`` records at a time
-        (memory bounded by one batch); same layout as :meth:`to_arrays`.
+        (memory bounded by one batch); same layout and channel rule as :meth:`to_arrays`.
 
         Parameters
         ----------
-        channels, window, hop, label, records
+        channels, window, hop, label, records, include_simulated
             As in :meth:`to_arrays`.
         batch_records : int
             Records per batch.
@@ -228,7 +234,7 @@ class Dataset:
         tuple
             ``(X, y, groups)`` of one batch.
         """
-        channels = self._channels(channels)
+        channels = self.select_channels(channels, include_simulated)
         window, hop = _check_window(window, hop)
         if label not in self.manifest.columns:
             raise ParameterError(f"label must be a manifest column, got {label!r}",
@@ -243,25 +249,52 @@ class Dataset:
             xs, ys, gs = [], [], []
             for pos in chosen[start:start + int(batch_records)]:
                 rec = self._record_at(pos)
-                sig = _read_record_file(rec._path, lambda z: np.stack([z[c] for c in channels]))
-                sig = sig.astype(np.float32, copy=False)
-                _check_window_fits(window, sig.shape[1], rec.record_id)
-                n = (sig.shape[1] - window) // hop + 1
-                idx = np.arange(window)[None, :] + hop * np.arange(n)[:, None]
-                xs.append(np.transpose(sig[:, idx], (1, 0, 2)))
-                ys.append(np.repeat(np.asarray([rec.row[label]], dtype=object), n))
-                gs.append(np.repeat(np.asarray([rec.record_id]), n))
+                w = self.record_windows(rec, channels, window, hop)
+                xs.append(w)
+                ys.append(np.repeat(np.asarray([rec.row[label]], dtype=object), len(w)))
+                gs.append(np.repeat(np.asarray([rec.record_id]), len(w)))
             if xs:
                 yield (np.concatenate(xs), np.concatenate(ys), np.concatenate(gs))
 
+    def record_windows(self, record, channels, window, hop):
+        """THE windowing of a record (:meth:`iter_arrays`, :meth:`to_arrays`, the Parquet
+        export and the PyTorch dataset all cut through it): windows of ``window`` samples
+        starting every ``hop`` samples from the first, the last one ending at or before the
+        record's end (a shorter tail is dropped).
+
+        Parameters
+        ----------
+        record : DatasetRecord
+        channels : sequence of str
+            Channel names, in the order of the output's axis 1 (not checked here).
+        window, hop : int
+            Samples per window and between window starts.
+
+        Returns
+        -------
+        ndarray, float32, shape (n_windows, n_channels, window)
+        """
+        sig = _read_record_file(record._path, lambda z: np.stack([z[c] for c in channels]))
+        sig = sig.astype(np.float32, copy=False)
+        _check_window_fits(window, sig.shape[1], record.record_id)
+        idx = window_starts(sig.shape[1], window, hop)[:, None] + np.arange(window)[None, :]
+        return np.transpose(sig[:, idx], (1, 0, 2))
+
     def to_arrays(self, channels=None, window=2048, hop=None, label="fault_label",
-                  records=None):
+                  records=None, include_simulated=False):
         """Windows of every (or the given) ok record as arrays.
+
+        Channel rule (sim-to-real): by default only the channels a real machine could
+        measure — housing accelerations ``accel_*``, the ``tacho`` and a calibrated machine's
+        own sensor channel (:func:`cmsim.run.is_measurable`). Simulated-only signals (``dte``,
+        ``dte_um``, bearing and mesh forces ``F_*``, ``Fmesh_*``, displacements, rotations)
+        come only when asked for, by name in ``channels`` or with ``include_simulated``, so a
+        model trained on the defaults never sees what a real machine cannot give it.
 
         Parameters
         ----------
         channels : sequence of str, optional
-            Channels to stack (default all of the dataset's).
+            Channels to stack, in this order (default: the dataset's measurable channels).
         window : int
             Samples per window.
         hop : int, optional
@@ -270,6 +303,8 @@ class Dataset:
             Manifest column giving ``y``.
         records : sequence of str or int, optional
             Record ids or indices (default every ok record).
+        include_simulated : bool
+            With ``channels`` None: every channel of the dataset, simulated-only ones too.
 
         Returns
         -------
@@ -280,22 +315,105 @@ class Dataset:
             Record id per window: windows of one record share a group, so a grouped split
             (``sklearn.model_selection.GroupKFold``) never puts one record in two sets.
         """
-        parts = list(self.iter_arrays(channels, window, hop, label, records, batch_records=256))
-        channels = self._channels(channels)
+        parts = list(self.iter_arrays(channels, window, hop, label, records, batch_records=256,
+                                      include_simulated=include_simulated))
+        channels = self.select_channels(channels, include_simulated)
         if not parts:
             return (np.empty((0, len(channels), int(window)), np.float32),
                     np.empty(0, object), np.empty(0, str))
         return tuple(np.concatenate(p) for p in zip(*parts))
 
-    def _channels(self, channels):
+    def to_parquet(self, path, window=2048, hop=None, channels=None, include_simulated=False,
+                   **options):
+        """Write the windowed Parquet layout (:func:`cmsim.datasets.windows.to_parquet`).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The ``.parquet`` file (written atomically).
+        window, hop, channels, include_simulated
+            As in :meth:`to_arrays`.
+        **options
+            ``group_by``, ``seed``, ``fractions``, ``batch_records`` of
+            :func:`~cmsim.datasets.windows.to_parquet`.
+
+        Returns
+        -------
+        dict
+            What was written (:func:`~cmsim.datasets.windows.to_parquet`).
+        """
+        from cmsim.datasets.windows import to_parquet
+        return to_parquet(self, path, window=window, hop=hop, channels=channels,
+                          include_simulated=include_simulated, **options)
+
+    def unit(self, channel):
+        """Unit of a channel's samples (``"m/s²"``, ``"V"``, ``"µm"``, ...; a calibrated
+        machine's channel: the machine's unit; ``""`` when unknown).
+
+        Parameters
+        ----------
+        channel : str
+        """
+        from cmsim.run import signal_info
+        try:
+            return signal_info(channel).unit
+        except ParameterError:
+            machine = (self.spec.get("machine") or {}).get("machine") or {}
+            return str(machine.get("unit") or "") if machine.get("channel") == channel else ""
+
+    def select_channels(self, channels=None, include_simulated=False):
+        """The channels :meth:`to_arrays` stacks (its channel rule), checked.
+
+        Parameters
+        ----------
+        channels : str or sequence of str, optional
+            Names asked for (each must be in :attr:`channels`); None: the default.
+        include_simulated : bool
+            With ``channels`` None: every channel, not only the measurable ones.
+
+        Returns
+        -------
+        list of str
+        """
         if channels is None:
-            return list(self.channels)
+            chosen = [c for c in self.channels if include_simulated or is_measurable(c)]
+            if not chosen:
+                raise ParameterError(
+                    f"channels: this dataset has no channel a real machine could measure "
+                    f"(accelerations, tacho); ask for simulated ones by name or with "
+                    f"include_simulated=True; available: {list(self.channels)}",
+                    param="channels")
+            return chosen
         channels = [channels] if isinstance(channels, str) else list(channels)
+        if not channels:
+            raise ParameterError(f"channels must name at least one channel; available: "
+                                 f"{list(self.channels)}", param="channels")
         for c in channels:
             if c not in self.channels:
                 raise ParameterError(f"channels: {c!r} is not in this dataset "
                                      f"{list(self.channels)}", param="channels")
         return channels
+
+
+def window_starts(n_samples, window, hop):
+    """Start sample of every window of a record (the rule of :meth:`Dataset.record_windows`).
+
+    Parameters
+    ----------
+    n_samples, window, hop : int
+        Record length, samples per window, samples between starts.
+
+    Returns
+    -------
+    ndarray of int, shape (max(0, (n_samples - window) // hop + 1),)
+
+    Examples
+    --------
+    >>> window_starts(10, 4, 3).tolist()
+    [0, 3, 6]
+    """
+    n = max(0, (int(n_samples) - int(window)) // int(hop) + 1)
+    return int(hop) * np.arange(n)
 
 
 def _check_window(window, hop):
