@@ -50,7 +50,8 @@ _ALWAYS_REWRITE = {"substeps"}
 PATHS = {"rig": "file", "faults": "file", "mesh_table": "file", "run": "file", "dir": "dir",
          "out": "out", "plot": "out", ("sweep", "out"): "outdir",
          ("evaluate", "report"): "out", ("dataset", "spec"): "file",
-         ("dataset", "out"): "outdir", ("compare", "report"): "outdir",
+         ("dataset", "out"): "outdir", ("export", "out"): "outdir",
+         ("compare", "report"): "outdir",
          ("evaluate", "train"): "dir", ("evaluate", "test"): "dir",
          ("calibrate", "out"): "out", ("calibrate", "report"): "outdir", "machine": "file"}
 

@@ -1,5 +1,34 @@
-"""Export a generated dataset in the schema of the ``bearing-datasets`` index: one Parquet row
-per signal, so cmsim data mix with public bearing datasets.
+"""Data out of cmsim: a run or a dataset as signal files (:func:`export`), and a dataset in the
+schema of the ``bearing-datasets`` index (:func:`to_bearing_datasets`).
+
+Signal files (``cmsim export``)
+-------------------------------
+:func:`export` writes a saved run or a generated dataset into a new folder, in one of
+:data:`FORMATS`: the run, or each record of a dataset, as one file ``<name>.<format>`` holding
+its channels (``npz``: float32 arrays named by channel; ``csv``: one column per channel, a
+header of names; ``wav``: float32 IEEE, one WAV channel per channel, the rate in the header and
+the channels and units in a ``LIST``/``INFO`` comment; ``uff``: one universal-file type 58
+set per channel, with the rate (abscissa increment) and the unit label; ``parquet``: one
+float32 column per channel, rate and units in the schema metadata), plus
+
+* ``metadata.json`` — the measured-record schema of ``../shared/datasets/README.md``: the
+  sample rate, each channel's unit (``sensors``), one ``recordings[]`` entry per file with its
+  operating point and the answer key (``condition``, ``fault``, ``fault_severity``);
+* for a dataset, ``labels.csv`` — one row per record: ``record_id``, ``file``, ``label``,
+  ``fault_component``, ``severity``, operating point, ``fs_hz``, ``n_samples``, ``group``,
+  ``split`` (:func:`cmsim.datasets.windows.split_of`).
+
+A dataset exported as ``parquet`` is the windowed layout instead
+(:mod:`cmsim.datasets.windows`, ``windows.parquet``) with the same ``labels.csv``. The
+default channels are those a real machine could measure (:func:`cmsim.run.is_measurable`).
+The folder is assembled beside ``out`` and renamed into place when complete: an interrupted
+export leaves no ``out``; an existing ``out`` is replaced only with ``force``.
+
+The formats are written by :func:`write_signals` alone (one private function per format).
+
+Bearing-datasets schema
+-----------------------
+One Parquet row per signal, so cmsim data mix with public bearing datasets.
 
 Columns (one row per record and vibration channel):
 
@@ -22,16 +51,26 @@ Columns (one row per record and vibration channel):
 from __future__ import annotations
 
 import io
+import json
 import math
+import os
+import shutil
+import struct
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from cmsim._io import atomic_write_bytes
-from cmsim.datasets.load import load
-from cmsim.errors import ParameterError
+from cmsim._io import atomic_savez, atomic_write, atomic_write_bytes, atomic_write_text
+from cmsim.datasets.load import Dataset, load
+from cmsim.errors import ParameterError, check_choice
+from cmsim.run import Run, is_measurable, signal_info
 
-__all__ = ["to_bearing_datasets", "bearing_datasets_frame"]
+__all__ = ["export", "write_signals", "FORMATS", "to_bearing_datasets",
+           "bearing_datasets_frame"]
+
+#: Formats of :func:`export` (the file suffix is ``.<format>``).
+FORMATS = ("csv", "wav", "uff", "parquet", "npz")
 
 _LOCAL = {"inner_race", "outer_race", "ball"}
 _GEAR = {"tooth_crack", "tooth_spall", "tooth_breakage", "eccentricity", "profile_error"}
@@ -132,3 +171,339 @@ def to_bearing_datasets(dataset, out, channels=None):
     out = Path(out)
     atomic_write_bytes(out, buf.getvalue())
     return out
+
+
+# ---------------------------------------------------------------------- signal files
+def write_signals(path, signals, rate_hz, units):
+    """Write channels to one signal file, its format chosen by the suffix of ``path``
+    (``.npz``, ``.csv``, ``.wav``, ``.uff``, ``.parquet``), atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    signals : dict of str to ndarray
+        Channel name → samples, shape (n,) each (written as float32).
+    rate_hz : float
+        Sample rate, Hz (stored by WAV, UFF and Parquet).
+    units : dict of str to str
+        Channel name → unit of its samples (stored by WAV, UFF and Parquet).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    path = Path(path)
+    fmt = path.suffix.lower().lstrip(".")
+    check_choice("format", fmt, FORMATS)
+    arrays = {c: np.asarray(x, dtype=np.float32) for c, x in signals.items()}
+    _WRITERS[fmt](path, arrays, float(rate_hz), dict(units))
+    return path
+
+
+def _write_npz(path, signals, rate_hz, units):
+    atomic_savez(path, **signals)
+
+
+def _write_csv(path, signals, rate_hz, units):
+    import pandas as pd
+    atomic_write_text(path, pd.DataFrame(signals).to_csv(index=False))
+
+
+def _write_wav(path, signals, rate_hz, units):
+    from scipy.io import wavfile
+    buf = io.BytesIO()
+    wavfile.write(buf, int(round(rate_hz)), np.column_stack(list(signals.values())))
+    info = json.dumps({"channels": list(signals), "units": units, "fs_hz": rate_hz},
+                      ensure_ascii=False).encode("utf-8") + b"\0"
+    info += b"\0" * (len(info) % 2)
+    sub = b"ICMT" + struct.pack("<I", len(info)) + info
+    chunk = b"LIST" + struct.pack("<I", 4 + len(sub)) + b"INFO" + sub
+    data = bytearray(buf.getvalue()) + chunk
+    data[4:8] = struct.pack("<I", len(data) - 8)
+    atomic_write_bytes(path, bytes(data))
+
+
+#: UFF ordinate specific data types (type 58, record 9) of the run schema's quantities.
+_UFF_DATA_TYPE = {"acceleration": 12, "force": 13, "displacement": 8}
+
+
+def _write_uff(path, signals, rate_hz, units):
+    try:
+        import pyuff
+    except ImportError:
+        raise ParameterError("format uff needs pyuff: pip install cmsim[uff]",
+                             param="format") from None
+    sets = []
+    for k, (name, x) in enumerate(signals.items()):
+        try:
+            kind = _UFF_DATA_TYPE.get(signal_info(name).quantity, 0)
+        except ParameterError:
+            kind = 12 if units.get(name) in ("m/s²", "m/s^2", "g") else 0
+        unit = units.get(name, "").replace("²", "^2").replace("µ", "u")
+        exps = {f"{axis}_{q}_unit_exp": 0 for axis in ("abscissa", "ordinate", "orddenom",
+                                                        "z_axis")
+                for q in ("len", "force", "temp")}
+        sets.append(pyuff.prepare_58(
+            binary=1, id1=name, id2=f"cmsim channel {name}", id3="NONE", id4="NONE",
+            id5="NONE", func_type=1, ver_num=0, load_case_id=0, rsp_ent_name=name[:10],
+            rsp_node=k + 1, rsp_dir=0, ref_ent_name="NONE", ref_node=0, ref_dir=0,
+            ord_data_type=4, num_pts=int(x.size), abscissa_spacing=1, abscissa_min=0.0,
+            abscissa_inc=1.0 / rate_hz, z_axis_value=0.0, abscissa_spec_data_type=17,
+            abscissa_axis_units_lab="s", ordinate_spec_data_type=kind,
+            ordinate_axis_units_lab=unit, orddenom_spec_data_type=0,
+            orddenom_axis_units_lab="NONE", z_axis_spec_data_type=0,
+            z_axis_axis_units_lab="NONE", data=np.asarray(x, dtype=np.float64),
+            x=np.arange(x.size) / rate_hz, **exps))
+    # every set in "add" mode into the new, empty temporary file: pyuff 2.5's "overwrite" of a
+    # binary set truncates the set's own header when it reopens the file for the samples
+    _atomic_by_name(path, lambda tmp: pyuff.UFF(tmp).write_sets(sets, mode="add"))
+
+
+def _atomic_by_name(path, write):
+    """``write(name)`` for writers that open the file themselves, atomically: ``name`` is a
+    temporary file beside ``path``, renamed to it when ``write`` returns."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _write_parquet(path, signals, rate_hz, units):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    meta = {"cmsim": json.dumps({"fs_hz": rate_hz, "units": units}, ensure_ascii=False)}
+    table = pa.table({c: pa.array(x) for c, x in signals.items()}).replace_schema_metadata(meta)
+    atomic_write(path, lambda fh: pq.write_table(table, fh))
+
+
+#: Format → writer ``(path, float32 signals, rate_hz, units)``.
+_WRITERS = {"npz": _write_npz, "csv": _write_csv, "wav": _write_wav, "uff": _write_uff,
+            "parquet": _write_parquet}
+
+
+def _source(source):
+    """``("run", Run)`` or ``("dataset", Dataset)`` of a path (or either object)."""
+    if isinstance(source, (Run, Dataset)):
+        return ("run" if isinstance(source, Run) else "dataset"), source
+    p = Path(source)
+    if p.is_dir():
+        return "dataset", load(p)
+    if p.is_file() and p.suffix.lower() == ".npz":
+        try:
+            return "run", Run.load(p)
+        except Exception:  # noqa: BLE001 - any failure: not a run
+            pass
+    raise ParameterError(f"source {p} is neither a cmsim run (.npz of cmsim simulate) nor a "
+                         f"dataset directory (cmsim dataset)", param="source",
+                         allowed="a run .npz or a dataset directory")
+
+
+def _channels(available, channels):
+    """The channels to export: those asked (each checked), else the measurable ones."""
+    available = list(available)
+    if channels:
+        for c in channels:
+            if c not in available:
+                raise ParameterError(f"channels: {c!r} is not a channel of the source; "
+                                     f"available: {available}", param="channels")
+        return list(channels)
+    chosen = [c for c in available if is_measurable(c)]
+    if not chosen:
+        raise ParameterError(f"channels: the source has no channel a real machine could "
+                             f"measure (accelerations, tacho); name the simulated ones to "
+                             f"export; available: {available}", param="channels")
+    return chosen
+
+
+def _sensors(channels, units):
+    out = {}
+    for c in channels:
+        try:
+            info = signal_info(c)
+            near = info.component if info.component[:1].isdigit() else "unknown"
+            out[c] = {"near": near, "direction": info.direction, "unit": units[c]}
+        except ParameterError:
+            out[c] = {"near": "unknown", "direction": None, "unit": units[c]}
+    return out
+
+
+def _run_entry(file, run, channels):
+    op = run.meta.get("operating_point") or {}
+    labels = run.meta.get("labels") or {}
+    return {"file": file, "n_samples": int(run.t.size), "fs_hz": run.fs_hz,
+            "shaft_speed_rpm": op.get("speed_rpm"), "torque_nm": op.get("torque_nm"),
+            "radial_load_n": op.get("radial_load_n"), "channels": list(channels),
+            "condition": labels.get("fault_label"), "fault": labels.get("fault_component"),
+            "fault_severity": labels.get("fault_severity")}
+
+
+def _json(value):
+    """JSON text with non-finite floats as null (JSON has no NaN)."""
+    def clean(v):
+        if isinstance(v, dict):
+            return {k: clean(x) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            return [clean(x) for x in v]
+        if isinstance(v, (float, np.floating)):
+            return float(v) if math.isfinite(v) else None
+        if isinstance(v, np.integer):
+            return int(v)
+        return v
+    return json.dumps(clean(value), indent=1, ensure_ascii=False)
+
+
+def export(source, out, fmt, channels=None, *, force=False, window=None, hop=None,
+           group_by="record_id", seed=0, fractions=(0.8, 0.1, 0.1), name=None):
+    """Write a run or a dataset into the new folder ``out`` (module docstring).
+
+    Parameters
+    ----------
+    source : str or path-like or cmsim.run.Run or cmsim.datasets.Dataset
+        A saved run (``.npz``) or a dataset directory.
+    out : str or path-like
+        The folder to make (it must not exist unless ``force``).
+    fmt : str
+        One of :data:`FORMATS`.
+    channels : sequence of str, optional
+        Channels to write (default: the measurable ones, :func:`cmsim.run.is_measurable`).
+    force : bool
+        Replace an existing ``out``.
+    window, hop : int, optional
+        Windows of the Parquet layout of a dataset (default window 2048, hop = window);
+        only for ``fmt="parquet"`` and a dataset.
+    group_by, seed, fractions
+        Group and split keys of ``labels.csv`` and of the windows
+        (:func:`cmsim.datasets.windows.to_parquet`).
+    name : str, optional
+        File name stem of a run (default: the run file's stem, or ``run``).
+
+    Returns
+    -------
+    dict
+        ``kind`` (``run`` or ``dataset``), ``format``, ``out``, ``files`` (written signal
+        files), ``records``, ``channels``, ``units``, ``fs_hz``; for windows, ``windows``
+        (:func:`~cmsim.datasets.windows.to_parquet`'s summary).
+    """
+    from cmsim.datasets.windows import check_fractions
+
+    check_choice("format", fmt, FORMATS)
+    out = Path(out)
+    if out.exists() and not force:
+        raise ParameterError(f"out {out} exists; give force (--force) to replace it",
+                             param="out", allowed="a new folder")
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"out {out} is a file (expected a folder)", param="out")
+    kind, src = _source(source)
+    windowed = kind == "dataset" and fmt == "parquet"
+    if not windowed and (window is not None or hop is not None):
+        raise ParameterError("window: windows are cut only for the parquet format of a "
+                             "dataset", param="window" if window is not None else "hop")
+    check_fractions(fractions)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".export", dir=out.parent))
+    try:
+        if kind == "run":
+            res = _export_run(src, stage, fmt, channels,
+                              name or (Path(source).stem if not isinstance(source, Run)
+                                       else "run"))
+        else:
+            res = _export_dataset(src, stage, fmt, channels, windowed, window, hop, group_by,
+                                  seed, fractions, out.name)
+        _replace_dir(stage, out)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    return {"kind": kind, "format": fmt, "out": str(out), **res}
+
+
+def _replace_dir(stage, out):
+    """Rename the finished ``stage`` to ``out``; an old ``out`` is moved away first and
+    removed after."""
+    old = None
+    if out.exists():
+        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".old", dir=out.parent))
+        os.replace(out, old / "dir")
+    os.replace(stage, out)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def _export_run(run, stage, fmt, channels, stem):
+    chans = _channels(run.names, channels)
+    units = {c: _run_unit(run, c) for c in chans}
+    file = f"{stem}.{fmt}"
+    write_signals(stage / file, {c: run.signals[c] for c in chans}, run.fs_hz, units)
+    meta = {"dataset": stem, "source": "cmsim export", "fs_hz": run.fs_hz,
+            "channels": {c: f"cmsim {run.source} signal {c}" for c in chans},
+            "sensors": _sensors(chans, units), "recordings": [_run_entry(file, run, chans)]}
+    atomic_write_text(stage / "metadata.json", _json(meta))
+    return {"files": 1, "records": 1, "channels": chans, "units": units, "fs_hz": run.fs_hz}
+
+
+def _run_unit(run, name):
+    try:
+        return signal_info(name).unit
+    except ParameterError:
+        machine = run.meta.get("machine") or {}
+        return str(machine.get("unit") or "") if machine.get("channel") == name else ""
+
+
+def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, seed,
+                    fractions, out_name):
+    from cmsim.datasets.windows import split_of
+
+    chans = ds.select_channels(channels or None)
+    units = {c: ds.unit(c) for c in chans}
+    if group_by not in ds.manifest.columns:
+        raise ParameterError(f"group_by must be a manifest column {list(ds.manifest.columns)}, "
+                             f"got {group_by!r}", param="group_by")
+    res = {"channels": chans, "units": units, "fs_hz": ds.fs_hz, "records": len(ds)}
+    if windowed:
+        res["windows"] = ds.to_parquet(stage / "windows.parquet", window=2048 if window is None
+                                       else window, hop=hop, channels=chans, group_by=group_by,
+                                       seed=seed, fractions=fractions)
+        res["windows"]["path"] = str(stage.parent / out_name / "windows.parquet")
+        res["files"] = 1
+    rows, entries = [], []
+    for rec in ds:
+        r = rec.row
+        file = None if windowed else f"{rec.record_id}.{fmt}"
+        if file is not None:
+            write_signals(stage / file, {c: rec.signals[c] for c in chans}, rec.fs_hz, units)
+        group = str(r[group_by])
+        n = int(r["n_samples"]) if r.get("n_samples") is not None else None
+        rows.append({"record_id": rec.record_id, "file": file, "label": r.get("fault_label"),
+                     "fault_component": r.get("fault_component"),
+                     "severity": r.get("fault_severity"), "speed_rpm": r.get("speed_rpm"),
+                     "torque_nm": r.get("torque_nm"), "radial_load_n": r.get("radial_load_n"),
+                     "fs_hz": rec.fs_hz, "n_samples": n, "group": group,
+                     "split": split_of(group, seed, fractions)})
+        if file is not None:
+            entries.append({"file": file, "n_samples": n, "fs_hz": rec.fs_hz,
+                            "shaft_speed_rpm": r.get("speed_rpm"),
+                            "torque_nm": r.get("torque_nm"),
+                            "radial_load_n": r.get("radial_load_n"), "channels": chans,
+                            "condition": r.get("fault_label"),
+                            "fault": r.get("fault_component"),
+                            "fault_severity": r.get("fault_severity")})
+    import pandas as pd
+    atomic_write_text(stage / "labels.csv", pd.DataFrame(
+        rows, columns=["record_id", "file", "label", "fault_component", "severity",
+                       "speed_rpm", "torque_nm", "radial_load_n", "fs_hz", "n_samples",
+                       "group", "split"]).to_csv(index=False))
+    if not windowed:
+        name = str(ds.spec.get("name") or ds.directory.name)
+        meta = {"dataset": name, "source": f"cmsim export of dataset {name}",
+                "fs_hz": ds.fs_hz,
+                "channels": {c: f"cmsim simulated {c}" for c in chans},
+                "sensors": _sensors(chans, units), "recordings": entries}
+        atomic_write_text(stage / "metadata.json", _json(meta))
+        res["files"] = len(entries)
+    return res
