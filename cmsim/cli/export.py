@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, ranged
+from cmsim.cli.options import number
 from cmsim.rig import Range
 
 
@@ -39,7 +40,7 @@ def register(sub):
     p.add_argument("--group-by", default="record_id", metavar="COLUMN",
                    help="manifest column whose value groups records for the split (default "
                         "record_id: each record its own machine)")
-    p.add_argument("--split-seed", type=ranged(Range(0, 2 ** 63 - 1, integer=True)), default=0,
+    p.add_argument("--split-seed", type=number("seed"), default=0,
                    help="seed of the train/val/test split of the groups (default 0)")
     p.add_argument("--fractions", type=ranged(Range(0.0, 1.0)), nargs=3,
                    default=[0.8, 0.1, 0.1], metavar=("TRAIN", "VAL", "TEST"),

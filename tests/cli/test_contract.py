@@ -62,6 +62,7 @@ BASE = {
     "evaluate": "evaluate {empty_dir} --algorithm envelope",
     "compare": "compare {record}",
     "dataset": "dataset {ds_spec} --out {work}/ds",
+    "export": "export {run} --format npz --out {work}/ex --channels F_1b1_loa",
     "losses": "losses --speed-rpm 1000 --torque-nm 10",
     "calibrate": "calibrate {record} --out {work}/machine.toml",
 }
@@ -305,6 +306,30 @@ CATALOGUE = [
     R("dataset-spec-unknown-key", "dataset {ds_unknown_key} --out {work}/d", "SPEC",
       "sensor.chanels"),
     R("dataset-out-file", "dataset {ds_spec} --out {text}", "--out"),
+    # ---- export (issue 28)
+    R("export-format-unknown", "export {run} --format mp3 --out {work}/ex", "--format",
+      "csv", "npz"),
+    R("export-channel-unknown", "export {gen_ds} --format csv --out {work}/ex --channels nope",
+      "--channels", "'nope'", "accel_1b1_y"),
+    R("export-run-channel-unknown", "export {run} --format csv --out {work}/ex --channels "
+      "accel_1b1_y", "--channels", "available", "F_1b1_loa"),
+    R("export-run-nothing-measurable", "export {run} --format csv --out {work}/ex",
+      "--channels", "real machine", "dte_um"),
+    R("export-out-exists", "export {gen_ds} --format npz --out {work}", "--out", "--force"),
+    R("export-out-file", "export {gen_ds} --format npz --out {text}", "--out"),
+    R("export-source-folder", "export {empty_dir} --format npz --out {work}/ex",
+      "RUN|DATASET", "dataset directory"),
+    R("export-source-text", "export {text} --format npz --out {work}/ex", "RUN|DATASET"),
+    R("export-source-not-a-run", "export {bad_meta} --format npz --out {work}/ex "
+      "--channels F_1b1_loa", "RUN|DATASET"),
+    R("export-window-of-a-run", "export {run} --format parquet --out {work}/ex --channels "
+      "F_1b1_loa --window 64", "--window", "parquet"),
+    R("export-window-too-long", "export {gen_ds} --format parquet --out {work}/ex "
+      "--window 100000000", "--window", "record length"),
+    R("export-fractions-sum", "export {gen_ds} --format csv --out {work}/ex --fractions "
+      "0.5 0.5 0.5", "--fractions", "sum"),
+    R("export-group-by-unknown", "export {gen_ds} --format csv --out {work}/ex --group-by "
+      "nope", "--group-by", "record_id"),
     R("dataset-out-missing", "dataset {ds_spec}", "--out"),
     R("dataset-workers-zero", "dataset {ds_spec} --out {work}/d --workers 0", "--workers",
       numeric=True),
@@ -835,8 +860,10 @@ def test_every_option_is_validated():
     # --algorithm: load_algorithm; --scheduler: checked by connecting (names --scheduler)
     # compare's RECORD and calibrate's BASELINE may be relative to $CMSIM_DATA: the library
     # checks them (and the command names them)
+    # export's RUN|DATASET is a file or a folder, its --channels are checked against the
+    # source, --group-by against the manifest
     free_text = {"signal", "bearing", "fault", "algorithm", "scheduler", "record", "channel",
-                 "baseline"}
+                 "baseline", "source", "channels", "group_by"}
     for command, sub in contract.subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):
