@@ -1,0 +1,240 @@
+"""Data out (issue 28): signal files, the windowed Parquet layout, the ML channel rule.
+
+Test tier: behaviour contracts (no physics). Every export format reads back with the same
+samples, rate and units (npz, csv, wav through cmsim's own measured reader, uff through
+pyuff); the windowed Parquet holds the windows of ``to_arrays`` (pandas, pyarrow and the
+HuggingFace loader when installed) and no group in two splits; ML loaders leave the
+simulated-only channels out unless asked; an interrupted export leaves nothing and a
+repeated one is refused without ``force``. The dataset has 4 records of 0.02 s.
+"""
+
+import json
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from cmsim.datasets import DatasetSpec, generate_dataset, load
+from cmsim.datasets import export as export_mod
+from cmsim.datasets.export import FORMATS, export
+from cmsim.datasets.windows import split_of
+from cmsim.errors import ParameterError
+from cmsim.measured.readers import read_signals
+from cmsim.run import Run
+
+SPEC = {
+    "dataset": {"name": "tiny", "records": 4, "seed": 3},
+    "rig": {"builtin": "paper_2016"},
+    "faults": {"healthy_share": 0.5,
+               "types": [{"type": "outer_race", "bearing": ["1b1"],
+                          "size_m": {"min": 0.5e-3, "max": 1.5e-3}, "depth_m": 1e-4}]},
+    "sensor": {"channels": ["accel_1b1_y", "tacho", "dte_um"], "fs_hz": 25600.0,
+               "duration_s": 0.02, "warmup_s": 0.01},
+}
+MEASURABLE = ["accel_1b1_y", "tacho"]
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory):
+    out = tmp_path_factory.mktemp("export") / "ds"
+    generate_dataset(DatasetSpec.from_dict(SPEC), out, workers=1, progress=False)
+    return out
+
+
+# ---------------------------------------------------------------------- channel rule
+def test_ml_defaults_leave_simulated_only_channels_out(made):
+    ds = load(made)
+    assert ds.select_channels() == MEASURABLE
+    X, y, g = ds.to_arrays(window=128)
+    assert X.shape[1] == 2
+    np.testing.assert_array_equal(X[0, 0], ds.record(0).signals["accel_1b1_y"][:128])
+    Xd, _, _ = ds.to_arrays(["dte_um"], window=128)                 # asked by name
+    np.testing.assert_array_equal(Xd[0, 0], ds.record(0).signals["dte_um"][:128])
+    Xa, _, _ = ds.to_arrays(window=128, include_simulated=True)
+    assert Xa.shape[1] == 3
+    np.testing.assert_array_equal(Xa[:, :2], X)
+    assert next(ds.iter_arrays(window=128))[0].shape[1] == 2
+    with pytest.raises(ParameterError, match=r"'F_1b1_loa' is not in this dataset.*dte_um"):
+        ds.to_arrays(["F_1b1_loa"], window=128)
+
+
+def test_a_dataset_of_simulated_signals_only_needs_them_named(made, monkeypatch):
+    ds = load(made)
+    monkeypatch.setattr(ds, "channels", ("dte_um",))
+    with pytest.raises(ParameterError, match="real machine") as err:
+        ds.to_arrays(window=128)
+    assert err.value.param == "channels"
+    assert ds.to_arrays(window=128, include_simulated=True)[0].shape[1] == 1
+
+
+# ---------------------------------------------------------------------- signal files
+@pytest.mark.parametrize("fmt", ["npz", "csv", "wav"])
+def test_run_round_trips_through_the_measured_reader(made, tmp_path, fmt):
+    src = made / "records" / "000002.npz"
+    run = Run.load(src)
+    res = export(src, tmp_path / "out", fmt, channels=["accel_1b1_y", "dte_um"])
+    assert res["kind"] == "run" and res["units"] == {"accel_1b1_y": "m/s²", "dte_um": "µm"}
+    signals, rate = read_signals(tmp_path / "out" / f"000002.{fmt}",
+                                 names=["accel_1b1_y", "dte_um"])
+    for c in ("accel_1b1_y", "dte_um"):
+        np.testing.assert_array_equal(signals[c].astype(np.float32), run[c])
+    meta = json.loads((tmp_path / "out" / "metadata.json").read_text())
+    assert meta["fs_hz"] == pytest.approx(25600.0)
+    assert meta["sensors"]["accel_1b1_y"]["unit"] == "m/s²"
+    assert meta["recordings"][0]["condition"] == "outer_race"
+    if fmt == "wav":                           # the rate and units in the WAV file itself
+        assert rate == pytest.approx(25600.0)
+        raw = (tmp_path / "out" / "000002.wav").read_bytes()
+        info = json.loads(raw[raw.index(b"ICMT") + 8:].split(b"\0")[0])
+        assert info["units"] == {"accel_1b1_y": "m/s²", "dte_um": "µm"}
+
+
+def test_uff_round_trips_through_pyuff(made, tmp_path):
+    pyuff = pytest.importorskip("pyuff")
+    src = made / "records" / "000002.npz"
+    run = Run.load(src)
+    export(src, tmp_path / "out", "uff")
+    sets = pyuff.UFF(str(tmp_path / "out" / "000002.uff")).read_sets()
+    assert [s["id1"].strip() for s in sets] == MEASURABLE
+    for s in sets:
+        name = s["id1"].strip()
+        assert s["type"] == 58 and s["abscissa_inc"] == pytest.approx(1 / 25600.0)
+        assert s["ordinate_axis_units_lab"].strip() == {"accel_1b1_y": "m/s^2",
+                                                        "tacho": "V"}[name]
+        np.testing.assert_array_equal(np.asarray(s["data"], np.float32), run[name])
+
+
+def test_uff_without_pyuff_names_the_extra(made, tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "pyuff", None)
+    with pytest.raises(ParameterError, match=r"pip install cmsim\[uff\]"):
+        export(made, tmp_path / "out", "uff")
+    assert not list(tmp_path.iterdir())
+
+
+def test_dataset_export_one_file_per_record_and_the_labels(made, tmp_path):
+    ds = load(made)
+    res = export(made, tmp_path / "out", "npz", seed=1)
+    assert res["files"] == len(ds) == 4 and res["channels"] == MEASURABLE
+    labels = pd.read_csv(tmp_path / "out" / "labels.csv", dtype={"record_id": str, "group": str})
+    assert list(labels["record_id"]) == list(ds.manifest["record_id"])
+    assert list(labels["label"]) == list(ds.manifest["fault_label"])
+    assert list(labels["split"]) == [split_of(g, 1) for g in labels["group"]]
+    for rid in labels["record_id"]:
+        signals, _ = read_signals(tmp_path / "out" / f"{rid}.npz")
+        assert sorted(signals) == MEASURABLE
+        np.testing.assert_array_equal(signals["tacho"], ds.record(rid).signals["tacho"])
+    meta = json.loads((tmp_path / "out" / "metadata.json").read_text())
+    assert [r["file"] for r in meta["recordings"]] == list(labels["file"])
+
+
+def test_export_refuses_an_existing_out_and_force_replaces_it(made, tmp_path):
+    out = tmp_path / "out"
+    export(made, out, "csv")
+    with pytest.raises(ParameterError, match="exists") as err:
+        export(made, out, "npz")
+    assert err.value.param == "out"
+    export(made, out, "npz", force=True)
+    assert sorted(p.suffix for p in out.iterdir()) == [".csv", ".json"] + [".npz"] * 4
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]     # no staging left
+
+
+def test_an_interrupted_export_leaves_nothing(made, tmp_path, monkeypatch):
+    real, calls = export_mod.write_signals, []
+
+    def interrupted(path, *args):
+        calls.append(path)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(path, *args)
+
+    monkeypatch.setattr(export_mod, "write_signals", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        export(made, tmp_path / "out", "wav")
+    assert len(calls) == 3 and not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("bad, match", [
+    ({"fmt": "mp3"}, "format"), ({"channels": ["nope"]}, "nope"),
+    ({"fractions": (0.5, 0.5, 0.5)}, "fractions"), ({"group_by": "nope"}, "group_by"),
+    ({"window": 64, "fmt": "csv"}, "window")])
+def test_bad_input_is_named(made, tmp_path, bad, match):
+    kwargs = {"fmt": "npz", **bad}
+    with pytest.raises(ParameterError, match=match):
+        export(made, tmp_path / "out", kwargs.pop("fmt"), **kwargs)
+    assert not list(tmp_path.iterdir())
+
+
+def test_not_a_run_nor_a_dataset(tmp_path):
+    np.savez(tmp_path / "x.npz", a=np.zeros(3))
+    for src in (tmp_path / "x.npz", tmp_path):
+        with pytest.raises(ParameterError, match="not a cmsim|neither"):
+            export(src, tmp_path / "out", "csv")
+
+
+def test_every_format_is_one_writer():
+    assert set(export_mod._WRITERS) == set(FORMATS)
+
+
+# ---------------------------------------------------------------------- windowed Parquet
+def test_windowed_parquet_holds_the_windows_of_to_arrays(made, tmp_path):
+    import pyarrow.parquet as pq
+
+    ds = load(made)
+    path = tmp_path / "w.parquet"
+    res = ds.to_parquet(path, window=128, hop=64, batch_records=1, seed=0,
+                        fractions=(0.5, 0.25, 0.25))
+    X, y, groups = ds.to_arrays(window=128, hop=64)
+    df = pd.read_parquet(path)
+    assert len(df) == res["rows"] == len(X) and res["row_groups"] == 4
+    assert pq.ParquetFile(path).metadata.num_row_groups == 4      # bounded memory
+    assert list(df["label"]) == list(y) and list(df["record_id"]) == list(groups)
+    for k, c in enumerate(MEASURABLE):
+        got = np.stack(df[c].to_numpy())
+        assert got.dtype == np.float32
+        np.testing.assert_array_equal(got, X[:, k])
+    assert "dte_um" not in df.columns
+    assert (df.groupby("group")["split"].nunique() == 1).all()    # a group in one split
+    assert set(df["split"]) <= {"train", "val", "test"}
+    row = ds.manifest.set_index("record_id").loc[df["record_id"].iloc[-1]]
+    assert df["speed_rpm"].iloc[-1] == pytest.approx(row["speed_rpm"])
+    assert df["fs_hz"].iloc[0] == pytest.approx(25600.0)
+    np.testing.assert_allclose(df["start_s"].iloc[:3], np.arange(3) * 64 / 25600.0)
+    meta = json.loads(pq.read_schema(path).metadata[b"cmsim"])
+    assert meta["units"] == {"accel_1b1_y": "m/s²", "tacho": "V"} and meta["hop"] == 64
+
+
+def test_windowed_parquet_loads_with_huggingface_datasets(made, tmp_path):
+    hf = pytest.importorskip("datasets")
+    if not hasattr(hf, "load_dataset"):            # the repo's datasets/ folder, not the library
+        pytest.skip("HuggingFace datasets is not installed")
+    ds = load(made)
+    path = tmp_path / "w.parquet"
+    ds.to_parquet(path, window=128)
+    X, y, _ = ds.to_arrays(window=128)
+    hds = hf.load_dataset("parquet", data_files=str(path), split="train",
+                          cache_dir=str(tmp_path / "hf"))
+    assert hds.num_rows == len(X) and list(hds["label"]) == list(y)
+    np.testing.assert_array_equal(np.asarray(hds[0]["accel_1b1_y"], np.float32), X[0, 0])
+
+
+def test_the_split_depends_on_the_group_alone():
+    groups = [f"{i:06d}" for i in range(2000)]
+    splits = [split_of(g, seed=7) for g in groups]
+    assert splits == [split_of(g, seed=7) for g in reversed(groups)][::-1]
+    share = {s: splits.count(s) / len(splits) for s in ("train", "val", "test")}
+    assert share["train"] == pytest.approx(0.8, abs=0.04)
+    assert share["test"] == pytest.approx(0.1, abs=0.03)
+    assert splits != [split_of(g, seed=8) for g in groups]
+    with pytest.raises(ParameterError, match="fractions"):
+        split_of("a", fractions=(1, 1))
+
+
+def test_dataset_exported_as_parquet_is_the_windowed_layout(made, tmp_path):
+    res = export(made, tmp_path / "out", "parquet", window=256, group_by="rig_name")
+    df = pd.read_parquet(tmp_path / "out" / "windows.parquet")
+    assert res["windows"]["rows"] == len(df) and res["windows"]["path"].startswith(
+        str(tmp_path / "out"))
+    assert df["group"].nunique() == 1 and df["split"].nunique() == 1   # one rig, one split
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["labels.csv",
+                                                                     "windows.parquet"]

@@ -1,0 +1,61 @@
+"""The PyTorch dataset over a generated dataset (issue 28) yields the windows of to_arrays.
+
+Test tier: behaviour contract (no physics, trains nothing). Skipped without torch. The
+dataset has 3 records of 0.02 s.
+"""
+
+import numpy as np
+import pytest
+
+from cmsim.datasets import DatasetSpec, generate_dataset, load
+from cmsim.datasets.torch_windows import WindowDataset
+
+SPEC = {
+    "dataset": {"name": "torch", "records": 3, "seed": 4},
+    "rig": {"builtin": "paper_2016"},
+    "faults": {"healthy_share": 0.5,
+               "types": [{"type": "inner_race", "bearing": ["1b1"],
+                          "size_m": {"min": 0.5e-3, "max": 1.5e-3}, "depth_m": 1e-4}]},
+    "sensor": {"channels": ["accel_1b1_y", "dte_um", "tacho"], "fs_hz": 25600.0,
+               "duration_s": 0.02, "warmup_s": 0.01},
+}
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory):
+    out = tmp_path_factory.mktemp("torch") / "ds"
+    generate_dataset(DatasetSpec.from_dict(SPEC), out, workers=1, progress=False)
+    return out
+
+
+@pytest.mark.parametrize("kwargs", [{}, {"channels": ["dte_um", "tacho"]}],
+                         ids=["measurable", "named"])
+def test_dataloader_yields_the_windows_of_to_arrays(made, kwargs):
+    torch = pytest.importorskip("torch")
+    from torch.utils.data import DataLoader
+
+    ds = load(made)
+    X, y, groups = ds.to_arrays(window=128, hop=96, **kwargs)
+    wins = WindowDataset(ds, window=128, hop=96, **kwargs)
+    assert len(wins) == len(X)
+    xs, ys, gs = [], [], []
+    for x, label, group in DataLoader(wins, batch_size=5, shuffle=False):
+        assert x.dtype == torch.float32 and x.shape[1:] == X.shape[1:]
+        xs.append(x.numpy())
+        ys += [wins.classes[i] for i in label.tolist()]
+        gs += list(group)
+    np.testing.assert_array_equal(np.concatenate(xs), X)
+    assert ys == list(y) and gs == list(groups)
+    if not kwargs:
+        assert wins.channels == ["accel_1b1_y", "tacho"]          # no DTE by default
+
+
+def test_shuffled_items_are_the_same_windows(made):
+    pytest.importorskip("torch")
+    ds = load(made)
+    X, _, _ = ds.to_arrays(window=256)
+    wins = WindowDataset(ds, window=256, cache_records=1)
+    for i in (5, 0, len(wins) - 1, 3):
+        np.testing.assert_array_equal(wins[i][0].numpy(), X[i])
+    with pytest.raises(IndexError):
+        wins[len(wins)]
