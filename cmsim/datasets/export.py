@@ -60,9 +60,11 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from scipy.io import wavfile
 
 from cmsim._io import atomic_savez, atomic_write, atomic_write_bytes, atomic_write_text
 from cmsim.datasets.load import Dataset, load
+from cmsim.datasets.windows import check_fractions, split_of
 from cmsim.errors import ParameterError, check_choice
 from cmsim.run import Run, is_measurable, signal_info
 
@@ -211,7 +213,6 @@ def _write_csv(path, signals, rate_hz, units):
 
 
 def _write_wav(path, signals, rate_hz, units):
-    from scipy.io import wavfile
     buf = io.BytesIO()
     wavfile.write(buf, int(round(rate_hz)), np.column_stack(list(signals.values())))
     info = json.dumps({"channels": list(signals), "units": units, "fs_hz": rate_hz},
@@ -391,8 +392,6 @@ def export(source, out, fmt, channels=None, *, force=False, window=None, hop=Non
         files), ``records``, ``channels``, ``units``, ``fs_hz``; for windows, ``windows``
         (:func:`~cmsim.datasets.windows.to_parquet`'s summary).
     """
-    from cmsim.datasets.windows import check_fractions
-
     check_choice("format", fmt, FORMATS)
     out = Path(out)
     if out.exists() and not force:
@@ -457,8 +456,6 @@ def _run_unit(run, name):
 
 def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, seed,
                     fractions, out_name):
-    from cmsim.datasets.windows import split_of
-
     chans = ds.select_channels(channels or None)
     units = {c: ds.unit(c) for c in chans}
     if group_by not in ds.manifest.columns:

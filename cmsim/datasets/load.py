@@ -29,9 +29,11 @@ from cmsim.datasets.manifest import PARQUET_NAME, SPEC_NAME, read_rows
 from cmsim.errors import ParameterError
 from cmsim.frequencies import rig_frequencies
 from cmsim.rig import OperatingPoint, Rig
-from cmsim.run import is_measurable
+from cmsim.datasets.windows import (check_window, check_window_fits, to_parquet,
+                                    window_starts)
+from cmsim.run import is_measurable, signal_info
 
-__all__ = ["load", "Dataset", "DatasetRecord", "window_starts"]
+__all__ = ["load", "Dataset", "DatasetRecord"]
 
 
 def _read_record_file(path, read):
@@ -235,7 +237,7 @@ class Dataset:
             ``(X, y, groups)`` of one batch.
         """
         channels = self.select_channels(channels, include_simulated)
-        window, hop = _check_window(window, hop)
+        window, hop = check_window(window, hop)
         if label not in self.manifest.columns:
             raise ParameterError(f"label must be a manifest column, got {label!r}",
                                  param="label")
@@ -243,7 +245,7 @@ class Dataset:
         if "n_samples" in self.manifest.columns and chosen:
             lengths = self.manifest["n_samples"].to_numpy()[chosen]
             shortest = int(np.argmin(lengths))
-            _check_window_fits(window, int(lengths[shortest]),
+            check_window_fits(window, int(lengths[shortest]),
                                self.manifest["record_id"].iloc[chosen[shortest]])
         for start in range(0, len(chosen), int(batch_records)):
             xs, ys, gs = [], [], []
@@ -276,7 +278,7 @@ class Dataset:
         """
         sig = _read_record_file(record._path, lambda z: np.stack([z[c] for c in channels]))
         sig = sig.astype(np.float32, copy=False)
-        _check_window_fits(window, sig.shape[1], record.record_id)
+        check_window_fits(window, sig.shape[1], record.record_id)
         idx = window_starts(sig.shape[1], window, hop)[:, None] + np.arange(window)[None, :]
         return np.transpose(sig[:, idx], (1, 0, 2))
 
@@ -342,7 +344,6 @@ class Dataset:
         dict
             What was written (:func:`~cmsim.datasets.windows.to_parquet`).
         """
-        from cmsim.datasets.windows import to_parquet
         return to_parquet(self, path, window=window, hop=hop, channels=channels,
                           include_simulated=include_simulated, **options)
 
@@ -354,7 +355,6 @@ class Dataset:
         ----------
         channel : str
         """
-        from cmsim.run import signal_info
         try:
             return signal_info(channel).unit
         except ParameterError:
@@ -393,43 +393,6 @@ class Dataset:
                 raise ParameterError(f"channels: {c!r} is not in this dataset "
                                      f"{list(self.channels)}", param="channels")
         return channels
-
-
-def window_starts(n_samples, window, hop):
-    """Start sample of every window of a record (the rule of :meth:`Dataset.record_windows`).
-
-    Parameters
-    ----------
-    n_samples, window, hop : int
-        Record length, samples per window, samples between starts.
-
-    Returns
-    -------
-    ndarray of int, shape (max(0, (n_samples - window) // hop + 1),)
-
-    Examples
-    --------
-    >>> window_starts(10, 4, 3).tolist()
-    [0, 3, 6]
-    """
-    n = max(0, (int(n_samples) - int(window)) // int(hop) + 1)
-    return int(hop) * np.arange(n)
-
-
-def _check_window(window, hop):
-    hop = window if hop is None else hop
-    for name, v in (("window", window), ("hop", hop)):
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-            raise ParameterError(f"{name} must be a positive integer, got {v!r}", param=name)
-    return int(window), int(hop)
-
-
-def _check_window_fits(window, n_samples, record_id):
-    """A window no longer than a record: else no window would come out of it."""
-    if window > n_samples:
-        raise ParameterError(f"window must be at most the record length, {n_samples} samples "
-                             f"(record {record_id}), got {window}", param="window",
-                             allowed=f"<= {n_samples}")
 
 
 def load(directory):

@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cmsim.datasets.load import Dataset, _check_window, _check_window_fits, load, window_starts
+from cmsim.datasets.load import Dataset, load
+from cmsim.datasets.windows import check_window, check_window_fits, window_starts
 from cmsim.errors import ParameterError
 
 __all__ = ["WindowDataset"]
@@ -55,7 +56,7 @@ class WindowDataset:
         self.dataset = dataset if isinstance(dataset, Dataset) else load(Path(dataset))
         ds = self.dataset
         self.channels = ds.select_channels(channels, include_simulated)
-        self.window, self.hop = _check_window(window, hop)
+        self.window, self.hop = check_window(window, hop)
         if label not in ds.manifest.columns:
             raise ParameterError(f"label must be a manifest column, got {label!r}",
                                  param="label")
@@ -66,7 +67,7 @@ class WindowDataset:
                 else None
             rec = ds._record_at(pos)
             n = int(n) if n is not None and n == n else rec.signals[self.channels[0]].size
-            _check_window_fits(self.window, n, rec.record_id)
+            check_window_fits(self.window, n, rec.record_id)
             starts = window_starts(n, self.window, self.hop)
             parts.append(np.column_stack([np.full(starts.size, pos), starts]))
         self.index = np.concatenate(parts) if parts else np.empty((0, 2), int)

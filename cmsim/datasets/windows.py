@@ -1,4 +1,6 @@
-"""The windowed Parquet layout of a dataset: one row per window, ready for ML loaders.
+"""Windows of a dataset: THE window rule (:func:`window_starts` and its checks), the
+train/val/test split of groups (:func:`split_of`), and the windowed Parquet layout
+(:func:`to_parquet`): one row per window, ready for ML loaders.
 
 The windows are those of :meth:`cmsim.datasets.Dataset.to_arrays` (the file is written from
 :meth:`~cmsim.datasets.Dataset.iter_arrays`, batch by batch, one Parquet row group per batch,
@@ -42,7 +44,8 @@ import numpy as np
 from cmsim._io import atomic_write
 from cmsim.errors import ParameterError
 
-__all__ = ["to_parquet", "split_of", "check_fractions", "SPLITS"]
+__all__ = ["to_parquet", "split_of", "check_fractions", "window_starts", "check_window",
+           "check_window_fits", "SPLITS"]
 
 #: Split names, in the order of the fractions.
 SPLITS = ("train", "val", "test")
@@ -51,6 +54,60 @@ SPLITS = ("train", "val", "test")
 _ROW_COLUMNS = (("fault_label", "label"), ("fault_component", "fault_component"),
                 ("fault_severity", "severity"), ("speed_rpm", "speed_rpm"),
                 ("torque_nm", "torque_nm"), ("radial_load_n", "radial_load_n"))
+
+
+def window_starts(n_samples, window, hop):
+    """Start sample of every window of a record (the rule of :meth:`Dataset.record_windows`).
+
+    Parameters
+    ----------
+    n_samples, window, hop : int
+        Record length, samples per window, samples between starts.
+
+    Returns
+    -------
+    ndarray of int, shape (max(0, (n_samples - window) // hop + 1),)
+
+    Examples
+    --------
+    >>> window_starts(10, 4, 3).tolist()
+    [0, 3, 6]
+    """
+    n = max(0, (int(n_samples) - int(window)) // int(hop) + 1)
+    return int(hop) * np.arange(n)
+
+
+def check_window(window, hop):
+    """``(window, hop)`` as ints, each a positive integer (``hop`` None: ``window``).
+
+    Parameters
+    ----------
+    window : int
+        Samples per window.
+    hop : int or None
+        Samples between window starts.
+    """
+    hop = window if hop is None else hop
+    for name, v in (("window", window), ("hop", hop)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+            raise ParameterError(f"{name} must be a positive integer, got {v!r}", param=name)
+    return int(window), int(hop)
+
+
+def check_window_fits(window, n_samples, record_id):
+    """A window no longer than a record: else no window would come out of it.
+
+    Parameters
+    ----------
+    window, n_samples : int
+        Samples per window and of the record.
+    record_id : str
+        The record, for the message.
+    """
+    if window > n_samples:
+        raise ParameterError(f"window must be at most the record length, {n_samples} samples "
+                             f"(record {record_id}), got {window}", param="window",
+                             allowed=f"<= {n_samples}")
 
 
 def check_fractions(fractions):
@@ -176,8 +233,8 @@ def to_parquet(dataset, path, window=2048, hop=None, channels=None, include_simu
 
     Parameters
     ----------
-    dataset : cmsim.datasets.Dataset or str or path-like
-        A dataset or its directory.
+    dataset : cmsim.datasets.Dataset
+        The dataset (``cmsim.datasets.load(DIR)``).
     path : str or path-like
         The ``.parquet`` file; an interrupted write leaves no file.
     window, hop, channels, include_simulated
@@ -200,9 +257,7 @@ def to_parquet(dataset, path, window=2048, hop=None, channels=None, include_simu
     """
     import pyarrow.parquet as pq
 
-    from cmsim.datasets.load import Dataset, _check_window, load
-
-    ds = dataset if isinstance(dataset, Dataset) else load(dataset)
+    ds = dataset
     channels = ds.select_channels(channels, include_simulated)
     fractions = check_fractions(fractions)
     if group_by not in ds.manifest.columns:
@@ -212,7 +267,7 @@ def to_parquet(dataset, path, window=2048, hop=None, channels=None, include_simu
             or batch_records < 1:
         raise ParameterError(f"batch_records must be a positive integer, got "
                              f"{batch_records!r}", param="batch_records")
-    window, hop = _check_window(window, hop)
+    window, hop = check_window(window, hop)
     batches = ds.iter_arrays(channels, window, hop, records=None,
                              batch_records=int(batch_records))
     units = {c: ds.unit(c) for c in channels}
