@@ -12,8 +12,13 @@
 * :mod:`~cmsim.datasets.runner` — :func:`generate_dataset`, the one runner;
 * :mod:`~cmsim.datasets.pool` — the task pool (local processes or Dask, Ctrl-C/SIGTERM);
 * :mod:`~cmsim.datasets.lock` — one run per directory (``fcntl.flock``);
+* :mod:`~cmsim.datasets.windows` — the one window rule, the train/val/test split of groups,
+  the windowed Parquet layout;
 * :mod:`~cmsim.datasets.load` — :func:`load`: the manifest, lazy :class:`DatasetRecord` s,
-  ML arrays; :mod:`~cmsim.datasets.export` — the bearing-datasets schema.
+  ML arrays (by default only the channels a real machine measures);
+* :mod:`~cmsim.datasets.export` — a run or a dataset as csv/wav/uff/parquet/npz files
+  (``cmsim export``), the bearing-datasets schema;
+* :mod:`~cmsim.datasets.torch_windows` — ``WindowDataset``, the windows for PyTorch.
 
 Example
 -------

@@ -318,8 +318,9 @@ def _channels(available, channels):
     chosen = [c for c in available if is_measurable(c)]
     if not chosen:
         raise ParameterError(f"channels: the source has no channel a real machine could "
-                             f"measure (accelerations, tacho); name the simulated ones to "
-                             f"export; available: {available}", param="channels")
+                             f"measure (accelerations, tacho: cmsim simulate --sensors adds "
+                             f"them); name the simulated ones to export; available: "
+                             f"{available}", param="channels")
     return chosen
 
 
