@@ -37,10 +37,17 @@ from cmsim.faults import (BallDefect, Eccentricity, InnerRaceDefect, OuterRaceDe
 from cmsim.rig import HousingPath, OperatingPoint, Rig
 
 __all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
-           "MACHINE_NUISANCES", "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO"]
+           "MACHINE_NUISANCES", "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO",
+           "STATISTICS"]
 
 #: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
 NOMINAL_NOISE_RATIO = 0.1
+
+#: Statistics of the whole signal that every impulsive fault moves (a bearing defect's and a
+#: tooth fault's signature share them): they add to a fault's evidence but never tell one
+#: fault from another, so a fault is told from the others by the rest of its signature, its
+#: *family* (:meth:`Cause.family`).
+STATISTICS = ("kurtosis_log", "crest_log")
 
 
 @dataclass(frozen=True)
@@ -198,6 +205,25 @@ class Cause:
             return list(names)
         pre = tuple(p.format(b=component) for p in self.signature)
         return [k for k in names if k.startswith(pre)]
+
+    def family(self, names, component):
+        """The features of ``names`` that tell this cause from the other faults: its signature
+        without the shared :data:`STATISTICS` (empty for a cause that reshapes the spectrum).
+
+        Parameters
+        ----------
+        names : sequence of str
+            Feature names.
+        component : str or None
+            The component it sits on (fills ``{b}``).
+
+        Returns
+        -------
+        list of str
+        """
+        if self.signature is None:
+            return []
+        return [k for k in self.judged_on(names, component) if k not in STATISTICS]
 
     @property
     def params(self):

@@ -202,7 +202,7 @@ def evidence(r, chi_of, nominal_features, names):
     r["delta_chi2"] = sum(pf[k] for k in judged)
 
 
-def decide(ranked, sensor_bearing, chi_nominal):
+def decide(ranked, sensor_bearing, chi_nominal, z=None):
     """(winner or None, near ties) from ranked causes with their evidence filled.
 
     Faults (causes with a signature) are decided first: of those whose evidence reaches
