@@ -60,9 +60,10 @@ def _plain_negative_numbers(argv):
 
 def _notice_compile(args, integrates=True):
     """Once per process, before the first heavy step of a command, on a cold numba cache:
-    compile the integration kernels now with progress lines on stderr (``integrates``:
-    the command simulates), or say in one stderr line that its own kernels compile. Also
-    with ``--json``: stdout keeps its one JSON object."""
+    compile the integration kernels now with progress lines on stderr (``integrates``: the
+    command simulates; also with ``--json``, whose stdout keeps its one JSON object), or
+    say in one stderr line that the command's own, smaller kernels compile (not with
+    ``--json``: a script reads that command's stderr as its warnings)."""
     from cmsim.dynamics.simulation import compile_kernels, kernels_cached
     from cmsim.progress import progress_enabled
 
@@ -71,7 +72,7 @@ def _notice_compile(args, integrates=True):
     args._compile_noticed = True
     if integrates:
         compile_kernels()
-    elif not kernels_cached() and progress_enabled():
+    elif not args.json and not kernels_cached() and progress_enabled():
         print("cmsim: compiling numba kernels (first run only; later runs load them from "
               "the cache)...", file=sys.stderr)
 

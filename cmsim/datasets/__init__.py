@@ -15,8 +15,8 @@
 * :mod:`~cmsim.datasets.load` — :func:`load`: the manifest, lazy :class:`DatasetRecord` s,
   ML arrays; :mod:`~cmsim.datasets.export` — the bearing-datasets schema.
 
-Example
--------
+Examples
+--------
 >>> from cmsim.datasets import DatasetSpec, Variation
 >>> spec = DatasetSpec([Variation("torque_nm", [10, 100]), Variation("clearance_m", [15e-6, 0])],
 ...                    fixed={"speed_rpm": 1000}, duration_s=0.1)
