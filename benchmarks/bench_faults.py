@@ -6,8 +6,8 @@ Prints
    an eccentric gear — against a healthy run, on the paper's rig at 1000 rpm, 20 N m, 75 kHz
    (default mesh: hybrid FE tables, model B); target <= 1.2x;
 2. the cost of a run-up (300 -> 1500 rpm) against a constant-speed run; target <= 1.2x;
-3. the signature table (the README's): envelope lines of bearing defects on the CWRU rig model
-   (6205, 1797 rpm, 500 N) in the faulty bearing's force F_1b1_y (N) and its housing
+3. the signature table (docs/guide/faults.md): envelope lines of bearing defects on the CWRU
+   rig model (6205, 1797 rpm, 500 N) in the faulty bearing's force F_1b1_y (N) and its housing
    accelerometer accel_1b1_y (m/s², 12 kHz, kurtogram band); the TE at the shaft rate and the
    GMF ± fr sidebands (N) of an eccentric gear; the TSA-residual kurtosis of the DTE and the
    sidebands of tooth faults (paper rig, potential-energy table).

@@ -58,15 +58,23 @@ def _plain_negative_numbers(argv):
             if _NEGATIVE_EXPONENT_NUMBER.match(a) else a for a in argv]
 
 
-def _notice_compile(args):
-    """Once per process, before the first heavy step of a command: say that the numba
-    kernels compile when their cache is cold (nothing with ``--json``)."""
-    from cmsim.dynamics.simulation import kernels_cached
+def _notice_compile(args, integrates=True):
+    """Once per process, before the first heavy step of a command, on a cold numba cache:
+    compile the integration kernels now with progress lines on stderr (``integrates``: the
+    command simulates; also with ``--json``, whose stdout keeps its one JSON object), or
+    say in one stderr line that the command's own, smaller kernels compile (not with
+    ``--json``: a script reads that command's stderr as its warnings)."""
+    from cmsim.dynamics.simulation import compile_kernels, kernels_cached
+    from cmsim.progress import progress_enabled
 
-    if not args.json and not args._compile_noticed and not kernels_cached():
-        print("cmsim: compiling numba kernels (first run only: 1-3 min on 2 cores; later "
-              "runs load them from the cache)...", file=sys.stderr)
+    if args._compile_noticed:
+        return
     args._compile_noticed = True
+    if integrates:
+        compile_kernels()
+    elif not args.json and not kernels_cached() and progress_enabled():
+        print("cmsim: compiling numba kernels (first run only; later runs load them from "
+              "the cache)...", file=sys.stderr)
 
 
 def main(argv=None):
@@ -87,7 +95,7 @@ def main(argv=None):
         options = options_of(parser, args.command)
         args.warn = lambda text: args.warnings.append(user_message(text, options)[0])
         args._compile_noticed = False
-        args.notice_compile = lambda: _notice_compile(args)
+        args.notice_compile = lambda integrates=True: _notice_compile(args, integrates)
         try:
             check_paths(args, args.command, options)
             res = args.func(args)

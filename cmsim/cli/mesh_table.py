@@ -42,7 +42,7 @@ def run(args):
     rig = load_rig(args)
     if rig.gears is None:
         raise CLIError(f"--rig {args.rig}: mesh-table needs a rig with gears", option="--rig")
-    args.notice_compile()
+    args.notice_compile(integrates=False)
     start = time.perf_counter()
     mesh_model = None
     cache = None

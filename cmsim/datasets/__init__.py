@@ -20,8 +20,8 @@
   (``cmsim export``), the bearing-datasets schema;
 * :mod:`~cmsim.datasets.torch_windows` — ``WindowDataset``, the windows for PyTorch.
 
-Example
--------
+Examples
+--------
 >>> from cmsim.datasets import DatasetSpec, Variation
 >>> spec = DatasetSpec([Variation("torque_nm", [10, 100]), Variation("clearance_m", [15e-6, 0])],
 ...                    fixed={"speed_rpm": 1000}, duration_s=0.1)

@@ -28,10 +28,11 @@ from cmsim.faults import (NO_SLIP, RollingSlip, check_faults, fault_frequencies,
                           operating_modulation, rig_with_faults, slip_from_faults)
 from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
+from cmsim.progress import stage
 from cmsim.rig import RANGES, SAMPLING
 from cmsim.run import Run
 
-__all__ = ["simulate", "integrate", "check_memory", "kernels_cached",
+__all__ = ["simulate", "integrate", "check_memory", "kernels_cached", "compile_kernels",
            "MAX_ROTATION_DEVIATION_RAD",           "STEPS_PER_PERIOD", "MAX_OUTPUT_BYTES"]
 
 #: Largest output a run may hold in memory, bytes (signals as float64); longer runs are
@@ -282,6 +283,29 @@ def _compile_seconds():
     return _compile_seconds.value
 
 
+#: What :func:`compile_kernels` announces on stderr while numba compiles on a cold cache.
+COMPILE_STAGE = ("compiling numba kernels (first run only: 1-3 min on 2 cores; later runs "
+                 "load them from the cache)")
+
+
+def compile_kernels():
+    """Compile the integration kernels now, or load them from numba's cache.
+
+    On a cold cache (:func:`kernels_cached` is False) the compile runs inside a
+    :func:`cmsim.progress.stage`: a start line, a heartbeat and the time taken, on stderr.
+    Once per process; :func:`simulate` calls it before integrating.
+
+    Returns
+    -------
+    float
+        Seconds the compile (or the cache load) took.
+    """
+    if hasattr(_compile_seconds, "value") or kernels_cached():
+        return _compile_seconds()
+    with stage(COMPILE_STAGE):
+        return _compile_seconds()
+
+
 def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLING.fs_hz,
              substeps=SAMPLING.substeps, scheme="ode3", slip=None, seed=SAMPLING.seed,
              warmup_s=SAMPLING.warmup_s, cage_phases_rad="random",
@@ -446,7 +470,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     stats = {}
     if on_start is not None:
         on_start(warmup_s + duration_s)
-    compile_s = _compile_seconds()      # after on_start: a front end announces the compile
+    compile_s = compile_kernels()       # after on_start: a front end announces the compile
     try:
         states, diag, wall, n_warm, aa = _integrate_run(
             model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress, q_cols,

@@ -1,13 +1,15 @@
 """The fault catalogue (issue 16): frozen values applied to the model before it is built.
 
->>> from cmsim.faults import parse_fault, FAULT_TYPES
->>> sorted(FAULT_TYPES)[:3]
-['ball', 'eccentricity', 'inner_race']
-
 See :mod:`cmsim.faults.base` (registry, parsing), :mod:`~cmsim.faults.bearing`,
 :mod:`~cmsim.faults.gear`, :mod:`~cmsim.faults.operating` (the entries),
 :mod:`~cmsim.faults.crack` (cracked-tooth stiffness) and :mod:`~cmsim.faults.compile`
 (what the dynamics consumes).
+
+Examples
+--------
+>>> from cmsim.faults import parse_fault, FAULT_TYPES
+>>> sorted(FAULT_TYPES)[:3]
+['ball', 'eccentricity', 'inner_race']
 """
 
 from cmsim.faults.base import (FAULT_TYPES, Fault, fault_from_dict, faults_to_toml_list,

@@ -25,7 +25,7 @@ from cmsim.measured.schema import answer_key, read_metadata
 
 __all__ = ["MeasuredDataset", "load_measured", "data_root", "MEASURED_DATASETS"]
 
-#: Folders of ``../shared/datasets`` scored in the README.
+#: Folders of ``../shared/datasets`` scored in the documentation (docs/guide/diagnostics.md).
 MEASURED_DATASETS = ("cwru_bearing_12k_de", "mfpt_bearing", "spectraquest_gearbox_gfd")
 
 

@@ -56,6 +56,7 @@ from cmsim.mesh_stiffness.fe_mesh import MeshSpec, tooth_rotation_rad
 from cmsim.mesh_stiffness.fe_model import PLANE_MODES, GearBodyModel
 from cmsim.mesh_stiffness.geometry import ToothProfile
 from cmsim.mesh_stiffness.root_crack import RootCrack
+from cmsim.progress import stage
 from cmsim.rig import SpurGear
 
 __all__ = ["InfluenceTable", "influence_table", "compute_influence_table", "flank_points",
@@ -372,14 +373,19 @@ def influence_table(gear, depth_m=None, spec=MeshSpec(), plane="strain", roll_st
                                   poisson_ratio=gear.poisson_ratio,
                                   face_width_m=gear.face_width_m, meta=meta)
     t0 = time.perf_counter()
+    what = f"FE body of the {gear.n_teeth}-tooth gear" + (
+        "" if crack is None else f" with a {crack.depth_m * 1e3:.3g} mm root crack")
     if body is None:
-        body = GearBodyModel.from_gear(gear, spec, plane, crack)
+        with stage(f"{what}: meshing, assembling, factorising"
+                   + (" (once: the table is cached)" if use_cache else "")):
+            body = GearBodyModel.from_gear(gear, spec, plane, crack)
     elif (not isinstance(body, GearBodyModel) or body.gear != gear
           or body.gear_mesh.spec != spec or body.model.plane != plane
           or body.gear_mesh.crack != crack):
         raise ParameterError("body must be a GearBodyModel of this gear, spec, plane and "
                              "crack")
-    table = compute_influence_table(body, rho, h, max_offset, load, hertz_half_width_m)
+    with stage(f"{what}: influence coefficients, {rho.size} loads"):
+        table = compute_influence_table(body, rho, h, max_offset, load, hertz_half_width_m)
     meta = dict(table.meta, build_seconds=time.perf_counter() - t0, key=key,
                 cache="miss" if use_cache else "off")
     if use_cache:

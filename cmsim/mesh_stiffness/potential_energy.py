@@ -505,7 +505,7 @@ def iso6336_stiffness(pair, c_m=0.8, c_r=1.0):
 
     q′ = C1 + C2/z_n1 + C3/z_n2 + C4 x1 + C5 x1/z_n1 + C6 x2 + C7 x2/z_n2 + C8 x1² + C9 x2²
     (mm·µm/N), c′_th = 1/q′, c′ = c′_th C_M C_R C_B cos β, c_γα = c′ (0.75 ε_α + 0.25), with
-    C_B = [1 + 0.5 (1.2 − h_fP/m)] [1 − 0.02 (20° − α)] (h_fP: basic-rack dedendum of the gear,
+    C_B = (1 + 0.5 (1.2 − h_fP/m))·(1 − 0.02 (20° − α)) (h_fP: basic-rack dedendum of the gear,
     i.e. the cutter addendum; averaged over both gears), β = 0 (spur), z_n = z and ε_α the
     transverse contact ratio for sharp tips. Valid for line loads F_t/b >= 100 N/mm (below,
     ISO scales c′ by (F_t/b / 100)^0.25, not applied here).

@@ -5,6 +5,7 @@ messages naming the parameter.
 """
 
 import json
+import time
 
 import numpy as np
 import pytest
@@ -199,3 +200,30 @@ def test_simulate_announces_the_compile_before_it_compiles(monkeypatch, capsys):
     monkeypatch.setattr(simulation, "_compile_seconds", compile_seconds)
     main(["simulate", "--speed-rpm", "1000", "--duration-s", "0.01"])
     assert seen and "compiling numba kernels" in seen[0]
+
+
+def test_json_stdout_stays_one_object_while_the_compile_progress_is_on_stderr(monkeypatch,
+                                                                              capsys):
+    """A cold cache with --json (issue 28): the compile's start, heartbeat and end lines go
+    to stderr and stdout holds exactly the run's JSON object; the run compiles once."""
+    import cmsim.dynamics.simulation as simulation
+    import cmsim.progress as progress
+
+    real = simulation._compile_seconds
+
+    def slow_compile():
+        time.sleep(0.35)
+        slow_compile.value = real()
+        return slow_compile.value
+
+    monkeypatch.setattr(simulation, "kernels_cached", lambda: False)
+    monkeypatch.setattr(simulation, "_compile_seconds", slow_compile)
+    monkeypatch.setattr(progress, "LOG_INTERVAL_S", 0.1)
+    assert main(["simulate", "--speed-rpm", "1000", "--duration-s", "0.01", "--json"]) == 0
+    cap = capsys.readouterr()
+    res = json.loads(cap.out)                      # one object, nothing around it
+    assert isinstance(res, dict) and res["compile_s"] >= 0
+    err = cap.err.splitlines()
+    assert err[0].startswith("cmsim: compiling numba kernels")
+    assert any("still running" in line for line in err)
+    assert sum("compiling numba kernels" in line and "done in" in line for line in err) == 1

@@ -28,7 +28,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2] / "cmsim"
 #: ``__init__`` is the package facade ``cmsim/__init__.py``, which re-exports only the rig's
 #: values and errors, so it sits with them.
 LAYERS = [
-    ("ground", {"errors", "_io", "_kernels"}),
+    ("ground", {"errors", "_io", "_kernels", "progress"}),
     ("values", {"rig", "run", "frequencies", "__init__"}),
     ("bearings", {"bearings"}),
     ("mesh_stiffness", {"mesh_stiffness"}),

@@ -215,3 +215,18 @@ def test_table_validation(table):
     with pytest.raises(ParameterError, match="body"):
         influence_table(Rig.paper_2016().gears.driving, spec=MeshSpec().scaled(2.0),
                         use_cache=False, body=object())
+
+
+def test_a_cache_miss_says_what_it_builds_on_stderr(gear, body, monkeypatch, capsys):
+    """The FE build (≈ 10-50 s, once per design or crack) announces its stages on stderr:
+    the body (mesh, assembly, factorisation) and the influence solve, each with its time
+    (issue 28); nothing on stdout. The body is the fixture's, so nothing is re-meshed."""
+    monkeypatch.setattr(GearBodyModel, "from_gear", classmethod(lambda cls, *a, **k: body))
+    influence_table(gear, use_cache=False, max_offset=1)
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    lines = cap.err.splitlines()
+    assert lines[0] == (f"cmsim: FE body of the {gear.n_teeth}-tooth gear: meshing, "
+                        f"assembling, factorising...")
+    assert any(": influence coefficients, " in line and ": done in " in line for line in lines)
+    assert len(lines) == 4
