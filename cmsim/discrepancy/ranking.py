@@ -219,6 +219,9 @@ def decide(ranked, sensor_bearing, chi_nominal, z=None):
         The bearing the sensor sits on (model name).
     chi_nominal : float
         χ² of the nominal model over every feature (fit segments).
+    z : dict of str to float, optional
+        The record's departure from the nominal model per feature, in σ (record above the
+        model: positive).
 
     Returns
     -------
