@@ -50,6 +50,7 @@ library is one line naming the extra to install.
 
 from __future__ import annotations
 
+import gc
 import io
 import json
 import math
@@ -57,6 +58,7 @@ import os
 import re
 import struct
 import tempfile
+import warnings
 from pathlib import Path
 from typing import NamedTuple
 
@@ -389,7 +391,10 @@ def _write_uff(path, signals, rate_hz, units):
     os.close(fd)
     os.unlink(tmp)
     try:
-        pyuff.UFF(tmp).write_sets(sets, mode="add")
+        with warnings.catch_warnings():   # pyuff leaves its text handle to the collector
+            warnings.simplefilter("ignore", ResourceWarning)
+            pyuff.UFF(tmp).write_sets(sets, mode="add")
+            gc.collect()
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
