@@ -27,6 +27,8 @@ from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_di
 from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
                                       model_operating_point, model_rig)
 from cmsim.measured.readers import read_file, resolve_path
+from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
+                                   SPEED_TOLERANCE, agreed, agreed_unit)
 from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metadata,
                                    recording_entry, unit_scale_of)
 from cmsim.rig import OperatingPoint, Rig
@@ -200,62 +202,6 @@ def _checked_samples(x, channel, name):
     return x
 
 
-#: Largest relative difference between two statements of a record's sample rate (file
-#: header, metadata.json, the caller) that still agree.
-HEADER_RATE_TOLERANCE = 1e-3
-
-#: Largest relative difference between two statements of a record's shaft speed (a file's
-#: measured mean against a metadata nominal); the speed is then refined from the signal.
-SPEED_TOLERANCE = 1e-2
-
-#: Largest relative difference between two statements of a calibration factor.
-CALIBRATION_TOLERANCE = 1e-6
-
-
-def _agreed(path, quantity, statements, tolerance, unit=""):
-    """The first of ``statements`` (``(phrase, param, value)``, None values left out) and
-    where it comes from, after checking that every statement agrees with it within
-    ``tolerance`` (relative); the first pair that does not is one error naming both values.
-
-    ``phrase`` names the source in a message (``the WAV header``, ``metadata.json "fs_hz"``,
-    ``fs_hz`` for the caller's option); ``param`` is the option an error is about (the
-    caller's, else ``record``).
-    """
-    given = [(what, param, v) for what, param, v in statements if v is not None]
-    if not given:
-        return None, None
-    (what0, param0, v0), rest = given[0], given[1:]
-    for what, param, v in rest:
-        if abs(float(v) / float(v0) - 1.0) > tolerance:
-            hint = (" (the file is what the recorder wrote)" if param0 == "record"
-                    and what0.startswith(("the", "its")) else "")
-            raise ParameterError(
-                f"record {path}: {what0} says {quantity} {float(v0):g}{unit} but {what} says "
-                f"{float(v):g}{unit}; correct the one that is wrong{hint}",
-                param=param if param != "record" else param0,
-                allowed=f"{quantity} = {float(v0):g}{unit}")
-    return float(v0), what0
-
-
-def _agreed_unit(path, channel, statements):
-    """The channel's unit from the first of ``statements`` (``(phrase, param, unit)``) that
-    states one; two units of different scale (``g`` and ``m/s^2``) are refused."""
-    given = [(what, param, str(u)) for what, param, u in statements if u]
-    if not given:
-        return None
-    what0, param0, u0 = given[0]
-    for what, param, u in given[1:]:
-        a, b = unit_scale_of(u0), unit_scale_of(u)
-        same = (a == b) if (a is not None and b is not None) \
-            else u0.split()[0].lower() == u.split()[0].lower()
-        if not same:
-            raise ParameterError(f"record {path}: {what0} says channel {channel!r} is in "
-                                 f"{u0!r} but {what} says {u!r}; correct the one that is "
-                                 f"wrong", param=param if param != "record" else param0,
-                                 allowed=f"unit = {u0}")
-    return u0
-
-
 def _sample_rate(fs, fs_from, x, speed_rpm, teeth, inferred, notes, meta):
     """The sample rate: stated (file, metadata.json, caller), else inferred from the
     signal."""
@@ -374,7 +320,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     signals = dict(f.signals)
     if not signals:
         raise ParameterError(f"record {p} holds no 1-D channel", param="record")
-    scale, _ = _agreed(p, "units per stored value", [
+    scale, _ = agreed(p, "units per stored value", [
         ("the file", "record", f.calibration),
         ('metadata.json "calibration"', "record", entry.get("calibration")),
         ("calibration", "calibration", calibration)], CALIBRATION_TOLERANCE)
@@ -382,7 +328,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         signals = {k: scale * v for k, v in signals.items()}
     channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, str(p))
     sensor = dict(sensors.get(channel) or {})
-    sensor_unit = _agreed_unit(p, channel, [
+    sensor_unit = agreed_unit(p, channel, [
         ("the file", "record", f.units.get(channel)),
         ('metadata.json "sensors"', "record", sensor.get("unit")),
         ("unit", "unit", unit)])
@@ -400,10 +346,10 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
     rpm_doc, rpm_key = _documented_speed(entry)
-    speed, speed_from = _agreed(p, "speed", [
+    speed, speed_from = agreed(p, "speed", [
         ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
         ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
-    fs, fs_from = _agreed(p, "sample rate", [
+    fs, fs_from = agreed(p, "sample rate", [
         (f.rate_from, "record", f.rate_hz),
         ('metadata.json "fs_hz"', "record", entry.get("fs_hz") or meta.get("fs_hz")),
         ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
@@ -443,11 +389,12 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         path_documented=rig_given)
 
 
-def read_run(path, *, channel=None):
+def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
+             calibration=None):
     """Any record cmsim writes or reads, as a :class:`~cmsim.run.Run` with its rig and
     operating point: a run (``cmsim simulate``, ``cmsim sweep``), a dataset record
-    (``cmsim dataset``) or a measured recording in a folder with ``metadata.json``
-    (:func:`read_record`, with every check it makes).
+    (``cmsim dataset``) or a measured recording (:func:`read_record`, with every check it
+    makes).
 
     Parameters
     ----------
@@ -456,6 +403,17 @@ def read_run(path, *, channel=None):
         a measured recording.
     channel : str, optional
         Compared channel of a measured recording (default as :func:`read_record`).
+    rig : cmsim.rig.Rig, optional
+        Model rig of a measured recording (:func:`read_record`).
+    fs_hz : float, optional
+        Sample rate of a measured recording, Hz (:func:`read_record`).
+    speed_rpm : float, optional
+        Input-shaft speed of a measured recording, rpm (:func:`read_record`).
+    unit : str, optional
+        Unit of a measured recording's compared channel (:func:`read_record`).
+    calibration : float, optional
+        Physical units per stored sample value of a measured recording
+        (:func:`read_record`).
 
     Returns
     -------
@@ -463,14 +421,28 @@ def read_run(path, *, channel=None):
     signal : str or None
         The signal to look at by default: a measured recording's compared channel, a dataset
         record's first channel, None for a simulated run (its caller's default).
+
+    Raises
+    ------
+    ParameterError
+        What :func:`read_record` raises; a value given for a file cmsim wrote (its rate,
+        speed and rig are its own).
     """
     p = resolve_path(path)
     names = _npz_names(p) if p.suffix.lower() == ".npz" else set()
+    stated = {"rig": rig, "fs_hz": fs_hz, "speed_rpm": speed_rpm, "unit": unit,
+              "calibration": calibration}
     if "meta" in names:
+        given = [k for k, v in stated.items() if v is not None]
+        if given:
+            raise ParameterError(f"{given[0]}: record {p} is one cmsim wrote (a run or a "
+                                 f"dataset record); its rate, speed and rig are its own: "
+                                 f"leave out {given[0]}", param=given[0],
+                                 allowed="a measured recording")
         run = Run.load(p)
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
         return run, (None if "t" in names else sorted(run.signals)[0])
-    rec = read_record(p, channel=channel)
+    rec = read_record(p, channel=channel, **stated)
     return rec.run, rec.channel
 
 
