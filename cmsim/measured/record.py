@@ -49,8 +49,9 @@ class MeasuredRecord:
     ----------
     run : cmsim.run.Run
         ``source="measured"``: every channel of the file (unit as recorded, float64) sampled
-        at :attr:`fs_hz`; its meta holds the readable metadata, the notes on what was assumed
-        and what was inferred — never the answer key or the file name.
+        at :attr:`fs_hz`; its meta holds the readable metadata, each channel's unit where
+        stated (``units``), the notes on what was assumed and what was inferred — never the
+        answer key or the file name.
     channel : str
         Channel compared with the model (default: the first sensor near a documented
         bearing, else the first channel).
@@ -202,7 +203,7 @@ def _checked_samples(x, channel, name):
     return x
 
 
-def _sample_rate(fs, fs_from, x, speed_rpm, teeth, inferred, notes, meta):
+def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
     """The sample rate: stated (file, metadata.json, caller), else inferred from the
     signal."""
     if fs is not None:
@@ -334,6 +335,14 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         ("unit", "unit", unit)])
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
+    rpm_doc, rpm_key = _documented_speed(entry)
+    speed, speed_from = agreed(p, "speed", [
+        ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
+        ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
+    fs, fs_from = agreed(p, "sample rate", [
+        (f.rate_from, "record", f.rate_hz),
+        ('metadata.json "fs_hz"', "record", entry.get("fs_hz") or meta.get("fs_hz")),
+        ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
     near = sensor.get("near")
     inferred, notes = {}, []
     rig_given = rig is not None
@@ -345,15 +354,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     if rig.gears is not None:
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
-    rpm_doc, rpm_key = _documented_speed(entry)
-    speed, speed_from = agreed(p, "speed", [
-        ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
-        ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
-    fs, fs_from = agreed(p, "sample rate", [
-        (f.rate_from, "record", f.rate_hz),
-        ('metadata.json "fs_hz"', "record", entry.get("fs_hz") or meta.get("fs_hz")),
-        ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
-    fs = _sample_rate(fs, fs_from, x, speed, teeth, inferred, notes, meta)
+    fs = _sample_rate(fs, x, speed, teeth, inferred, notes, meta)
     lines = documented_frequencies(geometry, 1.0)
     if rig_given and not lines.bearings and lines.gmf_hz is None:
         lines = rig_frequencies(rig, OperatingPoint(speed_rpm=60.0))
@@ -374,6 +375,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
               {"fs_hz": fs, "channel": channel, "sensor": sensor or None,
+               "units": _channel_units(signals, f.units, sensors, channel, sensor_unit),
                "recording": entry, "operating_point": {
                    "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
                    "radial_load_n": op.radial_load_n,
@@ -387,6 +389,14 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         record_id=p.stem, frequencies=documented_frequencies(geometry, speed / 60.0),
         operating_point=documented_operating_point(entry, speed),
         path_documented=rig_given)
+
+
+def _channel_units(signals, file_units, sensors, channel, unit):
+    """Channel → unit, where the file or metadata.json states it (the compared channel's
+    as agreed)."""
+    out = {c: file_units.get(c) or (sensors.get(c) or {}).get("unit") for c in signals}
+    out[channel] = unit
+    return {c: u for c, u in out.items() if u}
 
 
 def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,

@@ -57,7 +57,9 @@ LAYER_OF = {unit: i for i, (_, units) in enumerate(LAYERS) for unit in units}
 
 #: Third-party libraries slow to import or needed by one feature only: these may be imported
 #: inside the function that needs them.
-LAZY_LIBRARIES = {"matplotlib", "pandas", "pyarrow", "dask", "distributed", "tqdm", "skfem"}
+LAZY_LIBRARIES = {"matplotlib", "pandas", "pyarrow", "dask", "distributed", "tqdm", "skfem",
+                  # optional readers of measured recordings (cmsim[uff], cmsim[tdms])
+                  "pyuff", "nptdms", "h5py", "importlib"}
 
 #: Units where any function-local import is allowed (start-up time of the command).
 LAZY_UNITS = {"cli"}
