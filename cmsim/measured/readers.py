@@ -51,6 +51,7 @@ library is one line naming the extra to install.
 from __future__ import annotations
 
 import gc
+import importlib
 import io
 import json
 import math
@@ -63,7 +64,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
-from scipy.io import wavfile
+from scipy.io import loadmat, savemat, wavfile
 
 from cmsim._io import atomic_savez, atomic_write_bytes, atomic_write_text
 from cmsim.errors import ParameterError
@@ -126,7 +127,6 @@ def _channel_1d(path, name, a):
 
 def _optional(module, extra, path):
     """``import module``, or one line naming the extra that installs it."""
-    import importlib
     try:
         return importlib.import_module(module)
     except ImportError:
@@ -267,7 +267,6 @@ def _write_wav(path, signals, rate_hz, units):
 
 # ---------------------------------------------------------------------- .mat
 def _read_mat(path, names=None):
-    from scipy.io import loadmat
     try:
         variables = loadmat(path, squeeze_me=True, simplify_cells=True)
     except NotImplementedError:            # a v7.3 file: HDF5 inside
@@ -308,7 +307,6 @@ def _read_mat73(path):
 
 
 def _write_mat(path, signals, rate_hz, units):
-    from scipy.io import savemat
     out = {k: np.asarray(v, dtype=float).reshape(-1, 1) for k, v in signals.items()}
     out["fs_hz"] = float(rate_hz)
     if units:

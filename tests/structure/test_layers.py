@@ -59,7 +59,7 @@ LAYER_OF = {unit: i for i, (_, units) in enumerate(LAYERS) for unit in units}
 #: inside the function that needs them.
 LAZY_LIBRARIES = {"matplotlib", "pandas", "pyarrow", "dask", "distributed", "tqdm", "skfem",
                   # optional readers of measured recordings (cmsim[uff], cmsim[tdms])
-                  "pyuff", "nptdms", "h5py", "importlib"}
+                  "pyuff", "nptdms", "h5py"}
 
 #: Units where any function-local import is allowed (start-up time of the command).
 LAZY_UNITS = {"cli"}
