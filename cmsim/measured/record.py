@@ -225,9 +225,10 @@ def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
         inferred["fs_hz"] = {"value": note_hz, "how": "fs_note of metadata.json (not verified "
                              "against the signal: no gear tooth counts or speed)"}
         return note_hz
-    raise ParameterError("fs_hz is undocumented and cannot be inferred (needs gear tooth "
-                         "counts and a shaft speed)", param="fs_hz",
-                         allowed="a number > 0 in metadata.json")
+    raise ParameterError("fs_hz is undocumented (the file states no rate, metadata.json no "
+                         "\"fs_hz\") and cannot be inferred (needs gear tooth counts and a "
+                         "shaft speed)", param="fs_hz",
+                         allowed="a number > 0: fs_hz, or \"fs_hz\" in metadata.json")
 
 
 _SPEED_KEYS = (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0),

@@ -19,7 +19,7 @@ from scipy.io import savemat
 
 from cmsim.cli import main
 from cmsim.errors import ParameterError
-from cmsim.measured import data_root, read_record
+from cmsim.measured import data_root, load_measured, read_record
 from cmsim.measured.importing import folder_metadata
 from cmsim.measured.readers import WRITERS, read_file, write_signals
 
@@ -276,6 +276,14 @@ def test_import_writes_metadata_that_reads_back(tmp_path, capsys):
     status, err, _ = _error(capsys, ["import", str(folder), "--force", "--unit", "V"])
     assert status == 2 and err["option"] == "--unit" and "'g'" in err["error"]
     assert (folder / "metadata.json").read_text() == before
+    # with the geometry added by hand, the folder is a dataset (what cmsim evaluate reads)
+    meta = json.loads(before)
+    meta["geometry"]["bearings"] = {"de": {"n_balls": 9, "ball_diameter_mm": 7.94,
+                                           "pitch_diameter_mm": 39.04}}
+    (folder / "metadata.json").write_text(json.dumps(meta))
+    ds = load_measured(folder)
+    assert len(ds) == 2 and not ds.unreadable
+    assert list(ds.manifest["fs_hz"]) == [12000.0, 12000.0]
     assert main(["import", str(folder), "--force"]) == 0          # what the files state
     capsys.readouterr()
     meta = json.loads((folder / "metadata.json").read_text())
