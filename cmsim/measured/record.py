@@ -1,9 +1,11 @@
 """The one measured record: a measured :class:`~cmsim.run.Run` with what a diagnosis and a
 comparison with the model need.
 
-:func:`read_record` turns a signal file in a folder with ``metadata.json`` into a
-:class:`MeasuredRecord`: it reads the schema's readable keys (:mod:`cmsim.measured.schema`),
-the channels (:mod:`cmsim.measured.readers`), fills in what the metadata lacks from the signal
+:func:`read_record` turns a signal file (in a folder with ``metadata.json``, or with what
+the caller states in its place) into a :class:`MeasuredRecord`: it reads the schema's
+readable keys (:mod:`cmsim.measured.schema`), the channels and what the file states
+(:mod:`cmsim.measured.readers`), agrees the rate, speed, unit and calibration of every
+source (:mod:`cmsim.measured.stated`), fills in what they all lack from the signal
 (:mod:`cmsim.measured.inference`: sample rate, speed), checks a stated sample rate and
 speed against the record's own lines (:mod:`cmsim.measured.consistency`) before anything
 is computed on them, and builds the model of the record
@@ -27,10 +29,10 @@ from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_di
 from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
                                       model_operating_point, model_rig)
 from cmsim.measured.readers import read_file, resolve_path
-from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
-                                   SPEED_TOLERANCE, agreed, agreed_unit)
 from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metadata,
                                    recording_entry, unit_scale_of)
+from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
+                                   SPEED_TOLERANCE, agreed, agreed_unit)
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 
