@@ -218,6 +218,39 @@ def test_matlab_v73_is_refused_with_what_to_do(tmp_path, monkeypatch):
     assert str(path) in msg and "v7.3" in msg and "-v7" in msg and "h5py" in msg
 
 
+def test_matlab_v73_reads_through_h5py_when_present(tmp_path, monkeypatch):
+    """With h5py installed, a v7.3 file's numeric variables are its channels (MATLAB stores
+    them column-major: a (1, n) HDF5 dataset is the (n, 1) variable); a stand-in h5py here,
+    the real one being optional."""
+    import types
+
+    class Dataset(np.ndarray):
+        pass
+
+    x = np.arange(10.0)
+    data = {"X097_DE_time": x[None, :].view(Dataset), "X097RPM": np.array([[1797.0]]).view(
+        Dataset), "label": "not numeric"}
+
+    class File(dict):
+        def __init__(self, path, mode):
+            super().__init__(data)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+    monkeypatch.setitem(sys.modules, "h5py", types.SimpleNamespace(File=File,
+                                                                    Dataset=Dataset))
+    path = tmp_path / "big.mat"
+    header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Mon Jan 1 2024 HDF5 schema"
+    path.write_bytes(header.ljust(116, b" ") + b"\0" * 8 + b"\x00\x02" + b"IM" + b"\0" * 512)
+    f = read_file(path)
+    assert list(f.signals) == ["X097_DE_time"] and np.array_equal(f.signals["X097_DE_time"], x)
+    assert f.speed_rpm == 1797.0
+
+
 def test_uff_without_a_type_58_set_is_refused(tmp_path):
     path = tmp_path / "geometry.uff"
     pyuff.UFF(str(path)).write_sets([{"type": 15, "node_nums": [1, 2], "def_cs": [0, 0],
