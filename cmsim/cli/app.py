@@ -17,8 +17,8 @@ import sys
 
 import numpy as np
 
-from cmsim.cli import (calibrate, compare, dataset, evaluate, export, losses, mesh_table,
-                       modes, report, simulate, spectrum, sweep)
+from cmsim.cli import (calibrate, compare, dataset, evaluate, export, import_, losses,
+                       mesh_table, modes, report, simulate, spectrum, sweep)
 from cmsim.cli.contract import (CLIError, Parser, check_paths, finite, option_named_in,
                                 options_of, subparsers, user_message)
 from cmsim.errors import IntegrationDiverged, ParameterError, WorkersDied
@@ -29,7 +29,7 @@ __all__ = ["main", "build_parser", "COMMANDS"]
 #: its parser the defaults ``func=run`` (``run(args) -> dict``) and ``text`` (``text(dict)
 #: -> str``).
 COMMANDS = (simulate, modes, mesh_table, spectrum, sweep, dataset, export, report, evaluate,
-            compare, calibrate, losses)
+            compare, calibrate, import_, losses)
 
 
 def build_parser():

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, load_file, ranged
+from cmsim.cli.options import add_recording_options, recording_values
 from cmsim.errors import ParameterError
 from cmsim.rig import Range, Rig
 
@@ -21,14 +22,16 @@ def register(sub):
                                    "operating point, and the baseline's own spread of every "
                                    "feature; writes the machine file for --machine.")
     p.add_argument("baseline", nargs="+", metavar="BASELINE",
-                   help="healthy record(s) of one machine (files in folders with "
-                        "metadata.json; relative paths also under CMSIM_DATA)")
+                   help="healthy record(s) of one machine (.npz/.csv/.wav/.mat/.uff/.tdms; "
+                        "what a file does not state from metadata.json beside it, else from "
+                        "the options; relative paths also under CMSIM_DATA)")
     p.add_argument("--out", type=Path, required=True, metavar="MACHINE.toml",
                    help="the machine file to write")
     p.add_argument("--channel", metavar="NAME", help="channel (default: the first near a "
                                                      "documented bearing)")
     p.add_argument("--rig", metavar="FILE.toml",
                    help="model rig (default: built from metadata.json geometry)")
+    add_recording_options(p)
     p.add_argument("--span", type=ranged(Range(0.0, 1.0e5, unit="s")), nargs=2,
                    metavar=("START", "STOP"),
                    help="use only this part of each baseline, s (e.g. 0 5: calibrate on "
@@ -40,15 +43,16 @@ def register(sub):
     p.set_defaults(func=run, text=text)
 
 
-def read_records(paths, channel, rig_file, span):
-    """The measured records of ``paths`` (each cut to ``span`` when given)."""
+def read_records(paths, channel, rig_file, span, values=None):
+    """The measured records of ``paths`` (each cut to ``span`` when given), with the
+    recording options' ``values`` (:func:`~cmsim.cli.options.recording_values`)."""
     from cmsim.measured import read_record
 
     rig = load_file("--rig", rig_file, Rig.load, "a rig TOML file") if rig_file else None
     records = []
     for path in paths:
         try:
-            rec = read_record(path, channel=channel, rig=rig)
+            rec = read_record(path, channel=channel, rig=rig, **(values or {}))
         except ParameterError as exc:
             if exc.param != "record":
                 raise
@@ -68,7 +72,8 @@ def run(args):
     if args.span is not None and not args.span[0] < args.span[1]:
         raise CLIError(f"--span {args.span[0]:g} {args.span[1]:g}: START must be below STOP",
                        option="--span")
-    records = read_records(args.baseline, args.channel, args.rig, args.span)
+    records = read_records(args.baseline, args.channel, args.rig, args.span,
+                           recording_values(args))
     args.notice_compile()
     machine = calibrate(records, seed=args.seed)
     machine.save(args.out)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, load_file, ranged
+from cmsim.cli.options import add_recording_options, recording_values
 from cmsim.errors import ParameterError
 from cmsim.rig import RANGES, Range, Rig
 
@@ -14,15 +15,19 @@ def register(sub):
     """Add the ``compare`` parser."""
     p = sub.add_parser("compare", help="compare a measured record with the model, name the "
                                        "cause, fit it and measure the gain",
-                       description="RECORD is a .npz/.csv/.wav file in a folder whose "
-                                   "metadata.json gives rig, fs, speed and load (relative "
-                                   "paths are also looked up under CMSIM_DATA). The answer "
-                                   "key (condition, fault fields, file name) is never read.")
+                       description="RECORD is a .npz/.csv/.wav/.mat/.uff/.tdms recording; "
+                                   "rate, speed, unit and channel names come from the file "
+                                   "where it states them, else from metadata.json beside it "
+                                   "(rig geometry, load), else from --fs-hz, --speed-rpm, "
+                                   "--unit and --rig (relative paths are also looked up "
+                                   "under CMSIM_DATA). The answer key (condition, fault "
+                                   "fields, file name) is never read.")
     p.add_argument("record", metavar="RECORD", help="measured recording")
     p.add_argument("--channel", metavar="NAME", help="channel (default: the first near a "
                                                      "documented bearing)")
     p.add_argument("--rig", metavar="FILE.toml",
                    help="model rig (default: built from metadata.json geometry)")
+    add_recording_options(p)
     p.add_argument("--report", type=Path, metavar="DIR", help="write DIR/compare.html")
     p.add_argument("--budget", type=ranged(Range(10, 10000, integer=True)), default=None,
                    metavar="N", help="most simulations: ranking, fit and held-out "
@@ -52,7 +57,7 @@ def run(args):
                         "a machine file (cmsim calibrate --out)") if args.machine else None
     rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None
     channel = args.channel or (machine.channel if machine is not None else None)
-    record = read_record(args.record, channel=channel, rig=rig)
+    record = read_record(args.record, channel=channel, rig=rig, **recording_values(args))
     if args.span is not None:
         record = record.span(*args.span)
     kw = {} if args.budget is None else {"budget": args.budget}

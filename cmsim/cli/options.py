@@ -19,7 +19,7 @@ from cmsim.rig.plausibility import load_warnings
 __all__ = ["number", "add_rig_options", "load_rig", "add_sampling_options", "add_mesh_options",
            "mesh_argument", "prepare_tables", "add_fault_options", "faults_of", "add_losses_option",
            "check_losses_options", "resolved_setup", "operating_point", "operating_warnings",
-           "FAULT_NAMES"]
+           "add_recording_options", "recording_values", "FAULT_NAMES"]
 
 #: The catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
 #: pulls in the mesh-stiffness stack; tests check the two agree).
@@ -162,6 +162,33 @@ def prepare_tables(args, rig, mesh, torques_nm=()):
         hybrid_table_set(rig, progress=progress)
         for torque in torques_nm:
             resolve_mesh(rig, mesh, torque, progress=progress)
+
+
+# ---------------------------------------------------------------------- recordings
+def add_recording_options(p):
+    """Add --fs-hz, --speed-rpm, --unit and --calibration to the parser ``p``: what a
+    measured recording's file and metadata.json do not state (compare, calibrate, spectrum,
+    import; :func:`cmsim.measured.read_record`)."""
+    p.add_argument("--fs-hz", type=number("record_fs_hz"), metavar="HZ",
+                   help="sample rate of the recording, Hz, when neither the file nor "
+                        "metadata.json states it (one they state must agree)")
+    p.add_argument("--speed-rpm", type=number("speed_rpm"), metavar="RPM",
+                   help="input-shaft speed, rpm, when neither the file nor metadata.json "
+                        "states it (default: found in the signal)")
+    p.add_argument("--unit", metavar="UNIT",
+                   help="unit of the channel (g, m/s^2, V, ...) when neither the file nor "
+                        "metadata.json states it")
+    p.add_argument("--calibration", type=number("calibration"), metavar="C",
+                   help="physical units per stored sample value (a WAV in counts or volts), "
+                        "when neither the file nor metadata.json states it")
+
+
+def recording_values(args):
+    """The keyword arguments of :func:`cmsim.measured.read_record` that the recording
+    options of ``args`` give (``fs_hz``, ``speed_rpm``, ``unit``, ``calibration``)."""
+    unit = (args.unit or "").strip() or None
+    return {"fs_hz": args.fs_hz, "speed_rpm": args.speed_rpm, "unit": unit,
+            "calibration": args.calibration}
 
 
 # ---------------------------------------------------------------------- faults

@@ -5,9 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from cmsim.cli.contract import load_file, ranged
+from cmsim.cli.options import add_recording_options, recording_values
 from cmsim.errors import ParameterError
 from cmsim.cli.output import save_figure
-from cmsim.rig import Range
+from cmsim.rig import Range, Rig
 
 
 def register(sub):
@@ -20,7 +21,13 @@ def register(sub):
                                    "record's own rig and operating point.")
     p.add_argument("run", type=Path, metavar="RECORD",
                    help="a run (cmsim simulate, sweep), a dataset record (cmsim dataset) or "
-                        "a measured recording in a folder with metadata.json")
+                        "a measured recording (.npz/.csv/.wav/.mat/.uff/.tdms; what the file "
+                        "does not state from metadata.json beside it, else from the options "
+                        "below)")
+    p.add_argument("--rig", metavar="FILE.toml",
+                   help="model rig of a measured recording (default: built from its "
+                        "metadata.json geometry)")
+    add_recording_options(p)
     p.add_argument("--signal", help="signal name (default: F_1b1_loa of a simulated run, "
                                     "the first channel of a dataset record, the compared "
                                     "channel of a measured recording)")
@@ -46,7 +53,7 @@ def run(args):
     """The spectrum's labelled peaks (and its figure)."""
     from cmsim.spectra.run_spectrum import run_spectrum
 
-    run_, default_signal = _read(args.run)
+    run_, default_signal = _read(args)
     signal = args.signal or default_signal or "F_1b1_loa"
     spec = run_spectrum(run_, signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
                         resolution_hz=args.resolution_hz, bearing=args.bearing,
@@ -69,15 +76,22 @@ def run(args):
     return out
 
 
-def _read(path):
-    """The record as a run (:func:`cmsim.measured.read_run`): a measured recording's error
-    names the file itself (``RECORD ...``); a cmsim file that does not load is named here."""
+#: Parameters of :func:`cmsim.measured.read_run` whose errors name their own option.
+_RECORDING_PARAMS = ("record", "rig", "fs_hz", "speed_rpm", "unit", "calibration")
+
+
+def _read(args):
+    """The record of ``args.run`` as a run (:func:`cmsim.measured.read_run`, with --rig and
+    the recording options): a measured recording's error names the file itself
+    (``RECORD ...``) or the option; a cmsim file that does not load is named here."""
     from cmsim.measured import read_run
 
+    path = args.run
+    rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None
     try:
-        return read_run(path)
+        return read_run(path, rig=rig, **recording_values(args))
     except ParameterError as exc:
-        if exc.param == "record":
+        if exc.param in _RECORDING_PARAMS:
             raise
         return load_file("RECORD", path, _raise(exc), _WHAT)
     except Exception as exc:  # noqa: BLE001 - reported by load_file as one line

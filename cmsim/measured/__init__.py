@@ -1,12 +1,17 @@
 """The one measured record: ``metadata.json`` schema, signal readers, inference, model, dataset.
 
-A measured recording is a signal file in a folder with ``metadata.json`` (the schema of
-``../shared/datasets/README.md``). Modules, in reading order:
+A measured recording is a signal file, usually in a folder with ``metadata.json`` (the
+schema of ``../shared/datasets/README.md``); what neither states, the caller gives. Modules,
+in reading order:
 
 * :mod:`~cmsim.measured.schema` — the keys the pipeline reads, the answer key it never reads,
   unit constants (lbf, inch, g);
-* :mod:`~cmsim.measured.readers` — file I/O (``.npz``, ``.csv``, ``.wav``; one function per
-  type);
+* :mod:`~cmsim.measured.readers` — file I/O, reader and writer of each type side by side
+  (``.npz``, ``.csv``, ``.wav``, ``.mat``, ``.uff``/``.unv``, ``.tdms``; one function each);
+* :mod:`~cmsim.measured.stated` — one rule for what the file, ``metadata.json`` and the
+  caller state (rate, speed, unit, calibration): the first gives it, the others must agree;
+* :mod:`~cmsim.measured.importing` — a folder of recordings documented as ``metadata.json``
+  (``cmsim import``);
 * :mod:`~cmsim.measured.inference` — speed and sample rate from the signal when the metadata
   lacks them (one rule for an undocumented sample rate; a metadata note only cross-checks);
 * :mod:`~cmsim.measured.model_rig` — the model rig, operating point and characteristic

@@ -343,7 +343,8 @@ def family_verdicts(x, fs_hz, shaft_hz, frequencies):
     return out
 
 
-def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="fs_hz"):
+def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="fs_hz",
+                         speed_source="shaft_speed_rpm"):
     """Refuse a record whose lines stand at a ratio ≠ 1 of where its sample rate and speed
     put them.
 
@@ -361,6 +362,9 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
         The record, for the message.
     fs_source : str
         Where the sample rate came from (``"fs_hz"``, ``"the WAV header"``).
+    speed_source : str
+        Where the speed came from (``"shaft_speed_rpm"``, ``"speed_rpm"`` of a command
+        line, ``"the file"``).
 
     Returns
     -------
@@ -395,8 +399,8 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     ratio = f"{rho:g}" if rho >= 1 else f"1/{1 / rho:g}"
     raise ParameterError(
         f"record {where}: its {best.family.name} lines stand at {ratio} x where {fs_source} "
-        f"{fs_hz:g} Hz and shaft_speed_rpm {speed_rpm:g} put them ({best.level_db:.0f} dB "
-        f"over the floor there, not at the stated lines): the sample rate or the speed in "
-        f"metadata.json is wrong; {fs_source} {fs_hz / rho:g} Hz or shaft_speed_rpm "
-        f"{speed_rpm * rho:g} would fit", param="record",
-        allowed=f"fs_hz {fs_hz / rho:g} Hz or shaft_speed_rpm {speed_rpm * rho:g}")
+        f"{fs_hz:g} Hz and {speed_source} {speed_rpm:g} put them ({best.level_db:.0f} dB "
+        f"over the floor there, not at the stated lines): the sample rate or the speed "
+        f"stated (file, metadata.json or options) is wrong; {fs_source} {fs_hz / rho:g} Hz "
+        f"or {speed_source} {speed_rpm * rho:g} would fit", param="record",
+        allowed=f"sample rate {fs_hz / rho:g} Hz or speed {speed_rpm * rho:g} rpm")

@@ -1,9 +1,11 @@
 """The one measured record: a measured :class:`~cmsim.run.Run` with what a diagnosis and a
 comparison with the model need.
 
-:func:`read_record` turns a signal file in a folder with ``metadata.json`` into a
-:class:`MeasuredRecord`: it reads the schema's readable keys (:mod:`cmsim.measured.schema`),
-the channels (:mod:`cmsim.measured.readers`), fills in what the metadata lacks from the signal
+:func:`read_record` turns a signal file (in a folder with ``metadata.json``, or with what
+the caller states in its place) into a :class:`MeasuredRecord`: it reads the schema's
+readable keys (:mod:`cmsim.measured.schema`), the channels and what the file states
+(:mod:`cmsim.measured.readers`), agrees the rate, speed, unit and calibration of every
+source (:mod:`cmsim.measured.stated`), fills in what they all lack from the signal
 (:mod:`cmsim.measured.inference`: sample rate, speed), checks a stated sample rate and
 speed against the record's own lines (:mod:`cmsim.measured.consistency`) before anything
 is computed on them, and builds the model of the record
@@ -26,9 +28,11 @@ from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_di
                                       refine_speed, sample_rate_from_note)
 from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
                                       model_operating_point, model_rig)
-from cmsim.measured.readers import read_signals, resolve_path
+from cmsim.measured.readers import read_file, resolve_path
 from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metadata,
                                    recording_entry, unit_scale_of)
+from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
+                                   SPEED_TOLERANCE, agreed, agreed_unit)
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 
@@ -47,8 +51,9 @@ class MeasuredRecord:
     ----------
     run : cmsim.run.Run
         ``source="measured"``: every channel of the file (unit as recorded, float64) sampled
-        at :attr:`fs_hz`; its meta holds the readable metadata, the notes on what was assumed
-        and what was inferred — never the answer key or the file name.
+        at :attr:`fs_hz`; its meta holds the readable metadata, each channel's unit where
+        stated (``units``), the notes on what was assumed and what was inferred — never the
+        answer key or the file name.
     channel : str
         Channel compared with the model (default: the first sensor near a documented
         bearing, else the first channel).
@@ -200,20 +205,9 @@ def _checked_samples(x, channel, name):
     return x
 
 
-#: Largest relative difference between a file header's sample rate and metadata.json's.
-HEADER_RATE_TOLERANCE = 1e-3
-
-
-def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, path):
-    """The sample rate: documented (entry, folder, file), else inferred from the signal."""
-    stated = entry.get("fs_hz") or meta.get("fs_hz")
-    if stated is not None and file_rate is not None \
-            and abs(float(stated) / file_rate - 1.0) > HEADER_RATE_TOLERANCE:
-        raise ParameterError(f"record {path}: its header says {file_rate:g} Hz but "
-                             f"metadata.json says fs_hz {float(stated):g} Hz; correct the one "
-                             f"that is wrong (the header is what the recorder wrote)",
-                             param="record", allowed=f"fs_hz = {file_rate:g} Hz")
-    fs = stated or file_rate
+def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
+    """The sample rate: stated (file, metadata.json, caller), else inferred from the
+    signal."""
     if fs is not None:
         return float(fs)
     note_hz = sample_rate_from_note(meta.get("fs_note"))
@@ -233,17 +227,31 @@ def _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, p
         inferred["fs_hz"] = {"value": note_hz, "how": "fs_note of metadata.json (not verified "
                              "against the signal: no gear tooth counts or speed)"}
         return note_hz
-    raise ParameterError("fs_hz is undocumented and cannot be inferred (needs gear tooth "
-                         "counts and a shaft speed)", param="fs_hz",
-                         allowed="a number > 0 in metadata.json")
+    raise ParameterError("fs_hz is undocumented (the file states no rate, metadata.json no "
+                         "\"fs_hz\") and cannot be inferred (needs gear tooth counts and a "
+                         "shaft speed)", param="fs_hz",
+                         allowed="a number > 0: fs_hz, or \"fs_hz\" in metadata.json")
 
 
-def _check_against_lines(x, fs, speed_rpm, geometry, notes, path, fs_source):
+_SPEED_KEYS = (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0),
+               ("shaft_speed_rpm_nominal", 1.0), ("shaft_speed_hz_nominal", 60.0))
+
+
+def _documented_speed(entry):
+    """``(rpm, 'metadata.json "key"')`` of the entry's first speed key, else (None, None)
+    (the order of :func:`~cmsim.measured.schema.documented_speed_rpm`)."""
+    rpm = documented_speed_rpm(entry)
+    key = next((k for k, _ in _SPEED_KEYS if entry.get(k) is not None), None)
+    return rpm, (f'metadata.json "{key}"' if key else None)
+
+
+def _check_against_lines(x, fs, speed_rpm, frequencies, notes, path, fs_source,
+                         speed_source):
     """The stated sample rate and speed checked against the record's own lines
     (:func:`~cmsim.measured.consistency.check_rate_and_speed`); what was checked, or that
     nothing could be, goes to the notes."""
-    found = check_rate_and_speed(x, fs, speed_rpm, documented_frequencies(geometry, 1.0),
-                                 where=path, fs_source=fs_source)
+    found = check_rate_and_speed(x, fs, speed_rpm, frequencies, where=path,
+                                 fs_source=fs_source, speed_source=speed_source)
     if found is None:
         notes.append("sample rate and speed not checked against the signal: no shaft or "
                      "bearing lines stand clear of the floor")
@@ -252,19 +260,39 @@ def _check_against_lines(x, fs, speed_rpm, geometry, notes, path, fs_source):
                      f"lines ({found.level_db:.0f} dB over the floor)")
 
 
-def read_record(path, *, channel=None, rig=None):
-    """Read a measured record (``metadata.json`` schema) into a :class:`MeasuredRecord`.
+def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
+                calibration=None):
+    """Read a measured recording into a :class:`MeasuredRecord`.
+
+    Channel names, sample rate, unit, shaft speed and calibration come from the file where
+    it states them (:mod:`~cmsim.measured.readers`), else from ``metadata.json`` beside it,
+    else from the arguments here (a command line's ``--fs-hz``, ``--speed-rpm``, ``--unit``,
+    ``--calibration``); every source that states a value must agree with the others, or
+    the record is refused with both values named. Without ``metadata.json`` the file and
+    the arguments must give the sample rate, and ``rig`` the model (no geometry is
+    documented).
 
     Parameters
     ----------
     path : str or pathlib.Path
-        Signal file (:data:`~cmsim.measured.readers.READERS`) in a folder with
-        ``metadata.json``; a relative path is also looked up under ``$CMSIM_DATA``.
+        Signal file (:data:`~cmsim.measured.readers.READERS`: ``.npz``, ``.csv``, ``.wav``,
+        ``.mat``, ``.uff``/``.unv``, ``.tdms``), usually in a folder with ``metadata.json``;
+        a relative path is also looked up under ``$CMSIM_DATA``.
     channel : str, optional
         Channel to compare; default the first channel whose sensor sits near a documented
         bearing, else the first channel (sorted).
     rig : cmsim.rig.Rig, optional
         Model rig to use instead of the one built from the metadata geometry.
+    fs_hz : float, optional
+        Sample rate, Hz, when neither the file nor ``metadata.json`` states it.
+    speed_rpm : float, optional
+        Input-shaft speed, rpm, when neither the file nor ``metadata.json`` states it.
+    unit : str, optional
+        Unit of the compared channel (``g``, ``m/s^2``, ``V``), when neither the file nor
+        ``metadata.json`` states it.
+    calibration : float, optional
+        Physical units per stored sample value (a WAV in counts or volts), applied to every
+        channel, when neither the file nor ``metadata.json`` states it.
 
     Returns
     -------
@@ -273,22 +301,52 @@ def read_record(path, *, channel=None, rig=None):
     Raises
     ------
     ParameterError
-        Missing file or metadata, unknown channel, no way to get the sample rate; a damaged
-        file or channel (:mod:`~cmsim.measured.readers`, too few, non-finite or constant
-        samples); a sample rate or speed its own lines contradict
+        Missing file, or no ``metadata.json`` and no sample rate from the file or
+        ``fs_hz``; unknown channel (the message lists the file's); a value two sources
+        state differently; no way to get the sample rate; a damaged file or channel
+        (:mod:`~cmsim.measured.readers`, too few, non-finite or constant samples); a sample
+        rate or speed its own lines contradict
         (:func:`~cmsim.measured.consistency.check_rate_and_speed`).
     """
     p = resolve_path(path)
-    full = read_metadata(p.parent)
-    meta = {k: full.get(k) for k in FOLDER_KEYS}
-    entry = recording_entry(full, p.name, p.parent / "metadata.json")
+    full = read_metadata(p.parent, missing_ok=True)
+    meta = {k: (full or {}).get(k) for k in FOLDER_KEYS}
+    entry = recording_entry(full or {}, p.name, p.parent / "metadata.json")
     sensors = meta.get("sensors") or {}
     geometry = meta.get("geometry") or {}
-    signals, file_rate = read_signals(p, entry.get("channels"))
+    f = read_file(p, entry.get("channels"))
+    if full is None and f.rate_hz is None and fs_hz is None:
+        raise ParameterError(f"record {p}: no metadata.json in {p.parent} and the file states "
+                             f"no sample rate: give fs_hz (and speed_rpm, rig), or write the "
+                             f"metadata with cmsim import (the record format is the "
+                             f"metadata.json schema of the datasets README)", param="record",
+                             allowed="a file in a folder with metadata.json, or fs_hz")
+    signals = dict(f.signals)
     if not signals:
         raise ParameterError(f"record {p} holds no 1-D channel", param="record")
+    scale, _ = agreed(p, "units per stored value", [
+        ("the file", "record", f.calibration),
+        ('metadata.json "calibration"', "record", entry.get("calibration")),
+        ("calibration", "calibration", calibration)], CALIBRATION_TOLERANCE)
+    if scale is not None and f.calibration is None:      # the reader applied the file's
+        signals = {k: scale * v for k, v in signals.items()}
     channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, str(p))
-    near = (sensors.get(channel) or {}).get("near")
+    sensor = dict(sensors.get(channel) or {})
+    sensor_unit = agreed_unit(p, channel, [
+        ("the file", "record", f.units.get(channel)),
+        ('metadata.json "sensors"', "record", sensor.get("unit")),
+        ("unit", "unit", unit)])
+    if sensor_unit is not None:
+        sensor["unit"] = sensor_unit
+    rpm_doc, rpm_key = _documented_speed(entry)
+    speed, speed_from = agreed(p, "speed", [
+        ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
+        ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
+    fs, fs_from = agreed(p, "sample rate", [
+        (f.rate_from, "record", f.rate_hz),
+        ('metadata.json "fs_hz"', "record", entry.get("fs_hz") or meta.get("fs_hz")),
+        ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
+    near = sensor.get("near")
     inferred, notes = {}, []
     rig_given = rig is not None
     if rig is None:
@@ -299,25 +357,28 @@ def read_record(path, *, channel=None, rig=None):
     if rig.gears is not None:
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
-    speed_rpm = documented_speed_rpm(entry)
-    fs = _sample_rate(meta, entry, file_rate, x, speed_rpm, teeth, inferred, notes, p)
-    if speed_rpm is not None:         # before anything is computed on them
-        _check_against_lines(x, fs, speed_rpm, geometry, notes, p,
-                             "the WAV header" if file_rate is not None else "fs_hz")
+    fs = _sample_rate(fs, x, speed, teeth, inferred, notes, meta)
+    lines = documented_frequencies(geometry, 1.0)
+    if rig_given and not lines.bearings and lines.gmf_hz is None:
+        lines = rig_frequencies(rig, OperatingPoint(speed_rpm=60.0))
+    if speed is not None:             # before anything is computed on them
+        _check_against_lines(x, fs, speed, lines, notes, p, fs_from or "the inferred rate",
+                             speed_from)
     if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
-        speed_rpm, how = refine_speed(x, fs, speed_rpm, teeth)
+        speed, how = refine_speed(x, fs, speed, teeth)
         if how is not None:
-            inferred["speed_rpm"] = {"value": speed_rpm, "how": how}
-    op = model_operating_point(entry, rig, speed_rpm, notes)
+            inferred["speed_rpm"] = {"value": speed, "how": how}
+    op = model_operating_point(entry, rig, speed, notes)
 
-    direction = str((sensors.get(channel) or {}).get("direction", "")).lower()
+    direction = str(sensor.get("direction", "")).lower()
     axis = "x" if ("horizontal" in direction or "3 o'clock" in direction) else "y"
     bearing = "1b1"
     if rig.gears is None:
         bearing = next((b for b, key in components.items() if key == near), "1b1")
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
-              {"fs_hz": fs, "channel": channel, "sensor": sensors.get(channel),
+              {"fs_hz": fs, "channel": channel, "sensor": sensor or None,
+               "units": _channel_units(signals, f.units, sensors, channel, sensor_unit),
                "recording": entry, "operating_point": {
                    "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
                    "radial_load_n": op.radial_load_n,
@@ -327,17 +388,26 @@ def read_record(path, *, channel=None, rig=None):
     return MeasuredRecord(
         run=run, channel=channel, rig=rig, op=op, model_signal=f"accel_{bearing}_{axis}",
         components=components, inferred=inferred, path=str(p),
-        unit_scale=unit_scale_of((sensors.get(channel) or {}).get("unit")),
-        record_id=p.stem, frequencies=documented_frequencies(geometry, speed_rpm / 60.0),
-        operating_point=documented_operating_point(entry, speed_rpm),
+        unit_scale=unit_scale_of(sensor.get("unit")),
+        record_id=p.stem, frequencies=documented_frequencies(geometry, speed / 60.0),
+        operating_point=documented_operating_point(entry, speed),
         path_documented=rig_given)
 
 
-def read_run(path, *, channel=None):
+def _channel_units(signals, file_units, sensors, channel, unit):
+    """Channel → unit, where the file or metadata.json states it (the compared channel's
+    as agreed)."""
+    out = {c: file_units.get(c) or (sensors.get(c) or {}).get("unit") for c in signals}
+    out[channel] = unit
+    return {c: u for c, u in out.items() if u}
+
+
+def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
+             calibration=None):
     """Any record cmsim writes or reads, as a :class:`~cmsim.run.Run` with its rig and
     operating point: a run (``cmsim simulate``, ``cmsim sweep``), a dataset record
-    (``cmsim dataset``) or a measured recording in a folder with ``metadata.json``
-    (:func:`read_record`, with every check it makes).
+    (``cmsim dataset``) or a measured recording (:func:`read_record`, with every check it
+    makes).
 
     Parameters
     ----------
@@ -346,6 +416,17 @@ def read_run(path, *, channel=None):
         a measured recording.
     channel : str, optional
         Compared channel of a measured recording (default as :func:`read_record`).
+    rig : cmsim.rig.Rig, optional
+        Model rig of a measured recording (:func:`read_record`).
+    fs_hz : float, optional
+        Sample rate of a measured recording, Hz (:func:`read_record`).
+    speed_rpm : float, optional
+        Input-shaft speed of a measured recording, rpm (:func:`read_record`).
+    unit : str, optional
+        Unit of a measured recording's compared channel (:func:`read_record`).
+    calibration : float, optional
+        Physical units per stored sample value of a measured recording
+        (:func:`read_record`).
 
     Returns
     -------
@@ -353,14 +434,28 @@ def read_run(path, *, channel=None):
     signal : str or None
         The signal to look at by default: a measured recording's compared channel, a dataset
         record's first channel, None for a simulated run (its caller's default).
+
+    Raises
+    ------
+    ParameterError
+        What :func:`read_record` raises; a value given for a file cmsim wrote (its rate,
+        speed and rig are its own).
     """
     p = resolve_path(path)
     names = _npz_names(p) if p.suffix.lower() == ".npz" else set()
+    stated = {"rig": rig, "fs_hz": fs_hz, "speed_rpm": speed_rpm, "unit": unit,
+              "calibration": calibration}
     if "meta" in names:
+        given = [k for k, v in stated.items() if v is not None]
+        if given:
+            raise ParameterError(f"{given[0]}: record {p} is one cmsim wrote (a run or a "
+                                 f"dataset record); its rate, speed and rig are its own: "
+                                 f"leave out {given[0]}", param=given[0],
+                                 allowed="a measured recording")
         run = Run.load(p)
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
         return run, (None if "t" in names else sorted(run.signals)[0])
-    rec = read_record(p, channel=channel)
+    rec = read_record(p, channel=channel, **stated)
     return rec.run, rec.channel
 
 

@@ -31,7 +31,7 @@ __all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_
 RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_hz",
                   "shaft_speed_rpm_nominal", "shaft_speed_hz_nominal", "torque_nm",
                   "motor_load_hp", "radial_load_lbs", "radial_load_n", "load_percent",
-                  "channels", "segment")
+                  "channels", "segment", "calibration")
 
 #: Numeric keys of a recording (and the folder's ``fs_hz``) → the name of their range in
 #: :data:`cmsim.rig.RANGES`; ``null`` means undocumented, anything else must be in range.
@@ -40,7 +40,7 @@ NUMERIC_KEYS = {"fs_hz": "record_fs_hz", "n_samples": "n_samples",
                 "shaft_speed_hz": "shaft_speed_hz", "shaft_speed_hz_nominal": "shaft_speed_hz",
                 "torque_nm": "torque_nm", "motor_load_hp": "motor_load_hp",
                 "radial_load_lbs": "radial_load_lbs", "radial_load_n": "radial_load_n",
-                "load_percent": "load_percent"}
+                "load_percent": "load_percent", "calibration": "calibration"}
 
 #: Folder-level keys the pipeline reads (``fs_note`` only to cross-check an inferred rate).
 FOLDER_KEYS = ("fs_hz", "fs_note", "channels", "sensors", "geometry")
@@ -62,17 +62,20 @@ ACCELERATION_UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0, "m/s^2": 1.0, "m/
                       "mm/s2": 1e-3, "mm/s^2": 1e-3}
 
 
-def read_metadata(folder):
+def read_metadata(folder, missing_ok=False):
     """The ``metadata.json`` of a folder, as parsed JSON (a dict with ``recordings``).
 
     Parameters
     ----------
     folder : str or pathlib.Path
         Folder of measured records.
+    missing_ok : bool
+        Return None when the folder has no ``metadata.json`` (the record's file and the
+        caller then state what the metadata would).
 
     Returns
     -------
-    dict
+    dict or None
 
     Raises
     ------
@@ -80,6 +83,8 @@ def read_metadata(folder):
         No ``metadata.json``, not valid JSON, or no ``recordings`` list.
     """
     path = Path(folder) / "metadata.json"
+    if missing_ok and not path.exists():
+        return None
     if not path.is_file():
         raise ParameterError(f"no metadata.json in {Path(folder)} (the record format is the "
                              f"metadata.json schema of the datasets README)", param="record",
@@ -118,8 +123,8 @@ def checked_numbers(values, keys, where):
     for key in [keys] if isinstance(keys, str) else keys:
         if out.get(key) is None:
             continue
-        try:
-            out[key] = RANGES[NUMERIC_KEYS[key]].check(key, out[key])
+        try:    # a key of the file, in quotes: never read as a command's option
+            out[key] = RANGES[NUMERIC_KEYS[key]].check(f'"{key}"', out[key])
         except ParameterError as exc:
             raise ParameterError(f"{where}: {exc}; write a plain JSON number (e.g. 12000, "
                                  f"not \"12k\") or null when undocumented", param="record",

@@ -143,4 +143,6 @@ RANGES = {
     "radial_load_lbs": Range(0.0, 2.2e6, unit="lbf"),
     "load_percent": Range(0.0, 200.0, unit="%"),
     "n_samples": Range(1, 1.0e12, integer=True),
+    # physical units per stored sample value of a recording (a WAV in counts or volts)
+    "calibration": Range(0.0, 1.0e12, lo_open=True),
 }

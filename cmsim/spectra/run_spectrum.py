@@ -230,7 +230,9 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
     peaks = peaks[peaks["frequency_hz"] <= f_max]
     peaks = peaks.sort_values("amplitude", ascending=False, kind="stable").head(max_peaks)
     return RunSpectrum(signal=signal, kind=kind, freq_hz=np.asarray(f), amplitude=np.asarray(a),
-                       resolution_hz=float(df_hz), unit=signal_unit(signal), families=dict(fam),
+                       resolution_hz=float(df_hz),
+                       unit=signal_unit(signal) or (run.meta.get("units") or {}).get(signal, ""),
+                       families=dict(fam),
                        bearing=brg, peaks=peaks.reset_index(drop=True), band_hz=band_used,
                        max_hz=float(f_max), extra=extra)
 

@@ -65,6 +65,7 @@ BASE = {
     "export": "export {run} --format npz --out {work}/ex --channels F_1b1_loa",
     "losses": "losses --speed-rpm 1000 --torque-nm 10",
     "calibrate": "calibrate {record} --out {work}/machine.toml",
+    "import": "import {empty_dir} --out {work}/metadata.json",
 }
 
 CATALOGUE = [
@@ -398,7 +399,35 @@ CATALOGUE = [
     R("compare-record-nan", "compare {rec_nan}", "RECORD", "3 non-finite samples",
       "sample 100"),
     R("compare-wav-header-rate", "compare {rec_wav_rate}", "RECORD", "48000 Hz",
-      "fs_hz 12000 Hz"),
+      '"fs_hz" says 12000 Hz'),
+    # ---- issue 28: recordings in the formats labs produce, what options state for them
+    R("compare-fs-option-disagrees", "compare {record} --fs-hz 48000", "--fs-hz",
+      '"fs_hz" says sample rate 12000 Hz', "48000 Hz"),
+    R("compare-speed-option-disagrees", "compare {record} --speed-rpm 900", "--speed-rpm",
+      "1797 rpm", "900 rpm"),
+    R("compare-unit-option-disagrees", "compare {rec_unit_g} --unit V", "--unit", "'g'",
+      "'V'"),
+    R("calibrate-fs-option-disagrees", "calibrate {record} --fs-hz 48000 --out "
+      "{work}/m.toml", "--fs-hz", "12000 Hz", "48000 Hz"),
+    R("spectrum-fs-option-disagrees", "spectrum {record} --fs-hz 48000", "--fs-hz",
+      "12000 Hz", "48000 Hz"),
+    R("spectrum-option-for-a-run", "spectrum {run} --speed-rpm 1000", "--speed-rpm",
+      "cmsim wrote"),
+    R("spectrum-rig-missing", "spectrum {record} --rig {work}/none.toml", "--rig"),
+    R("compare-channel-not-in-mat", "compare {rec_mat} --channel X097_BA_time --fs-hz 12000",
+      "--channel", "X097_DE_time", "X097_FE_time"),
+    R("compare-mat-no-rig", "compare {rec_mat} --fs-hz 12000", "--rig", "geometry"),
+    R("import-empty-dir", "import {empty_dir} --out {work}/m.json", "DIR", "no recording"),
+    R("import-dir-missing", "import {work}/none", "DIR", "does not exist"),
+    R("import-out-exists", "import {measured_dir}", "--out", "exists", "--force"),
+    R("import-fs-disagrees", "import {rec_wav_rate_dir} --out {work}/m.json --fs-hz 12000",
+      "--fs-hz", "48000 Hz", "12000 Hz"),
+    R("import-channel-missing", "import {measured_dir} --out {work}/m.json --channel FE",
+      "--channel", "'FE'", "DE"),
+    R("import-wav-names-count", "import {rec_wav_rate_dir} --out {work}/m.json --channel A B",
+      "--channel", "got 2"),
+    R("import-damaged", "import {rec_truncated_dir} --out {work}/m.json", "DIR",
+      "truncated"),
     R("calibrate-record-truncated", "calibrate {rec_truncated} --out {work}/m.toml",
       "BASELINE", "truncated"),
     R("calibrate-metadata-fs-text", "calibrate {rec_fs_text} --out {work}/m.toml",
@@ -676,6 +705,13 @@ def files(tmp_path_factory):
             "n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04}}},
         "recordings": [{"file": "rec.npz", "shaft_speed_rpm": 1797.0}]}))
     f["record"] = meas / "rec.npz"
+    f["measured_dir"] = meas
+    mat = d / "mat"                                # a CWRU-layout .mat, no metadata.json
+    mat.mkdir()
+    from scipy.io import savemat
+    x = np.random.default_rng(2).standard_normal((24000, 1))
+    savemat(mat / "rec.mat", {"X097_DE_time": x, "X097_FE_time": x, "X097RPM": 1797.0})
+    f["rec_mat"] = mat / "rec.mat"
     f.update(_bad_recordings(d / "bad_recordings"))
     f["root"] = d
     return f
@@ -736,7 +772,8 @@ def _generated_datasets(d, f):
     f["algo_exit"] = d / "algo_exit.py"
 
 
-def _measured_folder(folder, arrays, *, fs_hz=12000.0, file="rec.npz", entry=None):
+def _measured_folder(folder, arrays, *, fs_hz=12000.0, file="rec.npz", entry=None,
+                     sensors_unit=None):
     """A folder with one recording (``arrays``: channel -> samples, or bytes: the raw file)
     and its metadata.json (a CWRU-like bearing rig, sensor DE near the drive end)."""
     folder.mkdir(parents=True)
@@ -745,7 +782,8 @@ def _measured_folder(folder, arrays, *, fs_hz=12000.0, file="rec.npz", entry=Non
     elif arrays is not None:
         np.savez(folder / file, **arrays)
     (folder / "metadata.json").write_text(json.dumps({
-        "fs_hz": fs_hz, "sensors": {"DE": {"near": "de", "direction": "radial"},
+        "fs_hz": fs_hz, "sensors": {"DE": {"near": "de", "direction": "radial",
+                                           "unit": sensors_unit},
                                     "FE": {"near": "fe", "direction": "radial"}},
         "geometry": {"gears": None, "bearings": {
             "de": {"n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04},
@@ -767,7 +805,8 @@ def _bad_recordings(d):
          "rec_fs_text": _measured_folder(d / "fs_text", {"DE": x}, entry={"fs_hz": "12k"}),
          "rec_2d": _measured_folder(d / "two_d", {"DE": np.stack([x, x], 1), "FE": x}),
          "rec_zero": _measured_folder(d / "zero", {"DE": np.zeros_like(x)}),
-         "rec_nan": _measured_folder(d / "nan", {"DE": with_nan})}
+         "rec_nan": _measured_folder(d / "nan", {"DE": with_nan}),
+         "rec_unit_g": _measured_folder(d / "unit_g", {"DE": x}, sensors_unit="g")}
     wav = _measured_folder(d / "wav", None, file="rec.wav", entry={"channels": ["DE"]})
     with wave.open(str(wav), "wb") as w:
         w.setnchannels(1)
@@ -863,7 +902,7 @@ def test_every_option_is_validated():
     # export's RUN|DATASET is a file or a folder, its --channels are checked against the
     # source, --group-by against the manifest
     free_text = {"signal", "bearing", "fault", "algorithm", "scheduler", "record", "channel",
-                 "baseline", "source", "channels", "group_by"}
+                 "baseline", "source", "channels", "group_by", "unit"}
     for command, sub in contract.subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):

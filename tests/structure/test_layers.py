@@ -58,8 +58,9 @@ LAYER_OF = {unit: i for i, (_, units) in enumerate(LAYERS) for unit in units}
 #: Third-party libraries slow to import or needed by one feature only: these may be imported
 #: inside the function that needs them.
 LAZY_LIBRARIES = {"matplotlib", "pandas", "pyarrow", "dask", "distributed", "tqdm", "skfem",
-                  # optional extras (cmsim[uff], cmsim[torch]): cmsim imports without them
-                  "pyuff", "torch"}
+                  # optional extras (cmsim[uff], cmsim[tdms], cmsim[torch]; h5py for MATLAB
+                  # v7.3 files): cmsim imports without them
+                  "pyuff", "nptdms", "h5py", "torch"}
 
 #: Units where any function-local import is allowed (start-up time of the command).
 LAZY_UNITS = {"cli"}

@@ -115,14 +115,15 @@ def _copy_record(tmp_path, folder, file, **changes):
 
 
 def test_compare_refuses_a_cwru_record_said_to_be_48k(tmp_path, capsys):
-    """The issue's case: exit 2, one line naming fs_hz and the rate that fits (12 kHz)."""
+    """The issue's case: exit 2, one line naming fs_hz and the rate that fits (12 kHz);
+    the metadata key in quotes (an option of the command is named --fs-hz)."""
     p = _copy_record(tmp_path, "cwru_bearing_12k_de", "OR007_at6_0.npz", fs_hz=48000.0)
     for argv in (["compare", str(p)], ["calibrate", str(p), "--out", str(tmp_path / "m.toml")]):
         assert main(argv + ["--json"]) == 2
         cap = capsys.readouterr()
         assert len(cap.err.strip().splitlines()) == 1
         err = json.loads(cap.out)["error"]
-        assert "fs_hz 48000 Hz" in err and "fs_hz 12000 Hz" in err, err
+        assert '"fs_hz" 48000 Hz' in err and '"fs_hz" 12000 Hz' in err, err
     assert not (tmp_path / "m.toml").exists()
 
 

@@ -1,0 +1,183 @@
+"""A folder of recordings documented as ``metadata.json``: what ``cmsim import`` writes.
+
+:func:`folder_metadata` reads every signal file of a folder (every suffix of
+:data:`~cmsim.measured.readers.READERS`) and writes down, in the schema
+:mod:`~cmsim.measured.schema` reads, what the files state (channel names, sample rate,
+units, a ``.mat`` file's shaft speed) and what the caller gives for what they do not
+(``fs_hz``, ``speed_rpm``, ``unit``, ``calibration``; a WAV's channel names), with the rule
+of :mod:`~cmsim.measured.stated` (a file and an argument that disagree are refused, naming
+both values). The geometry and the answer key are left for the user to add: nothing in a
+signal file states them. :func:`write_folder_metadata` writes the result atomically and
+never overwrites an existing file unless told to.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from cmsim._io import atomic_write_text
+from cmsim.errors import ParameterError
+from cmsim.measured.readers import READERS, read_file
+from cmsim.measured.schema import checked_numbers, recording_entry
+from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
+                                   SPEED_TOLERANCE, agreed, agreed_unit)
+
+__all__ = ["folder_metadata", "write_folder_metadata", "signal_files"]
+
+
+def signal_files(folder):
+    """The signal files of ``folder`` that cmsim reads, sorted by name (hidden files and
+    ``metadata.json`` left out).
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    return sorted(p for p in Path(folder).iterdir()
+                  if p.is_file() and not p.name.startswith(".")
+                  and p.suffix.lower() in READERS)
+
+
+def _channel_names(path, f, channels):
+    """The channel names an entry documents: the file's, or ``channels`` — naming a file's
+    unnamed channels (WAV ``ch0``, ...) in order, else choosing among the file's names."""
+    names = list(f.signals)
+    if not channels:
+        return names
+    unnamed = names == [f"ch{i}" for i in range(len(names))]
+    if unnamed:
+        if len(channels) != len(names):
+            raise ParameterError(f"channel: record {path} names none of its "
+                                 f"{len(names)} signal(s); give one name per signal in "
+                                 f"order: {len(names)}, got {len(channels)} "
+                                 f"({', '.join(channels)})", param="channel",
+                                 allowed=f"{len(names)} names")
+        return list(channels)
+    missing = [c for c in channels if c not in names]
+    if missing:
+        raise ParameterError(f"channel {missing[0]!r} is not in {path}; available: "
+                             f"{sorted(names)}", param="channel", allowed=", ".join(names))
+    return list(channels)
+
+
+def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=None,
+                    calibration=None):
+    """``metadata.json`` of a folder of recordings, from what the files state and the
+    arguments give.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        Folder with one signal file per recording.
+    fs_hz : float, optional
+        Sample rate, Hz, of the files that do not state one (one that does must agree).
+    speed_rpm : float, optional
+        Input-shaft speed, rpm (a file that states one must agree).
+    channels : sequence of str, optional
+        Names of a file's unnamed channels (a WAV's, in order), or the channels to document
+        of files that name theirs (each must be in the file).
+    unit : str, optional
+        Unit of the channels whose file states none (``g``, ``m/s^2``, ``V``).
+    calibration : float, optional
+        Physical units per stored sample value, for files that store counts or volts and
+        state no factor.
+
+    Returns
+    -------
+    metadata : dict
+        In the schema of :mod:`~cmsim.measured.schema`: ``fs_hz`` (the files' common rate or
+        null), ``channels``, ``sensors`` (units), ``geometry`` (null: not stated by any
+        file), ``recordings``.
+    undocumented : list of str
+        What neither a file nor an argument states (``x.npz: sample rate``).
+
+    Raises
+    ------
+    ParameterError
+        No signal file in the folder; a file that cannot be read; a channel not in a file;
+        a file and an argument (or two files, for a channel's unit) that disagree.
+    """
+    folder = Path(folder)
+    files = signal_files(folder)
+    if not files:
+        raise ParameterError(f"{folder} holds no recording ({', '.join(READERS)} files)",
+                             param="dataset", allowed="a folder with signal files")
+    recordings, units, unit_from, undocumented = [], {}, {}, []
+    for path in files:
+        f = read_file(path, channels)
+        names = _channel_names(path, f, channels)
+        first = f.signals[names[0]]
+        rate, _ = agreed(path, "sample rate", [(f.rate_from, "record", f.rate_hz),
+                                               ("fs_hz", "fs_hz", fs_hz)],
+                         HEADER_RATE_TOLERANCE, " Hz")
+        speed, _ = agreed(path, "speed", [("the file", "record", f.speed_rpm),
+                                          ("speed_rpm", "speed_rpm", speed_rpm)],
+                          SPEED_TOLERANCE, " rpm")
+        scale, _ = agreed(path, "units per stored value", [
+            ("the file", "record", f.calibration), ("calibration", "calibration", calibration)],
+            CALIBRATION_TOLERANCE)
+        entry = {"file": path.name, "n_samples": int(first.size), "fs_hz": rate,
+                 "shaft_speed_rpm": speed, "channels": names}
+        if scale is not None and f.calibration is None:
+            entry["calibration"] = scale
+        recordings.append(entry)
+        undocumented += [f"{path.name}: {what}" for what, v in
+                         (("sample rate", rate), ("shaft speed", speed)) if v is None]
+        for name in names:                # one unit per channel name over the folder
+            u = agreed_unit(path, name, [(unit_from.get(name), "record", units.get(name)),
+                                         ("the file", "record", f.units.get(name)),
+                                         ("unit", "unit", unit)])
+            if u is not None and name not in units:
+                units[name] = u
+                unit_from[name] = path.name if f.units.get(name) else "unit"
+    rates = {r["fs_hz"] for r in recordings}
+    all_channels = sorted({c for r in recordings for c in r["channels"]})
+    undocumented += [f"unit of {c}" for c in all_channels if c not in units]
+    meta = {"dataset": folder.resolve().name,
+            "source": "cmsim import: channel names, rates, units and speeds the files "
+                      "state, the rest from its options; add geometry and the answer key "
+                      "by hand",
+            "fs_hz": rates.pop() if len(rates) == 1 else None,
+            "channels": {c: f"channel {c} of the recordings" for c in all_channels},
+            "sensors": {c: {"near": "unknown", "direction": "unknown",
+                            "unit": units.get(c)} for c in all_channels},
+            "geometry": {"gears": None, "bearings": None},
+            "recordings": recordings}
+    return meta, undocumented
+
+
+def write_folder_metadata(path, metadata, *, force=False):
+    """Write ``metadata`` to ``path`` atomically, checked as :func:`read_metadata` reads it.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``metadata.json`` to write.
+    metadata : dict
+        From :func:`folder_metadata` (or edited).
+    force : bool
+        Overwrite an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    ParameterError
+        The file exists and ``force`` is False; a numeric key out of its range.
+    """
+    path = Path(path)
+    if path.exists() and not force:
+        raise ParameterError(f"out: {path} exists; give force to overwrite it", param="out",
+                             allowed="a new file, or force")
+    checked_numbers(metadata, "fs_hz", path)
+    for i, rec in enumerate(metadata.get("recordings") or []):
+        recording_entry({"recordings": [rec]}, rec.get("file"), f"{path} recordings[{i}]")
+    atomic_write_text(path, json.dumps(metadata, indent=1) + "\n")
+    return path
