@@ -11,10 +11,14 @@
   <cmsim.discrepancy.causes.Cause.judged_on>`: a bearing defect's families, a tooth fault's
   sidebands and statistics ...); a cause that reshapes the spectrum (load, clearance, speed
   fluctuation, the chain) is judged on every feature. A fault whose evidence reaches
-  :data:`MIN_SIGNATURE_DELTA_CHI2`, and exceeds what any reshaping cause that could be named
-  makes of the same features, wins over the reshaping causes: what stands out in a fault
-  family beyond what a load or a clearance does to it is that fault; of the faults that stand
-  out, the one with the most evidence on its own signature wins.
+  :data:`MIN_SIGNATURE_DELTA_CHI2`, and whose *family* (its signature without the statistics
+  every impulsive fault moves, :data:`~cmsim.discrepancy.causes.STATISTICS`) moved towards the
+  record by more than any reshaping cause that could be named moves the same features, wins
+  over the reshaping causes: what stands out in a fault family beyond what a load or a
+  clearance does to it is that fault. A record's kurtosis names no fault: a fault whose family
+  got no nearer (a defect on a bearing whose families the record does not show, a family the
+  model makes worse) is not named on the statistics alone. Of the faults that stand out, the
+  one with the most evidence on its own signature wins.
 * **The nearest bearing.** A bearing cause on a bearing other than the sensor's wins only
   with :data:`FAR_MARGIN` times the evidence of the same cause on the sensor's bearing.
 * **Near ties.** A runner-up of the same kind within :data:`NEAR_TIE` of the winner's
@@ -178,8 +182,9 @@ def refine(r, nominal, nuis):
 
 def evidence(r, chi_of, nominal_features, names):
     """Fill ``r["per_feature"]`` (Δχ² of each feature), ``r["delta_chi2"]`` (evidence on the
-    cause's signature), ``r["total"]`` (over every feature) and ``r["judged_on"]`` (the
-    signature's features) of a ranked cause.
+    cause's signature), ``r["total"]`` (over every feature), ``r["judged_on"]`` (the
+    signature's features) and ``r["family"]`` (those that tell it from other faults) of a
+    ranked cause.
 
     Parameters
     ----------
@@ -195,6 +200,7 @@ def evidence(r, chi_of, nominal_features, names):
     judged = r["cause"].judged_on(names, r["component"])
     sim = r.get("features")
     r["judged_on"] = judged
+    r["family"] = r["cause"].family(names, r["component"])
     # χ² is a sum over features: the evidence on any set of them is a sum of these
     r["per_feature"] = pf = {k: chi_of(nominal_features, [k]) - chi_of(sim, [k])
                              for k in names}
@@ -206,8 +212,9 @@ def decide(ranked, sensor_bearing, chi_nominal, z=None):
     """(winner or None, near ties) from ranked causes with their evidence filled.
 
     Faults (causes with a signature) are decided first: of those whose evidence reaches
-    :data:`MIN_SIGNATURE_DELTA_CHI2` and exceeds a nameable reshaping cause's Δχ² on the same
-    features, the strongest on its own signature wins, preferring the sensor's
+    :data:`MIN_SIGNATURE_DELTA_CHI2` and whose family's evidence is positive and exceeds a
+    nameable reshaping cause's Δχ² on the family's features, the strongest on its own
+    signature wins, preferring the sensor's
     bearing (:data:`FAR_MARGIN`); without one, the reshaping cause with the largest evidence,
     if it reaches :data:`MIN_DELTA_CHI2` and removes :data:`MIN_SCORE` of the nominal χ².
 
@@ -232,9 +239,11 @@ def decide(ranked, sensor_bearing, chi_nominal, z=None):
                  and r["delta_chi2"] >= MIN_SCORE * chi_nominal]
 
     def stands_out(r):
-        # beyond what a reshaping cause that could be named makes of the same features
-        return all(r["delta_chi2"] > sum(o["per_feature"][k] for k in r["judged_on"])
-                   for o in reshaping)
+        # its family moved towards the record, beyond what a reshaping cause that could be
+        # named makes of the same features (the shared statistics tell no fault from another)
+        own = sum(r["per_feature"][k] for k in r["family"])
+        return own > 0.0 and all(own > sum(o["per_feature"][k] for k in r["family"])
+                                 for o in reshaping)
 
     faults = [r for r in ranked if r["cause"].signature is not None
               and r["delta_chi2"] >= MIN_SIGNATURE_DELTA_CHI2 and stands_out(r)]

@@ -6,6 +6,7 @@ module docstring is a case that another rule would decide the other way.
 
 from types import SimpleNamespace
 
+from cmsim.discrepancy.causes import STATISTICS
 from cmsim.discrepancy.ranking import (FAR_MARGIN, MIN_DELTA_CHI2, MIN_SIGNATURE_DELTA_CHI2,
                                        NEAR_TIE, decide)
 
@@ -17,8 +18,9 @@ def _row(name, per_feature, signature=None, component=None):
     judged = [k for k in FEATURES if signature is None or k.startswith(signature)
               or k == "kurtosis_log" and signature is not None]
     pf = {k: per_feature.get(k, 0.0) for k in FEATURES}
-    return {"name": name, "component": component, "judged_on": judged, "per_feature": pf,
-            "delta_chi2": sum(pf[k] for k in judged),
+    family = [k for k in judged if signature is not None and k not in STATISTICS]
+    return {"name": name, "component": component, "judged_on": judged, "family": family,
+            "per_feature": pf, "delta_chi2": sum(pf[k] for k in judged),
             "cause": SimpleNamespace(signature=None if signature is None else (signature,),
                                      kind=name)}
 
@@ -29,9 +31,10 @@ def _outer(level, component="1b1"):
                 "env_bpfo_1b1", component)
 
 
-def _load(level, on_family=0.0):
-    return _row("torque_mismatch", {"shape_b3_db": level - on_family,
-                                    "env_bpfo_1b1_h1_db": on_family})
+def _load(level, on_family=0.0, on_kurtosis=0.0):
+    return _row("torque_mismatch", {"shape_b3_db": level - on_family - on_kurtosis,
+                                    "env_bpfo_1b1_h1_db": on_family,
+                                    "kurtosis_log": on_kurtosis})
 
 
 def test_a_fault_that_stands_out_wins_over_a_larger_reshaping_cause():
@@ -71,3 +74,24 @@ def test_a_close_runner_up_is_a_near_tie():
     inner = _row("bearing_inner_race", {"env_bpfi_1b1_h1_db": 40.0 * NEAR_TIE - 1},
                  "env_bpfi_1b1", "1b1")
     assert decide([_outer(40.0), inner], "1b1", 300.0)[1] == []
+
+
+def test_a_fault_is_not_named_on_the_shared_statistics_alone():
+    # a defect on a bearing whose families the record does not show moves only the kurtosis
+    far = _row("bearing_outer_race", {"kurtosis_log": 3 * MIN_SIGNATURE_DELTA_CHI2},
+               "env_bpfo_1b9", "1b9")
+    assert far["family"] == [] and far["delta_chi2"] > MIN_SIGNATURE_DELTA_CHI2
+    assert decide([far], "1b1", 300.0)[0] is None
+    # nor when its family gets further from the record than the statistics get nearer
+    worse = _row("bearing_inner_race", {"kurtosis_log": 40.0, "env_bpfi_1b1_h1_db": -5.0},
+                 "env_bpfi_1b1", "1b1")
+    assert decide([worse], "1b1", 300.0)[0] is None
+
+
+def test_a_reshaping_cause_blocks_a_fault_by_what_it_does_to_the_family_not_the_kurtosis():
+    # the load raises the kurtosis as the defect does, and half the BPFO line: the family
+    # still stands out beyond it (judged on every signature feature, the load would block it)
+    load = _load(200.0, on_family=15.0, on_kurtosis=20.0)
+    outer = _outer(30.0)
+    assert load["per_feature"]["kurtosis_log"] + 15.0 > outer["delta_chi2"]
+    assert decide([load, outer], "1b1", 300.0)[0]["name"] == "bearing_outer_race"
