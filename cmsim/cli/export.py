@@ -8,11 +8,16 @@ from cmsim.cli.contract import CLIError, ranged
 from cmsim.cli.options import number
 from cmsim.rig import Range
 
+#: The formats of ``--format``: :data:`cmsim.datasets.export.FORMATS`, written out so that
+#: building the parser imports none of the library (tests/cli/test_export.py checks that the
+#: two agree).
+FORMATS = ("npz", "csv", "wav", "mat", "uff", "tdms", "parquet")
+
 
 def register(sub):
     """Add the ``export`` parser."""
-    p = sub.add_parser("export", help="write a run or a dataset as csv, wav, uff, parquet or "
-                                      "npz files",
+    p = sub.add_parser("export", help="write a run or a dataset as npz, csv, wav, mat, uff, "
+                                      "tdms or parquet files",
                        description="Write a saved run (cmsim simulate --out) or a dataset "
                                    "(cmsim dataset) into the new folder OUT: one signal file "
                                    "per run or record with metadata.json (rate, units, "
@@ -25,9 +30,11 @@ def register(sub):
                                    "(dte_um, F_1b1_loa) with --channels.")
     p.add_argument("source", type=Path, metavar="RUN|DATASET",
                    help="a run file (.npz) or a dataset directory")
-    p.add_argument("--format", required=True, choices=("csv", "wav", "uff", "parquet", "npz"),
-                   help="file format (wav: float32 with the rate in the header and the "
-                        "units in its INFO comment; uff: type 58 sets, needs pyuff)")
+    p.add_argument("--format", required=True, choices=FORMATS,
+                   help="file format, each read back with its rate and units by cmsim "
+                        "compare, spectrum and calibrate (wav: float32 at full scale, the "
+                        "calibration factor, channels and units in its INFO comment; uff: "
+                        "type 58 sets, needs pyuff; tdms: needs npTDMS)")
     p.add_argument("--out", type=Path, required=True, metavar="OUT",
                    help="folder to make (refused if it exists, unless --force)")
     p.add_argument("--channels", nargs="+", metavar="NAME",

@@ -16,7 +16,7 @@
   the windowed Parquet layout;
 * :mod:`~cmsim.datasets.load` — :func:`load`: the manifest, lazy :class:`DatasetRecord` s,
   ML arrays (by default only the channels a real machine measures);
-* :mod:`~cmsim.datasets.export` — a run or a dataset as csv/wav/uff/parquet/npz files
+* :mod:`~cmsim.datasets.export` — a run or a dataset as npz/csv/wav/mat/uff/tdms/parquet files
   (``cmsim export``), the bearing-datasets schema;
 * :mod:`~cmsim.datasets.torch_windows` — ``WindowDataset``, the windows for PyTorch.
 

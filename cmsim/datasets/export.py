@@ -5,11 +5,15 @@ Signal files (``cmsim export``)
 -------------------------------
 :func:`export` writes a saved run or a generated dataset into a new folder, in one of
 :data:`FORMATS`: the run, or each record of a dataset, as one file ``<name>.<format>`` holding
-its channels (``npz``: float32 arrays named by channel; ``csv``: one column per channel, a
-header of names; ``wav``: float32 IEEE, one WAV channel per channel, the rate in the header and
-the channels and units in a ``LIST``/``INFO`` comment; ``uff``: one universal-file type 58
-set per channel, with the rate (abscissa increment) and the unit label; ``parquet``: one
-float32 column per channel, rate and units in the schema metadata), plus
+its channels, with the sample rate and each channel's unit where the format has a place for
+them. Every format but ``parquet`` is written by :func:`cmsim.measured.readers.write_signals`,
+the writer beside the reader of its format (that module's docstring gives each layout), so an
+exported file reads back through :func:`cmsim.measured.readers.read_file` with the same
+samples, rate and units; a ``wav`` holds float32 at full scale, its calibration factor,
+channels and units in cmsim's ``LIST``/``INFO`` comment. ``parquet``, written here, is one
+float32 column per channel, the rate and units in the schema metadata. Float32 samples (a
+dataset's records) stay float32 in ``npz``, ``mat``, ``tdms`` and ``parquet``. Each export
+also writes
 
 * ``metadata.json`` — the measured-record schema of ``../shared/datasets/README.md``: the
   sample rate, each channel's unit (``sensors``), one ``recordings[]`` entry per file with its
@@ -23,8 +27,6 @@ A dataset exported as ``parquet`` is the windowed layout instead
 default channels are those a real machine could measure (:func:`cmsim.run.is_measurable`).
 The folder is assembled beside ``out`` and renamed into place when complete: an interrupted
 export leaves no ``out``; an existing ``out`` is replaced only with ``force``.
-
-The formats are written by :func:`write_signals` alone (one private function per format).
 
 Bearing-datasets schema
 -----------------------
@@ -55,24 +57,24 @@ import json
 import math
 import os
 import shutil
-import struct
 import tempfile
 from pathlib import Path
 
 import numpy as np
-from scipy.io import wavfile
 
-from cmsim._io import atomic_savez, atomic_write, atomic_write_bytes, atomic_write_text
+from cmsim._io import atomic_write, atomic_write_bytes, atomic_write_text
 from cmsim.datasets.load import Dataset, load
 from cmsim.datasets.windows import check_fractions, split_of
 from cmsim.errors import ParameterError, check_choice
+from cmsim.measured.readers import WRITERS, write_signals
 from cmsim.run import Run, is_measurable, signal_info
 
-__all__ = ["export", "write_signals", "FORMATS", "to_bearing_datasets",
-           "bearing_datasets_frame"]
+__all__ = ["export", "FORMATS", "to_bearing_datasets", "bearing_datasets_frame"]
 
-#: Formats of :func:`export` (the file suffix is ``.<format>``).
-FORMATS = ("csv", "wav", "uff", "parquet", "npz")
+#: Formats of :func:`export` (the file suffix is ``.<format>``): every format of
+#: :data:`cmsim.measured.readers.WRITERS` (``.unv`` is ``.uff`` under another name), and
+#: ``parquet``.
+FORMATS = tuple(s.lstrip(".") for s in WRITERS if s != ".unv") + ("parquet",)
 
 _LOCAL = {"inner_race", "outer_race", "ball"}
 _GEAR = {"tooth_crack", "tooth_spall", "tooth_breakage", "eccentricity", "profile_error"}
@@ -176,117 +178,39 @@ def to_bearing_datasets(dataset, out, channels=None):
 
 
 # ---------------------------------------------------------------------- signal files
-def write_signals(path, signals, rate_hz, units):
-    """Write channels to one signal file, its format chosen by the suffix of ``path``
-    (``.npz``, ``.csv``, ``.wav``, ``.uff``, ``.parquet``), atomically.
+def _write_signals(path, signals, rate_hz, units):
+    """Write channels to one signal file, its format chosen by the suffix of ``path``,
+    atomically: :func:`cmsim.measured.readers.write_signals` (the writer beside each reader)
+    for every format but ``.parquet``, which only export writes.
 
     Parameters
     ----------
     path : str or path-like
-        The file.
+        The file, ``.<format>`` of one of :data:`FORMATS`.
     signals : dict of str to ndarray
-        Channel name → samples, shape (n,) each (written as float32).
+        Channel name → samples, shape (n,) each (float32 samples stay float32 where the
+        format stores the type: npz, mat, tdms, parquet).
     rate_hz : float
-        Sample rate, Hz (stored by WAV, UFF and Parquet).
+        Sample rate, Hz.
     units : dict of str to str
-        Channel name → unit of its samples (stored by WAV, UFF and Parquet).
+        Channel name → unit of its samples.
 
     Returns
     -------
     pathlib.Path
     """
     path = Path(path)
-    fmt = path.suffix.lower().lstrip(".")
-    check_choice("format", fmt, FORMATS)
-    arrays = {c: np.asarray(x, dtype=np.float32) for c, x in signals.items()}
-    _WRITERS[fmt](path, arrays, float(rate_hz), dict(units))
-    return path
-
-
-def _write_npz(path, signals, rate_hz, units):
-    atomic_savez(path, **signals)
-
-
-def _write_csv(path, signals, rate_hz, units):
-    import pandas as pd
-    atomic_write_text(path, pd.DataFrame(signals).to_csv(index=False))
-
-
-def _write_wav(path, signals, rate_hz, units):
-    buf = io.BytesIO()
-    wavfile.write(buf, int(round(rate_hz)), np.column_stack(list(signals.values())))
-    info = json.dumps({"channels": list(signals), "units": units, "fs_hz": rate_hz},
-                      ensure_ascii=False).encode("utf-8") + b"\0"
-    info += b"\0" * (len(info) % 2)
-    sub = b"ICMT" + struct.pack("<I", len(info)) + info
-    chunk = b"LIST" + struct.pack("<I", 4 + len(sub)) + b"INFO" + sub
-    data = bytearray(buf.getvalue()) + chunk
-    data[4:8] = struct.pack("<I", len(data) - 8)
-    atomic_write_bytes(path, bytes(data))
-
-
-#: UFF ordinate specific data types (type 58, record 9) of the run schema's quantities.
-_UFF_DATA_TYPE = {"acceleration": 12, "force": 13, "displacement": 8}
-
-
-def _write_uff(path, signals, rate_hz, units):
-    try:
-        import pyuff
-    except ImportError:
-        raise ParameterError("format uff needs pyuff: pip install cmsim[uff]",
-                             param="format") from None
-    sets = []
-    for k, (name, x) in enumerate(signals.items()):
-        try:
-            kind = _UFF_DATA_TYPE.get(signal_info(name).quantity, 0)
-        except ParameterError:
-            kind = 12 if units.get(name) in ("m/s²", "m/s^2", "g") else 0
-        unit = units.get(name, "").replace("²", "^2").replace("µ", "u")
-        exps = {f"{axis}_{q}_unit_exp": 0 for axis in ("abscissa", "ordinate", "orddenom",
-                                                        "z_axis")
-                for q in ("len", "force", "temp")}
-        sets.append(pyuff.prepare_58(
-            binary=1, id1=name, id2=f"cmsim channel {name}", id3="NONE", id4="NONE",
-            id5="NONE", func_type=1, ver_num=0, load_case_id=0, rsp_ent_name=name[:10],
-            rsp_node=k + 1, rsp_dir=0, ref_ent_name="NONE", ref_node=0, ref_dir=0,
-            ord_data_type=4, num_pts=int(x.size), abscissa_spacing=1, abscissa_min=0.0,
-            abscissa_inc=1.0 / rate_hz, z_axis_value=0.0, abscissa_spec_data_type=17,
-            abscissa_axis_units_lab="s", ordinate_spec_data_type=kind,
-            ordinate_axis_units_lab=unit, orddenom_spec_data_type=0,
-            orddenom_axis_units_lab="NONE", z_axis_spec_data_type=0,
-            z_axis_axis_units_lab="NONE", data=np.asarray(x, dtype=np.float64),
-            x=np.arange(x.size) / rate_hz, **exps))
-    # every set in "add" mode into the new, empty temporary file: pyuff 2.5's "overwrite" of a
-    # binary set truncates the set's own header when it reopens the file for the samples
-    _atomic_by_name(path, lambda tmp: pyuff.UFF(tmp).write_sets(sets, mode="add"))
-
-
-def _atomic_by_name(path, write):
-    """``write(name)`` for writers that open the file themselves, atomically: ``name`` is a
-    temporary file beside ``path``, renamed to it when ``write`` returns."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
-def _write_parquet(path, signals, rate_hz, units):
+    check_choice("format", path.suffix.lower().lstrip("."), FORMATS)
+    if path.suffix.lower() != ".parquet":
+        return write_signals(path, signals, rate_hz, units)
     import pyarrow as pa
     import pyarrow.parquet as pq
-    meta = {"cmsim": json.dumps({"fs_hz": rate_hz, "units": units}, ensure_ascii=False)}
-    table = pa.table({c: pa.array(x) for c, x in signals.items()}).replace_schema_metadata(meta)
+    meta = {"cmsim": json.dumps({"fs_hz": float(rate_hz), "units": dict(units)},
+                                ensure_ascii=False)}
+    table = pa.table({c: pa.array(np.asarray(x, dtype=np.float32))
+                      for c, x in signals.items()}).replace_schema_metadata(meta)
     atomic_write(path, lambda fh: pq.write_table(table, fh))
-
-
-#: Format → writer ``(path, float32 signals, rate_hz, units)``.
-_WRITERS = {"npz": _write_npz, "csv": _write_csv, "wav": _write_wav, "uff": _write_uff,
-            "parquet": _write_parquet}
+    return path
 
 
 def _source(source):
@@ -439,7 +363,7 @@ def _export_run(run, stage, fmt, channels, stem):
     chans = _channels(run.names, channels)
     units = {c: _run_unit(run, c) for c in chans}
     file = f"{stem}.{fmt}"
-    write_signals(stage / file, {c: run.signals[c] for c in chans}, run.fs_hz, units)
+    _write_signals(stage / file, {c: run.signals[c] for c in chans}, run.fs_hz, units)
     meta = {"dataset": stem, "source": "cmsim export", "fs_hz": run.fs_hz,
             "channels": {c: f"cmsim {run.source} signal {c}" for c in chans},
             "sensors": _sensors(chans, units), "recordings": [_run_entry(file, run, chans)]}
@@ -474,7 +398,7 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
         r = rec.row
         file = None if windowed else f"{rec.record_id}.{fmt}"
         if file is not None:
-            write_signals(stage / file, {c: rec.signals[c] for c in chans}, rec.fs_hz, units)
+            _write_signals(stage / file, {c: rec.signals[c] for c in chans}, rec.fs_hz, units)
         group = str(r[group_by])
         n = int(r["n_samples"]) if r.get("n_samples") is not None else None
         rows.append({"record_id": rec.record_id, "file": file, "label": r.get("fault_label"),

@@ -161,8 +161,7 @@ def _read_npz(path, names=None):
 
 
 def _write_npz(path, signals, rate_hz, units):
-    atomic_savez(path, **{k: np.asarray(v, dtype=float) for k, v in signals.items()},
-                 fs_hz=np.float64(rate_hz), units=np.array(json.dumps(units)))
+    atomic_savez(path, **signals, fs_hz=np.float64(rate_hz), units=np.array(json.dumps(units)))
 
 
 # ---------------------------------------------------------------------- .csv
@@ -307,7 +306,7 @@ def _read_mat73(path):
 
 
 def _write_mat(path, signals, rate_hz, units):
-    out = {k: np.asarray(v, dtype=float).reshape(-1, 1) for k, v in signals.items()}
+    out = {k: v.reshape(-1, 1) for k, v in signals.items()}
     out["fs_hz"] = float(rate_hz)
     if units:
         out["units"] = {k: str(v) for k, v in units.items()}
@@ -427,8 +426,7 @@ def _write_tdms(path, signals, rate_hz, units):
         props = {"wf_increment": 1.0 / float(rate_hz), "wf_start_offset": 0.0}
         if units.get(name):
             props["unit_string"] = units[name]
-        chans.append(nptdms.ChannelObject("signals", name, np.asarray(v, dtype=float),
-                                          properties=props))
+        chans.append(nptdms.ChannelObject("signals", name, v, properties=props))
     buf = io.BytesIO()
     with nptdms.TdmsWriter(buf) as w:
         w.write_segment([nptdms.GroupObject("signals")] + chans)
@@ -546,7 +544,9 @@ def write_signals(path, signals, rate_hz, units=None):
         and a ``units`` struct), ``.uff``/``.unv`` (one type-58 set per channel, the unit in
         its ordinate label; pyuff) or ``.tdms`` (npTDMS).
     signals : dict of str to array_like
-        Channel name → samples, shape (n,) each, all of one length.
+        Channel name → samples, shape (n,) each, all of one length; float32 samples are
+        stored as float32 where the format keeps the type (``.npz``, ``.mat``, ``.tdms``),
+        the rest as float64.
     rate_hz : float
         Sample rate, Hz (> 0; a whole number for WAV).
     units : dict of str to str or str, optional
@@ -569,7 +569,10 @@ def write_signals(path, signals, rate_hz, units=None):
                              allowed=", ".join(WRITERS))
     if not signals:
         raise ParameterError(f"{path}: no channel to write", param="signals")
-    arrays = {str(k): np.asarray(v, dtype=float) for k, v in signals.items()}
+    arrays = {}
+    for k, v in signals.items():
+        v = np.asarray(v)
+        arrays[str(k)] = v.astype(np.float32 if v.dtype == np.float32 else float, copy=False)
     lengths = {k: v.shape for k, v in arrays.items()}
     if any(len(s) != 1 for s in lengths.values()) or len(set(lengths.values())) != 1:
         raise ParameterError(f"{path}: channels must be 1-D and of one length, got "

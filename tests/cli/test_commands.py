@@ -1,15 +1,20 @@
 """The ``cmsim`` command line, called as ``main([...])``.
 
 Tier (c) behaviour: JSON contracts of the issue (keys and consistency), exit codes and error
-messages naming the parameter.
+messages naming the parameter; ``python -m cmsim`` is the same command.
 """
 
 import json
+import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import cmsim
 from cmsim.cli import main
 from cmsim.run import Run
 
@@ -227,3 +232,21 @@ def test_json_stdout_stays_one_object_while_the_compile_progress_is_on_stderr(mo
     assert err[0].startswith("cmsim: compiling numba kernels")
     assert any("still running" in line for line in err)
     assert sum("compiling numba kernels" in line and "done in" in line for line in err) == 1
+
+
+def test_python_m_cmsim_is_the_command(tmp_path):
+    """``python -m cmsim`` runs ``main`` and exits with its status (here the cmsim this test
+    imports, whichever checkout that is)."""
+    root = str(Path(cmsim.__file__).resolve().parents[1])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        p for p in (root, os.environ.get("PYTHONPATH")) if p)}
+
+    def python_m(*argv):
+        return subprocess.run([sys.executable, "-m", "cmsim", *argv], capture_output=True,
+                              text=True, env=env, cwd=tmp_path, timeout=120)
+
+    done = python_m("--help")
+    assert done.returncode == 0 and done.stdout.startswith("usage: cmsim")
+    done = python_m("export", "missing.npz", "--format", "npz", "--out", "x", "--json")
+    assert done.returncode == 2
+    assert json.loads(done.stdout)["option"] == "RUN|DATASET"

@@ -309,7 +309,7 @@ CATALOGUE = [
     R("dataset-out-file", "dataset {ds_spec} --out {text}", "--out"),
     # ---- export (issue 28)
     R("export-format-unknown", "export {run} --format mp3 --out {work}/ex", "--format",
-      "csv", "npz"),
+      "csv", "npz", "mat", "tdms"),
     R("export-channel-unknown", "export {gen_ds} --format csv --out {work}/ex --channels nope",
       "--channels", "'nope'", "accel_1b1_y"),
     R("export-run-channel-unknown", "export {run} --format csv --out {work}/ex --channels "

@@ -2,7 +2,8 @@
 
 Tier (c) behaviour: the JSON object and the files of a dataset exported as windows and as
 WAV, a simulated run exported with a simulated-only channel named, a repeated export refused
-without --force (its bad-input rows are in ``test_contract.py``). Records are 0.02 s.
+without --force (its bad-input rows are in ``test_contract.py``), the --format choices the
+library's formats. Records are 0.02 s.
 """
 
 import json
@@ -63,3 +64,12 @@ def test_run_with_a_simulated_channel_named(made, tmp_path, capsys):
     assert status == 0 and res["kind"] == "run" and res["units"] == {"dte_um": "µm"}
     signals, _ = read_signals(tmp_path / "r" / "000001.csv")
     np.testing.assert_array_equal(signals["dte_um"].astype(np.float32), Run.load(src)["dte_um"])
+
+
+def test_format_choices_are_the_formats_of_export():
+    """The parser writes the formats out (building it imports no library module): they must
+    be the library's."""
+    from cmsim.cli import export as cli_export
+    from cmsim.datasets.export import FORMATS
+
+    assert cli_export.FORMATS == FORMATS

@@ -1,11 +1,12 @@
 """Data out (issue 28): signal files, the windowed Parquet layout, the ML channel rule.
 
-Test tier: behaviour contracts (no physics). Every export format reads back with the same
-samples, rate and units (npz, csv, wav through cmsim's own measured reader, uff through
-pyuff); the windowed Parquet holds the windows of ``to_arrays`` (pandas, pyarrow and the
-HuggingFace loader when installed) and no group in two splits; ML loaders leave the
-simulated-only channels out unless asked; an interrupted export leaves nothing and a
-repeated one is refused without ``force``. The dataset has 4 records of 0.02 s.
+Test tier: behaviour contracts (no physics). Every export format but parquet is written by
+the measured writer beside its reader and reads back through that reader with the same
+samples, rate and units (uff also through pyuff itself); the windowed Parquet holds the
+windows of ``to_arrays`` (pandas, pyarrow and the HuggingFace loader when installed) and no
+group in two splits; ML loaders leave the simulated-only channels out unless asked; an
+interrupted export leaves nothing and a repeated one is refused without ``force``. The
+dataset has 4 records of 0.02 s.
 """
 
 import json
@@ -20,7 +21,7 @@ from cmsim.datasets import export as export_mod
 from cmsim.datasets.export import FORMATS, export
 from cmsim.datasets.windows import split_of
 from cmsim.errors import ParameterError
-from cmsim.measured.readers import read_signals
+from cmsim.measured.readers import WRITERS, read_file, read_signals
 from cmsim.run import Run
 
 SPEC = {
@@ -69,25 +70,31 @@ def test_a_dataset_of_simulated_signals_only_needs_them_named(made, monkeypatch)
 
 
 # ---------------------------------------------------------------------- signal files
-@pytest.mark.parametrize("fmt", ["npz", "csv", "wav"])
+FILE_FORMATS = [f for f in FORMATS if f != "parquet"]
+
+
+@pytest.mark.parametrize("fmt", FILE_FORMATS)
 def test_run_round_trips_through_the_measured_reader(made, tmp_path, fmt):
+    """The file states the rate and units itself; a WAV is float32 at full scale (its
+    calibration factor restores the values to float32 precision of the peak)."""
     src = made / "records" / "000002.npz"
     run = Run.load(src)
     res = export(src, tmp_path / "out", fmt, channels=["accel_1b1_y", "dte_um"])
     assert res["kind"] == "run" and res["units"] == {"accel_1b1_y": "m/s²", "dte_um": "µm"}
-    signals, rate = read_signals(tmp_path / "out" / f"000002.{fmt}",
-                                 names=["accel_1b1_y", "dte_um"])
+    f = read_file(tmp_path / "out" / f"000002.{fmt}")
+    assert f.rate_hz == pytest.approx(25600.0, rel=1e-12)
+    assert f.units == {"accel_1b1_y": "m/s²", "dte_um": "µm"}
+    assert sorted(f.signals) == ["accel_1b1_y", "dte_um"]
     for c in ("accel_1b1_y", "dte_um"):
-        np.testing.assert_array_equal(signals[c].astype(np.float32), run[c])
+        if fmt == "wav":
+            atol = 2 ** -23 * np.abs(np.stack([run[k] for k in f.signals])).max()
+            np.testing.assert_allclose(f.signals[c], run[c], rtol=0, atol=atol)
+        else:
+            np.testing.assert_array_equal(f.signals[c], run[c])
     meta = json.loads((tmp_path / "out" / "metadata.json").read_text())
     assert meta["fs_hz"] == pytest.approx(25600.0)
     assert meta["sensors"]["accel_1b1_y"]["unit"] == "m/s²"
     assert meta["recordings"][0]["condition"] == "outer_race"
-    if fmt == "wav":                           # the rate and units in the WAV file itself
-        assert rate == pytest.approx(25600.0)
-        raw = (tmp_path / "out" / "000002.wav").read_bytes()
-        info = json.loads(raw[raw.index(b"ICMT") + 8:].split(b"\0")[0])
-        assert info["units"] == {"accel_1b1_y": "m/s²", "dte_um": "µm"}
 
 
 def test_uff_round_trips_through_pyuff(made, tmp_path):
@@ -100,9 +107,9 @@ def test_uff_round_trips_through_pyuff(made, tmp_path):
     for s in sets:
         name = s["id1"].strip()
         assert s["type"] == 58 and s["abscissa_inc"] == pytest.approx(1 / 25600.0)
-        assert s["ordinate_axis_units_lab"].strip() == {"accel_1b1_y": "m/s^2",
+        assert s["ordinate_axis_units_lab"].strip() == {"accel_1b1_y": "m/s²",
                                                         "tacho": "V"}[name]
-        np.testing.assert_array_equal(np.asarray(s["data"], np.float32), run[name])
+        np.testing.assert_array_equal(s["data"], run[name])
 
 
 def test_uff_without_pyuff_names_the_extra(made, tmp_path, monkeypatch):
@@ -124,6 +131,7 @@ def test_dataset_export_one_file_per_record_and_the_labels(made, tmp_path):
         signals, _ = read_signals(tmp_path / "out" / f"{rid}.npz")
         assert sorted(signals) == MEASURABLE
         np.testing.assert_array_equal(signals["tacho"], ds.record(rid).signals["tacho"])
+        assert np.load(tmp_path / "out" / f"{rid}.npz")["tacho"].dtype == np.float32
     meta = json.loads((tmp_path / "out" / "metadata.json").read_text())
     assert [r["file"] for r in meta["recordings"]] == list(labels["file"])
 
@@ -140,7 +148,7 @@ def test_export_refuses_an_existing_out_and_force_replaces_it(made, tmp_path):
 
 
 def test_an_interrupted_export_leaves_nothing(made, tmp_path, monkeypatch):
-    real, calls = export_mod.write_signals, []
+    real, calls = export_mod._write_signals, []
 
     def interrupted(path, *args):
         calls.append(path)
@@ -148,7 +156,7 @@ def test_an_interrupted_export_leaves_nothing(made, tmp_path, monkeypatch):
             raise KeyboardInterrupt
         return real(path, *args)
 
-    monkeypatch.setattr(export_mod, "write_signals", interrupted)
+    monkeypatch.setattr(export_mod, "_write_signals", interrupted)
     with pytest.raises(KeyboardInterrupt):
         export(made, tmp_path / "out", "wav")
     assert len(calls) == 3 and not list(tmp_path.iterdir())
@@ -172,8 +180,16 @@ def test_not_a_run_nor_a_dataset(tmp_path):
             export(src, tmp_path / "out", "csv")
 
 
-def test_every_format_is_one_writer():
-    assert set(export_mod._WRITERS) == set(FORMATS)
+def test_every_format_is_one_writer(tmp_path, monkeypatch):
+    """Each format but parquet is the measured writer of its suffix (the one beside its
+    reader), and every measured writer is a format (.unv is .uff by another name)."""
+    assert set(FORMATS) == {s.lstrip(".") for s in WRITERS} - {"unv"} | {"parquet"}
+    used = []
+    for suffix in WRITERS:
+        monkeypatch.setitem(WRITERS, suffix, lambda path, *a, s=suffix: used.append(s))
+    for fmt in FILE_FORMATS:
+        export_mod._write_signals(tmp_path / f"x.{fmt}", {"a": np.zeros(4)}, 100.0, {"a": "V"})
+    assert used == [f".{f}" for f in FILE_FORMATS]
 
 
 # ---------------------------------------------------------------------- windowed Parquet

@@ -81,6 +81,24 @@ def test_every_writer_reads_back_the_same(tmp_path, suffix):
             assert np.allclose(f.signals[k], x, rtol=0, atol=tol * peak), (suffix, k)
 
 
+@pytest.mark.parametrize("suffix", [".npz", ".mat", ".tdms"])
+def test_float32_samples_are_stored_as_float32(tmp_path, suffix):
+    """Where the format keeps the sample type, float32 in (a dataset's records, cmsim export)
+    is float32 in the file, half the size of float64, and reads back exactly."""
+    sig = {k: x.astype(np.float32) for k, x in _signals(n=600).items()}
+    path = write_signals(tmp_path / f"rec{suffix}", sig, 12000.0, "g")
+    if suffix == ".npz":
+        stored = np.load(path)["DE"]
+    elif suffix == ".mat":
+        from scipy.io import loadmat
+        stored = loadmat(path)["DE"]
+    else:
+        stored = nptdms.TdmsFile.read(str(path))["signals"]["DE"][:]
+    assert stored.dtype == np.float32
+    for k, x in sig.items():
+        np.testing.assert_array_equal(read_file(path).signals[k], x)
+
+
 def test_uff_written_by_pyuff_reads_with_names_rate_and_unit(tmp_path):
     sig, fs = _signals(), 51200.0
     path = tmp_path / "testlab.uff"
