@@ -15,7 +15,7 @@ import cmsim
 from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
                                          make_integrator_buffers, make_work)
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.decimation import AntiAliasFilter
+from cmsim.dynamics.decimation import FIR_LANES, AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
@@ -229,18 +229,26 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
     tail = None                                   # fast samples not yet consumed
+    # the filtered columns side by side, padded with zeros to the filter kernel's lanes
+    width = -(-(qc.size + dc.size) // FIR_LANES) * FIR_LANES
     for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1):
         if i0 + len(st) <= first:                 # warm-up the filter never reads
             continue
         lo = max(first - i0, 0)
-        block = np.hstack([st[lo:, qc], dg[lo:, dc]])
-        buf = block if tail is None else np.vstack([tail, block])
+        n_tail = 0 if tail is None else len(tail)
+        buf = np.zeros((n_tail + len(st) - lo, width))
+        if n_tail:
+            buf[:n_tail] = tail
+        for j, c in enumerate(qc):
+            buf[n_tail:, j] = st[lo:, c]
+        for j, c in enumerate(dc):
+            buf[n_tail:, qc.size + j] = dg[lo:, c]
         # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
         out = aa.apply(buf)
         take = min(len(out), n_rec - m0)
         if take > 0:
             q_out[m0:m0 + take, qc] = out[:take, :qc.size]
-            d_out[m0:m0 + take, dc] = out[:take, qc.size:]
+            d_out[m0:m0 + take, dc] = out[:take, qc.size:qc.size + dc.size]
             m0 += take
         tail = buf[take * k:]
     stats.update(runner.stats())

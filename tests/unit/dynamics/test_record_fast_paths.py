@@ -60,3 +60,26 @@ def test_cage_only_slip_skips_the_ball_grid_bit_for_bit():
     # and the slip is felt: the run differs from one without slip
     no_slip_y, _ = _run(model, _model(None).kernel_params)
     assert not np.array_equal(fast_y, no_slip_y)
+
+
+@pytest.mark.parametrize("factor, width", [(3, 7), (2, 1), (5, 8), (3, 0)])
+def test_anti_alias_kernel_is_upfirdn_bit_for_bit(factor, width):
+    """The numba FIR gives :func:`scipy.signal.upfirdn`'s outputs exactly (the sums in the
+    same order), for any width (padded to the kernel's lanes), a transposed (non-contiguous)
+    block and a 1-D signal."""
+    from scipy.signal import upfirdn
+
+    from cmsim.dynamics.decimation import AntiAliasFilter
+
+    aa = AntiAliasFilter(factor, 25_600.0 * factor)
+    rng = np.random.default_rng(factor)
+    x = rng.standard_normal((5_003, width)) * np.logspace(-6, 3, width)
+    hl = aa.half_length
+    n_out = (x.shape[0] - 2 * hl - 1) // factor + 1
+    first = 2 * hl // factor
+    ref = upfirdn(aa.taps, x, up=1, down=factor, axis=0)[first:first + n_out]
+    assert np.array_equal(aa.apply(x), ref)
+    assert np.array_equal(aa.apply(np.asfortranarray(x)), ref)
+    if width:
+        assert np.array_equal(aa.apply(x[:, 0]), ref[:, 0])
+    assert aa.apply(x[:2 * hl]).shape == (0, width)
