@@ -83,3 +83,24 @@ def test_anti_alias_kernel_is_upfirdn_bit_for_bit(factor, width):
     if width:
         assert np.array_equal(aa.apply(x[:, 0]), ref[:, 0])
     assert aa.apply(x[:2 * hl]).shape == (0, width)
+
+
+@pytest.mark.parametrize("fs_hz", [25_600.0, 12_000.0, 200_000.0])
+def test_housing_path_kernel_is_sosfilt_bit_for_bit(fs_hz):
+    """The housing path's fused kernel gives the sum of one ``sosfilt`` per mode, kept every
+    k-th sample, exactly (the reference written as it was before the kernel)."""
+    import math
+
+    from scipy.signal import resample_poly, sosfilt
+
+    from cmsim.sensors import STEPS_PER_MODE_PERIOD, housing_acceleration, housing_sos
+
+    path = cmsim.Rig.paper_2016().housing
+    force = np.random.default_rng(7).standard_normal(4_001) * 300.0 + 1e3
+    k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs_hz))
+    x = force - force[0]
+    xk = resample_poly(x, k, 1) if k > 1 else x
+    ref = np.zeros_like(xk)
+    for section in housing_sos(path, fs_hz * k):
+        ref += sosfilt(section[None, :], xk)
+    assert np.array_equal(housing_acceleration(force, fs_hz, path), ref[::k])
