@@ -61,3 +61,16 @@ def fir_decimate_jit(x, h_flip, step, out):
                 out[m + 1, c0 + 2] = b2
                 out[m + 1, c0 + 3] = b3
             m += 2
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def gather_columns_jit(states, diag, lo, q_cols, d_cols, buf, row0):
+    """Copy rows ``lo:`` of the columns ``q_cols`` of ``states`` and ``d_cols`` of ``diag``
+    side by side into ``buf`` from row ``row0`` on (one pass over the rows, each read once)."""
+    nq = q_cols.shape[0]
+    nd = d_cols.shape[0]
+    for r in range(states.shape[0] - lo):
+        for j in range(nq):
+            buf[row0 + r, j] = states[lo + r, q_cols[j]]
+        for j in range(nd):
+            buf[row0 + r, nq + j] = diag[lo + r, d_cols[j]]

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 import cmsim
+from cmsim.dynamics._decimation_kernels import gather_columns_jit
 from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
                                          make_integrator_buffers, make_work)
 from cmsim.dynamics.integrator import SCHEMES
@@ -38,8 +39,12 @@ __all__ = ["simulate", "integrate", "check_memory", "kernels_cached",
 #: refused with the duration that fits.
 MAX_OUTPUT_BYTES = 8 * 2 ** 30
 
-#: Integration steps per chunk when decimating (bounds the memory of the fast-rate states).
+#: Integration steps per chunk (bounds the memory of the fast-rate states).
 CHUNK_STEPS = 2 ** 16
+
+#: Integration steps per chunk when decimating: a block small enough to be read back from
+#: the cache by the anti-alias filter (chunks do not change the result).
+DECIMATION_CHUNK_STEPS = 2 ** 13
 
 #: Grid spacing of a speed profile's kernel table, s (Θ interpolated linearly: error
 #: ≈ (dΩ/dt)·Δt²/8, below 1e-7 rad for a 0-3000 rpm run-up in 1 s).
@@ -54,8 +59,11 @@ class _Integrator:
     """The fixed-step kernel run in chunks with one scratch state (bit-identical to one call).
 
     ``chunks(y0, t0, h, n_out, substeps)`` yields ``(m0, states, diag)`` blocks of at most
-    :data:`CHUNK_STEPS` output samples; sample ``m0 + i`` is the state at
-    ``t0 + (m0 + i)·substeps·h``. The last state of a block is the first of the next one.
+    ``chunk_steps`` (default :data:`CHUNK_STEPS`) output samples; sample ``m0 + i`` is the
+    state at ``t0 + (m0 + i)·substeps·h``. The last state of a block is the first of the next
+    one. The blocks are views of one pair of buffers, valid until the next block is asked
+    for (a consumer copies what it keeps): fresh arrays for every block would cost the page
+    faults of tens of megabytes per run.
     """
 
     def __init__(self, model, scheme, progress=None):
@@ -67,7 +75,7 @@ class _Integrator:
         self.max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
         self.mask = model.translational_mask
 
-    def chunks(self, y0, t0, h, n_out, substeps):
+    def chunks(self, y0, t0, h, n_out, substeps, chunk_steps=CHUNK_STEPS):
         model, tab = self.model, self.tab
         n_diag = len(model.output_force_names)
         buffers = make_integrator_buffers(tab.b, y0.size, n_diag)
@@ -78,11 +86,14 @@ class _Integrator:
                       self.mask)
         self.work = make_work(model.kernel_params)
         y, m0 = y0, 0
+        rows = min(chunk_steps + 1, n_out)
+        states_buf = np.empty((rows, y0.size))
+        diag_buf = np.empty((rows, n_diag))
         while m0 < n_out:
             # one sample of overlap: a block's last state starts the next block
-            count = min(CHUNK_STEPS + 1, n_out - m0 + (1 if m0 else 0))
-            states = np.empty((count, y0.size))
-            diag = np.empty((count, n_diag))
+            count = min(chunk_steps + 1, n_out - m0 + (1 if m0 else 0))
+            states = states_buf[:count]
+            diag = diag_buf[:count]
             first = m0 - 1 if m0 else 0
             start = time.perf_counter()
             status = integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
@@ -228,29 +239,29 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
     runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
-    tail = None                                   # fast samples not yet consumed
-    # the filtered columns side by side, padded with zeros to the filter kernel's lanes
+    n_tail = 0                                    # fast samples not yet consumed, at buf[0:]
+    # the filtered columns side by side, padded with zeros to the filter kernel's lanes, in
+    # one buffer for the run: the tail a block leaves, then the next block
     width = -(-(qc.size + dc.size) // FIR_LANES) * FIR_LANES
-    for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1):
+    chunk = DECIMATION_CHUNK_STEPS
+    buf = np.zeros((2 * hl + k + chunk + 1, width))
+    for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1, chunk):
         if i0 + len(st) <= first:                 # warm-up the filter never reads
             continue
         lo = max(first - i0, 0)
-        n_tail = 0 if tail is None else len(tail)
-        buf = np.zeros((n_tail + len(st) - lo, width))
-        if n_tail:
-            buf[:n_tail] = tail
-        for j, c in enumerate(qc):
-            buf[n_tail:, j] = st[lo:, c]
-        for j, c in enumerate(dc):
-            buf[n_tail:, qc.size + j] = dg[lo:, c]
+        n_rows = n_tail + len(st) - lo
+        if n_rows > buf.shape[0]:                 # (not reached: the tail is <= 2·hl rows)
+            buf = np.vstack([buf[:n_tail], np.zeros((n_rows - n_tail, width))])
+        gather_columns_jit(st, dg, lo, qc, dc, buf, n_tail)
         # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
-        out = aa.apply(buf)
+        out = aa.apply(buf[:n_rows])
         take = min(len(out), n_rec - m0)
         if take > 0:
             q_out[m0:m0 + take, qc] = out[:take, :qc.size]
             d_out[m0:m0 + take, dc] = out[:take, qc.size:qc.size + dc.size]
             m0 += take
-        tail = buf[take * k:]
+        n_tail = n_rows - take * k
+        buf[:n_tail] = buf[take * k:n_rows].copy()
     stats.update(runner.stats())
     return q_out, d_out, runner.wall
 
