@@ -479,7 +479,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
                                   f"it), and the run from the nominal geometry diverged: "
                                   f"{exc}") from None
     t = (n_warm + np.arange(n_rec)) * dt
-    signals = _signals(model, t, states, diag, kprof)
+    signals = _signals(model, t, states, diag, kprof, wanted)
     if wanted is not None:
         signals = {k: v for k, v in signals.items() if k in wanted}
     meta = {
@@ -544,31 +544,52 @@ def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stat
     return states, diag, wall, n_warm, aa
 
 
-def _signals(model, t, states, diag, kprof=None):
+def _signals(model, t, states, diag, kprof=None, wanted=None):
+    """The run's named signals from its states and output forces; with ``wanted`` (a set of
+    names) only those are formed (a dataset record keeps a few)."""
     rig = model.rig
+
+    def keep(name):
+        return wanted is None or name in wanted
+
     sig = {}
     tau = t
-    if kprof is not None:
+    if kprof is not None and any(keep(name) for name in model.dof_names
+                                 if name.startswith("theta")):
         # equivalent time of the nominal rotation, Θ(t)/Ω_ref (as the kernels use it)
         grid = kprof.t0_s + kprof.dt_s * np.arange(kprof.table.shape[0])
         tau = np.interp(t, grid, kprof.table[:, PR_THETA]) / model.op.omega_rad_s
     for i, name in enumerate(model.dof_names):
+        if not keep(name):
+            continue
         value = states[:, i]
         if name.startswith("theta"):
             value = value + model.omega[i] * tau
         sig[name] = value
-    for j, name in enumerate(model.output_force_names):
-        sig[name] = diag[:, j].copy()
+    force_col = {name: j for j, name in enumerate(model.output_force_names)}
+    for name, j in force_col.items():
+        if keep(name):
+            sig[name] = diag[:, j].copy()
     for bname in rig.bearing_names:
+        loa, oloa = f"F_{bname}_loa", f"F_{bname}_oloa"
+        if not (keep(loa) or keep(oloa)):
+            continue
         e = model.loa_direction(0 if bname.startswith("1") else 1)
-        fx, fy = sig[f"F_{bname}_x"], sig[f"F_{bname}_y"]
-        sig[f"F_{bname}_loa"] = fx * e[0] + fy * e[1]
-        sig[f"F_{bname}_oloa"] = -fx * e[1] + fy * e[0]
+        fx, fy = diag[:, force_col[f"F_{bname}_x"]], diag[:, force_col[f"F_{bname}_y"]]
+        if keep(loa):
+            sig[loa] = fx * e[0] + fy * e[1]
+        if keep(oloa):
+            sig[oloa] = -fx * e[1] + fy * e[0]
     if rig.gears is not None:
-        ratio = rig.gears.driven.n_teeth / rig.gears.driving.n_teeth
-        dte = states[:, model.index("theta_1G1")] - ratio * states[:, model.index("theta_2G1")]
-        sig["dte"] = dte
-        sig["dte_um"] = dte * rig.gears.driving.base_radius_m * 1e6
-        slots = [k for k in model.output_force_names if k.startswith("Fmesh_")]
-        sig["Fmesh_total"] = np.sum([sig[k] for k in slots], axis=0)
+        if keep("dte") or keep("dte_um"):
+            ratio = rig.gears.driven.n_teeth / rig.gears.driving.n_teeth
+            dte = (states[:, model.index("theta_1G1")]
+                   - ratio * states[:, model.index("theta_2G1")])
+            if keep("dte"):
+                sig["dte"] = dte
+            if keep("dte_um"):
+                sig["dte_um"] = dte * rig.gears.driving.base_radius_m * 1e6
+        if keep("Fmesh_total"):
+            slots = [j for k, j in force_col.items() if k.startswith("Fmesh_")]
+            sig["Fmesh_total"] = np.sum([diag[:, j] for j in slots], axis=0)
     return sig
