@@ -122,3 +122,27 @@ def test_recorded_signals_are_those_of_the_full_run():
     assert sorted(part.signals) == sorted(keep)
     for name in keep:
         assert np.array_equal(part[name], full[name]), name
+
+
+def test_cracked_factor_with_the_healthy_pair_cached_is_unchanged():
+    """The cracked tooth's stiffness factor reads the healthy pair's compliance from a cache
+    the second time: the same factor, bit for bit, as the healthy pair computed afresh."""
+    import math
+
+    from cmsim.faults import crack
+    from cmsim.mesh_stiffness.potential_energy import pair_compliance_potential_energy
+
+    pair = cmsim.Rig.paper_2016().gears
+    lo, hi = crack._involute_domain(pair)
+    s = np.linspace(lo, hi, 57)
+    crack._healthy_pair_compliance.cache_clear()
+    first = crack.crack_stiffness_factor(pair, 2, 1.2e-3, math.pi / 4, s)
+    again = crack.crack_stiffness_factor(pair, 2, 1.2e-3, math.pi / 4, s)
+    assert crack._healthy_pair_compliance.cache_info().hits >= 1
+    healthy = pair_compliance_potential_energy(pair, s)
+    cracked = crack.cracked_tooth_compliance(
+        crack.ToothProfile.from_gear(pair.driven),
+        np.sqrt(pair.driven.base_radius_m ** 2 + (crack._path_length(pair) - s) ** 2),
+        1.2e-3, math.pi / 4)
+    ref = healthy.total / (healthy.hertz + healthy.driving.total + cracked.total)
+    assert np.array_equal(first, ref) and np.array_equal(again, ref)
