@@ -105,7 +105,6 @@ def integration_cpu(model, h, n_steps, repeats):
 def bench_integration(spec, h, n_steps, repeats):
     """Section 3: ``{variant: CPU s per record}`` (the healthy one first)."""
     import cmsim
-    from cmsim.datasets.records import simulate_record  # noqa: F401
     from cmsim.dynamics import build_model
     from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
     from cmsim.dynamics.simulation import PROFILE_STEP_S
@@ -260,7 +259,7 @@ def bench_stages(spec, n, tmp):
 # -- 5, 6: processes -----------------------------------------------------------------------
 
 PROCESS_PROBE = r"""
-import resource, sys, time
+import time
 t0 = time.process_time()
 import cmsim, cmsim.cli.app, cmsim.datasets.records  # what a worker process holds
 t1 = time.process_time()
