@@ -34,6 +34,8 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, SPEC_NAME, consolidate,
                                      done_indices, open_directory)
@@ -42,6 +44,7 @@ from cmsim.datasets.records import run_record
 from cmsim.datasets.spec import DatasetSpec
 from cmsim.dynamics import simulate
 from cmsim.errors import check_type
+from cmsim.sensors import housing_acceleration
 
 __all__ = ["generate_dataset", "DatasetSummary"]
 
@@ -114,7 +117,13 @@ class DatasetSummary:
 
 def _warm_kernels(spec, pending):
     """Compile/load the kernels here before forking workers: a 3-sample run of the first
-    pending record of each fault label (faulty bearings take their own kernels)."""
+    pending record of each fault label (faulty bearings take their own kernels), and the
+    housing path's kernel when the records have accelerometers."""
+    if any(c.startswith("accel_") for c in spec.channels or ()):
+        try:
+            housing_acceleration(np.zeros(8), spec.fs_hz, spec.rig.housing)
+        except Exception:                  # noqa: BLE001 - the record reports it
+            pass
     seen = set()
     for i in pending[:200]:
         plan = spec.record(i)

@@ -74,6 +74,16 @@ def track_gains_jit(track, tdt, t, gain):
         gain[r] = track[r, i] + f * (track[r, i + 1] - track[r, i])
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def cage_slip_jit(t, b_int, b_cos, jitter, jdt, cage_slip):
+    """Fill ``cage_slip`` with each cage's slip angle at time ``t`` (a slip that moves the
+    cages only: the balls keep their nominal offsets, exactly what
+    :func:`slip_offsets_jit` gives from all-zero ball rows)."""
+    row = b_cos.shape[1]
+    for ib in range(b_int.shape[0]):
+        cage_slip[ib] = _jitter_at(jitter, ib, row, t, jdt)
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def slip_offsets_jit(t, b_int, b_cos, b_sin, jitter, jdt, jit_cos, jit_sin, cage_slip):
     """Fill ``jit_cos``, ``jit_sin`` (n_bearings, max_balls) with cos, sin of the ball offsets

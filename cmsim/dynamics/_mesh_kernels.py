@@ -37,7 +37,8 @@ MI_G1, MI_G2, MI_SLOTS, MI_ON, MI_MODE, MI_TEETH, MI_ECC, MI_PROFILE, MI_TDOF = 
 MI_FAULTY_BALLS = 9     # 1 when any bearing has off-size balls
 MI_MUTAB = 10           # 1 when the friction coefficient follows ``mu_tab`` along the path
 MI_CTAB = 11            # 1 when the pair damping follows ``c_tab`` along the path
-MI_SIZE = 12
+MI_BALL_SLIP = 12       # 1 when the slip grid moves the balls (0: cages only, or no slip)
+MI_SIZE = 13
 MODE_TABLE, MODE_HYBRID = 0, 1
 # columns of the per-slot scratch ``W.slots`` of the mesh kernel
 SG_ON, SG_NX, SG_NY, SG_PX, SG_PY, SG_REQ, SG_ELASTIC, SG_GAP, SG_KPAIR, SG_S = range(10)

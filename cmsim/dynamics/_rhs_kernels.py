@@ -31,10 +31,11 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from cmsim.dynamics._bearing_kernels import (DF_SIZE, bearing_forces_jit,
+from cmsim.dynamics._bearing_kernels import (DF_SIZE, bearing_forces_jit, cage_slip_jit,
                                              faulty_bearing_forces_jit, slip_offsets_jit,
                                              track_gains_jit)
-from cmsim.dynamics._mesh_kernels import (MI_FAULTY_BALLS, MI_ON, MI_PROFILE, MI_SLOTS, MI_TDOF,
+from cmsim.dynamics._mesh_kernels import (MI_BALL_SLIP, MI_FAULTY_BALLS, MI_ON, MI_PROFILE,
+                                          MI_SLOTS, MI_TDOF,
                                           MP_JDT, MP_OMREF, MP_PDT, MP_PT0, MP_TDT, SG_SIZE,
                                           mesh_forces_jit)
 from cmsim.dynamics._rotation_kernels import AN_SIZE
@@ -256,12 +257,15 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
         ar = alpha_in * inv_ref
         if P.m_int[MI_TDOF] >= 0:
             g[P.m_int[MI_TDOF]] = -torque
-    if P.jitter.shape[2] > 1:
+    if P.jitter.shape[2] > 1 and P.m_int[MI_BALL_SLIP] != 0:
         slip_offsets_jit(t, P.b_int, P.b_cos, P.b_sin, P.jitter, P.m_par[MP_JDT], W.slip_cos,
                          W.slip_sin, W.cage_slip)
         ball_cos = W.slip_cos
         ball_sin = W.slip_sin
     else:
+        if P.jitter.shape[2] > 1:
+            # cages only: the per-ball grid (all zero) is not read
+            cage_slip_jit(t, P.b_int, P.b_cos, P.jitter, P.m_par[MP_JDT], W.cage_slip)
         ball_cos = P.b_cos
         ball_sin = P.b_sin
     if P.b_int.shape[0] > 0:

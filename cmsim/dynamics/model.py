@@ -32,8 +32,8 @@ from cmsim.bearings.kinematics import slip_jitter
 from cmsim.dynamics._bearing_kernels import (BI_DEF0, BI_FAULTY, BI_NDEF, BI_T, BP_CAGE, BP_PHASE,
                                              DEF_BALL, DF_AXIS, DF_BRG, DF_HALF, DF_KIND, DF_SIZE,
                                              DF_TRACK, DF_WANDER)
-from cmsim.dynamics._mesh_kernels import (MI_CTAB, MI_ECC, MI_FAULTY_BALLS, MI_MUTAB, MI_PROFILE,
-                                          MI_SIZE, MI_TDOF, MI_TEETH, MODE_HYBRID, MODE_TABLE,
+from cmsim.dynamics._mesh_kernels import (MI_BALL_SLIP, MI_CTAB, MI_ECC, MI_FAULTY_BALLS,
+                                          MI_MUTAB, MI_PROFILE, MI_SIZE, MI_TDOF, MI_TEETH, MODE_HYBRID, MODE_TABLE,
                                           MP_A0, MP_BETA, MP_COST0, MP_DIAGB, MP_DTHR, MP_JDT,
                                           MP_KOSTER, MP_MU, MP_OM1, MP_OM2, MP_OMREF, MP_PB,
                                           MP_PDT, MP_PHIT0, MP_PSI10, MP_PSI20, MP_PT0, MP_SINT0,
@@ -171,8 +171,11 @@ class DynamicModel:
         m_par = self.kernel_params.m_par.copy()
         m_par[MP_JDT] = jdt
         m_par[MP_TDT] = tdt
+        m_int = self.kernel_params.m_int.copy()
+        # a slip of the cages alone leaves the ball rows zero: the kernel then skips them
+        m_int[MI_BALL_SLIP] = int(bool(np.any(jitter[:, :-1] != 0.0)))
         kernel_params = self.kernel_params._replace(b_par=b_par, jitter=jitter, m_par=m_par,
-                                                    track=track)
+                                                    m_int=m_int, track=track)
         return replace(self, kernel_params=kernel_params, slip=slip, cage_phases_rad=phases)
 
     def rhs(self, t, y, want_diag=False):

@@ -12,10 +12,11 @@ from pathlib import Path
 import numpy as np
 
 import cmsim
+from cmsim.dynamics._decimation_kernels import gather_columns_jit
 from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
                                          make_integrator_buffers, make_work)
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.decimation import AntiAliasFilter
+from cmsim.dynamics.decimation import FIR_LANES, AntiAliasFilter
 from cmsim.dynamics.modal import highest_frequency_hz
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
@@ -39,8 +40,12 @@ __all__ = ["simulate", "integrate", "check_memory", "kernels_cached", "compile_k
 #: refused with the duration that fits.
 MAX_OUTPUT_BYTES = 8 * 2 ** 30
 
-#: Integration steps per chunk when decimating (bounds the memory of the fast-rate states).
+#: Integration steps per chunk (bounds the memory of the fast-rate states).
 CHUNK_STEPS = 2 ** 16
+
+#: Integration steps per chunk when decimating: a block small enough to be read back from
+#: the cache by the anti-alias filter (chunks do not change the result).
+DECIMATION_CHUNK_STEPS = 2 ** 13
 
 #: Grid spacing of a speed profile's kernel table, s (Θ interpolated linearly: error
 #: ≈ (dΩ/dt)·Δt²/8, below 1e-7 rad for a 0-3000 rpm run-up in 1 s).
@@ -55,8 +60,11 @@ class _Integrator:
     """The fixed-step kernel run in chunks with one scratch state (bit-identical to one call).
 
     ``chunks(y0, t0, h, n_out, substeps)`` yields ``(m0, states, diag)`` blocks of at most
-    :data:`CHUNK_STEPS` output samples; sample ``m0 + i`` is the state at
-    ``t0 + (m0 + i)·substeps·h``. The last state of a block is the first of the next one.
+    ``chunk_steps`` (default :data:`CHUNK_STEPS`) output samples; sample ``m0 + i`` is the
+    state at ``t0 + (m0 + i)·substeps·h``. The last state of a block is the first of the next
+    one. The blocks are views of one pair of buffers, valid until the next block is asked
+    for (a consumer copies what it keeps): fresh arrays for every block would cost the page
+    faults of tens of megabytes per run.
     """
 
     def __init__(self, model, scheme, progress=None):
@@ -68,7 +76,7 @@ class _Integrator:
         self.max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
         self.mask = model.translational_mask
 
-    def chunks(self, y0, t0, h, n_out, substeps):
+    def chunks(self, y0, t0, h, n_out, substeps, chunk_steps=CHUNK_STEPS):
         model, tab = self.model, self.tab
         n_diag = len(model.output_force_names)
         buffers = make_integrator_buffers(tab.b, y0.size, n_diag)
@@ -79,11 +87,14 @@ class _Integrator:
                       self.mask)
         self.work = make_work(model.kernel_params)
         y, m0 = y0, 0
+        rows = min(chunk_steps + 1, n_out)
+        states_buf = np.empty((rows, y0.size))
+        diag_buf = np.empty((rows, n_diag))
         while m0 < n_out:
             # one sample of overlap: a block's last state starts the next block
-            count = min(CHUNK_STEPS + 1, n_out - m0 + (1 if m0 else 0))
-            states = np.empty((count, y0.size))
-            diag = np.empty((count, n_diag))
+            count = min(chunk_steps + 1, n_out - m0 + (1 if m0 else 0))
+            states = states_buf[:count]
+            diag = diag_buf[:count]
             first = m0 - 1 if m0 else 0
             start = time.perf_counter()
             status = integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
@@ -229,21 +240,29 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
     runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
-    tail = None                                   # fast samples not yet consumed
-    for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1):
+    n_tail = 0                                    # fast samples not yet consumed, at buf[0:]
+    # the filtered columns side by side, padded with zeros to the filter kernel's lanes, in
+    # one buffer for the run: the tail a block leaves, then the next block
+    width = -(-(qc.size + dc.size) // FIR_LANES) * FIR_LANES
+    chunk = DECIMATION_CHUNK_STEPS
+    buf = np.zeros((2 * hl + k + chunk + 1, width))
+    for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1, chunk):
         if i0 + len(st) <= first:                 # warm-up the filter never reads
             continue
         lo = max(first - i0, 0)
-        block = np.hstack([st[lo:, qc], dg[lo:, dc]])
-        buf = block if tail is None else np.vstack([tail, block])
+        n_rows = n_tail + len(st) - lo
+        if n_rows > buf.shape[0]:                 # (not reached: the tail is <= 2·hl rows)
+            buf = np.vstack([buf[:n_tail], np.zeros((n_rows - n_tail, width))])
+        gather_columns_jit(st, dg, lo, qc, dc, buf, n_tail)
         # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
-        out = aa.apply(buf)
+        out = aa.apply(buf[:n_rows])
         take = min(len(out), n_rec - m0)
         if take > 0:
             q_out[m0:m0 + take, qc] = out[:take, :qc.size]
-            d_out[m0:m0 + take, dc] = out[:take, qc.size:]
+            d_out[m0:m0 + take, dc] = out[:take, qc.size:qc.size + dc.size]
             m0 += take
-        tail = buf[take * k:]
+        n_tail = n_rows - take * k
+        buf[:n_tail] = buf[take * k:n_rows].copy()
     stats.update(runner.stats())
     return q_out, d_out, runner.wall
 
@@ -484,7 +503,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
                                   f"it), and the run from the nominal geometry diverged: "
                                   f"{exc}") from None
     t = (n_warm + np.arange(n_rec)) * dt
-    signals = _signals(model, t, states, diag, kprof)
+    signals = _signals(model, t, states, diag, kprof, wanted)
     if wanted is not None:
         signals = {k: v for k, v in signals.items() if k in wanted}
     meta = {
@@ -549,31 +568,52 @@ def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stat
     return states, diag, wall, n_warm, aa
 
 
-def _signals(model, t, states, diag, kprof=None):
+def _signals(model, t, states, diag, kprof=None, wanted=None):
+    """The run's named signals from its states and output forces; with ``wanted`` (a set of
+    names) only those are formed (a dataset record keeps a few)."""
     rig = model.rig
+
+    def keep(name):
+        return wanted is None or name in wanted
+
     sig = {}
     tau = t
-    if kprof is not None:
+    if kprof is not None and any(keep(name) for name in model.dof_names
+                                 if name.startswith("theta")):
         # equivalent time of the nominal rotation, Θ(t)/Ω_ref (as the kernels use it)
         grid = kprof.t0_s + kprof.dt_s * np.arange(kprof.table.shape[0])
         tau = np.interp(t, grid, kprof.table[:, PR_THETA]) / model.op.omega_rad_s
     for i, name in enumerate(model.dof_names):
+        if not keep(name):
+            continue
         value = states[:, i]
         if name.startswith("theta"):
             value = value + model.omega[i] * tau
         sig[name] = value
-    for j, name in enumerate(model.output_force_names):
-        sig[name] = diag[:, j].copy()
+    force_col = {name: j for j, name in enumerate(model.output_force_names)}
+    for name, j in force_col.items():
+        if keep(name):
+            sig[name] = diag[:, j].copy()
     for bname in rig.bearing_names:
+        loa, oloa = f"F_{bname}_loa", f"F_{bname}_oloa"
+        if not (keep(loa) or keep(oloa)):
+            continue
         e = model.loa_direction(0 if bname.startswith("1") else 1)
-        fx, fy = sig[f"F_{bname}_x"], sig[f"F_{bname}_y"]
-        sig[f"F_{bname}_loa"] = fx * e[0] + fy * e[1]
-        sig[f"F_{bname}_oloa"] = -fx * e[1] + fy * e[0]
+        fx, fy = diag[:, force_col[f"F_{bname}_x"]], diag[:, force_col[f"F_{bname}_y"]]
+        if keep(loa):
+            sig[loa] = fx * e[0] + fy * e[1]
+        if keep(oloa):
+            sig[oloa] = -fx * e[1] + fy * e[0]
     if rig.gears is not None:
-        ratio = rig.gears.driven.n_teeth / rig.gears.driving.n_teeth
-        dte = states[:, model.index("theta_1G1")] - ratio * states[:, model.index("theta_2G1")]
-        sig["dte"] = dte
-        sig["dte_um"] = dte * rig.gears.driving.base_radius_m * 1e6
-        slots = [k for k in model.output_force_names if k.startswith("Fmesh_")]
-        sig["Fmesh_total"] = np.sum([sig[k] for k in slots], axis=0)
+        if keep("dte") or keep("dte_um"):
+            ratio = rig.gears.driven.n_teeth / rig.gears.driving.n_teeth
+            dte = (states[:, model.index("theta_1G1")]
+                   - ratio * states[:, model.index("theta_2G1")])
+            if keep("dte"):
+                sig["dte"] = dte
+            if keep("dte_um"):
+                sig["dte_um"] = dte * rig.gears.driving.base_radius_m * 1e6
+        if keep("Fmesh_total"):
+            slots = [j for k, j in force_col.items() if k.startswith("Fmesh_")]
+            sig["Fmesh_total"] = np.sum([diag[:, j] for j in slots], axis=0)
     return sig

@@ -83,6 +83,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -176,6 +177,15 @@ def cracked_tooth_compliance(profile, contact_radius_m, depth_m, angle_rad, n_no
     return tooth_compliance(profile, contact_radius_m, n_nodes=n_nodes, half_thickness=h_eff)
 
 
+@functools.lru_cache(maxsize=8)
+def _healthy_pair_compliance(pair, position_bytes, n_nodes):
+    """:func:`pair_compliance_potential_energy` at the float64 positions ``position_bytes``,
+    computed once per pair and grid: every cracked record of a dataset divides by the same
+    healthy pair (two thirds of the cracked factor's cost)."""
+    return pair_compliance_potential_energy(pair, np.frombuffer(position_bytes),
+                                            n_nodes=n_nodes)
+
+
 def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1001,
                            method="pe", load_n=DEFAULT_FE_LOAD_N, use_cache=True):
     """k_cracked(s) / k_healthy(s) of the pair whose tooth on ``gear`` carries the crack.
@@ -233,7 +243,7 @@ def crack_stiffness_factor(pair, gear, depth_m, angle_rad, position_m, n_nodes=1
         cracked = fe_pair_compliance(pair, s, load_n=load_n, use_cache=use_cache,
                                      crack_gear=gear, depth_m=depth_m, angle_rad=angle_rad)
         return healthy / cracked
-    healthy = pair_compliance_potential_energy(pair, s, n_nodes=n_nodes)
+    healthy = _healthy_pair_compliance(pair, np.ascontiguousarray(s).tobytes(), int(n_nodes))
     if gear == 1:
         g, rad = pair.driving, np.sqrt(pair.driving.base_radius_m ** 2 + s ** 2)
         other = healthy.driven
