@@ -110,13 +110,11 @@ class Comparison:
     departures: list = field(default_factory=list)
     not_judged: list = field(default_factory=list)
     words: str = ""
-    basis: str = "model"
     spectra: dict = field(default_factory=dict, repr=False)
 
     def to_dict(self):
         """JSON-ready dict."""
         return {"finding": self.finding, "component": self.component, "words": self.words,
-                "basis": self.basis,
                 "parameters": self.parameters, "ranges": self.ranges,
                 "near_ties": self.near_ties, "departures": self.departures,
                 "mode": self.mode, "not_judged": self.not_judged, "gain": self.gain,
@@ -317,7 +315,6 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
     top, ties = decide(ranked, ev.sensor_bearing, chi_nom,
                        {d["feature"]: d["z"] for d in discrepancies})
     finding, component, params, ranges, fitted = "none", None, {}, {}, setup_nom
-    basis = "record_family" if top is not None and "family_z" in top else "model"
     if top is not None:
         finding = top["name"]
         component = _component_name(record, top["component"])
@@ -369,11 +366,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
                 "machine": None if machine is None else machine.name},
         mode=mode, ranges={k: [float(a), float(b)] for k, (a, b) in ranges.items()},
         near_ties=near_ties, departures=departures if finding == "unexplained" else [],
-        not_judged=not_judged, basis=basis,
-        words=describe(finding, component, params, ranges) + (
-            f"; named from its envelope family in the record, {top['family_z']:.0f} sigma over "
-            "the model, which the model's defect did not reproduce"
-            if basis == "record_family" else ""),
+        not_judged=not_judged, words=describe(finding, component, params, ranges),
         spectra=spectra)
 
 

@@ -41,8 +41,7 @@ from cmsim.errors import ParameterError
 
 __all__ = ["Nuisances", "rank", "refine", "fit", "decide", "nuisance_params",
            "MIN_DELTA_CHI2", "MIN_SIGNATURE_DELTA_CHI2", "MIN_SCORE", "FIT_GRID",
-           "REFINE_TOP", "FAR_MARGIN", "NEAR_TIE", "SEVERITY_DELTA_CHI2", "FAMILY_STANDS_OUT_Z",
-           "FAMILY_LEAD", "record_family"]
+           "REFINE_TOP", "FAR_MARGIN", "NEAR_TIE", "SEVERITY_DELTA_CHI2"]
 
 #: Least evidence (Δχ² over every feature, fit segments) for a cause that reshapes the
 #: spectrum to be named.
@@ -71,13 +70,6 @@ NEAR_TIE = 0.8
 
 #: Rise of χ² over its best that bounds the reported range of a fitted parameter (~2σ).
 SEVERITY_DELTA_CHI2 = 4.0
-
-#: A bearing's envelope family stands out in the record itself when its two strongest
-#: features (harmonics, sidebands, band) sit on average this many σ above the nominal model ...
-FAMILY_STANDS_OUT_Z = 4.0
-
-#: ... and this many times as far as any other bearing family.
-FAMILY_LEAD = 2.0
 
 
 class Nuisances:
@@ -276,56 +268,12 @@ def decide(ranked, sensor_bearing, chi_nominal, z=None):
                 best[key] = r
         pool = sorted(best.values(), key=lambda r: -r["delta_chi2"])
     else:
-        standing = record_family(ranked, z or {})
-        if standing is not None:
-            # a race family far over the model in the record's own envelope, which no model
-            # defect reproduced: that defect, not a load or a clearance (nor none)
-            return standing, []
         pool = sorted(reshaping, key=lambda r: -r["delta_chi2"])
     if not pool:
         return None, []
     top = pool[0]
     ties = [r for r in pool[1:] if r["delta_chi2"] >= NEAR_TIE * top["delta_chi2"]]
     return top, ties
-
-
-def record_family(ranked, z):
-    """The bearing fault whose envelope family stands out in the record itself, or None.
-
-    The transfer-path-free evidence of envelope analysis, read from the record's departure
-    from the nominal model: a family stands out when its two strongest envelope features sit
-    on average :data:`FAMILY_STANDS_OUT_Z` σ above the model and :data:`FAMILY_LEAD` times as
-    far as every other bearing family (of another defect or another bearing). It names a
-    defect that the model's own defect did not reproduce (its shape or severity out of reach
-    of the probes), where a reshaping cause would otherwise take the blame.
-
-    Parameters
-    ----------
-    ranked : list of dict
-        Rows of :func:`rank` with :func:`evidence` filled.
-    z : dict of str to float
-        The record's departure from the nominal model per feature, in σ.
-
-    Returns
-    -------
-    dict or None
-        The row of that defect on that bearing, with ``"family_z"`` set.
-    """
-    lead = {}
-    for r in ranked:
-        if r["cause"].kind != "bearing" or r["cause"].signature is None:
-            continue
-        zs = sorted((z[k] for k in r["family"] if k.startswith("env_") and k in z),
-                    reverse=True)[:2]
-        if zs and (r["name"], r["component"]) not in lead:
-            lead[(r["name"], r["component"])] = (sum(zs) / len(zs), r)
-    order = sorted(lead.values(), key=lambda t: -t[0])
-    if not order or order[0][0] < FAMILY_STANDS_OUT_Z:
-        return None
-    if len(order) > 1 and order[0][0] < FAMILY_LEAD * max(order[1][0], 1.0):
-        return None
-    order[0][1]["family_z"] = order[0][0]
-    return order[0][1]
 
 
 def fit(top, nominal, nuis, ev):

@@ -7,8 +7,8 @@ module docstring is a case that another rule would decide the other way.
 from types import SimpleNamespace
 
 from cmsim.discrepancy.causes import STATISTICS
-from cmsim.discrepancy.ranking import (FAMILY_LEAD, FAMILY_STANDS_OUT_Z, FAR_MARGIN,
-                                       MIN_DELTA_CHI2, MIN_SIGNATURE_DELTA_CHI2, NEAR_TIE, decide)
+from cmsim.discrepancy.ranking import (FAR_MARGIN, MIN_DELTA_CHI2, MIN_SIGNATURE_DELTA_CHI2,
+                                       NEAR_TIE, decide)
 
 FEATURES = ["env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "env_bpfi_1b1_h1_db", "shape_b3_db",
             "shape_b4_db", "kurtosis_log"]
@@ -95,34 +95,3 @@ def test_a_reshaping_cause_blocks_a_fault_by_what_it_does_to_the_family_not_the_
     outer = _outer(30.0)
     assert load["per_feature"]["kurtosis_log"] + 15.0 > outer["delta_chi2"]
     assert decide([load, outer], "1b1", 300.0)[0]["name"] == "bearing_outer_race"
-
-
-def _bearing_kind(row):
-    row["cause"].kind = "bearing"
-    return row
-
-
-def test_a_race_family_over_the_model_in_the_record_names_its_defect_when_no_model_defect_did():
-    # the model's defect made its family worse (its shape is not the record's), a load takes
-    # the blame on the spectrum: the record's own envelope family decides
-    outer = _bearing_kind(_outer(-10.0))
-    inner = _bearing_kind(_row("bearing_inner_race", {"env_bpfi_1b1_h1_db": -5.0},
-                               "env_bpfi_1b1", "1b1"))
-    load = _load(200.0)
-    z = {"env_bpfo_1b1_h1_db": 12.0, "env_bpfo_1b1_h2_db": 7.0, "env_bpfi_1b1_h1_db": 2.0}
-    top, _ = decide([load, outer, inner], "1b1", 300.0, z)
-    assert top["name"] == "bearing_outer_race" and top["family_z"] == 9.5
-    assert decide([load, outer, inner], "1b1", 300.0)[0]["name"] == "torque_mismatch"
-
-
-def test_a_family_stands_out_only_far_over_the_model_and_far_ahead_of_the_others():
-    outer = _bearing_kind(_outer(-10.0))
-    inner = _bearing_kind(_row("bearing_inner_race", {}, "env_bpfi_1b1", "1b1"))
-    near = {"env_bpfo_1b1_h1_db": FAMILY_STANDS_OUT_Z - 0.5,
-            "env_bpfo_1b1_h2_db": FAMILY_STANDS_OUT_Z - 0.5}
-    assert decide([outer, inner], "1b1", 300.0, near)[0] is None
-    close = {"env_bpfo_1b1_h1_db": 10.0, "env_bpfo_1b1_h2_db": 10.0,
-             "env_bpfi_1b1_h1_db": 10.0 / FAMILY_LEAD + 0.5}
-    assert decide([outer, inner], "1b1", 300.0, close)[0] is None
-    close["env_bpfi_1b1_h1_db"] = 10.0 / FAMILY_LEAD - 0.5
-    assert decide([outer, inner], "1b1", 300.0, close)[0]["name"] == "bearing_outer_race"
