@@ -34,6 +34,7 @@ from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.simulation import integrate
 from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.mesh_stiffness._kernels import mesh_frame_jit, pair_contact_jit
+from bench_dataset import cpu_info  # the one CPU description of the benchmarks
 
 FS = 75_000.0
 REPEATS = 5
@@ -158,6 +159,10 @@ def main():
     op = cmsim.OperatingPoint(1000.0, 100.0)
     model = build_model(rig, op, resolve_mesh(rig, None, op.torque_nm),
                         cage_phases_rad=[0.3, 1.1, 2.0, 4.4])
+    name, cores, load = cpu_info()
+    print(f"CPU: {name}, {cores} cores usable, load average {load[0]:.1f} (figures are ratios "
+          "measured side by side in this run; absolute times depend on the machine and its "
+          "load)")
     print(f"mesh: {model.mesh_table.method} table at {model.mesh_table.torque_nm} N m")
     n = model.n_dof
     y0 = np.concatenate([quasi_static_state(model, 0.0), np.zeros(n)])
