@@ -15,9 +15,15 @@ float32 column per channel, the rate and units in the schema metadata. Float32 s
 dataset's records) stay float32 in ``npz``, ``mat``, ``tdms`` and ``parquet``. Each export
 also writes
 
-* ``metadata.json`` — the measured-record schema of ``../shared/datasets/README.md``: the
-  sample rate, each channel's unit (``sensors``), one ``recordings[]`` entry per file with its
-  operating point and the answer key (``condition``, ``fault``, ``fault_severity``);
+* ``metadata.json`` — the measured-record schema of ``../shared/datasets/README.md``,
+  written and checked by :func:`cmsim.measured.importing.write_folder_metadata` (the writer of
+  ``cmsim import``): the sample rate, each channel's unit (``sensors``), the rig's
+  ``geometry`` (:func:`cmsim.measured.schema.rig_geometry`: bearings and gears, so the files
+  read back in ``cmsim spectrum`` and ``compare`` with no ``--rig``), one ``recordings[]``
+  entry per file with its operating point and the answer key (``condition`` ``healthy`` or
+  ``faulty``, ``fault`` the fault type, ``fault_component``, ``fault_severity`` the main size
+  in SI; a run of ``cmsim simulate`` takes it from its faults, a dataset record from its
+  labels);
 * for a dataset, ``labels.csv`` — one row per record: ``record_id``, ``file``, ``label``,
   ``fault_component``, ``severity``, operating point, ``fs_hz``, ``n_samples``, ``group``,
   ``split`` (:func:`cmsim.datasets.windows.split_of`).
@@ -64,9 +70,14 @@ import numpy as np
 
 from cmsim._io import atomic_write, atomic_write_bytes, atomic_write_text
 from cmsim.datasets.load import Dataset, load
+from cmsim.datasets.plan import fault_answer_key
 from cmsim.datasets.windows import check_fractions, split_of
 from cmsim.errors import ParameterError, check_choice
+from cmsim.faults import fault_from_dict
+from cmsim.measured.importing import write_folder_metadata
 from cmsim.measured.readers import WRITERS, write_signals
+from cmsim.measured.schema import rig_geometry
+from cmsim.rig import Rig
 from cmsim.run import Run, is_measurable, signal_info
 
 __all__ = ["export", "FORMATS", "to_bearing_datasets", "bearing_datasets_frame"]
@@ -254,35 +265,63 @@ def _sensors(channels, units):
         try:
             info = signal_info(c)
             near = info.component if info.component[:1].isdigit() else "unknown"
-            out[c] = {"near": near, "direction": info.direction, "unit": units[c]}
+            out[c] = {"near": near, "direction": info.direction or "unknown", "unit": units[c]}
         except ParameterError:
-            out[c] = {"near": "unknown", "direction": None, "unit": units[c]}
+            out[c] = {"near": "unknown", "direction": "unknown", "unit": units[c]}
     return out
+
+
+def _answer_key(label, component, severity):
+    """The answer-key fields of a ``recordings[]`` entry, in the schema
+    :func:`cmsim.measured.schema.label_of` reads: ``condition`` (``healthy`` or ``faulty``),
+    ``fault`` (the fault type), ``fault_component`` (bearing or ``G<k>``), ``fault_severity``
+    (the fault's main size, SI)."""
+    healthy = label in (None, "healthy")
+    return {"condition": "healthy" if healthy else "faulty",
+            "fault": None if healthy else label, "fault_component": component or None,
+            "fault_severity": None if healthy else severity}
+
+
+def _run_answer_key(run):
+    """The answer key of a run: a dataset record's labels, else the run's first fault
+    (``meta["faults"]``; none: healthy), every fault's label in ``faults``."""
+    labels = run.meta.get("labels")
+    if labels:
+        return _answer_key(labels.get("fault_label"), labels.get("fault_component"),
+                           labels.get("fault_severity"))
+    faults = run.meta.get("faults") or []
+    if not faults:
+        return _answer_key("healthy", "", None)
+    first = fault_from_dict({k: v for k, v in faults[0].items() if k != "label"})
+    return {**_answer_key(*fault_answer_key(first)),
+            "faults": [f.get("label") or f.get("type") for f in faults]}
 
 
 def _run_entry(file, run, channels):
     op = run.meta.get("operating_point") or {}
-    labels = run.meta.get("labels") or {}
     return {"file": file, "n_samples": int(run.t.size), "fs_hz": run.fs_hz,
             "shaft_speed_rpm": op.get("speed_rpm"), "torque_nm": op.get("torque_nm"),
             "radial_load_n": op.get("radial_load_n"), "channels": list(channels),
-            "condition": labels.get("fault_label"), "fault": labels.get("fault_component"),
-            "fault_severity": labels.get("fault_severity")}
+            **_run_answer_key(run)}
 
 
-def _json(value):
-    """JSON text with non-finite floats as null (JSON has no NaN)."""
-    def clean(v):
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            return [clean(x) for x in v]
-        if isinstance(v, (float, np.floating)):
-            return float(v) if math.isfinite(v) else None
-        if isinstance(v, np.integer):
-            return int(v)
-        return v
-    return json.dumps(clean(value), indent=1, ensure_ascii=False)
+def _finite(value):
+    """``value`` with non-finite floats as None (JSON has no NaN) and numpy scalars as
+    Python numbers."""
+    if isinstance(value, dict):
+        return {k: _finite(x) for k, x in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(x) for x in value]
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
+
+
+def _write_metadata(stage, meta):
+    """``metadata.json`` of the export, written (and checked) by the measured writer."""
+    write_folder_metadata(stage / "metadata.json", _finite(meta))
 
 
 def export(source, out, fmt, channels=None, *, force=False, window=None, hop=None,
@@ -364,10 +403,13 @@ def _export_run(run, stage, fmt, channels, stem):
     units = {c: _run_unit(run, c) for c in chans}
     file = f"{stem}.{fmt}"
     _write_signals(stage / file, {c: run.signals[c] for c in chans}, run.fs_hz, units)
+    rig = run.meta.get("rig")
     meta = {"dataset": stem, "source": "cmsim export", "fs_hz": run.fs_hz,
             "channels": {c: f"cmsim {run.source} signal {c}" for c in chans},
-            "sensors": _sensors(chans, units), "recordings": [_run_entry(file, run, chans)]}
-    atomic_write_text(stage / "metadata.json", _json(meta))
+            "sensors": _sensors(chans, units),
+            "geometry": rig_geometry(Rig.from_dict(rig)) if rig else None,
+            "recordings": [_run_entry(file, run, chans)]}
+    _write_metadata(stage, meta)
     return {"files": 1, "records": 1, "channels": chans, "units": units, "fs_hz": run.fs_hz}
 
 
@@ -393,7 +435,7 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
                                        seed=seed, fractions=fractions)
         res["windows"]["path"] = str(stage.parent / out_name / "windows.parquet")
         res["files"] = 1
-    rows, entries = [], []
+    rows, entries, geometries = [], [], {}
     for rec in ds:
         r = rec.row
         file = None if windowed else f"{rec.record_id}.{fmt}"
@@ -412,9 +454,10 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
                             "shaft_speed_rpm": r.get("speed_rpm"),
                             "torque_nm": r.get("torque_nm"),
                             "radial_load_n": r.get("radial_load_n"), "channels": chans,
-                            "condition": r.get("fault_label"),
-                            "fault": r.get("fault_component"),
-                            "fault_severity": r.get("fault_severity")})
+                            **_answer_key(r.get("fault_label"), r.get("fault_component"),
+                                          r.get("fault_severity"))})
+            geometries.setdefault(json.dumps(rig_geometry(rec.rig), sort_keys=True),
+                                  rec.record_id)
     import pandas as pd
     atomic_write_text(stage / "labels.csv", pd.DataFrame(
         rows, columns=["record_id", "file", "label", "fault_component", "severity",
@@ -425,7 +468,13 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
         meta = {"dataset": name, "source": f"cmsim export of dataset {name}",
                 "fs_hz": ds.fs_hz,
                 "channels": {c: f"cmsim simulated {c}" for c in chans},
-                "sensors": _sensors(chans, units), "recordings": entries}
-        atomic_write_text(stage / "metadata.json", _json(meta))
+                "sensors": _sensors(chans, units),
+                "geometry": json.loads(next(iter(geometries))) if geometries else None,
+                "recordings": entries}
+        if len(geometries) > 1:
+            meta["geometry_note"] = (f"the records' rigs differ ({len(geometries)} bearing or "
+                                     f"gear geometries): this is record "
+                                     f"{next(iter(geometries.values()))}'s")
+        _write_metadata(stage, meta)
         res["files"] = len(entries)
     return res
