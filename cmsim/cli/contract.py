@@ -10,7 +10,8 @@
    an option of the command, into the option (``max_peaks`` → ``--top``) through
    :data:`PARAM_TO_DEST`. Library warnings (:func:`cmsim.rig.plausibility.load_warnings`) go
    through the same rewriting. A name in double quotes is a key of a file the user wrote
-   (``metadata.json "fs_hz"``), not an option, and is left as it is.
+   (``metadata.json "fs_hz"``), not an option, and is left as it is, as is a name that is
+   part of a path (``/tmp/out``).
 3. Files named by options are checked (:func:`check_paths`, by :data:`PATHS`) or loaded
    through :func:`load_file`, which turns any reading error into one line naming the option.
 4. Anything else is an internal error: exit 1, one line, "please report".
@@ -166,7 +167,8 @@ def user_message(exc, options):
         option = names[param]
     for name, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
         if name == param or "_" in name or name in _ALWAYS_REWRITE:
-            msg = re.sub(rf"(?<![\w.\[\-\"]){re.escape(name)}(?![\w\[\"])", opt, msg)
+            msg = re.sub(rf"(?<![\w.\[\-\"/\\]){re.escape(name)}(?![\w\[\"/\\])", opt,
+                         msg)
     if option is not None and option not in msg:
         msg = f"{option}: {msg}"
     return msg, option or option_named_in(msg, options)

@@ -197,6 +197,23 @@ def test_export_refuses_an_existing_out_and_force_replaces_it(made, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]     # no staging left
 
 
+@pytest.mark.parametrize("where", [".", "records", ".."])
+def test_export_never_replaces_its_source(made, tmp_path, where):
+    """An out that is, lies in or holds the source is refused even with force."""
+    before = sorted(p.name for p in made.rglob("*"))
+    with pytest.raises(ParameterError, match="source") as err:
+        export(made, (made / where).resolve(), "csv", force=True)
+    assert err.value.param == "out"
+    assert sorted(p.name for p in made.rglob("*")) == before
+
+
+def test_a_run_is_not_exported_as_parquet(made, tmp_path):
+    """Parquet is a dataset's windowed layout; a run is pointed at the signal formats."""
+    with pytest.raises(ParameterError, match="windowed layout.*npz") as err:
+        export(made / "records" / "000002.npz", tmp_path / "out", "parquet")
+    assert err.value.param == "format" and not list(tmp_path.iterdir())
+
+
 def test_an_interrupted_export_leaves_nothing(made, tmp_path, monkeypatch):
     real, calls = export_mod._write_signals, []
 
@@ -226,7 +243,7 @@ def test_bad_input_is_named(made, tmp_path, bad, match):
 def test_not_a_run_nor_a_dataset(tmp_path):
     np.savez(tmp_path / "x.npz", a=np.zeros(3))
     for src in (tmp_path / "x.npz", tmp_path):
-        with pytest.raises(ParameterError, match="not a cmsim|neither"):
+        with pytest.raises(ParameterError, match="not a cmsim run|without dataset.json"):
             export(src, tmp_path / "out", "csv")
 
 
@@ -240,6 +257,12 @@ def test_every_format_is_one_writer(tmp_path, monkeypatch):
     for fmt in FILE_FORMATS:
         export_mod._write_signals(tmp_path / f"x.{fmt}", {"a": np.zeros(4)}, 100.0, {"a": "V"})
     assert used == [f".{f}" for f in FILE_FORMATS]
+
+
+def test_bearing_datasets_rows_carry_each_channel_unit(made):
+    """The tacho is volts, not an acceleration."""
+    df = export_mod.bearing_datasets_frame(made, channels=["accel_1b1_y", "tacho"])
+    assert dict(zip(df["channel"], df["unit"])) == {"accel_1b1_y": "m/s^2", "tacho": "V"}
 
 
 # ---------------------------------------------------------------------- windowed Parquet
