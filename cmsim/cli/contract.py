@@ -20,13 +20,10 @@
 from __future__ import annotations
 
 import argparse
-import math
 import re
 from pathlib import Path
 
-import numpy as np
-
-from cmsim._io import READ_ERRORS
+from cmsim._io import READ_ERRORS, finite
 from cmsim.errors import ParameterError
 
 __all__ = ["CLIError", "Parser", "ranged", "subparsers", "options_of", "user_message",
@@ -253,16 +250,3 @@ def load_file(option, path, loader, what):
     except READ_ERRORS as exc:
         raise CLIError(f"{option} {path}: not {what} ({type(exc).__name__}: "
                        f"{' '.join(str(exc).split()) or 'unreadable'})", option=option) from None
-
-
-def finite(value):
-    """``value`` with non-finite floats as ``None``, at every depth (JSON has no NaN)."""
-    if isinstance(value, dict):
-        return {k: finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [finite(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    return value

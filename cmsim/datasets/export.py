@@ -70,7 +70,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cmsim._io import atomic_write_bytes, atomic_write_text
+from cmsim._io import atomic_write_bytes, atomic_write_text, finite
 from cmsim.datasets.load import Dataset, load
 from cmsim.datasets.plan import fault_answer_key
 from cmsim.datasets.windows import check_fractions, split_of
@@ -326,23 +326,9 @@ def _run_entry(file, run, channels):
             **_run_answer_key(run)}
 
 
-def _finite(value):
-    """``value`` with non-finite floats as None (JSON has no NaN) and numpy scalars as
-    Python numbers."""
-    if isinstance(value, dict):
-        return {k: _finite(x) for k, x in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(x) for x in value]
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    return value
-
-
 def _write_metadata(stage, meta):
     """``metadata.json`` of the export, written (and checked) by the measured writer."""
-    write_folder_metadata(stage / "metadata.json", _finite(meta))
+    write_folder_metadata(stage / "metadata.json", finite(meta))
 
 
 def export(source, out, fmt, channels=None, *, force=False, window=None, hop=None,
