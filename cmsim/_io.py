@@ -6,6 +6,7 @@ umask), not the owner-only mode of the temporary file.
 
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 import zipfile
@@ -14,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["atomic_write", "atomic_write_text", "atomic_write_bytes", "atomic_savez",
-           "READ_ERRORS"]
+           "READ_ERRORS", "finite"]
 
 #: What reading a file a user brings can raise when the file is missing, truncated, of the
 #: wrong kind or holds the wrong keys (an ``.npz`` cut short raises ``BadZipFile`` or
@@ -71,3 +72,28 @@ def atomic_savez(path, compressed=False, **arrays):
     """``np.savez`` to ``path`` atomically (no ``.npz`` suffix is appended)."""
     saver = np.savez_compressed if compressed else np.savez
     return _atomic(path, lambda fh: saver(fh, **arrays))
+
+
+def finite(value):
+    """``value`` ready for JSON, at every depth: non-finite floats as ``None`` (JSON has no
+    NaN), numpy scalars as Python numbers.
+
+    Parameters
+    ----------
+    value : object
+        A number, or dicts, lists and tuples of them (tuples become lists).
+
+    Examples
+    --------
+    >>> finite({"a": float("nan"), "b": [np.float32(1.5), np.int64(2)]})
+    {'a': None, 'b': [1.5, 2]}
+    """
+    if isinstance(value, dict):
+        return {k: finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    return value

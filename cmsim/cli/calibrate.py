@@ -26,7 +26,9 @@ def register(sub):
                         "what a file does not state from metadata.json beside it, else from "
                         "the options; relative paths also under CMSIM_DATA)")
     p.add_argument("--out", type=Path, required=True, metavar="MACHINE.toml",
-                   help="the machine file to write")
+                   help="the machine file to write (refused if it exists, unless --force; "
+                        "never one of the inputs)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --out file")
     p.add_argument("--channel", metavar="NAME", help="channel (default: the first near a "
                                                      "documented bearing)")
     p.add_argument("--rig", metavar="FILE.toml",
@@ -69,6 +71,7 @@ def run(args):
     from cmsim.machine import calibrate
     from cmsim.machine.report import write_calibration_report
 
+    _check_out(args)
     if args.span is not None and not args.span[0] < args.span[1]:
         raise CLIError(f"--span {args.span[0]:g} {args.span[1]:g}: START must be below STOP",
                        option="--span")
@@ -91,6 +94,18 @@ def run(args):
     if args.report:
         out["report"] = str(write_calibration_report(machine, records, args.report))
     return out
+
+
+def _check_out(args):
+    """--out is a new file (or --force), and never an input: refused before any work."""
+    out = Path(args.out).resolve()
+    for option, path in [("--rig", args.rig)] + [("BASELINE", b) for b in args.baseline]:
+        if path is not None and Path(path).resolve() == out:
+            raise CLIError(f"--out {args.out}: is the {option} input; write the machine to "
+                           f"another file", option="--out")
+    if out.exists() and not args.force:
+        raise CLIError(f"--out {args.out}: exists; give --force to overwrite it (or a new "
+                       f"file)", option="--out")
 
 
 def _wobble(w):

@@ -10,7 +10,8 @@
    an option of the command, into the option (``max_peaks`` → ``--top``) through
    :data:`PARAM_TO_DEST`. Library warnings (:func:`cmsim.rig.plausibility.load_warnings`) go
    through the same rewriting. A name in double quotes is a key of a file the user wrote
-   (``metadata.json "fs_hz"``), not an option, and is left as it is.
+   (``metadata.json "fs_hz"``), not an option, and is left as it is, as is a name that is
+   part of a path (``/tmp/out``).
 3. Files named by options are checked (:func:`check_paths`, by :data:`PATHS`) or loaded
    through :func:`load_file`, which turns any reading error into one line naming the option.
 4. Anything else is an internal error: exit 1, one line, "please report".
@@ -19,13 +20,10 @@
 from __future__ import annotations
 
 import argparse
-import math
 import re
 from pathlib import Path
 
-import numpy as np
-
-from cmsim._io import READ_ERRORS
+from cmsim._io import READ_ERRORS, finite
 from cmsim.errors import ParameterError
 
 __all__ = ["CLIError", "Parser", "ranged", "subparsers", "options_of", "user_message",
@@ -166,7 +164,8 @@ def user_message(exc, options):
         option = names[param]
     for name, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
         if name == param or "_" in name or name in _ALWAYS_REWRITE:
-            msg = re.sub(rf"(?<![\w.\[\-\"]){re.escape(name)}(?![\w\[\"])", opt, msg)
+            msg = re.sub(rf"(?<![\w.\[\-\"/\\]){re.escape(name)}(?![\w\[\"/\\])", opt,
+                         msg)
     if option is not None and option not in msg:
         msg = f"{option}: {msg}"
     return msg, option or option_named_in(msg, options)
@@ -251,16 +250,3 @@ def load_file(option, path, loader, what):
     except READ_ERRORS as exc:
         raise CLIError(f"{option} {path}: not {what} ({type(exc).__name__}: "
                        f"{' '.join(str(exc).split()) or 'unreadable'})", option=option) from None
-
-
-def finite(value):
-    """``value`` with non-finite floats as ``None``, at every depth (JSON has no NaN)."""
-    if isinstance(value, dict):
-        return {k: finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [finite(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        return float(value) if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    return value

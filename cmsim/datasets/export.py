@@ -4,29 +4,36 @@ schema of the ``bearing-datasets`` index (:func:`to_bearing_datasets`).
 Signal files (``cmsim export``)
 -------------------------------
 :func:`export` writes a saved run or a generated dataset into a new folder, in one of
-:data:`FORMATS`: the run, or each record of a dataset, as one file ``<name>.<format>`` holding
-its channels, with the sample rate and each channel's unit where the format has a place for
-them. Every format but ``parquet`` is written by :func:`cmsim.measured.readers.write_signals`,
-the writer beside the reader of its format (that module's docstring gives each layout), so an
-exported file reads back through :func:`cmsim.measured.readers.read_file` with the same
-samples, rate and units; a ``wav`` holds float32 at full scale, its calibration factor,
-channels and units in cmsim's ``LIST``/``INFO`` comment. ``parquet``, written here, is one
-float32 column per channel, the rate and units in the schema metadata. Float32 samples (a
-dataset's records) stay float32 in ``npz``, ``mat``, ``tdms`` and ``parquet``. Each export
-also writes
+:data:`SIGNAL_FORMATS`: the run, or each record of a dataset, as one file
+``<name>.<format>`` holding its channels, with the sample rate and each channel's unit where
+the format has a place for them. Each is written by
+:func:`cmsim.measured.readers.write_signals`, the writer beside the reader of its format (that
+module's docstring gives each layout), so an exported file reads back through
+:func:`cmsim.measured.readers.read_file` with the same samples, rate and units; a ``wav``
+holds float32 at full scale, its calibration factor, channels and units in cmsim's
+``LIST``/``INFO`` comment. Float32 samples (a dataset's records) stay float32 in ``npz``,
+``mat`` and ``tdms``. Each export also writes
 
-* ``metadata.json`` — the measured-record schema of ``../shared/datasets/README.md``: the
-  sample rate, each channel's unit (``sensors``), one ``recordings[]`` entry per file with its
-  operating point and the answer key (``condition``, ``fault``, ``fault_severity``);
+* ``metadata.json`` — the measured-record schema of ``../shared/datasets/README.md``,
+  written and checked by :func:`cmsim.measured.importing.write_folder_metadata` (the writer of
+  ``cmsim import``): the sample rate, each channel's unit (``sensors``), the rig's
+  ``geometry`` (:func:`cmsim.measured.schema.rig_geometry`: bearings and gears, so the files
+  read back in ``cmsim spectrum`` and ``compare`` with no ``--rig``), one ``recordings[]``
+  entry per file with its operating point and the answer key (``condition`` ``healthy`` or
+  ``faulty``, ``fault`` the fault type, ``fault_component``, ``fault_severity`` the main size
+  in SI; a run of ``cmsim simulate`` takes it from its faults, a dataset record from its
+  labels);
 * for a dataset, ``labels.csv`` — one row per record: ``record_id``, ``file``, ``label``,
   ``fault_component``, ``severity``, operating point, ``fs_hz``, ``n_samples``, ``group``,
   ``split`` (:func:`cmsim.datasets.windows.split_of`).
 
 A dataset exported as ``parquet`` is the windowed layout instead
-(:mod:`cmsim.datasets.windows`, ``windows.parquet``) with the same ``labels.csv``. The
+(:mod:`cmsim.datasets.windows`, ``windows.parquet``) with the same ``labels.csv``; a single
+run has no windowed layout and is refused as ``parquet``. The
 default channels are those a real machine could measure (:func:`cmsim.run.is_measurable`).
 The folder is assembled beside ``out`` and renamed into place when complete: an interrupted
-export leaves no ``out``; an existing ``out`` is replaced only with ``force``.
+export leaves no ``out``; an existing ``out`` is replaced only with ``force``, and never when
+it is, holds or lies in the source.
 
 Bearing-datasets schema
 -----------------------
@@ -35,7 +42,8 @@ One Parquet row per signal, so cmsim data mix with public bearing datasets.
 Columns (one row per record and vibration channel):
 
 * ``dataset``, ``signal_id`` (``<dataset>/<record_id>/<channel>``), ``record_id``,
-  ``channel``, ``unit`` (``m/s^2``), ``signal`` (list of float32), ``n_samples``, ``fs``
+  ``channel``, ``unit`` (the channel's unit in ASCII: ``m/s^2`` for an acceleration, ``V``
+  for the tacho), ``signal`` (list of float32), ``n_samples``, ``fs``
   (Hz), ``duration_s``;
 * ``speed_rpm``, ``load`` (radial load on the bearing, N; the torque for a gear rig),
   ``load_unit``;
@@ -62,19 +70,28 @@ from pathlib import Path
 
 import numpy as np
 
-from cmsim._io import atomic_write, atomic_write_bytes, atomic_write_text
+from cmsim._io import atomic_write_bytes, atomic_write_text, finite
 from cmsim.datasets.load import Dataset, load
+from cmsim.datasets.plan import fault_answer_key
 from cmsim.datasets.windows import check_fractions, split_of
 from cmsim.errors import ParameterError, check_choice
+from cmsim.faults import fault_from_dict
+from cmsim.measured.importing import write_folder_metadata
 from cmsim.measured.readers import WRITERS, write_signals
+from cmsim.measured.schema import rig_geometry
+from cmsim.rig import Rig
 from cmsim.run import Run, is_measurable, signal_info
 
-__all__ = ["export", "FORMATS", "to_bearing_datasets", "bearing_datasets_frame"]
+__all__ = ["export", "FORMATS", "SIGNAL_FORMATS", "to_bearing_datasets",
+           "bearing_datasets_frame"]
 
-#: Formats of :func:`export` (the file suffix is ``.<format>``): every format of
-#: :data:`cmsim.measured.readers.WRITERS` (``.unv`` is ``.uff`` under another name), and
-#: ``parquet``.
-FORMATS = tuple(s.lstrip(".") for s in WRITERS if s != ".unv") + ("parquet",)
+#: Signal-file formats (the file suffix is ``.<format>``): every format of
+#: :data:`cmsim.measured.readers.WRITERS` (``.unv`` is ``.uff`` under another name); each
+#: reads back through :func:`cmsim.measured.readers.read_file`.
+SIGNAL_FORMATS = tuple(s.lstrip(".") for s in WRITERS if s != ".unv")
+
+#: Formats of :func:`export`: the signal formats, and ``parquet`` (a dataset's windows).
+FORMATS = SIGNAL_FORMATS + ("parquet",)
 
 _LOCAL = {"inner_race", "outer_race", "ball"}
 _GEAR = {"tooth_crack", "tooth_spall", "tooth_breakage", "eccentricity", "profile_error"}
@@ -113,6 +130,7 @@ def bearing_datasets_frame(dataset, channels=None):
         if c not in ds.channels:
             raise ParameterError(f"channels: {c!r} is not in {list(ds.channels)}",
                                  param="channels")
+    units = {c: ds.unit(c).replace("²", "^2").replace("µ", "u") for c in chans}
     man = ds.manifest[ds.manifest["status"] == "ok"].copy()
     level = np.zeros(len(man), int)
     for lab, idx in man.groupby("fault_label").groups.items():
@@ -136,7 +154,7 @@ def bearing_datasets_frame(dataset, channels=None):
             x = np.asarray(sig[ch], np.float32)
             rows.append({
                 "dataset": name, "signal_id": f"{name}/{row['record_id']}/{ch}",
-                "record_id": row["record_id"], "channel": ch, "unit": "m/s^2",
+                "record_id": row["record_id"], "channel": ch, "unit": units[ch],
                 "signal": x, "n_samples": int(x.size), "fs": float(rec.fs_hz),
                 "duration_s": x.size / float(rec.fs_hz),
                 "speed_rpm": float(row["speed_rpm"]),
@@ -179,17 +197,17 @@ def to_bearing_datasets(dataset, out, channels=None):
 
 # ---------------------------------------------------------------------- signal files
 def _write_signals(path, signals, rate_hz, units):
-    """Write channels to one signal file, its format chosen by the suffix of ``path``,
-    atomically: :func:`cmsim.measured.readers.write_signals` (the writer beside each reader)
-    for every format but ``.parquet``, which only export writes.
+    """Write channels to one signal file (its format chosen by the suffix of ``path``, one of
+    :data:`SIGNAL_FORMATS`), atomically, by :func:`cmsim.measured.readers.write_signals`: the
+    writer beside each reader.
 
     Parameters
     ----------
     path : str or path-like
-        The file, ``.<format>`` of one of :data:`FORMATS`.
+        The file, ``.<format>``.
     signals : dict of str to ndarray
         Channel name → samples, shape (n,) each (float32 samples stay float32 where the
-        format stores the type: npz, mat, tdms, parquet).
+        format stores the type: npz, mat, tdms).
     rate_hz : float
         Sample rate, Hz.
     units : dict of str to str
@@ -200,17 +218,8 @@ def _write_signals(path, signals, rate_hz, units):
     pathlib.Path
     """
     path = Path(path)
-    check_choice("format", path.suffix.lower().lstrip("."), FORMATS)
-    if path.suffix.lower() != ".parquet":
-        return write_signals(path, signals, rate_hz, units)
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-    meta = {"cmsim": json.dumps({"fs_hz": float(rate_hz), "units": dict(units)},
-                                ensure_ascii=False)}
-    table = pa.table({c: pa.array(np.asarray(x, dtype=np.float32))
-                      for c, x in signals.items()}).replace_schema_metadata(meta)
-    atomic_write(path, lambda fh: pq.write_table(table, fh))
-    return path
+    check_choice("format", path.suffix.lower().lstrip("."), SIGNAL_FORMATS)
+    return write_signals(path, signals, rate_hz, units)
 
 
 def _source(source):
@@ -218,16 +227,39 @@ def _source(source):
     if isinstance(source, (Run, Dataset)):
         return ("run" if isinstance(source, Run) else "dataset"), source
     p = Path(source)
-    if p.is_dir():
+    if p.is_dir() and (p / "dataset.json").is_file():
         return "dataset", load(p)
     if p.is_file() and p.suffix.lower() == ".npz":
         try:
             return "run", Run.load(p)
         except Exception:  # noqa: BLE001 - any failure: not a run
-            pass
-    raise ParameterError(f"source {p} is neither a cmsim run (.npz of cmsim simulate) nor a "
-                         f"dataset directory (cmsim dataset)", param="source",
-                         allowed="a run .npz or a dataset directory")
+            why = "is a .npz file but not a cmsim run"
+    else:
+        why = ("does not exist" if not p.exists() else "is a directory without dataset.json"
+               if p.is_dir() else "is not a .npz file")
+    raise ParameterError(f"source {p}: {why}; expected a run file (.npz of cmsim simulate "
+                         f"--out) or a dataset directory (cmsim dataset --out)",
+                         param="source", allowed="a run .npz or a dataset directory")
+
+
+def _check_out(out, source, force):
+    """``out`` is a new folder (or ``force`` and a folder) that neither is, holds nor lies in
+    the source: replacing it must never remove what is being exported."""
+    if out.exists() and not force:
+        raise ParameterError(f"out {out}: exists; give force (--force) to replace it (or a "
+                             f"new folder)", param="out", allowed="a new folder")
+    if out.exists() and not out.is_dir():
+        raise ParameterError(f"out {out}: is a file (expected a folder)", param="out",
+                             allowed="a folder")
+    if isinstance(source, (Run, Dataset)):
+        source = getattr(source, "directory", None)
+    if source is None:
+        return
+    src, dst = Path(source).resolve(), out.resolve()
+    if dst == src or src in dst.parents or dst in src.parents:
+        raise ParameterError(f"out {out}: is, holds or lies in the source {source}; export "
+                             f"to a folder outside it", param="out",
+                             allowed="a folder outside the source")
 
 
 def _channels(available, channels):
@@ -254,35 +286,49 @@ def _sensors(channels, units):
         try:
             info = signal_info(c)
             near = info.component if info.component[:1].isdigit() else "unknown"
-            out[c] = {"near": near, "direction": info.direction, "unit": units[c]}
+            out[c] = {"near": near, "direction": info.direction or "unknown", "unit": units[c]}
         except ParameterError:
-            out[c] = {"near": "unknown", "direction": None, "unit": units[c]}
+            out[c] = {"near": "unknown", "direction": "unknown", "unit": units[c]}
     return out
+
+
+def _answer_key(label, component, severity):
+    """The answer-key fields of a ``recordings[]`` entry, in the schema
+    :func:`cmsim.measured.schema.label_of` reads: ``condition`` (``healthy`` or ``faulty``),
+    ``fault`` (the fault type), ``fault_component`` (bearing or ``G<k>``), ``fault_severity``
+    (the fault's main size, SI)."""
+    healthy = label in (None, "healthy")
+    return {"condition": "healthy" if healthy else "faulty",
+            "fault": None if healthy else label, "fault_component": component or None,
+            "fault_severity": None if healthy else severity}
+
+
+def _run_answer_key(run):
+    """The answer key of a run: a dataset record's labels, else the run's first fault
+    (``meta["faults"]``; none: healthy), every fault's label in ``faults``."""
+    labels = run.meta.get("labels")
+    if labels:
+        return _answer_key(labels.get("fault_label"), labels.get("fault_component"),
+                           labels.get("fault_severity"))
+    faults = run.meta.get("faults") or []
+    if not faults:
+        return _answer_key("healthy", "", None)
+    first = fault_from_dict({k: v for k, v in faults[0].items() if k != "label"})
+    return {**_answer_key(*fault_answer_key(first)),
+            "faults": [f.get("label") or f.get("type") for f in faults]}
 
 
 def _run_entry(file, run, channels):
     op = run.meta.get("operating_point") or {}
-    labels = run.meta.get("labels") or {}
     return {"file": file, "n_samples": int(run.t.size), "fs_hz": run.fs_hz,
             "shaft_speed_rpm": op.get("speed_rpm"), "torque_nm": op.get("torque_nm"),
             "radial_load_n": op.get("radial_load_n"), "channels": list(channels),
-            "condition": labels.get("fault_label"), "fault": labels.get("fault_component"),
-            "fault_severity": labels.get("fault_severity")}
+            **_run_answer_key(run)}
 
 
-def _json(value):
-    """JSON text with non-finite floats as null (JSON has no NaN)."""
-    def clean(v):
-        if isinstance(v, dict):
-            return {k: clean(x) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            return [clean(x) for x in v]
-        if isinstance(v, (float, np.floating)):
-            return float(v) if math.isfinite(v) else None
-        if isinstance(v, np.integer):
-            return int(v)
-        return v
-    return json.dumps(clean(value), indent=1, ensure_ascii=False)
+def _write_metadata(stage, meta):
+    """``metadata.json`` of the export, written (and checked) by the measured writer."""
+    write_folder_metadata(stage / "metadata.json", finite(meta))
 
 
 def export(source, out, fmt, channels=None, *, force=False, window=None, hop=None,
@@ -319,16 +365,21 @@ def export(source, out, fmt, channels=None, *, force=False, window=None, hop=Non
     """
     check_choice("format", fmt, FORMATS)
     out = Path(out)
-    if out.exists() and not force:
-        raise ParameterError(f"out {out} exists; give force (--force) to replace it",
-                             param="out", allowed="a new folder")
-    if out.exists() and not out.is_dir():
-        raise ParameterError(f"out {out} is a file (expected a folder)", param="out")
     kind, src = _source(source)
+    _check_out(out, source, force)
+    if kind == "run" and fmt == "parquet":
+        raise ParameterError(f"format parquet is the windowed layout of a dataset "
+                             f"(windows.parquet); export a run as one of "
+                             f"{', '.join(f for f in FORMATS if f != 'parquet')}",
+                             param="format", allowed="a signal format for a run")
     windowed = kind == "dataset" and fmt == "parquet"
-    if not windowed and (window is not None or hop is not None):
-        raise ParameterError("window: windows are cut only for the parquet format of a "
-                             "dataset", param="window" if window is not None else "hop")
+    for key, value in (("window", window), ("hop", hop)):
+        if value is not None and not windowed:
+            raise ParameterError(f"{key}: windows are cut only for the parquet format of a "
+                                 f"dataset", param=key)
+    if kind == "run" and group_by != "record_id":
+        raise ParameterError("group_by: groups split the records of a dataset; a run has "
+                             "none", param="group_by")
     check_fractions(fractions)
     out.parent.mkdir(parents=True, exist_ok=True)
     stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".export", dir=out.parent))
@@ -364,10 +415,13 @@ def _export_run(run, stage, fmt, channels, stem):
     units = {c: _run_unit(run, c) for c in chans}
     file = f"{stem}.{fmt}"
     _write_signals(stage / file, {c: run.signals[c] for c in chans}, run.fs_hz, units)
+    rig = run.meta.get("rig")
     meta = {"dataset": stem, "source": "cmsim export", "fs_hz": run.fs_hz,
             "channels": {c: f"cmsim {run.source} signal {c}" for c in chans},
-            "sensors": _sensors(chans, units), "recordings": [_run_entry(file, run, chans)]}
-    atomic_write_text(stage / "metadata.json", _json(meta))
+            "sensors": _sensors(chans, units),
+            "geometry": rig_geometry(Rig.from_dict(rig)) if rig else None,
+            "recordings": [_run_entry(file, run, chans)]}
+    _write_metadata(stage, meta)
     return {"files": 1, "records": 1, "channels": chans, "units": units, "fs_hz": run.fs_hz}
 
 
@@ -393,7 +447,7 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
                                        seed=seed, fractions=fractions)
         res["windows"]["path"] = str(stage.parent / out_name / "windows.parquet")
         res["files"] = 1
-    rows, entries = [], []
+    rows, entries, geometries = [], [], {}
     for rec in ds:
         r = rec.row
         file = None if windowed else f"{rec.record_id}.{fmt}"
@@ -412,9 +466,10 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
                             "shaft_speed_rpm": r.get("speed_rpm"),
                             "torque_nm": r.get("torque_nm"),
                             "radial_load_n": r.get("radial_load_n"), "channels": chans,
-                            "condition": r.get("fault_label"),
-                            "fault": r.get("fault_component"),
-                            "fault_severity": r.get("fault_severity")})
+                            **_answer_key(r.get("fault_label"), r.get("fault_component"),
+                                          r.get("fault_severity"))})
+            geometries.setdefault(json.dumps(rig_geometry(rec.rig), sort_keys=True),
+                                  rec.record_id)
     import pandas as pd
     atomic_write_text(stage / "labels.csv", pd.DataFrame(
         rows, columns=["record_id", "file", "label", "fault_component", "severity",
@@ -425,7 +480,13 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
         meta = {"dataset": name, "source": f"cmsim export of dataset {name}",
                 "fs_hz": ds.fs_hz,
                 "channels": {c: f"cmsim simulated {c}" for c in chans},
-                "sensors": _sensors(chans, units), "recordings": entries}
-        atomic_write_text(stage / "metadata.json", _json(meta))
+                "sensors": _sensors(chans, units),
+                "geometry": json.loads(next(iter(geometries))) if geometries else None,
+                "recordings": entries}
+        if len(geometries) > 1:
+            meta["geometry_note"] = (f"the records' rigs differ ({len(geometries)} bearing or "
+                                     f"gear geometries): this is record "
+                                     f"{next(iter(geometries.values()))}'s")
+        _write_metadata(stage, meta)
         res["files"] = len(entries)
     return res

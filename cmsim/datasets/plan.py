@@ -19,7 +19,8 @@ from cmsim.errors import ParameterError
 from cmsim.faults import FAULT_TYPES, RollingSlip, SpeedFluctuation, check_faults
 from cmsim.rig import RANGES, Range
 
-__all__ = ["RecordPlan", "FaultChoice", "SEVERITY_FIELDS", "NUISANCES", "PER_MODE"]
+__all__ = ["RecordPlan", "FaultChoice", "SEVERITY_FIELDS", "NUISANCES", "PER_MODE",
+           "fault_answer_key"]
 
 #: Main size of each fault type: the record's ``fault_severity`` (SI).
 SEVERITY_FIELDS = {"outer_race": "size_m", "inner_race": "size_m", "ball": "size_m",
@@ -191,26 +192,46 @@ class RecordPlan:
     @property
     def fault_label(self):
         """``"healthy"`` or the labelled fault's type."""
-        return "healthy" if self.fault is None else self.fault.name
+        return fault_answer_key(self.fault)[0]
 
     @property
     def fault_component(self):
         """Bearing name, ``"G<k>"`` for a gear, or ``""``."""
-        f = self.fault
-        if f is None:
-            return ""
-        if hasattr(f, "bearing"):
-            return str(f.bearing)
-        if hasattr(f, "gear"):
-            return f"G{f.gear}"
-        return ""
+        return fault_answer_key(self.fault)[1]
 
     @property
     def fault_severity(self):
         """The labelled fault's main size (SI, :data:`SEVERITY_FIELDS`), NaN when healthy."""
-        if self.fault is None:
-            return math.nan
-        return float(getattr(self.fault, SEVERITY_FIELDS.get(self.fault.name, ""), math.nan))
+        return fault_answer_key(self.fault)[2]
+
+
+def fault_answer_key(fault):
+    """The answer key of a labelled fault: its label, component and severity.
+
+    Parameters
+    ----------
+    fault : Fault or None
+        A catalogue fault (:mod:`cmsim.faults`); None for a healthy record.
+
+    Returns
+    -------
+    label : str
+        ``"healthy"`` or the fault's type.
+    component : str
+        Bearing name, ``"G<k>"`` for a gear, or ``""``.
+    severity : float
+        The fault's main size (SI, :data:`SEVERITY_FIELDS`), NaN when healthy.
+    """
+    if fault is None:
+        return "healthy", "", math.nan
+    if hasattr(fault, "bearing"):
+        component = str(fault.bearing)
+    elif hasattr(fault, "gear"):
+        component = f"G{fault.gear}"
+    else:
+        component = ""
+    return fault.name, component, float(getattr(fault, SEVERITY_FIELDS.get(fault.name, ""),
+                                                math.nan))
 
 
 def nuisance_faults(params):

@@ -6,7 +6,9 @@ window ``i`` of :meth:`cmsim.datasets.Dataset.to_arrays` with the same arguments
 windowing code (:meth:`~cmsim.datasets.Dataset.record_windows`), same order, same default
 channels (the measurable ones) — as ``(x, label_index, group)``: ``x`` a float32 tensor of
 shape (channels, window), ``label_index`` the position of the window's label in
-:attr:`WindowDataset.classes` (sorted labels of the chosen records), ``group`` the record id.
+:attr:`WindowDataset.classes` (sorted labels of every record of the dataset, not only the
+chosen ones, so a train and a test loader over parts of one dataset number the labels alike;
+or the ``classes`` given), ``group`` the record id.
 
 torch is imported when an item is made, not with this module (``pip install cmsim[torch]``).
 
@@ -38,6 +40,10 @@ class WindowDataset:
         A dataset or its directory.
     channels, window, hop, label, records, include_simulated
         As in :meth:`~cmsim.datasets.Dataset.to_arrays`.
+    classes : sequence, optional
+        The labels, in the order of the label indices (default: the sorted distinct labels
+        of every ok record of the dataset, whatever ``records`` chooses). Each chosen
+        record's label must be among them.
     cache_records : int
         Records kept in memory (read ones are reused while a DataLoader walks windows in
         order; with shuffling each item may read its record again).
@@ -46,13 +52,14 @@ class WindowDataset:
     ----------
     channels : list of str
     classes : list
-        Sorted distinct labels; an item's label index points into it.
+        The labels (default: sorted, of the whole dataset); an item's label index points
+        into it.
     index : ndarray of int, shape (n_windows, 2)
         Per window: the record's position in the manifest and the window's start sample.
     """
 
     def __init__(self, dataset, channels=None, window=2048, hop=None, label="fault_label",
-                 records=None, include_simulated=False, cache_records=4):
+                 records=None, include_simulated=False, classes=None, cache_records=4):
         self.dataset = dataset if isinstance(dataset, Dataset) else load(Path(dataset))
         ds = self.dataset
         self.channels = ds.select_channels(channels, include_simulated)
@@ -71,9 +78,17 @@ class WindowDataset:
             starts = window_starts(n, self.window, self.hop)
             parts.append(np.column_stack([np.full(starts.size, pos), starts]))
         self.index = np.concatenate(parts) if parts else np.empty((0, 2), int)
-        labels = ds.manifest[label].to_numpy()[chosen]
-        self.classes = sorted({v for v in labels}, key=str)
-        self._label = {pos: self.classes.index(v) for pos, v in zip(chosen, labels)}
+        column = ds.manifest[label].to_numpy()
+        if classes is None:
+            self.classes = sorted({v for v in column[ds._select(None)]}, key=str)
+        else:
+            self.classes = list(classes)
+            missing = sorted({str(v) for v in column[chosen] if v not in self.classes})
+            if missing:
+                raise ParameterError(f"classes {self.classes} lack the label(s) "
+                                     f"{', '.join(missing)} of the chosen records",
+                                     param="classes", allowed="every label of the records")
+        self._label = {pos: self.classes.index(column[pos]) for pos in chosen}
         self._cache, self._cache_records = {}, max(1, int(cache_records))
 
     def __len__(self):

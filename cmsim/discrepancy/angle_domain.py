@@ -3,8 +3,10 @@ synthesis of a machine, written to a folder in the ``metadata.json`` schema of r
 
 The hidden-effect benchmark's first generator (:mod:`cmsim.discrepancy.synthetic`) makes its
 records with cmsim's own dynamics, so a comparison that knows that model sees them through
-its own eyes. This one shares no code with cmsim (numpy and scipy only, its own kinematic
-formulas) and builds a signal the way condition-monitoring textbooks describe a machine's
+its own eyes. This one shares no code with cmsim's model (numpy and scipy, its own kinematic
+formulas; of cmsim only the ``g`` of the schema's unit,
+:data:`cmsim.measured.schema.STANDARD_GRAVITY_M_S2`, which the reader converts back with)
+and builds a signal the way condition-monitoring textbooks describe a machine's
 vibration (Randall 2011, ch. 2-3; McFadden & Smith 1984; Antoni & Randall 2002):
 
 * each machine is drawn: shaft speed, gear tooth counts (gear machines) or none, bearing
@@ -47,6 +49,8 @@ from pathlib import Path
 import numpy as np
 from scipy import signal as sps
 
+from cmsim.measured.schema import STANDARD_GRAVITY_M_S2
+
 __all__ = ["Machine", "draw_machine", "synthesise", "write_machine", "EFFECTS",
            "GEAR_ONLY", "BEARING_ONLY"]
 
@@ -58,9 +62,6 @@ EFFECTS = ("bearing_outer_race", "bearing_inner_race", "bearing_ball", "tooth_fa
 #: Effects only a gear machine has; only a bearing machine has.
 GEAR_ONLY = ("tooth_fault", "eccentricity")
 BEARING_ONLY = ()
-
-_G = 9.80665
-
 
 @dataclass(frozen=True)
 class Machine:
@@ -358,7 +359,8 @@ def write_machine(folder, m, records, *, duration_s=3.0):
     folder.mkdir(parents=True, exist_ok=True)
     entries = []
     for name, effect, severity, seed in records:
-        x = synthesise(m, effect, severity, duration_s=duration_s, seed=seed) / _G
+        x = synthesise(m, effect, severity, duration_s=duration_s,
+                       seed=seed) / STANDARD_GRAVITY_M_S2
         _atomic_npz(folder / f"{name}.npz", acc=x.astype(np.float32))
         entries.append({"file": f"{name}.npz", "n_samples": int(x.size), "fs_hz": m.fs_hz,
                         "shaft_speed_rpm": round(m.speed_rpm, 3),

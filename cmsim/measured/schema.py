@@ -25,7 +25,7 @@ from cmsim.rig import RANGES
 __all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_N", "INCH_M",
            "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
            "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
-           "documented_radial_load_n", "unit_scale_of"]
+           "documented_radial_load_n", "unit_scale_of", "rig_geometry"]
 
 #: Keys of a ``recordings[]`` entry the pipeline reads; everything else is ignored.
 RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_hz",
@@ -280,3 +280,40 @@ def unit_scale_of(unit):
     if not isinstance(unit, str) or not unit.strip():
         return None
     return ACCELERATION_UNITS.get(unit.strip().split()[0].lower())
+
+
+def rig_geometry(rig):
+    """The ``geometry`` block of ``metadata.json`` that documents a cmsim rig: what
+    :func:`cmsim.measured.model_rig.model_rig` and
+    :func:`~cmsim.measured.model_rig.documented_frequencies` read back.
+
+    Parameters
+    ----------
+    rig : cmsim.rig.Rig
+
+    Returns
+    -------
+    dict
+        ``gears``: one stage (``input_teeth``, ``output_teeth``, ``module_mm``,
+        ``pressure_angle_deg``, ``face_width_mm``) or None for a bearing rig; ``bearings``:
+        per bearing node (``1b1``, ``1b2``, ...; the ``near`` of a cmsim sensor) its
+        ``n_balls``, ``ball_diameter_mm``, ``pitch_diameter_mm``, ``contact_angle_deg`` (the
+        effective one), ``shaft`` (``input`` or ``output``) and ``outer_ring_fixed``.
+    """
+    gears = None
+    if rig.gears is not None:
+        g1, g2 = rig.gears.driving, rig.gears.driven
+        gears = [{"stage": 1, "input_teeth": int(g1.n_teeth), "output_teeth": int(g2.n_teeth),
+                  "module_mm": 1e3 * g1.module_m,
+                  "pressure_angle_deg": math.degrees(g1.pressure_angle_rad),
+                  "face_width_mm": 1e3 * min(g1.face_width_m, g2.face_width_m),
+                  "documented": True}]
+    shaft_of = [i for i, s in enumerate(rig.shafts) for _ in s.bearings]
+    bearings = {name: {"model": f"cmsim rig {rig.name!r}, bearing {name}",
+                       "n_balls": int(b.n_balls), "ball_diameter_mm": 1e3 * b.ball_diameter_m,
+                       "pitch_diameter_mm": 1e3 * b.pitch_diameter_m,
+                       "contact_angle_deg": math.degrees(b.effective_contact_angle_rad),
+                       "shaft": "input" if i == 0 else "output", "location": name,
+                       "outer_ring_fixed": b.outer_ring_speed_ratio == 0}
+                for name, b, i in zip(rig.bearing_names, rig.bearings, shaft_of)}
+    return {"gears": gears, "bearings": bearings}

@@ -326,8 +326,16 @@ CATALOGUE = [
     R("export-source-text", "export {text} --format npz --out {work}/ex", "RUN|DATASET"),
     R("export-source-not-a-run", "export {bad_meta} --format npz --out {work}/ex "
       "--channels F_1b1_loa", "RUN|DATASET"),
-    R("export-window-of-a-run", "export {run} --format parquet --out {work}/ex --channels "
+    R("export-window-of-a-run", "export {run} --format csv --out {work}/ex --channels "
       "F_1b1_loa --window 64", "--window", "parquet"),
+    R("export-run-as-parquet", "export {run} --format parquet --out {work}/ex --channels "
+      "F_1b1_loa", "--format", "windowed layout of a dataset", "npz"),
+    R("export-group-by-of-a-run", "export {run} --format csv --out {work}/ex --channels "
+      "F_1b1_loa --group-by rig_name", "--group-by", "dataset"),
+    R("export-out-is-the-source", "export {gen_ds} --format csv --out {gen_ds} --force",
+      "--out", "source"),
+    R("export-out-in-the-source", "export {gen_ds} --format csv --out {gen_ds}/records "
+      "--force", "--out", "source"),
     R("export-window-too-long", "export {gen_ds} --format parquet --out {work}/ex "
       "--window 100000000", "--window", "record length"),
     R("export-fractions-sum", "export {gen_ds} --format csv --out {work}/ex --fractions "
@@ -360,6 +368,9 @@ CATALOGUE = [
     R("calibrate-span-negative", "calibrate {record} --span -1 0.5 --out {work}/m.toml",
       "--span", numeric=True),
     R("calibrate-out-directory", "calibrate {record} --out {work}", "--out"),
+    R("calibrate-out-exists", "calibrate {record} --out {text}", "--out", "--force"),
+    R("calibrate-out-is-the-rig", "calibrate {record} --rig {rig_ok} --out {rig_ok} --force",
+      "--out", "--rig"),
     R("simulate-machine-missing", "simulate --speed-rpm 1000 --machine {work}/none.toml",
       "--machine"),
     R("compare-record-missing-arg", "compare", "RECORD"),
@@ -952,6 +963,11 @@ def test_param_names_map_to_options():
     msg, _ = contract.user_message(ParameterError("n_positions must be an integer >= 4"),
                                contract.options_of(build_parser(), "modes"))
     assert msg.startswith("--positions")
+    # a name that is part of a path stays as typed (export --out /tmp/out)
+    msg, option = contract.user_message(
+        ParameterError("out /tmp/out/x/out: exists", param="out"),
+        contract.options_of(build_parser(), "export"))
+    assert option == "--out" and msg == "--out /tmp/out/x/out: exists"
 
 
 def test_internal_error_is_one_line_status_1(capsys, monkeypatch):

@@ -9,6 +9,7 @@ interrupted export leaves nothing and a repeated one is refused without ``force`
 dataset has 4 records of 0.02 s.
 """
 
+import dataclasses
 import json
 import sys
 
@@ -21,7 +22,10 @@ from cmsim.datasets import export as export_mod
 from cmsim.datasets.export import FORMATS, export
 from cmsim.datasets.windows import split_of
 from cmsim.errors import ParameterError
+from cmsim.frequencies import rig_frequencies
+from cmsim.measured.model_rig import documented_frequencies, model_rig
 from cmsim.measured.readers import WRITERS, read_file, read_signals
+from cmsim.measured.schema import answer_key, rig_geometry
 from cmsim.run import Run
 
 SPEC = {
@@ -94,7 +98,50 @@ def test_run_round_trips_through_the_measured_reader(made, tmp_path, fmt):
     meta = json.loads((tmp_path / "out" / "metadata.json").read_text())
     assert meta["fs_hz"] == pytest.approx(25600.0)
     assert meta["sensors"]["accel_1b1_y"]["unit"] == "m/s²"
-    assert meta["recordings"][0]["condition"] == "outer_race"
+    assert answer_key(meta["recordings"][0])["fault_label"] == "outer_race"
+    # the geometry is the run's rig: the file reads back with no rig given (the model and
+    # the lines a measured record gets from its metadata)
+    model_rig(meta["geometry"], near=meta["sensors"]["accel_1b1_y"]["near"])
+    want = rig_frequencies(run.rig, run.operating_point)
+    got = documented_frequencies(meta["geometry"], run.operating_point.shaft_hz)
+    assert got.gmf_hz == pytest.approx(want.gmf_hz, rel=1e-9)
+    assert got.bearing("1b1").bpfo_hz == pytest.approx(want.bearing("1b1").bpfo_hz, rel=1e-9)
+
+
+@pytest.mark.parametrize("faults, label", [
+    ([], "healthy"),
+    ([{"type": "inner_race", "bearing": "2b1", "size_m": 1e-3, "depth_m": 1e-4,
+       "label": "inner_race@2b1 size=1mm depth=0.1mm"}], "inner_race")])
+def test_a_plain_run_exports_its_faults_as_the_answer_key(made, tmp_path, faults, label):
+    """A run of cmsim simulate keeps its faults in meta["faults"] (no dataset labels)."""
+    rec = Run.load(made / "records" / "000002.npz")
+    meta = {k: v for k, v in rec.meta.items() if k != "labels"}
+    run = dataclasses.replace(rec, meta={**meta, "faults": faults})
+    export(run, tmp_path / "out", "npz")
+    entry = json.loads((tmp_path / "out" / "metadata.json").read_text())["recordings"][0]
+    assert answer_key(entry)["fault_label"] == label
+    assert entry["condition"] == ("healthy" if label == "healthy" else "faulty")
+    if faults:
+        assert entry["fault_component"] == "2b1"
+        assert entry["fault_severity"] == pytest.approx(1e-3)
+
+
+def test_the_geometry_of_a_bearing_rig_reads_back_as_the_same_lines():
+    """The geometry block of a rig gives, through the measured reader's model, the rig's own
+    defect frequencies (the contact angle included)."""
+    from cmsim.rig import OperatingPoint
+    from cmsim.rig.presets import PRESETS
+
+    for make in PRESETS.values():
+        rig = make()
+        op = OperatingPoint(speed_rpm=1500.0)
+        want = rig_frequencies(rig, op)
+        got = documented_frequencies(rig_geometry(rig), op.shaft_hz)
+        assert got.gmf_hz == pytest.approx(want.gmf_hz)
+        for name in rig.bearing_names:
+            for key in ("bpfo_hz", "bpfi_hz", "bsf_hz", "ftf_hz"):
+                assert getattr(got.bearing(name), key) == pytest.approx(
+                    getattr(want.bearing(name), key), rel=1e-9), (name, key)
 
 
 def test_uff_round_trips_through_pyuff(made, tmp_path):
@@ -134,6 +181,9 @@ def test_dataset_export_one_file_per_record_and_the_labels(made, tmp_path):
         assert np.load(tmp_path / "out" / f"{rid}.npz")["tacho"].dtype == np.float32
     meta = json.loads((tmp_path / "out" / "metadata.json").read_text())
     assert [r["file"] for r in meta["recordings"]] == list(labels["file"])
+    assert [answer_key(r)["fault_label"] for r in meta["recordings"]] == list(labels["label"])
+    assert meta["geometry"] == json.loads(json.dumps(rig_geometry(ds.record(0).rig)))
+    assert all(s["direction"] for s in meta["sensors"].values())
 
 
 def test_export_refuses_an_existing_out_and_force_replaces_it(made, tmp_path):
@@ -145,6 +195,23 @@ def test_export_refuses_an_existing_out_and_force_replaces_it(made, tmp_path):
     export(made, out, "npz", force=True)
     assert sorted(p.suffix for p in out.iterdir()) == [".csv", ".json"] + [".npz"] * 4
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]     # no staging left
+
+
+@pytest.mark.parametrize("where", [".", "records", ".."])
+def test_export_never_replaces_its_source(made, tmp_path, where):
+    """An out that is, lies in or holds the source is refused even with force."""
+    before = sorted(p.name for p in made.rglob("*"))
+    with pytest.raises(ParameterError, match="source") as err:
+        export(made, (made / where).resolve(), "csv", force=True)
+    assert err.value.param == "out"
+    assert sorted(p.name for p in made.rglob("*")) == before
+
+
+def test_a_run_is_not_exported_as_parquet(made, tmp_path):
+    """Parquet is a dataset's windowed layout; a run is pointed at the signal formats."""
+    with pytest.raises(ParameterError, match="windowed layout.*npz") as err:
+        export(made / "records" / "000002.npz", tmp_path / "out", "parquet")
+    assert err.value.param == "format" and not list(tmp_path.iterdir())
 
 
 def test_an_interrupted_export_leaves_nothing(made, tmp_path, monkeypatch):
@@ -176,7 +243,7 @@ def test_bad_input_is_named(made, tmp_path, bad, match):
 def test_not_a_run_nor_a_dataset(tmp_path):
     np.savez(tmp_path / "x.npz", a=np.zeros(3))
     for src in (tmp_path / "x.npz", tmp_path):
-        with pytest.raises(ParameterError, match="not a cmsim|neither"):
+        with pytest.raises(ParameterError, match="not a cmsim run|without dataset.json"):
             export(src, tmp_path / "out", "csv")
 
 
@@ -190,6 +257,12 @@ def test_every_format_is_one_writer(tmp_path, monkeypatch):
     for fmt in FILE_FORMATS:
         export_mod._write_signals(tmp_path / f"x.{fmt}", {"a": np.zeros(4)}, 100.0, {"a": "V"})
     assert used == [f".{f}" for f in FILE_FORMATS]
+
+
+def test_bearing_datasets_rows_carry_each_channel_unit(made):
+    """The tacho is volts, not an acceleration."""
+    df = export_mod.bearing_datasets_frame(made, channels=["accel_1b1_y", "tacho"])
+    assert dict(zip(df["channel"], df["unit"])) == {"accel_1b1_y": "m/s^2", "tacho": "V"}
 
 
 # ---------------------------------------------------------------------- windowed Parquet

@@ -9,6 +9,7 @@ import pytest
 
 from cmsim.datasets import DatasetSpec, generate_dataset, load
 from cmsim.datasets.torch_windows import WindowDataset
+from cmsim.errors import ParameterError
 
 SPEC = {
     "dataset": {"name": "torch", "records": 3, "seed": 4},
@@ -59,3 +60,21 @@ def test_shuffled_items_are_the_same_windows(made):
         np.testing.assert_array_equal(wins[i][0].numpy(), X[i])
     with pytest.raises(IndexError):
         wins[len(wins)]
+
+
+def test_label_indices_do_not_depend_on_the_chosen_records(made):
+    """A train and a test loader over parts of one dataset number the labels alike: classes
+    come from the whole dataset (or are given)."""
+    ds = load(made)
+    labels = dict(zip(ds.manifest["record_id"], ds.manifest["fault_label"]))
+    assert len(set(labels.values())) == 2
+    every = sorted(set(labels.values()))
+    for rid in labels:
+        wins = WindowDataset(ds, window=256, records=[rid])
+        assert wins.classes == every
+        assert wins.classes[wins._label[int(wins.index[0, 0])]] == labels[rid]
+    given = WindowDataset(ds, window=256, classes=every[::-1] + ["ball"])
+    assert given.classes == every[::-1] + ["ball"]
+    with pytest.raises(ParameterError, match="classes") as err:
+        WindowDataset(ds, window=256, classes=["ball"])
+    assert err.value.param == "classes"
