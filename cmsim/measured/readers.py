@@ -70,7 +70,7 @@ from cmsim._io import atomic_savez, atomic_write_bytes, atomic_write_text
 from cmsim.errors import ParameterError
 
 __all__ = ["READERS", "WRITERS", "SignalFile", "read_file", "read_signals", "resolve_path",
-           "write_signals"]
+           "write_signals", "is_cmsim_run", "npz_names"]
 
 #: Array names of a saved run (and of :func:`write_signals`' ``.npz``) that are not channels.
 _NOT_CHANNELS = ("t", "meta", "source", "fs_hz", "units")
@@ -440,6 +440,43 @@ READERS = {".npz": _read_npz, ".csv": _read_csv, ".wav": _read_wav, ".mat": _rea
 #: File suffix → writer ``(path, signals, rate_hz, units)``, beside each reader.
 WRITERS = {".npz": _write_npz, ".csv": _write_csv, ".wav": _write_wav, ".mat": _write_mat,
            ".uff": _write_uff, ".unv": _write_uff, ".tdms": _write_tdms}
+
+
+def npz_names(path):
+    """Array names of an ``.npz`` (empty when it is not one or is unreadable: the reader then
+    names the damage).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    set of str
+    """
+    if Path(path).suffix.lower() != ".npz":
+        return set()
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return set(z.files)
+    except Exception:  # noqa: BLE001 - any failure is the reader's to report
+        return set()
+
+
+def is_cmsim_run(path):
+    """Whether ``path`` is a file cmsim wrote (a run of ``cmsim simulate``/``sweep`` or a
+    ``cmsim dataset`` record): an ``.npz`` holding a ``meta`` array. Such a file states its
+    own rate, speed and rig; it is not a measured recording.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    bool
+    """
+    return "meta" in npz_names(path)
 
 
 def resolve_path(path):

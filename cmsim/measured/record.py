@@ -28,8 +28,8 @@ from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_di
                                       refine_speed, sample_rate_from_note)
 from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
                                       model_operating_point, model_rig)
-from cmsim.measured.readers import read_file, resolve_path
-from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metadata,
+from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
+from cmsim.measured.schema import (FOLDER_KEYS, documented_speed, read_metadata,
                                    recording_entry, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
                                    SPEED_TOLERANCE, agreed, agreed_unit)
@@ -233,18 +233,6 @@ def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
                          allowed="a number > 0: fs_hz, or \"fs_hz\" in metadata.json")
 
 
-_SPEED_KEYS = (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0),
-               ("shaft_speed_rpm_nominal", 1.0), ("shaft_speed_hz_nominal", 60.0))
-
-
-def _documented_speed(entry):
-    """``(rpm, 'metadata.json "key"')`` of the entry's first speed key, else (None, None)
-    (the order of :func:`~cmsim.measured.schema.documented_speed_rpm`)."""
-    rpm = documented_speed_rpm(entry)
-    key = next((k for k, _ in _SPEED_KEYS if entry.get(k) is not None), None)
-    return rpm, (f'metadata.json "{key}"' if key else None)
-
-
 def _check_against_lines(x, fs, speed_rpm, frequencies, notes, path, fs_source,
                          speed_source):
     """The stated sample rate and speed checked against the record's own lines
@@ -338,7 +326,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         ("unit", "unit", unit)])
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
-    rpm_doc, rpm_key = _documented_speed(entry)
+    rpm_doc, rpm_key = documented_speed(entry)
     speed, speed_from = agreed(p, "speed", [
         ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
         ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
@@ -442,10 +430,9 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
         speed and rig are its own).
     """
     p = resolve_path(path)
-    names = _npz_names(p) if p.suffix.lower() == ".npz" else set()
     stated = {"rig": rig, "fs_hz": fs_hz, "speed_rpm": speed_rpm, "unit": unit,
               "calibration": calibration}
-    if "meta" in names:
+    if is_cmsim_run(p):
         given = [k for k, v in stated.items() if v is not None]
         if given:
             raise ParameterError(f"{given[0]}: record {p} is one cmsim wrote (a run or a "
@@ -454,19 +441,9 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
                                  allowed="a measured recording")
         run = Run.load(p)
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
-        return run, (None if "t" in names else sorted(run.signals)[0])
+        return run, (None if "t" in npz_names(p) else sorted(run.signals)[0])
     rec = read_record(p, channel=channel, **stated)
     return rec.run, rec.channel
-
-
-def _npz_names(path):
-    """Array names of an ``.npz`` (empty when unreadable: :func:`read_record` then names
-    the damage)."""
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return set(z.files)
-    except Exception:  # noqa: BLE001 - any failure is the reader's to report
-        return set()
 
 
 def record_from_run(run, channel, rig, op, model_signal=None, components=None,

@@ -335,10 +335,11 @@ def test_import_writes_metadata_that_reads_back(tmp_path, capsys):
     ds = load_measured(folder)
     assert len(ds) == 2 and not ds.unreadable
     assert list(ds.manifest["fs_hz"]) == [12000.0, 12000.0]
-    assert main(["import", str(folder), "--force"]) == 0          # what the files state
+    assert main(["import", str(folder), "--force"]) == 0   # the files, then metadata.json
     capsys.readouterr()
-    meta = json.loads((folder / "metadata.json").read_text())
-    assert meta["recordings"][1]["fs_hz"] is None
+    again = json.loads((folder / "metadata.json").read_text())
+    assert again["recordings"][1]["fs_hz"] == 12000.0
+    assert again["geometry"] == meta["geometry"]
 
 
 def test_import_names_a_wavs_channels(tmp_path):
@@ -350,8 +351,70 @@ def test_import_names_a_wavs_channels(tmp_path):
         w.setsampwidth(2)
         w.setframerate(12000)
         w.writeframes(x.tobytes())
-    meta, undocumented = folder_metadata(folder, channels=["DE", "FE"], calibration=1e-3)
+    meta, undocumented, _ = folder_metadata(folder, channels=["DE", "FE"], calibration=1e-3)
     rec = meta["recordings"][0]
     assert rec["channels"] == ["DE", "FE"] and rec["fs_hz"] == 12000.0
     assert rec["calibration"] == 1e-3
     assert "r.wav: shaft speed" in undocumented and "unit of DE" in undocumented
+
+
+def test_import_leaves_out_files_cmsim_wrote(tmp_path, capsys):
+    """A run or dataset record (an .npz with a meta array) states its own rate, speed and
+    rig: import leaves it out, names it on stderr, and refuses a folder of nothing else."""
+    folder = tmp_path / "mixed"
+    folder.mkdir()
+    np.savez(folder / "a.npz", DE=_signals(4000)["DE"])
+    np.savez(folder / "sim.npz", t=np.arange(4000) / 12000.0, accel_1b1_y=np.zeros(4000),
+             meta=np.array("{}"))
+    assert main(["import", str(folder), "--fs-hz", "12000", "--json"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert [r["file"] for r in out["recordings"]] == ["a.npz"]
+    assert out["channels"] == ["DE"] and out["skipped"] == ["sim.npz"]
+    assert any("sim.npz" in w and "need no metadata" in w for w in out["warnings"])
+    (folder / "a.npz").unlink()
+    (folder / "metadata.json").unlink()
+    status, err, _ = _error(capsys, ["import", str(folder), "--fs-hz", "12000"])
+    assert status == 2 and err["option"] == "DIR"
+    assert "sim.npz" in err["error"] and "cmsim wrote" in err["error"]
+
+
+def test_import_reads_the_folders_metadata_and_keeps_hand_written_keys(tmp_path, capsys):
+    """metadata.json beside the files is a source (file > metadata.json > options), and
+    --force keeps every key import does not write (geometry, sensor position, condition)."""
+    folder = tmp_path / "lab"
+    folder.mkdir()
+    np.savez(folder / "b.npz", DE=_signals(4000)["DE"])      # states neither rate nor unit
+    geometry = {"gears": None, "bearings": {"de": {"n_balls": 9, "ball_diameter_mm": 7.94,
+                                                   "pitch_diameter_mm": 39.04}}}
+    (folder / "metadata.json").write_text(json.dumps({
+        "dataset": "lab", "fs_hz": 12000, "geometry": geometry, "rig": "a test stand",
+        "sensors": {"DE": {"near": "de", "direction": "radial", "unit": "g"}},
+        "recordings": [{"file": "b.npz", "shaft_speed_rpm": 1797, "condition": "healthy"}]}))
+    other = tmp_path / "x.json"
+    assert main(["import", str(folder), "--out", str(other), "--json"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert out["undocumented"] == [] and "warnings" not in out
+    rec = out["recordings"][0]
+    assert rec["fs_hz"] == 12000.0 and rec["shaft_speed_rpm"] == 1797.0
+    assert out["units"] == {"DE": "g"}
+    assert main(["import", str(folder), "--force"]) == 0
+    capsys.readouterr()
+    meta = json.loads((folder / "metadata.json").read_text())
+    assert meta["geometry"] == geometry and meta["rig"] == "a test stand"
+    assert meta["sensors"]["DE"] == {"near": "de", "direction": "radial", "unit": "g"}
+    assert meta["recordings"][0]["condition"] == "healthy"
+    assert meta["recordings"][0]["n_samples"] == 4000
+    status, err, _ = _error(capsys, ["import", str(folder), "--force", "--fs-hz", "24000"])
+    assert status == 2 and err["option"] == "--fs-hz"
+    assert 'metadata.json "fs_hz"' in err["error"]
+
+
+def test_import_warnings_name_the_option(tmp_path, capsys):
+    folder = tmp_path / "bare"
+    folder.mkdir()
+    np.savez(folder / "b.npz", DE=_signals(4000)["DE"])
+    assert main(["import", str(folder)]) == 0
+    err = capsys.readouterr().err
+    assert "give --fs-hz" in err and "give --speed-rpm" in err and "give --unit" in err
