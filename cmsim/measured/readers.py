@@ -15,9 +15,12 @@ Types, and what each states:
   (1, n), is read as the 1-D channel it is; any other 2-D array is refused, never dropped).
   Optional ``fs_hz`` (a scalar: the rate) and ``units`` (a JSON object string, channel →
   unit), as :func:`write_signals` writes them.
-* ``.csv`` — one column per channel, a header row of channel names; a header
-  ``name [unit]`` states the unit; a first column ``t``, ``time``, ``time_s`` or
-  ``time [s]`` is the time axis (its spacing gives the rate), not a channel.
+* ``.csv`` — one column per channel, a header row of channel names, separated by ``,``,
+  ``;`` or tabs (sniffed; a ``;`` file may use decimal commas); a header ``name [unit]`` or
+  ``name (unit)`` states the unit; a first column named ``t`` or ``time``, bare or with
+  its unit (``time_s``, ``Time (s)``, ``time [ms]``; any case) is the time axis, not a
+  channel: its steps must be even (within :data:`CSV_STEP_TOLERANCE`), and give the
+  rate.
 * ``.wav`` — one channel per WAV channel, named by ``names`` (the entry's ``channels``) when
   they match in number, else ``ch0``, ``ch1``, ...; the header rate is the sample rate. The
   samples are read as stored (integer counts of a PCM file, floats of a float file). A
@@ -77,9 +80,6 @@ _NOT_CHANNELS = ("t", "meta", "source", "fs_hz", "units")
 
 #: Scalar names of a ``.mat`` file that hold the sample rate, Hz.
 _MAT_RATE_NAMES = ("fs", "fs_hz", "sample_rate", "samplerate", "sampling_rate")
-
-#: Names of a CSV's first column that make it the time axis, s.
-_CSV_TIME_NAMES = ("t", "time", "time_s", "time [s]", "t [s]")
 
 #: Prefix of the WAV ``LIST/INFO`` comment cmsim writes and reads.
 _WAV_TAG = "cmsim "
@@ -165,24 +165,69 @@ def _write_npz(path, signals, rate_hz, units):
 
 
 # ---------------------------------------------------------------------- .csv
-_CSV_UNIT = re.compile(r"^(.*\S)\s*\[([^\]]*)\]$")
+_CSV_UNIT = re.compile(r"^(.*\S)\s*(?:\[([^\]]*)\]|\(([^)]*)\))$")
+
+#: A CSV time column's name (``t``, ``time``, ``time_s``, ``Time (s)``, ``time [ms]``, any
+#: case) → group 1 the unit (``s`` when none is written).
+_CSV_TIME = re.compile(r"^(?:t|time)(?:_(s|ms)|\s*\[\s*(s|ms)\s*\]|\s*\(\s*(s|ms)\s*\))?$",
+                       re.IGNORECASE)
+
+#: Largest relative departure of one time step of a CSV from the mean step that still
+#: counts as evenly spaced (time stamps printed to 2 significant digits of the step).
+CSV_STEP_TOLERANCE = 0.1
+
+
+def _csv_dialect(path):
+    """``(delimiter, decimal)`` of a CSV, sniffed from its first lines: ``,``, ``;`` or
+    a tab; a ``;`` file whose numbers carry a decimal comma (European locale) reads them."""
+    import csv
+    with open(path, newline="", encoding="utf-8", errors="replace") as fh:
+        head = [fh.readline() for _ in range(5)]
+    try:
+        sep = csv.Sniffer().sniff("".join(head), delimiters=",;\t").delimiter
+    except csv.Error:
+        sep = ","
+    body = "".join(head[1:])
+    decimal = "," if sep in ";\t" and re.search(r"\d,\d", body) else "."
+    return sep, decimal
+
+
+def _csv_time_rate(path, name, t, unit):
+    """The sample rate of a CSV time column ``t`` (unit ``s`` or ``ms``), checked for even
+    steps: a gap or a jump back is refused, naming where."""
+    t = np.asarray(t, dtype=float) * (1e-3 if unit.lower() == "ms" else 1.0)
+    steps = np.diff(t)
+    step = (t[-1] - t[0]) / (t.size - 1)
+    bad = np.flatnonzero(~(np.abs(steps - step) <= CSV_STEP_TOLERANCE * abs(step)))
+    if step <= 0 or not np.isfinite(step) or bad.size:
+        i = int(bad[0]) if bad.size else 0
+        raise ParameterError(
+            f"record {path}: time column {name!r} is not evenly spaced (step {i} from "
+            f"{t[i]:.9g} s to {t[i + 1]:.9g} s, the mean step is {step:.6g} s); cmsim reads "
+            f"evenly sampled records: export without gaps, or cut the record at the gap",
+            param="record", allowed="evenly spaced time stamps")
+    return _rate_of_step(step, digits=12)
 
 
 def _read_csv(path, names=None):
     import pandas as pd
-    df = pd.read_csv(path)
+    sep, decimal = _csv_dialect(path)
+    df = pd.read_csv(path, sep=sep, decimal=decimal)
     cols = [str(c) for c in df.columns]
     rate = None
-    if cols and cols[0].strip().lower() in _CSV_TIME_NAMES and len(df) > 1:
-        t = df[df.columns[0]].to_numpy(dtype=float)
-        rate = _rate_of_step((t[-1] - t[0]) / (t.size - 1), digits=12)
+    m = _CSV_TIME.match(cols[0].strip()) if cols else None
+    if m and len(df) > 1:
+        unit = next((g for g in m.groups() if g), "s")
+        rate = _csv_time_rate(path, cols[0], df[df.columns[0]].to_numpy(dtype=float), unit)
         df, cols = df.iloc[:, 1:], cols[1:]
     signals, units = {}, {}
     for c, col in zip(cols, df.columns):
         m = _CSV_UNIT.match(c)
         name = m.group(1) if m else c
-        if m and m.group(2).strip():
-            units[name] = m.group(2).strip()
+        unit = ((m.group(2) if m.group(2) is not None else m.group(3)) or "").strip() \
+            if m else ""
+        if unit:
+            units[name] = unit
         signals[name] = df[col].to_numpy(dtype=float)
     return SignalFile(signals, rate, units, rate_from="its time column")
 

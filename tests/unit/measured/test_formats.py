@@ -418,3 +418,42 @@ def test_import_warnings_name_the_option(tmp_path, capsys):
     assert main(["import", str(folder)]) == 0
     err = capsys.readouterr().err
     assert "give --fs-hz" in err and "give --speed-rpm" in err and "give --unit" in err
+
+
+# ---------------------------------------------------------------------- CSV forms
+@pytest.mark.parametrize("time_name, scale", [("t", 1.0), ("Time", 1.0), ("TIME_S", 1.0),
+                                              ("Time (s)", 1.0), ("time [s]", 1.0),
+                                              ("time [ms]", 1e3), ("t_ms", 1e3)])
+@pytest.mark.parametrize("sep", [",", ";", "\t"])
+def test_csv_time_column_forms_units_and_separators(tmp_path, time_name, scale, sep):
+    """The time column in the forms DAQ exports write it, units in [] or (), and the
+    separator sniffed (a ';' file with decimal commas, as a European locale writes it)."""
+    x = _signals(50)["DE"]
+    t = np.arange(50) / 12000.0 * scale
+    comma = sep == ";"
+    fmt = (lambda v: f"{v:.9g}".replace(".", ",")) if comma else (lambda v: f"{v:.9g}")
+    lines = [sep.join([time_name, "acc (g)", "ref [m/s^2]"])]
+    lines += [sep.join([fmt(a), fmt(b), fmt(2 * b)]) for a, b in zip(t, x)]
+    path = tmp_path / "r.csv"
+    path.write_text("\n".join(lines) + "\n")
+    f = read_file(path)
+    assert f.rate_hz == pytest.approx(12000.0, rel=1e-6)
+    assert sorted(f.signals) == ["acc", "ref"]
+    assert f.units == {"acc": "g", "ref": "m/s^2"}
+    assert np.allclose(f.signals["acc"], x, rtol=1e-8)
+
+
+@pytest.mark.parametrize("gap", ["a 10 ms gap", "a missing sample", "a step back"])
+def test_csv_uneven_time_steps_are_refused(tmp_path, gap):
+    t = np.arange(2000) / 12000.0
+    if gap == "a 10 ms gap":
+        t[1000:] += 0.01
+    elif gap == "a missing sample":
+        t = np.delete(np.arange(2001) / 12000.0, 700)
+    else:
+        t[500] = t[498]
+    path = tmp_path / "u.csv"
+    path.write_text("time_s,x [g]\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in
+                                                zip(t, _signals(2000)["DE"])))
+    with pytest.raises(ParameterError, match="not evenly spaced"):
+        read_file(path)
