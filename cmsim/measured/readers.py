@@ -30,9 +30,13 @@ Types, and what each states:
   factor may come from ``metadata.json`` (``calibration`` of the entry, applied by
   :func:`~cmsim.measured.record.read_record`).
 * ``.mat`` — MATLAB v4–v7.2 (:func:`scipy.io.loadmat`): every numeric vector is a channel
-  named by its variable (the CWRU files: ``X097_DE_time``, ``X097_FE_time``); a scalar whose
-  name ends in ``RPM`` (``X097RPM``) is the shaft speed, a scalar ``fs``, ``Fs``, ``fs_hz``
-  or ``sample_rate`` the sample rate, a struct ``units`` (channel → text) the units; other
+  named by its variable (the CWRU files: ``X097_DE_time``, ``X097_FE_time``), an n × k
+  matrix (a DAQ export's ``data``) k channels ``data_0`` ... ``data_{k-1}`` (its columns
+  when n > k); a vector ``t`` or ``time`` (``time_s``, ``t_ms``) is the time base, not a
+  channel: its steps must be even, and give the rate; a scalar whose name ends in ``RPM``
+  (``X097RPM``) is the shaft speed (several of different values are refused as
+  ambiguous), a scalar ``fs``, ``Fs``, ``fs_hz`` or ``sample_rate`` the sample rate (it
+  must agree with a time vector), a struct ``units`` (channel → text) the units; other
   scalars, strings and structs are skipped. A v7.3 file (HDF5) is read with h5py when it is
   installed, else refused with what to do.
 * ``.uff`` / ``.unv`` — Universal File Format, data sets of type 58 (what Siemens Testlab,
@@ -192,9 +196,10 @@ def _csv_dialect(path):
     return sep, decimal
 
 
-def _csv_time_rate(path, name, t, unit):
-    """The sample rate of a CSV time column ``t`` (unit ``s`` or ``ms``), checked for even
-    steps: a gap or a jump back is refused, naming where."""
+def _time_rate(path, name, t, unit="s"):
+    """The sample rate of a time column or vector ``t`` (unit ``s`` or ``ms``; a CSV's time
+    column, a ``.mat`` file's ``t``), checked for even steps: a gap or a jump back is
+    refused, naming where."""
     t = np.asarray(t, dtype=float) * (1e-3 if unit.lower() == "ms" else 1.0)
     steps = np.diff(t)
     step = (t[-1] - t[0]) / (t.size - 1)
@@ -202,7 +207,7 @@ def _csv_time_rate(path, name, t, unit):
     if step <= 0 or not np.isfinite(step) or bad.size:
         i = int(bad[0]) if bad.size else 0
         raise ParameterError(
-            f"record {path}: time column {name!r} is not evenly spaced (step {i} from "
+            f"record {path}: time {name!r} is not evenly spaced (step {i} from "
             f"{t[i]:.9g} s to {t[i + 1]:.9g} s, the mean step is {step:.6g} s); cmsim reads "
             f"evenly sampled records: export without gaps, or cut the record at the gap",
             param="record", allowed="evenly spaced time stamps")
@@ -218,7 +223,7 @@ def _read_csv(path, names=None):
     m = _CSV_TIME.match(cols[0].strip()) if cols else None
     if m and len(df) > 1:
         unit = next((g for g in m.groups() if g), "s")
-        rate = _csv_time_rate(path, cols[0], df[df.columns[0]].to_numpy(dtype=float), unit)
+        rate = _time_rate(path, cols[0], df[df.columns[0]].to_numpy(dtype=float), unit)
         df, cols = df.iloc[:, 1:], cols[1:]
     signals, units = {}, {}
     for c, col in zip(cols, df.columns):
@@ -310,12 +315,23 @@ def _write_wav(path, signals, rate_hz, units):
 
 
 # ---------------------------------------------------------------------- .mat
+def _mat_channels(path, name, a):
+    """The channels of one ``.mat`` variable: a vector is one channel; an n × k matrix (a
+    DAQ export's ``data``) is k channels ``name_0`` ... ``name_{k-1}`` — its columns when
+    n > k, else its rows."""
+    if a.ndim == 2 and min(a.shape) > 1:
+        cols = a if a.shape[0] > a.shape[1] else a.T
+        return {f"{name}_{i}": np.asarray(cols[:, i], dtype=float)
+                for i in range(cols.shape[1])}
+    return {name: _channel_1d(path, name, a)}
+
+
 def _read_mat(path, names=None):
     try:
         variables = loadmat(path, squeeze_me=True, simplify_cells=True)
     except NotImplementedError:            # a v7.3 file: HDF5 inside
         variables = _read_mat73(path)
-    signals, rate, speed, units = {}, None, None, {}
+    signals, rates, speeds, units, time = {}, {}, {}, {}, None
     for name, value in variables.items():
         if name.startswith("__"):
             continue
@@ -327,12 +343,27 @@ def _read_mat(path, names=None):
             continue                       # strings, structs, cells, logicals, complex
         if a.size == 1:
             if name.lower().endswith("rpm"):
-                speed = float(a.reshape(-1)[0])
+                speeds[name] = float(a.reshape(-1)[0])
             elif name.lower() in _MAT_RATE_NAMES:
-                rate = float(a.reshape(-1)[0])
+                rates[name] = float(a.reshape(-1)[0])
             continue
-        signals[name] = _channel_1d(path, name, a)
-    return SignalFile(signals, rate, units, speed, rate_from="its sample-rate variable")
+        m = _CSV_TIME.match(name)
+        if m and (a.ndim == 1 or 1 in a.shape) and a.size > 1:
+            time = name
+            rates[name] = _time_rate(path, name, a.reshape(-1),
+                                     next((g for g in m.groups() if g), "s"))
+            continue
+        signals.update(_mat_channels(path, name, a))
+    if len(set(speeds.values())) > 1:
+        raise ParameterError(f"record {path}: the speed is ambiguous: "
+                             + ", ".join(f"{k} = {v:g}" for k, v in speeds.items())
+                             + "; keep one rpm variable (or give --speed-rpm after removing "
+                               "the others)", param="record",
+                             allowed="one rpm value per file")
+    rate = _one_rate(path, rates, 1e-3)
+    return SignalFile(signals, rate, units, next(iter(speeds.values()), None),
+                      rate_from=(f"its time vector {time!r}" if time
+                                 else "its sample-rate variable"))
 
 
 def _read_mat73(path):
@@ -401,13 +432,16 @@ def _read_uff(path, names=None):
                       rate_from="its abscissa increment")
 
 
-def _one_rate(path, rates):
-    """The one sample rate of a file's channels (refused when they differ)."""
+def _one_rate(path, rates, tolerance=0.0):
+    """The one sample rate of a file's channels (or of its rate statements: a ``.mat``
+    file's ``fs`` and time vector), refused when two differ by more than ``tolerance``
+    (relative)."""
     values = sorted(set(rates.values()))
-    if len(values) > 1:
-        raise ParameterError(f"record {path}: channels at different sample rates ("
+    if values and values[-1] - values[0] > tolerance * values[0]:
+        raise ParameterError(f"record {path}: states different sample rates ("
                              + ", ".join(f"{k} {v:g} Hz" for k, v in rates.items())
-                             + "); export the channels of one rate to one file",
+                             + "); export the channels of one rate to one file, or "
+                               "correct the one that is wrong",
                              param="record", allowed="one sample rate per file")
     return values[0] if values else None
 

@@ -457,3 +457,39 @@ def test_csv_uneven_time_steps_are_refused(tmp_path, gap):
                                                 zip(t, _signals(2000)["DE"])))
     with pytest.raises(ParameterError, match="not evenly spaced"):
         read_file(path)
+
+
+# ---------------------------------------------------------------------- .mat forms
+def test_mat_time_vector_is_the_time_base(tmp_path):
+    x = _signals(3000)["DE"]
+    savemat(tmp_path / "r.mat", {"t": np.arange(3000) / 25600.0, "acc": x})
+    f = read_file(tmp_path / "r.mat")
+    assert list(f.signals) == ["acc"] and f.rate_hz == pytest.approx(25600.0)
+    t = np.arange(3000) / 25600.0
+    t[2000:] += 0.01
+    savemat(tmp_path / "gap.mat", {"time": t, "acc": x})
+    with pytest.raises(ParameterError, match="not evenly spaced"):
+        read_file(tmp_path / "gap.mat")
+    savemat(tmp_path / "both.mat", {"t": np.arange(3000) / 25600.0, "acc": x, "fs": 12000.0})
+    with pytest.raises(ParameterError, match="different sample rates"):
+        read_file(tmp_path / "both.mat")
+
+
+@pytest.mark.parametrize("transpose", [False, True])
+def test_mat_matrix_is_split_into_channels(tmp_path, transpose):
+    """The usual DAQ export: one n x k matrix ``data``, columns the channels (n > k)."""
+    data = np.column_stack([_signals(3000, seed=s)["DE"] for s in range(3)])
+    savemat(tmp_path / "d.mat", {"data": data.T if transpose else data, "Fs": 12000.0})
+    f = read_file(tmp_path / "d.mat")
+    assert list(f.signals) == ["data_0", "data_1", "data_2"] and f.rate_hz == 12000.0
+    assert np.allclose(f.signals["data_2"], data[:, 2])
+
+
+def test_mat_rpm_scalars_of_different_values_are_ambiguous(tmp_path):
+    x = _signals(3000)["DE"]
+    savemat(tmp_path / "same.mat", {"acc": x, "X097RPM": 1796.0, "motor_rpm": 1796.0})
+    assert read_file(tmp_path / "same.mat").speed_rpm == 1796.0
+    savemat(tmp_path / "two.mat", {"acc": x, "X097RPM": 1796.0, "motor_rpm": 1750.0})
+    with pytest.raises(ParameterError, match="ambiguous") as exc:
+        read_file(tmp_path / "two.mat")
+    assert "X097RPM = 1796" in str(exc.value) and "motor_rpm = 1750" in str(exc.value)
