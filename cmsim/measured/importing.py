@@ -24,8 +24,8 @@ from pathlib import Path
 from cmsim._io import atomic_write_text
 from cmsim.errors import ParameterError
 from cmsim.measured.readers import READERS, is_cmsim_run, read_file
-from cmsim.measured.schema import (checked_numbers, documented_speed, read_metadata,
-                                   recording_entry)
+from cmsim.measured.schema import (checked_numbers, checked_unit, documented_speed,
+                                   read_metadata, recording_entry)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
                                    SPEED_TOLERANCE, agreed, agreed_unit)
 
@@ -88,7 +88,9 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
         Names of a file's unnamed channels (a WAV's, in order), or the channels to document
         of files that name theirs (each must be in the file).
     unit : str, optional
-        Unit of the channels whose file states none (``g``, ``m/s^2``, ``V``).
+        Unit of every channel whose file and the folder's metadata state none (``g``,
+        ``m/s^2``, ``V``; :func:`~cmsim.measured.schema.checked_unit`), the rule of
+        :func:`~cmsim.measured.record.read_record`.
     calibration : float, optional
         Physical units per stored sample value, for files that store counts or volts and
         state no factor.
@@ -116,6 +118,7 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
         disagree.
     """
     folder = Path(folder)
+    unit = checked_unit(unit)
     stated = read_metadata(folder, missing_ok=True) or {}
     keep = stated if keep is None else keep
     where = folder / "metadata.json"

@@ -29,8 +29,8 @@ from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_di
 from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
                                       model_operating_point, model_rig)
 from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
-from cmsim.measured.schema import (FOLDER_KEYS, documented_speed, read_metadata,
-                                   recording_entry, unit_scale_of)
+from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
+                                   read_metadata, recording_entry, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
                                    SPEED_TOLERANCE, agreed, agreed_unit)
 from cmsim.rig import OperatingPoint, Rig
@@ -276,8 +276,9 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     speed_rpm : float, optional
         Input-shaft speed, rpm, when neither the file nor ``metadata.json`` states it.
     unit : str, optional
-        Unit of the compared channel (``g``, ``m/s^2``, ``V``), when neither the file nor
-        ``metadata.json`` states it.
+        Unit of every channel whose file and ``metadata.json`` state none (``g``,
+        ``m/s^2``, ``V``; :func:`~cmsim.measured.schema.checked_unit`), as ``calibration``
+        applies to every channel; one they state must agree.
     calibration : float, optional
         Physical units per stored sample value (a WAV in counts or volts), applied to every
         channel, when neither the file nor ``metadata.json`` states it.
@@ -297,6 +298,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         (:func:`~cmsim.measured.consistency.check_rate_and_speed`).
     """
     p = resolve_path(path)
+    unit = checked_unit(unit)
     full = read_metadata(p.parent, missing_ok=True)
     meta = {k: (full or {}).get(k) for k in FOLDER_KEYS}
     entry = recording_entry(full or {}, p.name, p.parent / "metadata.json")
@@ -366,7 +368,8 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
               {"fs_hz": fs, "channel": channel, "sensor": sensor or None,
-               "units": _channel_units(signals, f.units, sensors, channel, sensor_unit),
+               "units": _channel_units(p, signals, f.units, sensors, channel, sensor_unit,
+                                       unit),
                "recording": entry, "operating_point": {
                    "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
                    "radial_load_n": op.radial_load_n,
@@ -382,11 +385,16 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         path_documented=rig_given)
 
 
-def _channel_units(signals, file_units, sensors, channel, unit):
-    """Channel → unit, where the file or metadata.json states it (the compared channel's
-    as agreed)."""
-    out = {c: file_units.get(c) or (sensors.get(c) or {}).get("unit") for c in signals}
-    out[channel] = unit
+def _channel_units(path, signals, file_units, sensors, channel, channel_unit, unit):
+    """Channel → unit: the compared channel's ``channel_unit`` (as agreed), every other
+    channel's from the file, metadata.json or ``unit`` by the same rule
+    (:func:`~cmsim.measured.stated.agreed_unit`), as ``cmsim import`` documents them."""
+    out = {c: agreed_unit(path, c, [("the file", "record", file_units.get(c)),
+                                    ('metadata.json "sensors"', "record",
+                                     (sensors.get(c) or {}).get("unit")),
+                                    ("unit", "unit", unit)])
+           for c in signals if c != channel}
+    out[channel] = channel_unit
     return {c: u for c, u in out.items() if u}
 
 
@@ -411,7 +419,7 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
     speed_rpm : float, optional
         Input-shaft speed of a measured recording, rpm (:func:`read_record`).
     unit : str, optional
-        Unit of a measured recording's compared channel (:func:`read_record`).
+        Unit of a measured recording's channels that state none (:func:`read_record`).
     calibration : float, optional
         Physical units per stored sample value of a measured recording
         (:func:`read_record`).

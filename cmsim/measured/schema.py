@@ -26,7 +26,7 @@ __all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_
            "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
            "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
            "documented_radial_load_n", "unit_scale_of",
-           "documented_speed", "SPEED_KEYS"]
+           "documented_speed", "SPEED_KEYS", "checked_unit", "OTHER_UNITS"]
 
 #: Keys of a ``recordings[]`` entry the pipeline reads; everything else is ignored.
 RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_hz",
@@ -286,6 +286,41 @@ def documented_radial_load_n(entry):
     if entry.get("radial_load_lbs") is not None:
         return LBF_N * float(entry["radial_load_lbs"])
     return 0.0
+
+
+#: Units a channel may be given in that have no scale to m/s² (compared by shape only).
+OTHER_UNITS = ("V", "mV")
+
+
+def checked_unit(unit, param="unit"):
+    """``unit`` (stripped) when the unit table knows it (:data:`ACCELERATION_UNITS`,
+    :data:`OTHER_UNITS`, any case), None when empty or None; anything else is refused,
+    listing the known units.
+
+    Parameters
+    ----------
+    unit : str or None
+        A unit given from outside (``--unit``).
+    param : str
+        What an error is about.
+
+    Returns
+    -------
+    str or None
+
+    Raises
+    ------
+    ParameterError
+        A unit the table does not know (``furlongs``), or a blank one.
+    """
+    if unit is None:
+        return None
+    text = str(unit).strip()
+    known = tuple(ACCELERATION_UNITS) + OTHER_UNITS
+    if text.lower() not in {k.lower() for k in known}:
+        raise ParameterError(f"{param} {unit!r} is not a unit cmsim knows; allowed: "
+                             f"{', '.join(known)}", param=param, allowed=", ".join(known))
+    return text
 
 
 def unit_scale_of(unit):

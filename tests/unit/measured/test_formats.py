@@ -493,3 +493,38 @@ def test_mat_rpm_scalars_of_different_values_are_ambiguous(tmp_path):
     with pytest.raises(ParameterError, match="ambiguous") as exc:
         read_file(tmp_path / "two.mat")
     assert "X097RPM = 1796" in str(exc.value) and "motor_rpm = 1750" in str(exc.value)
+
+
+# ---------------------------------------------------------------------- --unit
+def test_unit_means_every_unstated_channel_in_read_record_as_in_import(tmp_path):
+    """One rule for --unit: every channel whose file and metadata state none (as
+    --calibration), in compare/spectrum (read_record) as in import."""
+    folder = tmp_path / "u"
+    folder.mkdir()
+    sig = _signals(8000)
+    np.savez(folder / "r.npz", DE=sig["DE"], FE=sig["FE"])
+    rec = read_record(folder / "r.npz", channel="DE", rig=_bearing_rig(), fs_hz=12000.0,
+                      unit="g")
+    meta, _, _ = folder_metadata(folder, fs_hz=12000.0, unit="g")
+    assert rec.run.meta["units"] == {"DE": "g", "FE": "g"}
+    assert {c: s["unit"] for c, s in meta["sensors"].items()} == rec.run.meta["units"]
+
+
+@pytest.mark.parametrize("unit", ["", "furlongs", "  "])
+@pytest.mark.parametrize("command", ["import", "spectrum"])
+def test_unknown_units_are_refused_listing_the_known(tmp_path, capsys, unit, command):
+    np.savez(tmp_path / "r.npz", DE=_signals(4000)["DE"])
+    target = tmp_path if command == "import" else tmp_path / "r.npz"
+    status, err, lines = _error(capsys, [command, str(target), "--fs-hz", "12000",
+                                         "--unit", unit])
+    assert status == 2 and err["option"] == "--unit" and len(lines) == 1
+    assert "m/s^2" in err["error"] and "V" in err["error"]
+    assert not (tmp_path / "metadata.json").exists()
+    with pytest.raises(ParameterError, match="allowed: g"):
+        folder_metadata(tmp_path, fs_hz=12000.0, unit=unit)
+
+
+def test_unit_names_of_the_help_are_the_unit_table():
+    from cmsim.cli.options import UNIT_NAMES
+    from cmsim.measured.schema import ACCELERATION_UNITS, OTHER_UNITS
+    assert UNIT_NAMES == tuple(ACCELERATION_UNITS) + OTHER_UNITS
