@@ -528,3 +528,25 @@ def test_unit_names_of_the_help_are_the_unit_table():
     from cmsim.cli.options import UNIT_NAMES
     from cmsim.measured.schema import ACCELERATION_UNITS, OTHER_UNITS
     assert UNIT_NAMES == tuple(ACCELERATION_UNITS) + OTHER_UNITS
+
+
+# ---------------------------------------------------------------------- inferred speed
+@needs_cwru
+def test_spectrum_says_the_speed_was_inferred_and_from_what(tmp_path, capsys):
+    """CWRU normal_0 as a WAV states no speed: the spectrum's speed comes from the signal,
+    and the text, the JSON and a stderr warning say so (as compare prints it)."""
+    _, rig, de, _ = _cwru_mat(tmp_path, N_SHORT)
+    write_signals(tmp_path / "n.wav", {"DE": de}, 12000.0, "g")
+    argv = ["spectrum", str(tmp_path / "n.wav"), "--rig", str(rig), "--top", "3"]
+    assert main(argv + ["--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    how = out["inferred"]["speed_rpm"]["how"]
+    assert how and any("inferred from the signal" in w and "--speed-rpm" in w
+                       for w in out["warnings"])
+    assert main(argv) == 0
+    cap = capsys.readouterr()
+    assert "shaft speed inferred from the signal" in cap.out and how in cap.out
+    assert "warning: shaft speed" in cap.err
+    assert main(argv + ["--speed-rpm", "1796", "--json"]) == 0     # stated: nothing inferred
+    out = json.loads(capsys.readouterr().out)
+    assert out["inferred"] == {} and "warnings" not in out
