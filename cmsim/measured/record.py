@@ -26,8 +26,9 @@ from cmsim.frequencies import RigFrequencies, rig_frequencies
 from cmsim.measured.consistency import check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
                                       refine_speed, sample_rate_from_note)
-from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
-                                      model_operating_point, model_rig)
+from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
+                                      documented_operating_point, model_operating_point,
+                                      model_rig)
 from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
 from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
                                    read_metadata, recording_entry, unit_scale_of)
@@ -340,6 +341,9 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     inferred, notes = {}, []
     rig_given = rig is not None
     if rig is None:
+        if full is None:
+            raise ParameterError(f"record {p}: {NO_GEOMETRY}", param="rig",
+                                 allowed="a rig TOML, or metadata.json with geometry")
         rig, components, notes = model_rig(geometry, near)
     else:
         components = {b: b for b in rig.bearing_names}

@@ -550,3 +550,13 @@ def test_spectrum_says_the_speed_was_inferred_and_from_what(tmp_path, capsys):
     assert main(argv + ["--speed-rpm", "1796", "--json"]) == 0     # stated: nothing inferred
     out = json.loads(capsys.readouterr().out)
     assert out["inferred"] == {} and "warnings" not in out
+
+
+@pytest.mark.parametrize("command", ["spectrum", "compare"])
+def test_no_metadata_and_no_rig_says_how_to_get_a_rig(tmp_path, capsys, command):
+    np.savez(tmp_path / "rec.npz", DE=_signals(8000)["DE"])
+    status, err, lines = _error(capsys, [command, str(tmp_path / "rec.npz"), "--fs-hz",
+                                         "12000"])
+    assert status == 2 and err["option"] == "--rig" and len(lines) == 1
+    assert "the recording has no geometry: give --rig FILE.toml" in err["error"]
+    assert "neither bearing geometry" not in err["error"]
