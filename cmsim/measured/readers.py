@@ -57,6 +57,7 @@ library is one line naming the extra to install.
 
 from __future__ import annotations
 
+import csv
 import gc
 import importlib
 import io
@@ -184,7 +185,6 @@ CSV_STEP_TOLERANCE = 0.1
 def _csv_dialect(path):
     """``(delimiter, decimal)`` of a CSV, sniffed from its first lines: ``,``, ``;`` or
     a tab; a ``;`` file whose numbers carry a decimal comma (European locale) reads them."""
-    import csv
     with open(path, newline="", encoding="utf-8", errors="replace") as fh:
         head = [fh.readline() for _ in range(5)]
     try:
