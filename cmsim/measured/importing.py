@@ -59,9 +59,9 @@ def _channel_names(path, f, channels):
     if unnamed:
         if len(channels) != len(names):
             raise ParameterError(f"channel: record {path} holds {len(names)} unnamed "
-                                 f"channel(s) ({', '.join(names)}) but {len(channels)} "
-                                 f"name(s) were given ({', '.join(channels)}); give one "
-                                 f"name per channel, in the file's order", param="channel",
+                                 f"signal(s) ({', '.join(names)}) but channel gives "
+                                 f"{len(channels)} names ({', '.join(channels)}); give one "
+                                 f"name per signal, in the file's order", param="channel",
                                  allowed=f"{len(names)} names")
         return list(channels)
     missing = [c for c in channels if c not in names]

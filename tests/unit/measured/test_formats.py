@@ -356,6 +356,10 @@ def test_import_names_a_wavs_channels(tmp_path):
     assert rec["channels"] == ["DE", "FE"] and rec["fs_hz"] == 12000.0
     assert rec["calibration"] == 1e-3
     assert "r.wav: shaft speed" in undocumented and "unit of DE" in undocumented
+    with pytest.raises(ParameterError, match=r"holds 2 unnamed signal\(s\) \(ch0, ch1\) "
+                                             r"but channel gives 1 names \(DE\); give one "
+                                             r"name per signal, in the file's order"):
+        folder_metadata(folder, channels=["DE"])
 
 
 def test_import_leaves_out_files_cmsim_wrote(tmp_path, capsys):
