@@ -1,7 +1,10 @@
 """``main(argv)``: parse, run one command, print its result (text or one JSON object).
 
 Exit status: 0 success, 1 internal error (please report) or worker processes that kept
-dying, 2 bad input, 3 diverged integration, 130 interrupted. With ``--json`` stdout holds
+dying, 2 bad input, 3 diverged integration, 130 interrupted, 141 stdout closed early (``cmsim
+... | head``: the reader left before the result was written; quietly, no traceback, and the
+status a Unix filter killed by SIGPIPE gives, so ``set -o pipefail`` treats cmsim as it
+treats ``grep`` or ``cat``: the output did not all arrive). With ``--json`` stdout holds
 exactly one JSON object, also on errors: ``{"error": message, "status": code, "option":
 "--top" or null}``; warnings go to stderr (and, with ``--json``, to the object's
 ``warnings`` list).
@@ -77,14 +80,36 @@ def _notice_compile(args, integrates=True):
               "the cache)...", file=sys.stderr)
 
 
+#: Exit status when stdout is closed before the result is written (128 + SIGPIPE).
+BROKEN_PIPE_STATUS = 141
+
+
 def main(argv=None):
     """Entry point of the ``cmsim`` console script; returns the exit status.
+
+    A reader that closes stdout early (``cmsim ... | head``) ends the command quietly with
+    :data:`BROKEN_PIPE_STATUS` (the Python documentation's recipe: the rest of stdout goes
+    to ``os.devnull``, so the interpreter's own flush at exit does not fail either).
 
     Parameters
     ----------
     argv : list of str, optional
         The arguments (default ``sys.argv[1:]``).
     """
+    try:
+        status = _main(argv)
+        sys.stdout.flush()
+        return status
+    except BrokenPipeError:
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError, AttributeError):   # stdout is no file (a capture)
+            pass
+        return BROKEN_PIPE_STATUS
+
+
+def _main(argv):
     argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
     parser = build_parser()
     args = argparse.Namespace(json="--json" in argv, command=argv[0] if argv else None,
@@ -115,6 +140,8 @@ def main(argv=None):
         return _fail(parser, args, str(exc), exc.status, exc.option, exc.extra)
     except KeyboardInterrupt:
         return _fail(parser, args, "interrupted", 130)
+    except BrokenPipeError:
+        raise                                   # main's: stdout closed early, not an error
     except Exception as exc:  # noqa: BLE001 - the last line of defence
         if os.environ.get("CMSIM_DEBUG"):
             raise

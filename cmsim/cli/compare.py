@@ -7,6 +7,7 @@ from pathlib import Path
 
 from cmsim.cli.contract import CLIError, load_file, ranged
 from cmsim.cli.options import add_recording_options, recording_values
+from cmsim.cli.output import inferred_lines
 from cmsim.errors import ParameterError
 from cmsim.rig import RANGES, Range, Rig
 
@@ -101,8 +102,7 @@ def text(res):
                 else "")
         lines.append(f"  {d['feature'] + band:24s} measured {d['measured']:.3g} simulated "
                      f"{d['simulated']:.3g} (z {d['z']:.1f})")
-    for k, v in res["inferred"].items():
-        lines.append(f"inferred {k}: {v['value']:.6g} ({v['how']})")
+    lines += inferred_lines(res["inferred"])
     lines.append(f"{res['simulations']} simulations, {res['wall_s']:.1f} s")
     if res["report"]:
         lines.append(f"wrote {res['report']}")

@@ -19,13 +19,18 @@ from cmsim.rig.plausibility import load_warnings
 __all__ = ["number", "add_rig_options", "load_rig", "add_sampling_options", "add_mesh_options",
            "mesh_argument", "prepare_tables", "add_fault_options", "faults_of", "add_losses_option",
            "check_losses_options", "resolved_setup", "operating_point", "operating_warnings",
-           "add_recording_options", "recording_values", "FAULT_NAMES"]
+           "add_recording_options", "recording_values", "FAULT_NAMES", "UNIT_NAMES"]
 
 #: The catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
 #: pulls in the mesh-stiffness stack; tests check the two agree).
 FAULT_NAMES = ("outer_race", "inner_race", "ball", "wear", "off_size_ball", "rolling_slip",
                "eccentricity", "tooth_crack", "tooth_spall", "tooth_breakage", "profile_error",
                "speed_fluctuation", "torque_ripple")
+
+
+#: The unit table's units for --help (cmsim.measured.schema ACCELERATION_UNITS + OTHER_UNITS;
+#: not imported at start-up, it pulls in the measured stack; tests check the two agree).
+UNIT_NAMES = ("g", "m/s2", "m/s^2", "m/s²", "mm/s2", "mm/s^2", "V", "mV")
 
 
 def number(name):
@@ -176,17 +181,30 @@ def add_recording_options(p):
                    help="input-shaft speed, rpm, when neither the file nor metadata.json "
                         "states it (default: found in the signal)")
     p.add_argument("--unit", metavar="UNIT",
-                   help="unit of the channel (g, m/s^2, V, ...) when neither the file nor "
-                        "metadata.json states it")
+                   help="unit of every channel whose file and metadata.json state none (as "
+                        "--calibration applies to every channel; one they state must "
+                        "agree): " + ", ".join(UNIT_NAMES))
     p.add_argument("--calibration", type=number("calibration"), metavar="C",
                    help="physical units per stored sample value (a WAV in counts or volts), "
                         "when neither the file nor metadata.json states it")
 
 
+def ranged_unit(text):
+    """The ``--unit`` ``text`` checked against the unit table
+    (:func:`cmsim.measured.schema.checked_unit`); one line naming the option and the
+    known units otherwise."""
+    from cmsim.measured.schema import checked_unit
+
+    try:
+        return checked_unit(text, "--unit")
+    except ParameterError as exc:
+        raise CLIError(str(exc), option="--unit") from None
+
+
 def recording_values(args):
     """The keyword arguments of :func:`cmsim.measured.read_record` that the recording
     options of ``args`` give (``fs_hz``, ``speed_rpm``, ``unit``, ``calibration``)."""
-    unit = (args.unit or "").strip() or None
+    unit = None if args.unit is None else ranged_unit(args.unit)
     return {"fs_hz": args.fs_hz, "speed_rpm": args.speed_rpm, "unit": unit,
             "calibration": args.calibration}
 

@@ -7,7 +7,7 @@ from pathlib import Path
 from cmsim.cli.contract import load_file, ranged
 from cmsim.cli.options import add_recording_options, recording_values
 from cmsim.errors import ParameterError
-from cmsim.cli.output import save_figure
+from cmsim.cli.output import inferred_lines, save_figure, warn_inferred
 from cmsim.rig import Range, Rig
 
 
@@ -62,7 +62,8 @@ def run(args):
            "resolution_hz": spec.resolution_hz, "bearing": spec.bearing,
            "families": spec.families, "band_hz": list(spec.band_hz) if spec.band_hz else None,
            "max_hz": spec.max_hz, "n_peaks": len(spec.peaks), "peaks": spec.peak_records(),
-           "plot": None, **spec.extra}
+           "plot": None, "inferred": dict(run_.meta.get("inferred") or {}), **spec.extra}
+    warn_inferred(args, out["inferred"])
     if args.plot:
         from cmsim.spectra.plots import plot_spectrum
         fam = spec.families
@@ -112,6 +113,7 @@ def text(res):
     lines = [f"{res['kind']} spectrum of {res['signal']} [{res['unit']}], resolution "
              f"{res['resolution_hz']:.4g} Hz, families of bearing {res['bearing']}: "
              + ", ".join(f"{k} {v:.3f} Hz" for k, v in res["families"].items())]
+    lines += inferred_lines(res.get("inferred"))
     if res["band_hz"]:
         lines.append(f"demodulation band {res['band_hz'][0]:.0f}-{res['band_hz'][1]:.0f} Hz")
     lines.append(f"{'frequency_hz':>13}  {'amplitude':>11}  {'dB re carrier':>13}  label")

@@ -5,10 +5,15 @@
 :mod:`~cmsim.measured.schema` reads, what the files state (channel names, sample rate,
 units, a ``.mat`` file's shaft speed) and what the caller gives for what they do not
 (``fs_hz``, ``speed_rpm``, ``unit``, ``calibration``; a WAV's channel names), with the rule
-of :mod:`~cmsim.measured.stated` (a file and an argument that disagree are refused, naming
-both values). The geometry and the answer key are left for the user to add: nothing in a
-signal file states them. :func:`write_folder_metadata` writes the result atomically and
-never overwrites an existing file unless told to.
+of :mod:`~cmsim.measured.stated`: the file first, then a ``metadata.json`` already in the
+folder, then the arguments (two sources that disagree are refused, naming both values).
+The geometry and the answer key are left for the user to add: nothing in a signal file
+states them; every key of an existing ``metadata.json`` that import does not produce
+itself (geometry, sensor positions, a recording's condition or answer key) is kept. A file
+cmsim wrote (an ``.npz`` with a ``meta`` array: a run or a dataset record) states its own
+rate, speed and rig and needs no metadata: it is left out and named.
+:func:`write_folder_metadata` writes the result atomically and never overwrites an
+existing file unless told to.
 """
 
 from __future__ import annotations
@@ -18,8 +23,9 @@ from pathlib import Path
 
 from cmsim._io import atomic_write_text
 from cmsim.errors import ParameterError
-from cmsim.measured.readers import READERS, read_file
-from cmsim.measured.schema import checked_numbers, recording_entry
+from cmsim.measured.readers import READERS, is_cmsim_run, read_file
+from cmsim.measured.schema import (checked_numbers, checked_unit, documented_speed,
+                                   read_metadata, recording_entry)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
                                    SPEED_TOLERANCE, agreed, agreed_unit)
 
@@ -52,10 +58,10 @@ def _channel_names(path, f, channels):
     unnamed = names == [f"ch{i}" for i in range(len(names))]
     if unnamed:
         if len(channels) != len(names):
-            raise ParameterError(f"channel: record {path} names none of its "
-                                 f"{len(names)} signal(s); give one name per signal in "
-                                 f"order: {len(names)}, got {len(channels)} "
-                                 f"({', '.join(channels)})", param="channel",
+            raise ParameterError(f"channel: record {path} holds {len(names)} unnamed "
+                                 f"signal(s) ({', '.join(names)}) but channel gives "
+                                 f"{len(channels)} names ({', '.join(channels)}); give one "
+                                 f"name per signal, in the file's order", param="channel",
                                  allowed=f"{len(names)} names")
         return list(channels)
     missing = [c for c in channels if c not in names]
@@ -66,7 +72,7 @@ def _channel_names(path, f, channels):
 
 
 def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=None,
-                    calibration=None):
+                    calibration=None, keep=None):
     """``metadata.json`` of a folder of recordings, from what the files state and the
     arguments give.
 
@@ -82,45 +88,69 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
         Names of a file's unnamed channels (a WAV's, in order), or the channels to document
         of files that name theirs (each must be in the file).
     unit : str, optional
-        Unit of the channels whose file states none (``g``, ``m/s^2``, ``V``).
+        Unit of every channel whose file and the folder's metadata state none (``g``,
+        ``m/s^2``, ``V``; :func:`~cmsim.measured.schema.checked_unit`), the rule of
+        :func:`~cmsim.measured.record.read_record`.
     calibration : float, optional
         Physical units per stored sample value, for files that store counts or volts and
         state no factor.
+    keep : dict, optional
+        Metadata whose keys are kept where import does not produce them (default the
+        folder's ``metadata.json``, also read as a source of the values).
 
     Returns
     -------
     metadata : dict
         In the schema of :mod:`~cmsim.measured.schema`: ``fs_hz`` (the files' common rate or
-        null), ``channels``, ``sensors`` (units), ``geometry`` (null: not stated by any
-        file), ``recordings``.
+        null), ``channels``, ``sensors`` (units), ``geometry`` (null unless ``keep`` has
+        it: not stated by any file), ``recordings``; every other key of ``keep`` as it is.
     undocumented : list of str
-        What neither a file nor an argument states (``x.npz: sample rate``).
+        What neither a file, the folder's metadata nor an argument states (``x.npz: sample
+        rate``).
+    skipped : list of str
+        Files cmsim wrote (runs, dataset records), left out: they need no metadata.
 
     Raises
     ------
     ParameterError
-        No signal file in the folder; a file that cannot be read; a channel not in a file;
-        a file and an argument (or two files, for a channel's unit) that disagree.
+        No measured recording in the folder; a file that cannot be read; a
+        ``metadata.json`` that is not valid; a channel not in a file; two sources that
+        disagree.
     """
     folder = Path(folder)
+    unit = checked_unit(unit)
+    stated = read_metadata(folder, missing_ok=True) or {}
+    keep = stated if keep is None else keep
+    where = folder / "metadata.json"
     files = signal_files(folder)
+    skipped = [p.name for p in files if is_cmsim_run(p)]
+    files = [p for p in files if p.name not in skipped]
     if not files:
-        raise ParameterError(f"{folder} holds no recording ({', '.join(READERS)} files)",
-                             param="dataset", allowed="a folder with signal files")
+        found = (f" (only files cmsim wrote, which need no metadata: {', '.join(skipped)})"
+                 if skipped else "")
+        raise ParameterError(f"{folder} holds no measured recording ({', '.join(READERS)} "
+                             f"files){found}", param="dataset",
+                             allowed="a folder with signal files")
+    sensors_stated = stated.get("sensors") if isinstance(stated.get("sensors"), dict) else {}
     recordings, units, unit_from, undocumented = [], {}, {}, []
     for path in files:
-        f = read_file(path, channels)
+        doc = recording_entry(stated, path.name, where)
+        f = read_file(path, channels or doc.get("channels"))
         names = _channel_names(path, f, channels)
         first = f.signals[names[0]]
-        rate, _ = agreed(path, "sample rate", [(f.rate_from, "record", f.rate_hz),
-                                               ("fs_hz", "fs_hz", fs_hz)],
-                         HEADER_RATE_TOLERANCE, " Hz")
+        rate, _ = agreed(path, "sample rate", [
+            (f.rate_from, "record", f.rate_hz),
+            ('metadata.json "fs_hz"', "record", doc.get("fs_hz") or stated.get("fs_hz")),
+            ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
+        rpm_doc, rpm_key = documented_speed(doc)
         speed, _ = agreed(path, "speed", [("the file", "record", f.speed_rpm),
+                                          (rpm_key, "record", rpm_doc),
                                           ("speed_rpm", "speed_rpm", speed_rpm)],
                           SPEED_TOLERANCE, " rpm")
         scale, _ = agreed(path, "units per stored value", [
-            ("the file", "record", f.calibration), ("calibration", "calibration", calibration)],
-            CALIBRATION_TOLERANCE)
+            ("the file", "record", f.calibration),
+            ('metadata.json "calibration"', "record", doc.get("calibration")),
+            ("calibration", "calibration", calibration)], CALIBRATION_TOLERANCE)
         entry = {"file": path.name, "n_samples": int(first.size), "fs_hz": rate,
                  "shaft_speed_rpm": speed, "channels": names}
         if scale is not None and f.calibration is None:
@@ -131,6 +161,8 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
         for name in names:                # one unit per channel name over the folder
             u = agreed_unit(path, name, [(unit_from.get(name), "record", units.get(name)),
                                          ("the file", "record", f.units.get(name)),
+                                         ('metadata.json "sensors"', "record",
+                                          (sensors_stated.get(name) or {}).get("unit")),
                                          ("unit", "unit", unit)])
             if u is not None and name not in units:
                 units[name] = u
@@ -148,7 +180,30 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
                             "unit": units.get(c)} for c in all_channels},
             "geometry": {"gears": None, "bearings": None},
             "recordings": recordings}
-    return meta, undocumented
+    return _merged(keep, meta), undocumented, skipped
+
+
+def _merged(kept, made):
+    """``made`` over ``kept``: every key of ``kept`` that import does not produce stays as it
+    is (the description, geometry, sensor positions, a recording's condition and answer
+    key); what import produces (rates, speeds, units, channels of each file) replaces it."""
+    if not isinstance(kept, dict) or not kept:
+        return made
+    out = dict(kept)
+    for key in ("dataset", "source", "geometry"):     # descriptions the user wrote win
+        out.setdefault(key, made[key])
+    out["fs_hz"] = made["fs_hz"]
+    old_channels = kept.get("channels") if isinstance(kept.get("channels"), dict) else {}
+    out["channels"] = {**made["channels"], **old_channels}
+    old_sensors = kept.get("sensors") if isinstance(kept.get("sensors"), dict) else {}
+    out["sensors"] = dict(old_sensors)
+    for c, s in made["sensors"].items():
+        old = old_sensors.get(c) if isinstance(old_sensors.get(c), dict) else {}
+        out["sensors"][c] = {**s, **old, "unit": s["unit"] if s["unit"] else old.get("unit")}
+    old_recs = {r.get("file"): r for r in kept.get("recordings") or []
+                if isinstance(r, dict)}
+    out["recordings"] = [{**old_recs.get(r["file"], {}), **r} for r in made["recordings"]]
+    return out
 
 
 def write_folder_metadata(path, metadata, *, force=False):

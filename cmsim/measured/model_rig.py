@@ -21,7 +21,7 @@ from cmsim.frequencies import RigFrequencies, bearing_frequencies
 from cmsim.measured.schema import STANDARD_GRAVITY_M_S2, documented_radial_load_n
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
 
-__all__ = ["model_rig", "documented_frequencies", "model_operating_point",
+__all__ = ["model_rig", "documented_frequencies", "model_operating_point", "NO_GEOMETRY",
            "documented_operating_point", "DEFAULT_ROTOR_MASS_KG", "DEFAULT_CLEARANCE_M"]
 
 #: Rotor mass assumed for a bearing rig whose rotor is not documented, kg.
@@ -57,6 +57,12 @@ def _gear_rig(stage):
     return replace(base, gears=pair)
 
 
+#: What to do when nothing states a recording's geometry (the start of the message).
+NO_GEOMETRY = ("the recording has no geometry: give --rig FILE.toml (a rig TOML, see "
+               "docs/guide/measured.md: cmsim.rig.preset('cwru_6205').save(...) or "
+               "Rig.save) or a metadata.json with geometry")
+
+
 def model_rig(geometry, near=None):
     """The model rig of a record's documented geometry.
 
@@ -88,8 +94,8 @@ def model_rig(geometry, near=None):
             ["gear data beyond tooth counts undocumented: the paper rig's gears and 209 "
              "bearings with the documented tooth counts"]
     if not bearings:
-        raise ParameterError("metadata.json has neither bearing geometry nor gear tooth "
-                             "counts: give a rig with --rig", param="geometry",
+        raise ParameterError(f"{NO_GEOMETRY}; metadata.json states neither bearing geometry "
+                             f"nor gear tooth counts", param="geometry",
                              allowed="geometry.bearings or geometry.gears")
     keys = list(bearings)
     first = near if near in bearings else keys[0]

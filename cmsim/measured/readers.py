@@ -15,9 +15,12 @@ Types, and what each states:
   (1, n), is read as the 1-D channel it is; any other 2-D array is refused, never dropped).
   Optional ``fs_hz`` (a scalar: the rate) and ``units`` (a JSON object string, channel →
   unit), as :func:`write_signals` writes them.
-* ``.csv`` — one column per channel, a header row of channel names; a header
-  ``name [unit]`` states the unit; a first column ``t``, ``time``, ``time_s`` or
-  ``time [s]`` is the time axis (its spacing gives the rate), not a channel.
+* ``.csv`` — one column per channel, a header row of channel names, separated by ``,``,
+  ``;`` or tabs (sniffed; a ``;`` file may use decimal commas); a header ``name [unit]`` or
+  ``name (unit)`` states the unit; a first column named ``t`` or ``time``, bare or with
+  its unit (``time_s``, ``Time (s)``, ``time [ms]``; any case) is the time axis, not a
+  channel: its steps must be even (within :data:`CSV_STEP_TOLERANCE`), and give the
+  rate.
 * ``.wav`` — one channel per WAV channel, named by ``names`` (the entry's ``channels``) when
   they match in number, else ``ch0``, ``ch1``, ...; the header rate is the sample rate. The
   samples are read as stored (integer counts of a PCM file, floats of a float file). A
@@ -27,9 +30,13 @@ Types, and what each states:
   factor may come from ``metadata.json`` (``calibration`` of the entry, applied by
   :func:`~cmsim.measured.record.read_record`).
 * ``.mat`` — MATLAB v4–v7.2 (:func:`scipy.io.loadmat`): every numeric vector is a channel
-  named by its variable (the CWRU files: ``X097_DE_time``, ``X097_FE_time``); a scalar whose
-  name ends in ``RPM`` (``X097RPM``) is the shaft speed, a scalar ``fs``, ``Fs``, ``fs_hz``
-  or ``sample_rate`` the sample rate, a struct ``units`` (channel → text) the units; other
+  named by its variable (the CWRU files: ``X097_DE_time``, ``X097_FE_time``), an n × k
+  matrix (a DAQ export's ``data``) k channels ``data_0`` ... ``data_{k-1}`` (its columns
+  when n > k); a vector ``t`` or ``time`` (``time_s``, ``t_ms``) is the time base, not a
+  channel: its steps must be even, and give the rate; a scalar whose name ends in ``RPM``
+  (``X097RPM``) is the shaft speed (several of different values are refused as
+  ambiguous), a scalar ``fs``, ``Fs``, ``fs_hz`` or ``sample_rate`` the sample rate (it
+  must agree with a time vector), a struct ``units`` (channel → text) the units; other
   scalars, strings and structs are skipped. A v7.3 file (HDF5) is read with h5py when it is
   installed, else refused with what to do.
 * ``.uff`` / ``.unv`` — Universal File Format, data sets of type 58 (what Siemens Testlab,
@@ -50,6 +57,7 @@ library is one line naming the extra to install.
 
 from __future__ import annotations
 
+import csv
 import gc
 import importlib
 import io
@@ -70,16 +78,13 @@ from cmsim._io import atomic_savez, atomic_write_bytes, atomic_write_text
 from cmsim.errors import ParameterError
 
 __all__ = ["READERS", "WRITERS", "SignalFile", "read_file", "read_signals", "resolve_path",
-           "write_signals"]
+           "write_signals", "is_cmsim_run", "npz_names"]
 
 #: Array names of a saved run (and of :func:`write_signals`' ``.npz``) that are not channels.
 _NOT_CHANNELS = ("t", "meta", "source", "fs_hz", "units")
 
 #: Scalar names of a ``.mat`` file that hold the sample rate, Hz.
 _MAT_RATE_NAMES = ("fs", "fs_hz", "sample_rate", "samplerate", "sampling_rate")
-
-#: Names of a CSV's first column that make it the time axis, s.
-_CSV_TIME_NAMES = ("t", "time", "time_s", "time [s]", "t [s]")
 
 #: Prefix of the WAV ``LIST/INFO`` comment cmsim writes and reads.
 _WAV_TAG = "cmsim "
@@ -165,24 +170,69 @@ def _write_npz(path, signals, rate_hz, units):
 
 
 # ---------------------------------------------------------------------- .csv
-_CSV_UNIT = re.compile(r"^(.*\S)\s*\[([^\]]*)\]$")
+_CSV_UNIT = re.compile(r"^(.*\S)\s*(?:\[([^\]]*)\]|\(([^)]*)\))$")
+
+#: A CSV time column's name (``t``, ``time``, ``time_s``, ``Time (s)``, ``time [ms]``, any
+#: case) → group 1 the unit (``s`` when none is written).
+_CSV_TIME = re.compile(r"^(?:t|time)(?:_(s|ms)|\s*\[\s*(s|ms)\s*\]|\s*\(\s*(s|ms)\s*\))?$",
+                       re.IGNORECASE)
+
+#: Largest relative departure of one time step of a CSV from the mean step that still
+#: counts as evenly spaced (time stamps printed to 2 significant digits of the step).
+CSV_STEP_TOLERANCE = 0.1
+
+
+def _csv_dialect(path):
+    """``(delimiter, decimal)`` of a CSV, sniffed from its first lines: ``,``, ``;`` or
+    a tab; a ``;`` file whose numbers carry a decimal comma (European locale) reads them."""
+    with open(path, newline="", encoding="utf-8", errors="replace") as fh:
+        head = [fh.readline() for _ in range(5)]
+    try:
+        sep = csv.Sniffer().sniff("".join(head), delimiters=",;\t").delimiter
+    except csv.Error:
+        sep = ","
+    body = "".join(head[1:])
+    decimal = "," if sep in ";\t" and re.search(r"\d,\d", body) else "."
+    return sep, decimal
+
+
+def _time_rate(path, name, t, unit="s"):
+    """The sample rate of a time column or vector ``t`` (unit ``s`` or ``ms``; a CSV's time
+    column, a ``.mat`` file's ``t``), checked for even steps: a gap or a jump back is
+    refused, naming where."""
+    t = np.asarray(t, dtype=float) * (1e-3 if unit.lower() == "ms" else 1.0)
+    steps = np.diff(t)
+    step = (t[-1] - t[0]) / (t.size - 1)
+    bad = np.flatnonzero(~(np.abs(steps - step) <= CSV_STEP_TOLERANCE * abs(step)))
+    if step <= 0 or not np.isfinite(step) or bad.size:
+        i = int(bad[0]) if bad.size else 0
+        raise ParameterError(
+            f"record {path}: time {name!r} is not evenly spaced (step {i} from "
+            f"{t[i]:.9g} s to {t[i + 1]:.9g} s, the mean step is {step:.6g} s); cmsim reads "
+            f"evenly sampled records: export without gaps, or cut the record at the gap",
+            param="record", allowed="evenly spaced time stamps")
+    return _rate_of_step(step, digits=12)
 
 
 def _read_csv(path, names=None):
     import pandas as pd
-    df = pd.read_csv(path)
+    sep, decimal = _csv_dialect(path)
+    df = pd.read_csv(path, sep=sep, decimal=decimal)
     cols = [str(c) for c in df.columns]
     rate = None
-    if cols and cols[0].strip().lower() in _CSV_TIME_NAMES and len(df) > 1:
-        t = df[df.columns[0]].to_numpy(dtype=float)
-        rate = _rate_of_step((t[-1] - t[0]) / (t.size - 1), digits=12)
+    m = _CSV_TIME.match(cols[0].strip()) if cols else None
+    if m and len(df) > 1:
+        unit = next((g for g in m.groups() if g), "s")
+        rate = _time_rate(path, cols[0], df[df.columns[0]].to_numpy(dtype=float), unit)
         df, cols = df.iloc[:, 1:], cols[1:]
     signals, units = {}, {}
     for c, col in zip(cols, df.columns):
         m = _CSV_UNIT.match(c)
         name = m.group(1) if m else c
-        if m and m.group(2).strip():
-            units[name] = m.group(2).strip()
+        unit = ((m.group(2) if m.group(2) is not None else m.group(3)) or "").strip() \
+            if m else ""
+        if unit:
+            units[name] = unit
         signals[name] = df[col].to_numpy(dtype=float)
     return SignalFile(signals, rate, units, rate_from="its time column")
 
@@ -265,12 +315,23 @@ def _write_wav(path, signals, rate_hz, units):
 
 
 # ---------------------------------------------------------------------- .mat
+def _mat_channels(path, name, a):
+    """The channels of one ``.mat`` variable: a vector is one channel; an n × k matrix (a
+    DAQ export's ``data``) is k channels ``name_0`` ... ``name_{k-1}`` — its columns when
+    n > k, else its rows."""
+    if a.ndim == 2 and min(a.shape) > 1:
+        cols = a if a.shape[0] > a.shape[1] else a.T
+        return {f"{name}_{i}": np.asarray(cols[:, i], dtype=float)
+                for i in range(cols.shape[1])}
+    return {name: _channel_1d(path, name, a)}
+
+
 def _read_mat(path, names=None):
     try:
         variables = loadmat(path, squeeze_me=True, simplify_cells=True)
     except NotImplementedError:            # a v7.3 file: HDF5 inside
         variables = _read_mat73(path)
-    signals, rate, speed, units = {}, None, None, {}
+    signals, rates, speeds, units, time = {}, {}, {}, {}, None
     for name, value in variables.items():
         if name.startswith("__"):
             continue
@@ -282,12 +343,27 @@ def _read_mat(path, names=None):
             continue                       # strings, structs, cells, logicals, complex
         if a.size == 1:
             if name.lower().endswith("rpm"):
-                speed = float(a.reshape(-1)[0])
+                speeds[name] = float(a.reshape(-1)[0])
             elif name.lower() in _MAT_RATE_NAMES:
-                rate = float(a.reshape(-1)[0])
+                rates[name] = float(a.reshape(-1)[0])
             continue
-        signals[name] = _channel_1d(path, name, a)
-    return SignalFile(signals, rate, units, speed, rate_from="its sample-rate variable")
+        m = _CSV_TIME.match(name)
+        if m and (a.ndim == 1 or 1 in a.shape) and a.size > 1:
+            time = name
+            rates[name] = _time_rate(path, name, a.reshape(-1),
+                                     next((g for g in m.groups() if g), "s"))
+            continue
+        signals.update(_mat_channels(path, name, a))
+    if len(set(speeds.values())) > 1:
+        raise ParameterError(f"record {path}: the speed is ambiguous: "
+                             + ", ".join(f"{k} = {v:g}" for k, v in speeds.items())
+                             + "; keep one rpm variable (or give --speed-rpm after removing "
+                               "the others)", param="record",
+                             allowed="one rpm value per file")
+    rate = _one_rate(path, rates, 1e-3)
+    return SignalFile(signals, rate, units, next(iter(speeds.values()), None),
+                      rate_from=(f"its time vector {time!r}" if time
+                                 else "its sample-rate variable"))
 
 
 def _read_mat73(path):
@@ -356,13 +432,16 @@ def _read_uff(path, names=None):
                       rate_from="its abscissa increment")
 
 
-def _one_rate(path, rates):
-    """The one sample rate of a file's channels (refused when they differ)."""
+def _one_rate(path, rates, tolerance=0.0):
+    """The one sample rate of a file's channels (or of its rate statements: a ``.mat``
+    file's ``fs`` and time vector), refused when two differ by more than ``tolerance``
+    (relative)."""
     values = sorted(set(rates.values()))
-    if len(values) > 1:
-        raise ParameterError(f"record {path}: channels at different sample rates ("
+    if values and values[-1] - values[0] > tolerance * values[0]:
+        raise ParameterError(f"record {path}: states different sample rates ("
                              + ", ".join(f"{k} {v:g} Hz" for k, v in rates.items())
-                             + "); export the channels of one rate to one file",
+                             + "); export the channels of one rate to one file, or "
+                               "correct the one that is wrong",
                              param="record", allowed="one sample rate per file")
     return values[0] if values else None
 
@@ -440,6 +519,43 @@ READERS = {".npz": _read_npz, ".csv": _read_csv, ".wav": _read_wav, ".mat": _rea
 #: File suffix → writer ``(path, signals, rate_hz, units)``, beside each reader.
 WRITERS = {".npz": _write_npz, ".csv": _write_csv, ".wav": _write_wav, ".mat": _write_mat,
            ".uff": _write_uff, ".unv": _write_uff, ".tdms": _write_tdms}
+
+
+def npz_names(path):
+    """Array names of an ``.npz`` (empty when it is not one or is unreadable: the reader then
+    names the damage).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    set of str
+    """
+    if Path(path).suffix.lower() != ".npz":
+        return set()
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return set(z.files)
+    except Exception:  # noqa: BLE001 - any failure is the reader's to report
+        return set()
+
+
+def is_cmsim_run(path):
+    """Whether ``path`` is a file cmsim wrote (a run of ``cmsim simulate``/``sweep`` or a
+    ``cmsim dataset`` record): an ``.npz`` holding a ``meta`` array. Such a file states its
+    own rate, speed and rig; it is not a measured recording.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    bool
+    """
+    return "meta" in npz_names(path)
 
 
 def resolve_path(path):

@@ -26,11 +26,12 @@ from cmsim.frequencies import RigFrequencies, rig_frequencies
 from cmsim.measured.consistency import check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
                                       refine_speed, sample_rate_from_note)
-from cmsim.measured.model_rig import (documented_frequencies, documented_operating_point,
-                                      model_operating_point, model_rig)
-from cmsim.measured.readers import read_file, resolve_path
-from cmsim.measured.schema import (FOLDER_KEYS, documented_speed_rpm, read_metadata,
-                                   recording_entry, unit_scale_of)
+from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
+                                      documented_operating_point, model_operating_point,
+                                      model_rig)
+from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
+from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
+                                   read_metadata, recording_entry, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
                                    SPEED_TOLERANCE, agreed, agreed_unit)
 from cmsim.rig import OperatingPoint, Rig
@@ -233,18 +234,6 @@ def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
                          allowed="a number > 0: fs_hz, or \"fs_hz\" in metadata.json")
 
 
-_SPEED_KEYS = (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0),
-               ("shaft_speed_rpm_nominal", 1.0), ("shaft_speed_hz_nominal", 60.0))
-
-
-def _documented_speed(entry):
-    """``(rpm, 'metadata.json "key"')`` of the entry's first speed key, else (None, None)
-    (the order of :func:`~cmsim.measured.schema.documented_speed_rpm`)."""
-    rpm = documented_speed_rpm(entry)
-    key = next((k for k, _ in _SPEED_KEYS if entry.get(k) is not None), None)
-    return rpm, (f'metadata.json "{key}"' if key else None)
-
-
 def _check_against_lines(x, fs, speed_rpm, frequencies, notes, path, fs_source,
                          speed_source):
     """The stated sample rate and speed checked against the record's own lines
@@ -288,8 +277,9 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     speed_rpm : float, optional
         Input-shaft speed, rpm, when neither the file nor ``metadata.json`` states it.
     unit : str, optional
-        Unit of the compared channel (``g``, ``m/s^2``, ``V``), when neither the file nor
-        ``metadata.json`` states it.
+        Unit of every channel whose file and ``metadata.json`` state none (``g``,
+        ``m/s^2``, ``V``; :func:`~cmsim.measured.schema.checked_unit`), as ``calibration``
+        applies to every channel; one they state must agree.
     calibration : float, optional
         Physical units per stored sample value (a WAV in counts or volts), applied to every
         channel, when neither the file nor ``metadata.json`` states it.
@@ -309,6 +299,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         (:func:`~cmsim.measured.consistency.check_rate_and_speed`).
     """
     p = resolve_path(path)
+    unit = checked_unit(unit)
     full = read_metadata(p.parent, missing_ok=True)
     meta = {k: (full or {}).get(k) for k in FOLDER_KEYS}
     entry = recording_entry(full or {}, p.name, p.parent / "metadata.json")
@@ -338,7 +329,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         ("unit", "unit", unit)])
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
-    rpm_doc, rpm_key = _documented_speed(entry)
+    rpm_doc, rpm_key = documented_speed(entry)
     speed, speed_from = agreed(p, "speed", [
         ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
         ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
@@ -350,6 +341,9 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     inferred, notes = {}, []
     rig_given = rig is not None
     if rig is None:
+        if full is None:
+            raise ParameterError(f"record {p}: {NO_GEOMETRY}", param="rig",
+                                 allowed="a rig TOML, or metadata.json with geometry")
         rig, components, notes = model_rig(geometry, near)
     else:
         components = {b: b for b in rig.bearing_names}
@@ -378,7 +372,8 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
               {"fs_hz": fs, "channel": channel, "sensor": sensor or None,
-               "units": _channel_units(signals, f.units, sensors, channel, sensor_unit),
+               "units": _channel_units(p, signals, f.units, sensors, channel, sensor_unit,
+                                       unit),
                "recording": entry, "operating_point": {
                    "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
                    "radial_load_n": op.radial_load_n,
@@ -394,11 +389,16 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         path_documented=rig_given)
 
 
-def _channel_units(signals, file_units, sensors, channel, unit):
-    """Channel → unit, where the file or metadata.json states it (the compared channel's
-    as agreed)."""
-    out = {c: file_units.get(c) or (sensors.get(c) or {}).get("unit") for c in signals}
-    out[channel] = unit
+def _channel_units(path, signals, file_units, sensors, channel, channel_unit, unit):
+    """Channel → unit: the compared channel's ``channel_unit`` (as agreed), every other
+    channel's from the file, metadata.json or ``unit`` by the same rule
+    (:func:`~cmsim.measured.stated.agreed_unit`), as ``cmsim import`` documents them."""
+    out = {c: agreed_unit(path, c, [("the file", "record", file_units.get(c)),
+                                    ('metadata.json "sensors"', "record",
+                                     (sensors.get(c) or {}).get("unit")),
+                                    ("unit", "unit", unit)])
+           for c in signals if c != channel}
+    out[channel] = channel_unit
     return {c: u for c, u in out.items() if u}
 
 
@@ -423,7 +423,7 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
     speed_rpm : float, optional
         Input-shaft speed of a measured recording, rpm (:func:`read_record`).
     unit : str, optional
-        Unit of a measured recording's compared channel (:func:`read_record`).
+        Unit of a measured recording's channels that state none (:func:`read_record`).
     calibration : float, optional
         Physical units per stored sample value of a measured recording
         (:func:`read_record`).
@@ -442,10 +442,9 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
         speed and rig are its own).
     """
     p = resolve_path(path)
-    names = _npz_names(p) if p.suffix.lower() == ".npz" else set()
     stated = {"rig": rig, "fs_hz": fs_hz, "speed_rpm": speed_rpm, "unit": unit,
               "calibration": calibration}
-    if "meta" in names:
+    if is_cmsim_run(p):
         given = [k for k, v in stated.items() if v is not None]
         if given:
             raise ParameterError(f"{given[0]}: record {p} is one cmsim wrote (a run or a "
@@ -454,19 +453,9 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
                                  allowed="a measured recording")
         run = Run.load(p)
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
-        return run, (None if "t" in names else sorted(run.signals)[0])
+        return run, (None if "t" in npz_names(p) else sorted(run.signals)[0])
     rec = read_record(p, channel=channel, **stated)
     return rec.run, rec.channel
-
-
-def _npz_names(path):
-    """Array names of an ``.npz`` (empty when unreadable: :func:`read_record` then names
-    the damage)."""
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return set(z.files)
-    except Exception:  # noqa: BLE001 - any failure is the reader's to report
-        return set()
 
 
 def record_from_run(run, channel, rig, op, model_signal=None, components=None,

@@ -25,7 +25,8 @@ from cmsim.rig import RANGES
 __all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_N", "INCH_M",
            "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
            "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
-           "documented_radial_load_n", "unit_scale_of", "rig_geometry"]
+           "documented_radial_load_n", "unit_scale_of", "rig_geometry",
+           "documented_speed", "SPEED_KEYS", "checked_unit", "OTHER_UNITS"]
 
 #: Keys of a ``recordings[]`` entry the pipeline reads; everything else is ignored.
 RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_hz",
@@ -223,6 +224,29 @@ def answer_key(rec):
             "condition": rec.get("condition")}
 
 
+#: Speed keys of a recording entry, in the order they are read, with their factor to rpm.
+SPEED_KEYS = (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0),
+              ("shaft_speed_rpm_nominal", 1.0), ("shaft_speed_hz_nominal", 60.0))
+
+
+def documented_speed(entry):
+    """``(rpm, 'metadata.json "key"')`` of the entry's first speed key (:data:`SPEED_KEYS`),
+    else ``(None, None)``: the value and the phrase naming its source in a message.
+
+    Parameters
+    ----------
+    entry : dict
+        Readable keys of the entry (:func:`recording_entry`).
+
+    Returns
+    -------
+    rpm : float or None
+    phrase : str or None
+    """
+    key = next((k for k, _ in SPEED_KEYS if entry.get(k) is not None), None)
+    return documented_speed_rpm(entry), (f'metadata.json "{key}"' if key else None)
+
+
 def documented_speed_rpm(entry):
     """Input-shaft speed of a recording entry, rpm, or None when undocumented.
 
@@ -238,8 +262,7 @@ def documented_speed_rpm(entry):
     -------
     float or None
     """
-    for key, factor in (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0),
-                        ("shaft_speed_rpm_nominal", 1.0), ("shaft_speed_hz_nominal", 60.0)):
+    for key, factor in SPEED_KEYS:
         if entry.get(key) is not None:
             return factor * float(entry[key])
     return None
@@ -263,6 +286,41 @@ def documented_radial_load_n(entry):
     if entry.get("radial_load_lbs") is not None:
         return LBF_N * float(entry["radial_load_lbs"])
     return 0.0
+
+
+#: Units a channel may be given in that have no scale to m/s² (compared by shape only).
+OTHER_UNITS = ("V", "mV")
+
+
+def checked_unit(unit, param="unit"):
+    """``unit`` (stripped) when the unit table knows it (:data:`ACCELERATION_UNITS`,
+    :data:`OTHER_UNITS`, any case), None when empty or None; anything else is refused,
+    listing the known units.
+
+    Parameters
+    ----------
+    unit : str or None
+        A unit given from outside (``--unit``).
+    param : str
+        What an error is about.
+
+    Returns
+    -------
+    str or None
+
+    Raises
+    ------
+    ParameterError
+        A unit the table does not know (``furlongs``), or a blank one.
+    """
+    if unit is None:
+        return None
+    text = str(unit).strip()
+    known = tuple(ACCELERATION_UNITS) + OTHER_UNITS
+    if text.lower() not in {k.lower() for k in known}:
+        raise ParameterError(f"{param} {unit!r} is not a unit cmsim knows; allowed: "
+                             f"{', '.join(known)}", param=param, allowed=", ".join(known))
+    return text
 
 
 def unit_scale_of(unit):

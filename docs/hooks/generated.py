@@ -109,7 +109,8 @@ def cli_reference():
              "site is built; `cmsim COMMAND --help` prints the same. Every command takes "
              "`--json` (one JSON object on stdout, also on errors: "
              '`{"error", "status", "option"}`); exit status 0 success, 1 internal error, '
-             "2 bad input, 3 diverged integration, 130 interrupted. Progress of long steps "
+             "2 bad input, 3 diverged integration, 130 interrupted, 141 stdout closed "
+             "early (`cmsim ... | head`; quietly, as a Unix filter). Progress of long steps "
              "(a first numba compile, an FE gear-body build) goes to stderr "
              "(`CMSIM_PROGRESS=0` silences it).", "",
              "```text", parser.format_usage().strip(), "```", ""]

@@ -431,15 +431,18 @@ CATALOGUE = [
     R("compare-channel-not-in-mat", "compare {rec_mat} --channel X097_BA_time --fs-hz 12000",
       "--channel", "X097_DE_time", "X097_FE_time"),
     R("compare-mat-no-rig", "compare {rec_mat} --fs-hz 12000", "--rig", "geometry"),
-    R("import-empty-dir", "import {empty_dir} --out {work}/m.json", "DIR", "no recording"),
+    R("import-empty-dir", "import {empty_dir} --out {work}/m.json", "DIR",
+      "no measured recording"),
     R("import-dir-missing", "import {work}/none", "DIR", "does not exist"),
     R("import-out-exists", "import {measured_dir}", "--out", "exists", "--force"),
-    R("import-fs-disagrees", "import {rec_wav_rate_dir} --out {work}/m.json --fs-hz 12000",
+    R("import-fs-disagrees", "import {rec_wav_bare_dir} --out {work}/m.json --fs-hz 12000",
       "--fs-hz", "48000 Hz", "12000 Hz"),
+    R("import-metadata-disagrees", "import {rec_wav_rate_dir} --out {work}/m.json", "DIR",
+      "48000 Hz", 'metadata.json "fs_hz" says 12000 Hz'),
     R("import-channel-missing", "import {measured_dir} --out {work}/m.json --channel FE",
       "--channel", "'FE'", "DE"),
-    R("import-wav-names-count", "import {rec_wav_rate_dir} --out {work}/m.json --channel A B",
-      "--channel", "got 2"),
+    R("import-wav-names-count", "import {rec_wav_bare_dir} --out {work}/m.json --channel A B",
+      "--channel", "1 unnamed signal", "2 names"),
     R("import-damaged", "import {rec_truncated_dir} --out {work}/m.json", "DIR",
       "truncated"),
     R("calibrate-record-truncated", "calibrate {rec_truncated} --out {work}/m.toml",
@@ -830,6 +833,10 @@ def _bad_recordings(d):
         w.setframerate(48000)
         w.writeframes((x / np.abs(x).max() * 30000).astype("<i2").tobytes())
     f["rec_wav_rate"] = wav
+    bare = d / "wav_bare"                    # the same WAV without metadata.json
+    bare.mkdir()
+    (bare / "rec.wav").write_bytes(wav.read_bytes())
+    f["rec_wav_bare"] = bare / "rec.wav"
     f.update({f"{k}_dir": v.parent for k, v in list(f.items())})
     return f
 

@@ -335,10 +335,11 @@ def test_import_writes_metadata_that_reads_back(tmp_path, capsys):
     ds = load_measured(folder)
     assert len(ds) == 2 and not ds.unreadable
     assert list(ds.manifest["fs_hz"]) == [12000.0, 12000.0]
-    assert main(["import", str(folder), "--force"]) == 0          # what the files state
+    assert main(["import", str(folder), "--force"]) == 0   # the files, then metadata.json
     capsys.readouterr()
-    meta = json.loads((folder / "metadata.json").read_text())
-    assert meta["recordings"][1]["fs_hz"] is None
+    again = json.loads((folder / "metadata.json").read_text())
+    assert again["recordings"][1]["fs_hz"] == 12000.0
+    assert again["geometry"] == meta["geometry"]
 
 
 def test_import_names_a_wavs_channels(tmp_path):
@@ -350,8 +351,216 @@ def test_import_names_a_wavs_channels(tmp_path):
         w.setsampwidth(2)
         w.setframerate(12000)
         w.writeframes(x.tobytes())
-    meta, undocumented = folder_metadata(folder, channels=["DE", "FE"], calibration=1e-3)
+    meta, undocumented, _ = folder_metadata(folder, channels=["DE", "FE"], calibration=1e-3)
     rec = meta["recordings"][0]
     assert rec["channels"] == ["DE", "FE"] and rec["fs_hz"] == 12000.0
     assert rec["calibration"] == 1e-3
     assert "r.wav: shaft speed" in undocumented and "unit of DE" in undocumented
+    with pytest.raises(ParameterError, match=r"holds 2 unnamed signal\(s\) \(ch0, ch1\) "
+                                             r"but channel gives 1 names \(DE\); give one "
+                                             r"name per signal, in the file's order"):
+        folder_metadata(folder, channels=["DE"])
+
+
+def test_import_leaves_out_files_cmsim_wrote(tmp_path, capsys):
+    """A run or dataset record (an .npz with a meta array) states its own rate, speed and
+    rig: import leaves it out, names it on stderr, and refuses a folder of nothing else."""
+    folder = tmp_path / "mixed"
+    folder.mkdir()
+    np.savez(folder / "a.npz", DE=_signals(4000)["DE"])
+    np.savez(folder / "sim.npz", t=np.arange(4000) / 12000.0, accel_1b1_y=np.zeros(4000),
+             meta=np.array("{}"))
+    assert main(["import", str(folder), "--fs-hz", "12000", "--json"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert [r["file"] for r in out["recordings"]] == ["a.npz"]
+    assert out["channels"] == ["DE"] and out["skipped"] == ["sim.npz"]
+    assert any("sim.npz" in w and "need no metadata" in w for w in out["warnings"])
+    (folder / "a.npz").unlink()
+    (folder / "metadata.json").unlink()
+    status, err, _ = _error(capsys, ["import", str(folder), "--fs-hz", "12000"])
+    assert status == 2 and err["option"] == "DIR"
+    assert "sim.npz" in err["error"] and "cmsim wrote" in err["error"]
+
+
+def test_import_reads_the_folders_metadata_and_keeps_hand_written_keys(tmp_path, capsys):
+    """metadata.json beside the files is a source (file > metadata.json > options), and
+    --force keeps every key import does not write (geometry, sensor position, condition)."""
+    folder = tmp_path / "lab"
+    folder.mkdir()
+    np.savez(folder / "b.npz", DE=_signals(4000)["DE"])      # states neither rate nor unit
+    geometry = {"gears": None, "bearings": {"de": {"n_balls": 9, "ball_diameter_mm": 7.94,
+                                                   "pitch_diameter_mm": 39.04}}}
+    (folder / "metadata.json").write_text(json.dumps({
+        "dataset": "lab", "fs_hz": 12000, "geometry": geometry, "rig": "a test stand",
+        "sensors": {"DE": {"near": "de", "direction": "radial", "unit": "g"}},
+        "recordings": [{"file": "b.npz", "shaft_speed_rpm": 1797, "condition": "healthy"}]}))
+    other = tmp_path / "x.json"
+    assert main(["import", str(folder), "--out", str(other), "--json"]) == 0
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert out["undocumented"] == [] and "warnings" not in out
+    rec = out["recordings"][0]
+    assert rec["fs_hz"] == 12000.0 and rec["shaft_speed_rpm"] == 1797.0
+    assert out["units"] == {"DE": "g"}
+    assert main(["import", str(folder), "--force"]) == 0
+    capsys.readouterr()
+    meta = json.loads((folder / "metadata.json").read_text())
+    assert meta["geometry"] == geometry and meta["rig"] == "a test stand"
+    assert meta["sensors"]["DE"] == {"near": "de", "direction": "radial", "unit": "g"}
+    assert meta["recordings"][0]["condition"] == "healthy"
+    assert meta["recordings"][0]["n_samples"] == 4000
+    status, err, _ = _error(capsys, ["import", str(folder), "--force", "--fs-hz", "24000"])
+    assert status == 2 and err["option"] == "--fs-hz"
+    assert 'metadata.json "fs_hz"' in err["error"]
+
+
+def test_import_warnings_name_the_option(tmp_path, capsys):
+    folder = tmp_path / "bare"
+    folder.mkdir()
+    np.savez(folder / "b.npz", DE=_signals(4000)["DE"])
+    assert main(["import", str(folder)]) == 0
+    err = capsys.readouterr().err
+    assert "give --fs-hz" in err and "give --speed-rpm" in err and "give --unit" in err
+
+
+# ---------------------------------------------------------------------- CSV forms
+@pytest.mark.parametrize("time_name, scale", [("t", 1.0), ("Time", 1.0), ("TIME_S", 1.0),
+                                              ("Time (s)", 1.0), ("time [s]", 1.0),
+                                              ("time [ms]", 1e3), ("t_ms", 1e3)])
+@pytest.mark.parametrize("sep", [",", ";", "\t"])
+def test_csv_time_column_forms_units_and_separators(tmp_path, time_name, scale, sep):
+    """The time column in the forms DAQ exports write it, units in [] or (), and the
+    separator sniffed (a ';' file with decimal commas, as a European locale writes it)."""
+    x = _signals(50)["DE"]
+    t = np.arange(50) / 12000.0 * scale
+    comma = sep == ";"
+    fmt = (lambda v: f"{v:.9g}".replace(".", ",")) if comma else (lambda v: f"{v:.9g}")
+    lines = [sep.join([time_name, "acc (g)", "ref [m/s^2]"])]
+    lines += [sep.join([fmt(a), fmt(b), fmt(2 * b)]) for a, b in zip(t, x)]
+    path = tmp_path / "r.csv"
+    path.write_text("\n".join(lines) + "\n")
+    f = read_file(path)
+    assert f.rate_hz == pytest.approx(12000.0, rel=1e-6)
+    assert sorted(f.signals) == ["acc", "ref"]
+    assert f.units == {"acc": "g", "ref": "m/s^2"}
+    assert np.allclose(f.signals["acc"], x, rtol=1e-8)
+
+
+@pytest.mark.parametrize("gap", ["a 10 ms gap", "a missing sample", "a step back"])
+def test_csv_uneven_time_steps_are_refused(tmp_path, gap):
+    t = np.arange(2000) / 12000.0
+    if gap == "a 10 ms gap":
+        t[1000:] += 0.01
+    elif gap == "a missing sample":
+        t = np.delete(np.arange(2001) / 12000.0, 700)
+    else:
+        t[500] = t[498]
+    path = tmp_path / "u.csv"
+    path.write_text("time_s,x [g]\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in
+                                                zip(t, _signals(2000)["DE"])))
+    with pytest.raises(ParameterError, match="not evenly spaced"):
+        read_file(path)
+
+
+# ---------------------------------------------------------------------- .mat forms
+def test_mat_time_vector_is_the_time_base(tmp_path):
+    x = _signals(3000)["DE"]
+    savemat(tmp_path / "r.mat", {"t": np.arange(3000) / 25600.0, "acc": x})
+    f = read_file(tmp_path / "r.mat")
+    assert list(f.signals) == ["acc"] and f.rate_hz == pytest.approx(25600.0)
+    t = np.arange(3000) / 25600.0
+    t[2000:] += 0.01
+    savemat(tmp_path / "gap.mat", {"time": t, "acc": x})
+    with pytest.raises(ParameterError, match="not evenly spaced"):
+        read_file(tmp_path / "gap.mat")
+    savemat(tmp_path / "both.mat", {"t": np.arange(3000) / 25600.0, "acc": x, "fs": 12000.0})
+    with pytest.raises(ParameterError, match="different sample rates"):
+        read_file(tmp_path / "both.mat")
+
+
+@pytest.mark.parametrize("transpose", [False, True])
+def test_mat_matrix_is_split_into_channels(tmp_path, transpose):
+    """The usual DAQ export: one n x k matrix ``data``, columns the channels (n > k)."""
+    data = np.column_stack([_signals(3000, seed=s)["DE"] for s in range(3)])
+    savemat(tmp_path / "d.mat", {"data": data.T if transpose else data, "Fs": 12000.0})
+    f = read_file(tmp_path / "d.mat")
+    assert list(f.signals) == ["data_0", "data_1", "data_2"] and f.rate_hz == 12000.0
+    assert np.allclose(f.signals["data_2"], data[:, 2])
+
+
+def test_mat_rpm_scalars_of_different_values_are_ambiguous(tmp_path):
+    x = _signals(3000)["DE"]
+    savemat(tmp_path / "same.mat", {"acc": x, "X097RPM": 1796.0, "motor_rpm": 1796.0})
+    assert read_file(tmp_path / "same.mat").speed_rpm == 1796.0
+    savemat(tmp_path / "two.mat", {"acc": x, "X097RPM": 1796.0, "motor_rpm": 1750.0})
+    with pytest.raises(ParameterError, match="ambiguous") as exc:
+        read_file(tmp_path / "two.mat")
+    assert "X097RPM = 1796" in str(exc.value) and "motor_rpm = 1750" in str(exc.value)
+
+
+# ---------------------------------------------------------------------- --unit
+def test_unit_means_every_unstated_channel_in_read_record_as_in_import(tmp_path):
+    """One rule for --unit: every channel whose file and metadata state none (as
+    --calibration), in compare/spectrum (read_record) as in import."""
+    folder = tmp_path / "u"
+    folder.mkdir()
+    sig = _signals(8000)
+    np.savez(folder / "r.npz", DE=sig["DE"], FE=sig["FE"])
+    rec = read_record(folder / "r.npz", channel="DE", rig=_bearing_rig(), fs_hz=12000.0,
+                      unit="g")
+    meta, _, _ = folder_metadata(folder, fs_hz=12000.0, unit="g")
+    assert rec.run.meta["units"] == {"DE": "g", "FE": "g"}
+    assert {c: s["unit"] for c, s in meta["sensors"].items()} == rec.run.meta["units"]
+
+
+@pytest.mark.parametrize("unit", ["", "furlongs", "  "])
+@pytest.mark.parametrize("command", ["import", "spectrum"])
+def test_unknown_units_are_refused_listing_the_known(tmp_path, capsys, unit, command):
+    np.savez(tmp_path / "r.npz", DE=_signals(4000)["DE"])
+    target = tmp_path if command == "import" else tmp_path / "r.npz"
+    status, err, lines = _error(capsys, [command, str(target), "--fs-hz", "12000",
+                                         "--unit", unit])
+    assert status == 2 and err["option"] == "--unit" and len(lines) == 1
+    assert "m/s^2" in err["error"] and "V" in err["error"]
+    assert not (tmp_path / "metadata.json").exists()
+    with pytest.raises(ParameterError, match="allowed: g"):
+        folder_metadata(tmp_path, fs_hz=12000.0, unit=unit)
+
+
+def test_unit_names_of_the_help_are_the_unit_table():
+    from cmsim.cli.options import UNIT_NAMES
+    from cmsim.measured.schema import ACCELERATION_UNITS, OTHER_UNITS
+    assert UNIT_NAMES == tuple(ACCELERATION_UNITS) + OTHER_UNITS
+
+
+# ---------------------------------------------------------------------- inferred speed
+@needs_cwru
+def test_spectrum_says_the_speed_was_inferred_and_from_what(tmp_path, capsys):
+    """CWRU normal_0 as a WAV states no speed: the spectrum's speed comes from the signal,
+    and the text, the JSON and a stderr warning say so (as compare prints it)."""
+    _, rig, de, _ = _cwru_mat(tmp_path, N_SHORT)
+    write_signals(tmp_path / "n.wav", {"DE": de}, 12000.0, "g")
+    argv = ["spectrum", str(tmp_path / "n.wav"), "--rig", str(rig), "--top", "3"]
+    assert main(argv + ["--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    how = out["inferred"]["speed_rpm"]["how"]
+    assert how and any("inferred from the signal" in w and "--speed-rpm" in w
+                       for w in out["warnings"])
+    assert main(argv) == 0
+    cap = capsys.readouterr()
+    assert "shaft speed inferred from the signal" in cap.out and how in cap.out
+    assert "warning: shaft speed" in cap.err
+    assert main(argv + ["--speed-rpm", "1796", "--json"]) == 0     # stated: nothing inferred
+    out = json.loads(capsys.readouterr().out)
+    assert out["inferred"] == {} and "warnings" not in out
+
+
+@pytest.mark.parametrize("command", ["spectrum", "compare"])
+def test_no_metadata_and_no_rig_says_how_to_get_a_rig(tmp_path, capsys, command):
+    np.savez(tmp_path / "rec.npz", DE=_signals(8000)["DE"])
+    status, err, lines = _error(capsys, [command, str(tmp_path / "rec.npz"), "--fs-hz",
+                                         "12000"])
+    assert status == 2 and err["option"] == "--rig" and len(lines) == 1
+    assert "the recording has no geometry: give --rig FILE.toml" in err["error"]
+    assert "neither bearing geometry" not in err["error"]
