@@ -143,6 +143,6 @@ def test_calibrate_reports_an_inferred_speed_in_text_and_json(tmp_path, capsys):
     assert main(argv) == 0
     line = next(s for s in capsys.readouterr().out.splitlines() if s.startswith("inferred"))
     assert line.startswith("inferred speed_rpm of IR007_0: 1799"), line
-    assert main(argv + ["--json"]) == 0
+    assert main(argv + ["--json", "--force"]) == 0          # the machine file exists now
     inferred = json.loads(capsys.readouterr().out)["inferred"]
     assert inferred["IR007_0"]["speed_rpm"]["value"] == pytest.approx(1797.0, rel=5e-3)
