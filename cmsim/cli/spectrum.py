@@ -110,16 +110,23 @@ def _raise(exc):
 
 def text(res):
     """The peaks as a table."""
+    order = res["kind"] == "order"
+    fr = res["families"].get("fr") or 1.0
+    families = (", ".join(f"{k} {v / fr:.3f}" for k, v in res["families"].items()) + " orders"
+                if order else ", ".join(f"{k} {v:.3f} Hz" for k, v in res["families"].items()))
     lines = [f"{res['kind']} spectrum of {res['signal']} [{res['unit']}], resolution "
-             f"{res['resolution_hz']:.4g} Hz, families of bearing {res['bearing']}: "
-             + ", ".join(f"{k} {v:.3f} Hz" for k, v in res["families"].items())]
+             + (f"{res['resolution_hz'] / fr:.4g} orders (angle from the "
+                f"{res.get('angle_from', 'nominal speed')})" if order
+                else f"{res['resolution_hz']:.4g} Hz")
+             + f", families of bearing {res['bearing']}: " + families]
     lines += inferred_lines(res.get("inferred"))
     if res["band_hz"]:
         lines.append(f"demodulation band {res['band_hz'][0]:.0f}-{res['band_hz'][1]:.0f} Hz")
-    lines.append(f"{'frequency_hz':>13}  {'amplitude':>11}  {'dB re carrier':>13}  label")
+    column = "order" if order else "frequency_hz"
+    lines.append(f"{column:>13}  {'amplitude':>11}  {'dB re carrier':>13}  label")
     for p in res["peaks"]:
         db = "" if p["db_re_carrier"] is None else f"{p['db_re_carrier']:.1f}"
-        lines.append(f"{p['frequency_hz']:13.2f}  {p['amplitude']:11.4g}  {db:>13}  "
+        lines.append(f"{p[column]:13.2f}  {p['amplitude']:11.4g}  {db:>13}  "
                      f"{p['label']}")
     if res["plot"]:
         lines.append(f"wrote {res['plot']}")

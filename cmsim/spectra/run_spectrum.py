@@ -152,7 +152,8 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         Signal name, one of ``run.names``.
     kind : {"amplitude", "envelope", "order"}
         Amplitude spectrum of the record, envelope spectrum (band ``band_hz``, default the
-        kurtogram's), or order spectrum at the nominal shaft speed.
+        kurtogram's), or order spectrum (the shaft angle from the run's ``tacho`` when it has
+        one, so a run-up's lines stay at their orders; else from the nominal shaft speed).
     band_hz : tuple of float, optional
         Demodulation band (lo, hi) in Hz, 0 <= lo < hi <= fs/2; only for ``kind="envelope"``.
     max_hz : float, optional
@@ -210,7 +211,15 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         lab_f, lab_fam, scale = f, fam, 1.0
     else:
         fr = fam["fr"]
-        osp = order_spectrum(x, fs, speed_rpm=60.0 * fr)
+        # the shaft angle from the run's own tacho where it has one (a run-up's lines stay at
+        # their orders), else from the nominal speed
+        tacho = run.signals.get("tacho")
+        if tacho is not None:
+            osp = order_spectrum(x, fs, tacho=np.asarray(tacho, dtype=float))
+            extra["angle_from"] = "tacho"
+        else:
+            osp = order_spectrum(x, fs, speed_rpm=60.0 * fr)
+            extra["angle_from"] = "nominal speed"
         df_hz = osp.resolution_order * fr
         if res is not None and df_hz > res * (1.0 + 1e-12):
             need = math.ceil(fr / res)

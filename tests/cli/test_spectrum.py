@@ -137,3 +137,21 @@ def test_measured_recording(capsys):
     bpfi = res["families"]["BPFI"]
     assert bpfi == pytest.approx(162.19, rel=1e-3)
     assert any(abs(p["frequency_hz"] - bpfi) < 1.0 for p in res["peaks"]), res["peaks"]
+
+
+def test_order_spectrum_of_a_run_up_follows_its_tacho(capsys, tmp_path):
+    """A run-up's mesh stays at order 28 (the 28-tooth pinion) when the angle comes from the
+    run's tacho; at the nominal speed it would smear over 1.5x the orders."""
+    path = tmp_path / "runup.npz"
+    main(["simulate", "--speed-rpm", "600", "--ramp-to-rpm", "900", "--torque-nm", "50",
+          "--duration-s", "0.6", "--sensors", "--out", str(path)])
+    capsys.readouterr()
+    status, res = cli_json(capsys, ["spectrum", str(path), "--kind", "order", "--top", "5"])
+    assert status == 0 and res["angle_from"] == "tacho"
+    gmf = [p for p in res["peaks"] if p["family"] == "GMF" and p["m"] == 0 and p["n"] == 0]
+    assert len(gmf) >= 2                      # mesh harmonics stand out, at their orders
+    assert all(p["order"] == pytest.approx(28.0 * p["k"], abs=0.05) for p in gmf)
+    assert main(["spectrum", str(path), "--kind", "order"]) == 0
+    out = capsys.readouterr().out
+    assert "orders (angle from the tacho)" in out and "GMF 28.000" in out
+    assert out.splitlines()[1].split()[0] == "order"
