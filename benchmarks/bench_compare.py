@@ -69,14 +69,14 @@ def _spy_on_decisions():
     original = cm.decide
     seen = {}
 
-    def decide(ranked, sensor_bearing, chi_nominal, z=None):
+    def decide(ranked, sensor_bearing, chi_nominal):
         seen["decide"] = {
-            "sensor_bearing": sensor_bearing, "chi_nominal": chi_nominal, "z": z,
+            "sensor_bearing": sensor_bearing, "chi_nominal": chi_nominal,
             "ranked": [{"name": r["name"], "component": r["component"],
                         "fault": r["cause"].signature is not None,
                         "delta_chi2": r["delta_chi2"], "judged_on": r["judged_on"],
                         "per_feature": r["per_feature"]} for r in ranked]}
-        return original(ranked, sensor_bearing, chi_nominal, z)
+        return original(ranked, sensor_bearing, chi_nominal)
 
     cm.decide = decide
     return seen

@@ -312,8 +312,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
           "sigma": sigma[k], "z": (meas_fit[k] - f_nom_fit[k]) / sigma[k],
           **_band_of(k, edges)} for k in cols),
         key=lambda d: -abs(d["z"]))
-    top, ties = decide(ranked, ev.sensor_bearing, chi_nom,
-                       {d["feature"]: d["z"] for d in discrepancies})
+    top, ties = decide(ranked, ev.sensor_bearing, chi_nom)
     finding, component, params, ranges, fitted = "none", None, {}, {}, setup_nom
     if top is not None:
         finding = top["name"]

@@ -208,7 +208,7 @@ def evidence(r, chi_of, nominal_features, names):
     r["delta_chi2"] = sum(pf[k] for k in judged)
 
 
-def decide(ranked, sensor_bearing, chi_nominal, z=None):
+def decide(ranked, sensor_bearing, chi_nominal):
     """(winner or None, near ties) from ranked causes with their evidence filled.
 
     Faults (causes with a signature) are decided first: of those whose evidence reaches
@@ -226,9 +226,6 @@ def decide(ranked, sensor_bearing, chi_nominal, z=None):
         The bearing the sensor sits on (model name).
     chi_nominal : float
         χ² of the nominal model over every feature (fit segments).
-    z : dict of str to float, optional
-        The record's departure from the nominal model per feature, in σ (record above the
-        model: positive).
 
     Returns
     -------
