@@ -29,7 +29,8 @@ from cmsim.dynamics._bearing_kernels import BI_SIZE, BP_C, BP_CAGE, BP_K, BP_P, 
 from cmsim.dynamics._mesh_kernels import (MI_SIZE, MP_A0, MP_BETA, MP_DTHR, MP_KOSTER, MP_MU,
                                           MP_OM1, MP_OM2, MP_PB, MP_PSI10, MP_PSI20, MP_SLO,
                                           MP_TAB0, MP_TABD, MP_V0, MP_ZAFTER, MP_ZBEFORE)
-from cmsim.dynamics._rhs_kernels import integrate_jit, make_integrator_buffers, make_work
+from cmsim.dynamics._rhs_kernels import (integrate_jit, make_integrator_buffers, make_work,
+                                         no_propagator)
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.simulation import integrate
 from cmsim.dynamics.tooth_contact import resolve_mesh
@@ -191,7 +192,8 @@ def main():
 
     def linear_only():
         # without the mesh, the load torque spins shaft 2 up: lift the divergence limits
-        status = integrate_jit(y0, 0.0, h, n_steps, 1, 0, tab.a, tab.b, tab.c, P,
+        status = integrate_jit(y0, 0.0, h, n_steps, 1, 0, tab.a, tab.b, tab.c,
+                               no_propagator(tab.b.shape[0]), P,
                                make_work(P), make_integrator_buffers(tab.b, 2 * n, diag.shape[1]),
                                out, diag, math.inf, math.inf, model.translational_mask)
         assert status == -1

@@ -301,12 +301,88 @@ def make_integrator_buffers(tableau_b, dim, n_diag):
                              np.empty(dim), np.empty(n_diag))
 
 
+#: States of one chain's block in a :class:`LinearPropagator` (a chain of at most 4 DOFs):
+#: a fixed size, so the block products unroll and vectorise.
+CHAIN_STATES = 8
+
+
+class LinearPropagator(NamedTuple):
+    """Exact propagator ``X`` of the linear part an exponential scheme integrates in closed form.
+
+    An exponential (Lawson) scheme splits ``y' = L y + N(t, y)`` where ``L`` is the linear
+    spring-damper part of some chains of DOFs (:mod:`cmsim.dynamics.exponential` chooses
+    them) and ``N`` everything else, and runs the Runge-Kutta tableau on
+    ``w = e^{−(t − t_n)L} y``. ``L`` is block diagonal, one block per chain of ``m`` DOFs
+    (``2m <=`` :data:`CHAIN_STATES`): ``idx[b, :2m]`` are chain ``b``'s state entries (its
+    DOFs' positions, then their velocities), ``size[b] = 2m``. ``ahead[i, b] = e^{c_i h L_b}``
+    for each stage node ``c_i`` and ``ahead[s, b] = e^{h L_b}``; ``back[i, b] =
+    e^{−c_i h L_b}``, each padded with zeros to :data:`CHAIN_STATES`. No chains (see
+    :func:`no_propagator`) is the plain Runge-Kutta scheme, bit for bit.
+    """
+
+    idx: np.ndarray      # int64 (chains, CHAIN_STATES) state entries of each chain
+    size: np.ndarray     # int64 (chains,) states of each chain
+    ahead: np.ndarray    # (s + 1, chains, CHAIN_STATES, CHAIN_STATES)
+    back: np.ndarray     # (s, chains, CHAIN_STATES, CHAIN_STATES)
+    tmp: np.ndarray      # (CHAIN_STATES,) scratch
+
+
+def no_propagator(stages):
+    """The neutral :class:`LinearPropagator` of a plain ``stages``-stage scheme."""
+    return LinearPropagator(np.zeros((0, CHAIN_STATES), dtype=np.int64),
+                            np.zeros(0, dtype=np.int64),
+                            np.zeros((stages + 1, 0, CHAIN_STATES, CHAIN_STATES)),
+                            np.zeros((stages, 0, CHAIN_STATES, CHAIN_STATES)),
+                            np.zeros(CHAIN_STATES))
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
-def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, P, W, B, out_y,
+def _propagate_row_jit(X, which, x, row):
+    """``x[row, idx] = back[which] @ x[row, idx]`` chain by chain, from the velocity entries
+    only (the slope ``N`` has no position entries there: ``L`` carries the chains'
+    kinematics)."""
+    tmp = X.tmp
+    for b in range(X.size.shape[0]):
+        size = X.size[b]
+        half = size // 2
+        for i in range(CHAIN_STATES):
+            tmp[i] = 0.0
+        for i in range(half, size):
+            tmp[i] = x[row, X.idx[b, i]]
+        for i in range(size):
+            acc = 0.0
+            for j in range(CHAIN_STATES):
+                acc += X.back[which, b, i, j] * tmp[j]
+            x[row, X.idx[b, i]] = acc
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _propagate_jit(X, which, x):
+    """``x[idx] = ahead[which] @ x[idx]`` chain by chain (a state)."""
+    tmp = X.tmp
+    for b in range(X.size.shape[0]):
+        size = X.size[b]
+        for i in range(CHAIN_STATES):
+            tmp[i] = 0.0
+        for i in range(size):
+            tmp[i] = x[X.idx[b, i]]
+        for i in range(size):
+            acc = 0.0
+            for j in range(CHAIN_STATES):
+                acc += X.ahead[which, b, i, j] * tmp[j]
+            x[X.idx[b, i]] = acc
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, X, P, W, B, out_y,
                   out_diag, max_disp, max_rot, trans_mask):
     """Fixed-step explicit Runge-Kutta with output every ``substeps`` steps.
 
-    The scheme is data: ``rk_a`` (s, s) strictly lower triangular, ``rk_b`` (s,), ``rk_c`` (s,).
+    The scheme is data: ``rk_a`` (s, s) strictly lower triangular, ``rk_b`` (s,), ``rk_c`` (s,),
+    and ``X`` the :class:`LinearPropagator` of its exponential (Lawson) form — stage ``i``
+    evaluates ``N`` at ``e^{c_i h L} W_i`` and its slope is ``e^{−c_i h L} N``, the step ends
+    with ``e^{hL}`` — or :func:`no_propagator` for the plain scheme; ``P`` then holds the
+    springs of ``N`` only.
     ``W`` is the :class:`Work` of :func:`make_work`, ``B`` the :class:`IntegratorBuffers` of
     :func:`make_integrator_buffers`. Sample ``m`` of ``out_y`` is the state at
     ``t0 + (m_offset + m)·substeps·h``; ``out_diag[m]`` holds the output forces at that
@@ -329,6 +405,7 @@ def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, P, W, 
     ns = rk_b.shape[0]
     dim = y0.shape[0]
     n = dim // 2
+    n_ex = X.size.shape[0]
     for i in range(dim):
         y[i] = y0[i]
     for m in range(n_out):
@@ -346,16 +423,26 @@ def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, P, W, 
                     out_diag[m, i] = scratch[i]
                 if m == n_out - 1:
                     return -1
+            if n_ex > 0:
+                # L carries the exact chains' kinematics: N has no position entries there
+                # (c_0 = 0: no propagation)
+                _propagate_row_jit(X, 0, k, 0)
             for st in range(1, ns):
                 for i in range(dim):
                     acc = y[i]
                     for jj in range(st):
                         acc += h * rk_a[st, jj] * k[jj, i]
                     yi[i] = acc
+                if n_ex > 0:
+                    _propagate_jit(X, st, yi)
                 rhs_jit(t + rk_c[st] * h, yi, k, st, P, scratch, False, W)
+                if n_ex > 0:
+                    _propagate_row_jit(X, st, k, st)
             for i in range(dim):
                 acc = 0.0
                 for st in range(ns):
                     acc += rk_b[st] * k[st, i]
                 y[i] += h * acc
+            if n_ex > 0:
+                _propagate_jit(X, ns, y)
     return -1

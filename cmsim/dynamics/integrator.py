@@ -4,11 +4,13 @@ References
 ----------
 .. [1] P. Bogacki, L. F. Shampine, "A 3(2) pair of Runge-Kutta formulas", Appl. Math. Lett.
    2 (1989) 321-325 (MATLAB/Simulink ``ode3``).
+.. [2] J. D. Lawson, "Generalized Runge-Kutta processes for stable systems with large
+   Lipschitz constants", SIAM J. Numer. Anal. 4 (1967) 372-380 (``lawson-ode3``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -29,19 +31,26 @@ class ButcherTableau:
         Nodes.
     order : int
         Order of accuracy.
+    exponential : bool
+        Run in Lawson form: the stiff linear chains in closed form
+        (:mod:`cmsim.dynamics.exponential`), the rest with these coefficients.
     """
 
     a: np.ndarray
     b: np.ndarray
     c: np.ndarray
     order: int
+    exponential: bool = False
 
+
+# Bogacki-Shampine 3rd order (Simulink ode3), without the FSAL error stage
+_ODE3 = ButcherTableau(np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, 0.75, 0.0]]),
+                       np.array([2.0 / 9.0, 1.0 / 3.0, 4.0 / 9.0]), np.array([0.0, 0.5, 0.75]), 3)
 
 SCHEMES = {
-    # Bogacki-Shampine 3rd order (Simulink ode3), without the FSAL error stage
-    "ode3": ButcherTableau(np.array([[0.0, 0.0, 0.0], [0.5, 0.0, 0.0], [0.0, 0.75, 0.0]]),
-                           np.array([2.0 / 9.0, 1.0 / 3.0, 4.0 / 9.0]),
-                           np.array([0.0, 0.5, 0.75]), 3),
+    "ode3": _ODE3,
+    # ode3 in Lawson form: the stiff linear chains in closed form (cmsim.dynamics.exponential)
+    "lawson-ode3": replace(_ODE3, exponential=True),
     # classical 4th-order Runge-Kutta, for convergence checks
     "rk4": ButcherTableau(np.array([[0.0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1.0, 0]]),
                           np.array([1.0, 2.0, 2.0, 1.0]) / 6.0, np.array([0.0, 0.5, 0.5, 1.0]), 4),

@@ -104,11 +104,12 @@ def _averaged_bearing_stiffness(model, states, times):
     return out / len(states)
 
 
-def _linearised_stiffness(model, k_brg, k_mesh):
-    """Symmetric K of the linearised model: the linear part, each bearing's tangent stiffness
-    ``k_brg`` (nb, 2, 2) on its x, y DOFs and the mesh stiffness ``k_mesh`` (N/m) along the
-    mesh Jacobian (a rig without gears has no mesh term)."""
-    kmat = model.stiffness.copy()
+def _linearised_stiffness(model, k_brg, k_mesh, linear_stiffness=None):
+    """Symmetric K of the linearised model: the linear part (``model.stiffness`` unless
+    ``linear_stiffness`` is given), each bearing's tangent stiffness ``k_brg`` (nb, 2, 2) on its
+    x, y DOFs and the mesh stiffness ``k_mesh`` (N/m) along the mesh Jacobian (a rig without
+    gears has no mesh term)."""
+    kmat = (model.stiffness if linear_stiffness is None else linear_stiffness).copy()
     for ib in range(k_brg.shape[0]):
         ix = int(model.kernel_params.b_int[ib, BI_X])
         kmat[ix:ix + 2, ix:ix + 2] += k_brg[ib]
@@ -118,18 +119,20 @@ def _linearised_stiffness(model, k_brg, k_mesh):
     return 0.5 * (kmat + kmat.T)
 
 
-def highest_frequency_hz(model, q, t=0.0):
+def highest_frequency_hz(model, q, t=0.0, linear_stiffness=None):
     """Highest natural frequency of ``model`` linearised at state ``q`` (time ``t``), Hz.
 
     Bearings enter with their tangent stiffness at ``q`` and the mesh with the peak of its
     total stiffness over a mesh cycle (double contact), so the figure bounds the stiffest
     mode the integrator meets; it sets the automatic integration step of
     :func:`cmsim.dynamics.simulate`. One 19×19 eigenvalue problem: cheap.
+    ``linear_stiffness`` replaces the linear springs' K (the part an exponential scheme
+    leaves to the explicit stages).
     """
     k_brg = _averaged_bearing_stiffness(model, [np.asarray(q, float)], [t])
     gears = model.rig.gears
     k_peak = 0.0 if gears is None else float(np.max(model.mesh_table.mesh_stiffness(gears)[1]))
-    eig = scipy.linalg.eigvalsh(_linearised_stiffness(model, k_brg, k_peak),
+    eig = scipy.linalg.eigvalsh(_linearised_stiffness(model, k_brg, k_peak, linear_stiffness),
                                 np.diag(model.mass))
     return float(math.sqrt(max(eig[-1], 0.0)) / (2.0 * math.pi))
 

@@ -14,10 +14,10 @@ import numpy as np
 import cmsim
 from cmsim.dynamics._decimation_kernels import gather_columns_jit
 from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
-                                         make_integrator_buffers, make_work)
+                                         make_integrator_buffers, make_work, no_propagator)
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import FIR_LANES, AntiAliasFilter
-from cmsim.dynamics.modal import highest_frequency_hz
+from cmsim.dynamics.exponential import choose_scheme
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
@@ -67,10 +67,14 @@ class _Integrator:
     faults of tens of megabytes per run.
     """
 
-    def __init__(self, model, scheme, progress=None):
+    def __init__(self, model, scheme, progress=None, split=None):
         check_choice("scheme", scheme, tuple(SCHEMES))
         self.model = model
         self.tab = SCHEMES[scheme]
+        # an exponential scheme integrates the split's chains in closed form and the rest
+        # (its kernel arrays) with the tableau; a plain one everything with the tableau
+        self.split = split if self.tab.exponential else None
+        self.params = model.kernel_params if self.split is None else self.split.kernel_params
         self.progress = progress
         self.wall = 0.0
         self.max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
@@ -80,12 +84,14 @@ class _Integrator:
         model, tab = self.model, self.tab
         n_diag = len(model.output_force_names)
         buffers = make_integrator_buffers(tab.b, y0.size, n_diag)
+        prop = (no_propagator(tab.b.shape[0]) if self.split is None
+                else self.split.propagator(tab, h))
         # compile (or load from cache) outside the timed region, then start from fresh scratch
-        integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
-                      make_work(model.kernel_params), buffers, np.empty((1, y0.size)),
+        integrate_jit(y0, t0, h, 1, 1, 0, tab.a, tab.b, tab.c, prop, self.params,
+                      make_work(self.params), buffers, np.empty((1, y0.size)),
                       np.empty((1, n_diag)), self.max_disp, MAX_ROTATION_DEVIATION_RAD,
                       self.mask)
-        self.work = make_work(model.kernel_params)
+        self.work = make_work(self.params)
         y, m0 = y0, 0
         rows = min(chunk_steps + 1, n_out)
         states_buf = np.empty((rows, y0.size))
@@ -97,8 +103,8 @@ class _Integrator:
             diag = diag_buf[:count]
             first = m0 - 1 if m0 else 0
             start = time.perf_counter()
-            status = integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c,
-                                   model.kernel_params, self.work, buffers, states, diag,
+            status = integrate_jit(y, t0, h, count, substeps, first, tab.a, tab.b, tab.c, prop,
+                                   self.params, self.work, buffers, states, diag,
                                    self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
             self.wall += time.perf_counter() - start
             if status >= 0:
@@ -122,7 +128,7 @@ class _Integrator:
 
 
 def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=None,
-              progress=None):
+              progress=None, split=None):
     """Run the fixed-step kernel; returns ``(states, diag, wall_s)``.
 
     Parameters
@@ -146,6 +152,10 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     progress : callable, optional
         Called as ``progress(done, total)`` (output samples) after each chunk of
         :data:`CHUNK_STEPS` samples; chunks do not change the result.
+    split : LinearSplit, optional
+        The chains an exponential ``scheme`` integrates in closed form
+        (:func:`cmsim.dynamics.exponential.choose_scheme`; without it, an exponential
+        scheme runs as its plain tableau).
 
     Returns
     -------
@@ -154,7 +164,7 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     wall_s : float
         Wall time of the integration proper (compilation excluded), s.
     """
-    runner = _Integrator(model, scheme, progress)
+    runner = _Integrator(model, scheme, progress, split)
     states = np.empty((n_out, y0.size))
     diag = np.empty((n_out, len(model.output_force_names)))
     for m0, st, dg in runner.chunks(np.asarray(y0, dtype=float), t0, dt_out / substeps, n_out,
@@ -224,7 +234,7 @@ def _recorded(model, record):
 
 
 def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, progress=None,
-                         q_cols=None, d_cols=None):
+                         q_cols=None, d_cols=None, split=None):
     """Integrate at ``aa.factor`` steps per output sample in chunks and decimate through
     ``aa``; returns the recorded ``(q, forces, wall_s)`` at the output instants
     ``n_warm .. n_warm + n_rec − 1``. With ``q_cols``/``d_cols`` only those state and force
@@ -238,7 +248,7 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     d_out = np.full((n_rec, n_forces), np.nan)
     qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
     dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
-    runner = _Integrator(model, scheme, progress)
+    runner = _Integrator(model, scheme, progress, split)
     m0 = 0                                        # next output sample to fill
     n_tail = 0                                    # fast samples not yet consumed, at buf[0:]
     # the filtered columns side by side, padded with zeros to the filter kernel's lanes, in
@@ -292,7 +302,8 @@ def _compile_seconds():
                             (MeshStiffnessTable.constant(rig.gears, 1e8), None))
         y0 = np.zeros(2 * model.n_dof)
         tab = SCHEMES["ode3"]
-        integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c, model.kernel_params,
+        integrate_jit(y0, 0.0, 1e-5, 2, 1, 0, tab.a, tab.b, tab.c,
+                      no_propagator(tab.b.shape[0]), model.kernel_params,
                       make_work(model.kernel_params),
                       make_integrator_buffers(tab.b, y0.size, len(model.output_force_names)),
                       np.empty((2, y0.size)),
@@ -361,7 +372,11 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
         Integration steps per output sample (default: chosen from the highest mode and the
         fastest excitation, see above; 1 = the paper's fixed step 1/fs, no filter).
     scheme : str
-        ``"ode3"`` (Bogacki-Shampine, default), ``"rk4"`` or ``"heun"``.
+        ``"ode3"`` (Bogacki-Shampine, default), ``"rk4"``, ``"heun"``, or
+        ``"lawson-ode3"``: ode3 with the stiff linear chains of the shafts in closed form
+        (:mod:`cmsim.dynamics.exponential`); its automatic step is set by the rest of the
+        model (2 steps per sample at 25.6 kHz on the paper's rig instead of 3), and the
+        run's meta lists the DOFs it integrated exactly (``exact_linear_dofs``).
     mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
         Tooth contact model: ``None`` (default) = the rig's hybrid FE + Weber–Banaschek
         tables at the run's torque (paper 001 §6.1, model B); ``"potential-energy"`` (paper
@@ -420,6 +435,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     -------
     Run
     """
+    check_choice("scheme", scheme, tuple(SCHEMES))
     duration_s = RANGES["duration_s"].check("duration_s", duration_s)
     fs_hz = RANGES["fs_hz"].check("fs_hz", fs_hz)
     warmup_s = RANGES["warmup_s"].check("warmup_s", warmup_s)
@@ -483,9 +499,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     if n_rec < 2:
         raise ParameterError(f"duration_s = {duration_s:g} s gives fewer than 2 samples at "
                              f"fs_hz = {fs_hz:g}")
-    f_max = highest_frequency_hz(model, q0)
-    if substeps is None:
-        substeps = integration_substeps(fs_hz, excitation, f_max)
+    split, substeps, f_max = choose_scheme(model, q0, fs_hz, excitation, scheme, substeps)
     stats = {}
     if on_start is not None:
         on_start(warmup_s + duration_s)
@@ -493,7 +507,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     try:
         states, diag, wall, n_warm, aa = _integrate_run(
             model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress, q_cols,
-            d_cols)
+            d_cols, split)
     except IntegrationDiverged as exc:
         if not start_method.endswith("(no equilibrium found)"):
             raise
@@ -514,6 +528,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
                             "radial_load_angle_rad": op.radial_load_angle_rad},
         "fs_hz": fs_hz, "substeps": int(substeps), "scheme": scheme,
         "integration_fs_hz": fs_hz * substeps, "highest_mode_hz": f_max,
+        "exact_linear_dofs": [] if split is None else [model.dof_names[d] for d in split.dofs],
         "fastest_excitation": {"name": excitation.name, "hz": excitation.hz},
         "anti_alias": None if aa is None else aa.to_dict(), "warmup_s": n_warm / fs_hz,
         "duration_s": n_rec / fs_hz, "seed": int(seed),
@@ -548,7 +563,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
 
 
 def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress,
-                   q_cols, d_cols):
+                   q_cols, d_cols, split=None):
     """The run's integration: ``(states, diag, wall_s, n_warm, anti_alias)`` of the recorded
     samples, directly at ``fs_hz`` (one step per sample) or through the anti-alias filter."""
     if substeps == 1:
@@ -556,7 +571,7 @@ def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stat
         report = None if progress is None else (lambda done, total: progress(done * dt,
                                                                              total * dt))
         states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
-                                       report)
+                                       report, split)
         return states[n_warm:, :model.n_dof], diag[n_warm:], wall, n_warm, None
     aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
     # the centred filter needs half its length of integration before the first sample
@@ -564,7 +579,7 @@ def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stat
     report = None if progress is None else (lambda done, total: progress(
         done * dt / substeps, total * dt / substeps))
     states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme, stats,
-                                              report, q_cols, d_cols)
+                                              report, q_cols, d_cols, split)
     return states, diag, wall, n_warm, aa
 
 

@@ -19,7 +19,7 @@ from cmsim.dynamics import build_model, quasi_static_state
 from cmsim.dynamics._bearing_kernels import BI_SIZE, BP_CAGE, BP_PHASE, BP_SENSE, BP_SIZE, DF_SIZE
 from cmsim.dynamics._mesh_kernels import MI_SIZE, MP_SIZE, no_hybrid
 from cmsim.dynamics._rhs_kernels import (KernelParams, integrate_jit, make_integrator_buffers,
-                                         make_work, no_profile)
+                                         make_work, no_profile, no_propagator)
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.simulation import check_memory, integrate
 from cmsim.errors import ParameterError
@@ -55,7 +55,8 @@ def run_sdof(scheme, h, t_end=2e-3):
     P = sdof_packed()
     n_out = int(round(t_end / h)) + 1
     out = np.empty((n_out, 2))
-    status = integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, 0, tab.a, tab.b, tab.c, P,
+    status = integrate_jit(np.array([X0, 0.0]), 0.0, h, n_out, 1, 0, tab.a, tab.b, tab.c,
+                           no_propagator(tab.b.shape[0]), P,
                            make_work(P), make_integrator_buffers(tab.b, 2, 0), out,
                            np.empty((n_out, 0)), 1.0, 1.0, np.array([True]))
     assert status == -1

@@ -12,7 +12,8 @@ import pytest
 import cmsim
 from cmsim.dynamics import build_model, quasi_static_state
 from cmsim.dynamics._mesh_kernels import MI_BALL_SLIP
-from cmsim.dynamics._rhs_kernels import integrate_jit, make_integrator_buffers, make_work
+from cmsim.dynamics._rhs_kernels import (integrate_jit, make_integrator_buffers, make_work,
+                                         no_propagator)
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.tooth_contact import resolve_mesh
 from cmsim.faults import RollingSlip
@@ -32,7 +33,8 @@ def _run(model, P, n_out=1500):
     y0 = np.concatenate([quasi_static_state(model, 0.0), np.zeros(model.n_dof)])
     out = np.empty((n_out, y0.size))
     diag = np.empty((n_out, len(model.output_force_names)))
-    status = integrate_jit(y0, 0.0, H, n_out, 1, 0, tab.a, tab.b, tab.c, P, make_work(P),
+    status = integrate_jit(y0, 0.0, H, n_out, 1, 0, tab.a, tab.b, tab.c, no_propagator(3), P,
+                           make_work(P),
                            make_integrator_buffers(tab.b, y0.size, diag.shape[1]), out, diag,
                            1e-3, 0.5, model.translational_mask)
     assert status == -1
