@@ -17,7 +17,7 @@ from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
                                          make_integrator_buffers, make_work, no_propagator)
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.decimation import FIR_LANES, AntiAliasFilter
-from cmsim.dynamics.exponential import choose_scheme
+from cmsim.dynamics.schemes import choose_scheme
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
 from cmsim.dynamics.quasistatic import initial_state
@@ -337,7 +337,7 @@ def compile_kernels():
 
 
 def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLING.fs_hz,
-             substeps=SAMPLING.substeps, scheme="ode3", slip=None, seed=SAMPLING.seed,
+             substeps=SAMPLING.substeps, scheme="auto", slip=None, seed=SAMPLING.seed,
              warmup_s=SAMPLING.warmup_s, cage_phases_rad="random",
              profile=None, faults=(), progress=None, loads=None, friction_table=None,
              damping_table=None, losses=None, record=None, on_start=None):
@@ -348,12 +348,14 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     ``duration_s`` at ``fs_hz``.
 
     The integration step is ``1/(fs_hz·substeps)`` (the rule: :mod:`cmsim.dynamics.step`). By
-    default ``substeps`` is the smallest integer that gives at least :data:`STEPS_PER_PERIOD`
-    steps per period of the model's highest natural frequency (linearised at the start;
-    15.9 kHz for the paper's rig, so 75 kHz as in the paper) and of each of the first
+    default ``substeps`` is the smallest integer that gives the scheme enough steps per
+    period of the model's highest natural frequency (linearised at the start; 15.9 kHz for
+    the paper's rig; ode3 :data:`STEPS_PER_PERIOD`, so 75 kHz as in the paper) and
+    :data:`STEPS_PER_PERIOD` per period of each of the first
     :data:`~cmsim.dynamics.step.RESOLVED_HARMONICS` harmonics of the fastest excitation (the
     gear mesh or a ball pass, at the fastest speed of the run); a ``substeps`` given that
-    does not resolve the excitation is refused. With ``substeps > 1`` the states and forces
+    does not resolve the excitation is refused. The scheme is chosen with the step
+    (:mod:`cmsim.dynamics.schemes`): ode3 at 75 kHz, rk4 at 2 steps per sample at 25.6 kHz. With ``substeps > 1`` the states and forces
     pass through an anti-alias FIR (:class:`~cmsim.dynamics.decimation.AntiAliasFilter`:
     flat to 0.8 × Nyquist, ≥ 80 dB down from Nyquist on) before every ``substeps``-th
     sample is kept, as an acquisition system does: nothing above the output Nyquist
@@ -372,11 +374,12 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
         Integration steps per output sample (default: chosen from the highest mode and the
         fastest excitation, see above; 1 = the paper's fixed step 1/fs, no filter).
     scheme : str
-        ``"ode3"`` (Bogacki-Shampine, default), ``"rk4"``, ``"heun"``, or
-        ``"lawson-ode3"``: ode3 with the stiff linear chains of the shafts in closed form
-        (:mod:`cmsim.dynamics.exponential`); its automatic step is set by the rest of the
-        model (2 steps per sample at 25.6 kHz on the paper's rig instead of 3), and the
-        run's meta lists the DOFs it integrated exactly (``exact_linear_dofs``).
+        ``"auto"`` (default: ode3 or rk4, whichever takes fewer right-hand-side evaluations
+        per sample, :mod:`cmsim.dynamics.schemes`), ``"ode3"`` (Bogacki-Shampine),
+        ``"rk4"``, ``"heun"``, or ``"lawson-ode3"``: ode3 with the stiff linear chains of
+        the shafts in closed form (:mod:`cmsim.dynamics.exponential`; its step is set by
+        the rest of the model, and the run's meta lists the DOFs it integrated exactly,
+        ``exact_linear_dofs``). The run's meta records the scheme and steps taken.
     mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
         Tooth contact model: ``None`` (default) = the rig's hybrid FE + Weber–Banaschek
         tables at the run's torque (paper 001 §6.1, model B); ``"potential-energy"`` (paper
@@ -435,7 +438,7 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     -------
     Run
     """
-    check_choice("scheme", scheme, tuple(SCHEMES))
+    check_choice("scheme", scheme, ("auto",) + tuple(SCHEMES))
     duration_s = RANGES["duration_s"].check("duration_s", duration_s)
     fs_hz = RANGES["fs_hz"].check("fs_hz", fs_hz)
     warmup_s = RANGES["warmup_s"].check("warmup_s", warmup_s)
@@ -499,7 +502,8 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     if n_rec < 2:
         raise ParameterError(f"duration_s = {duration_s:g} s gives fewer than 2 samples at "
                              f"fs_hz = {fs_hz:g}")
-    split, substeps, f_max = choose_scheme(model, q0, fs_hz, excitation, scheme, substeps)
+    scheme, split, substeps, f_max = choose_scheme(model, q0, fs_hz, excitation, scheme,
+                                                   substeps)
     stats = {}
     if on_start is not None:
         on_start(warmup_s + duration_s)

@@ -29,12 +29,33 @@ from cmsim.frequencies import rig_frequencies
 from cmsim.rig import RANGES
 
 __all__ = ["STEPS_PER_PERIOD", "RESOLVED_HARMONICS", "Excitation", "fastest_excitation",
-           "integration_substeps"]
+           "integration_substeps", "steps_per_period"]
 
 #: Integration steps per period of the highest natural frequency (and of each resolved
 #: excitation harmonic): ω_max·h <= 2π/4.7 = 1.34, 77 % of ode3's stability limit √3 on the
 #: imaginary axis (the paper's 75 kHz for its rig's 15.94 kHz mode 19).
 STEPS_PER_PERIOD = 4.7
+
+#: ode3's stability interval on the imaginary axis (:data:`STEPS_PER_PERIOD` uses 77 % of it).
+ODE3_IMAGINARY_LIMIT = math.sqrt(3.0)
+
+def steps_per_period(tableau):
+    """Steps per period of the highest mode that ``tableau`` needs: :data:`STEPS_PER_PERIOD`
+    scaled by ode3's imaginary stability interval over the scheme's, so every scheme keeps
+    the same 77 % margin (rk4: 2.88). A scheme without a wider interval (heun has none) is
+    held to ode3's.
+
+    Examples
+    --------
+    >>> from cmsim.dynamics.integrator import SCHEMES
+    >>> steps_per_period(SCHEMES["ode3"]), round(steps_per_period(SCHEMES["rk4"]), 2)
+    (4.7, 2.88)
+    """
+    limit = float(tableau.imaginary_limit)
+    if limit <= ODE3_IMAGINARY_LIMIT:
+        return STEPS_PER_PERIOD
+    return STEPS_PER_PERIOD * ODE3_IMAGINARY_LIMIT / limit
+
 
 #: Harmonics of the fastest excitation the step resolves: the GMF harmonics the features
 #: measure (:data:`cmsim.features.N_GMF_HARMONICS`; the report's waterfalls reach 6.5·GMF).
@@ -108,7 +129,8 @@ def _substeps_for(rate_hz, fs_hz):
     return max(1, math.ceil(rate_hz / fs_hz - 1e-9))
 
 
-def integration_substeps(fs_hz, excitation, highest_mode_hz=0.0, substeps=None):
+def integration_substeps(fs_hz, excitation, highest_mode_hz=0.0, substeps=None,
+                         mode_steps=STEPS_PER_PERIOD):
     """Integration steps per output sample at ``fs_hz``: chosen, or checked when given.
 
     Parameters
@@ -124,6 +146,9 @@ def integration_substeps(fs_hz, excitation, highest_mode_hz=0.0, substeps=None):
         Steps per sample the caller chose (checked against the excitation only: a step too
         long for the highest mode diverges visibly); ``None`` chooses the fewest that meet
         both rules of the module docstring.
+    mode_steps : float
+        Steps per period of the highest mode the scheme needs (:func:`steps_per_period`;
+        ode3's by default).
 
     Returns
     -------
@@ -161,7 +186,7 @@ def integration_substeps(fs_hz, excitation, highest_mode_hz=0.0, substeps=None):
             f"must be {allowed} (or left out: automatic), or speed_rpm at most "
             f"{excitation.fastest_speed_rpm(fs_hz * substeps):.6g} rpm", param="substeps",
             allowed=allowed)
-    rate = max(STEPS_PER_PERIOD * highest_mode_hz, need)
+    rate = max(mode_steps * highest_mode_hz, need)
     chosen = _substeps_for(rate, fs_hz)
     if chosen > top:
         if need >= rate:
@@ -170,7 +195,7 @@ def integration_substeps(fs_hz, excitation, highest_mode_hz=0.0, substeps=None):
             what, slower = f"the highest mode {highest_mode_hz:.6g} Hz (>= {rate:.4g} Hz)", ""
         raise ParameterError(
             f"fs_hz = {fs_hz:g} Hz would need substeps = {chosen} (at most {top}) to resolve "
-            f"{what} with {STEPS_PER_PERIOD:g} steps per period: fs_hz must be >= "
+            f"{what} with {mode_steps:.3g} steps per period: fs_hz must be >= "
             f"{rate / top:.6g} Hz{slower}", param="fs_hz",
             allowed=f"a number >= {rate / top:.6g} Hz")
     return chosen

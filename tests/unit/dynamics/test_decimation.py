@@ -62,7 +62,8 @@ def test_bad_filter_input():
 def runs():
     rig = cmsim.Rig.paper_2016()
     op = cmsim.OperatingPoint(1000.0, 100.0)
-    kw = dict(seed=5, cage_phases_rad=[0.3, 1.1, 2.0, 4.4], mesh="potential-energy")
+    kw = dict(seed=5, cage_phases_rad=[0.3, 1.1, 2.0, 4.4], mesh="potential-energy",
+              scheme="ode3")
     slow = simulate(rig, op, 0.5, fs_hz=FS_OUT, **kw)          # 3 steps per sample
     fast = simulate(rig, op, 0.5, fs_hz=3 * FS_OUT, **kw)      # the same steps, all kept
     return slow, fast

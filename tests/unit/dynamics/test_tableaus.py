@@ -54,3 +54,23 @@ def test_declared_orders():
     assert {k: v.order for k, v in SCHEMES.items()} == {"ode3": 3, "lawson-ode3": 3, "rk4": 4,
                                                         "heun": 2}
     assert [k for k, v in SCHEMES.items() if v.exponential] == ["lawson-ode3"]
+
+
+@pytest.mark.parametrize("name", sorted(SCHEMES))
+def test_imaginary_stability_interval(name):
+    """The declared interval is where |R(iθ)| <= 1 ends, R(z) = 1 + z bᵀ(I − zA)⁻¹1 the
+    stability function (0 when an undamped mode grows from the start: heun)."""
+    tab = SCHEMES[name]
+
+    def growth(theta):
+        z = 1j * theta
+        s = tab.b.size
+        return abs(1 + z * tab.b @ np.linalg.solve(np.eye(s) - z * tab.a, np.ones(s)))
+
+    limit = tab.imaginary_limit
+    inside = np.linspace(1e-3, limit, 200)[:-1] if limit > 0 else np.array([1e-3, 0.1])
+    if limit > 0:
+        assert max(growth(t) for t in inside) <= 1.0 + 1e-12
+        assert growth(limit * 1.01) > 1.0
+    else:
+        assert all(growth(t) > 1.0 for t in inside)
