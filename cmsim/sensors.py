@@ -289,15 +289,16 @@ def tacho_signal(theta_rad, *, level_v=TACHO_LEVEL_V, pulse_width_rad=TACHO_PULS
     return np.where(np.mod(theta, 2.0 * math.pi) < width, float(level_v), 0.0)
 
 
-def _force_bearings(run):
-    """Bearings with both ``F_<b>_x`` and ``F_<b>_y`` in the run, in the run's order."""
+def _force_bearings(run, directions=("x", "y")):
+    """Bearings with ``F_<b>_<d>`` in the run for every direction d of ``directions``, in the
+    run's order."""
     found = {}
     for name in run.signals:
         m = _FORCE.fullmatch(name)
         if m:
             found.setdefault(m["b"], set()).add(m["d"])
     order = list(run.meta.get("rig") and run.rig.bearing_names or sorted(found))
-    return [b for b in order if found.get(b) == {"x", "y"}]
+    return [b for b in order if found.get(b, set()) >= set(directions)]
 
 
 def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearings=None,
@@ -307,8 +308,9 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     Parameters
     ----------
     run : Run
-        A run with bearing forces ``F_<bearing>_x``, ``F_<bearing>_y`` (N) and, for the tacho,
-        the input shaft's total rotation ``theta_1b1`` (rad).
+        A run with bearing forces ``F_<bearing>_x``, ``F_<bearing>_y`` (N; those of
+        ``directions``) and, for the tacho, the input shaft's total rotation ``theta_1b1``
+        (rad).
     path : HousingPath, optional
         Housing transfer path; default the run's rig's :attr:`~cmsim.rig.Rig.housing` (the
         documented defaults of :class:`~cmsim.rig.HousingPath` for a run without a rig).
@@ -320,7 +322,8 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     seed : int, optional
         Seed of the noise generator; default the run's ``meta["seed"]`` (else 0).
     bearings : sequence of str, optional
-        Bearings to instrument (``"1b1"``, ...); default every bearing with x and y forces.
+        Bearings to instrument (``"1b1"``, ...); default every bearing with the forces of
+        ``directions``.
     directions : sequence of {"x", "y"}
         Accelerometer directions on each bearing (default both).
 
@@ -351,23 +354,24 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     elif not isinstance(path, HousingPath):
         raise ParameterError(f"path must be a HousingPath, got {type(path).__name__}",
                              param="path")
-    available = _force_bearings(run)
+    directions = [directions] if isinstance(directions, str) else list(directions)
+    if not directions or any(d not in ("x", "y") for d in directions):
+        raise ParameterError(f"directions must name x and/or y, got {directions!r}",
+                             param="directions", allowed="x, y")
+    available = _force_bearings(run, directions)
     if bearings is None:
         chosen = available
     else:
         chosen = [bearings] if isinstance(bearings, str) else list(bearings)
         for b in chosen:
             if b not in available:
-                raise ParameterError(f"bearing {b!r} has no forces F_{b}_x, F_{b}_y in the run; "
+                forces = ", ".join(f"F_{b}_{d}" for d in directions)
+                raise ParameterError(f"bearing {b!r} has no forces {forces} in the run; "
                                      f"available: {available}", param="bearings",
                                      allowed=str(available))
     if not chosen:
         raise ParameterError("the run has no bearing forces F_<bearing>_<x|y> to feel "
                              "through the housing", param="run")
-    directions = [directions] if isinstance(directions, str) else list(directions)
-    if not directions or any(d not in ("x", "y") for d in directions):
-        raise ParameterError(f"directions must name x and/or y, got {directions!r}",
-                             param="directions", allowed="x, y")
     if seed is None:
         seed = int(run.meta.get("seed", 0) or 0)
     new = {f"accel_{b}_{d}": housing_acceleration(run[f"F_{b}_{d}"], fs_in, path)

@@ -28,7 +28,7 @@ from scipy.signal import firwin, kaiserord
 from cmsim.dynamics._decimation_kernels import FIR_LANES, fir_decimate_jit
 from cmsim.errors import ParameterError, check_range
 
-__all__ = ["AntiAliasFilter", "FIR_LANES"]
+__all__ = ["AntiAliasFilter"]
 
 
 @dataclass(frozen=True)
@@ -91,6 +91,14 @@ class AntiAliasFilter:
         """Pass-band edge, Hz."""
         return self.passband * 0.5 * self.fs_out_hz
 
+    @staticmethod
+    def block_width(n_columns):
+        """Columns of the block :meth:`apply` reads in place for ``n_columns`` signals: the
+        kernel's groups of four, one column left over as it is, two or three padded to a
+        group (module :mod:`~cmsim.dynamics._decimation_kernels`: the cheaper way)."""
+        left = n_columns % FIR_LANES
+        return n_columns if left <= 1 else n_columns + FIR_LANES - left
+
     def apply(self, x):
         """Filter and decimate the columns of ``x``.
 
@@ -98,8 +106,8 @@ class AntiAliasFilter:
         ----------
         x : ndarray, shape (L, C)
             Input samples; row ``half_length + m·factor`` is output instant m. A C-contiguous
-            float64 block whose width is a multiple of :data:`FIR_LANES` (pad with zero
-            columns) is read in place; anything else is copied into one first.
+            float64 block of :meth:`block_width` columns (pad with zero columns) is read in
+            place; anything else is copied into one first.
 
         Returns
         -------
@@ -114,7 +122,7 @@ class AntiAliasFilter:
         hl = self.half_length
         n_out = max((x.shape[0] - 2 * hl - 1) // self.factor + 1, 0)
         width = x.shape[1]
-        lanes = -(-width // FIR_LANES) * FIR_LANES
+        lanes = self.block_width(width)
         if lanes != width or not x.flags.c_contiguous:
             padded = np.zeros((x.shape[0], lanes))
             padded[:, :width] = x
