@@ -182,7 +182,7 @@ def simulate_record(spec, index):
         return {"t": run.t, "source": np.asarray(run.source), **run.signals}, \
             {**run.meta, **record}
     meta = {"fs_hz": run.fs_hz, "t0_s": float(run.t[0]), "n_samples": int(run.t.size),
-            "rig": rig.to_dict(), "operating_point": run.meta["operating_point"],
+            "rig": run.meta["rig"], "operating_point": run.meta["operating_point"],
             "profile": None if profile is None else {"times_s": list(profile.times_s),
                                                      "speeds_rpm": list(profile.speeds_rpm)},
             "faults": [f.to_dict() for f in plan.faults], "substeps": run.meta.get("substeps"),
