@@ -36,6 +36,7 @@ H(0) = 0).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import re
 from fractions import Fraction
@@ -43,7 +44,7 @@ from fractions import Fraction
 import numpy as np
 from scipy.signal import firwin, kaiserord, resample_poly
 
-from cmsim._kernels import housing_modes_jit
+from cmsim._kernels import HOUSING_BLOCK, housing_path_jit
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.errors import ParameterError, check_range
 from cmsim.rig import HousingPath
@@ -120,9 +121,9 @@ def housing_acceleration(force_n, fs_hz, path):
 
     Parameters
     ----------
-    force_n : array_like, shape (n,)
+    force_n : array_like, shape (n,) or (n, C)
         Force transmitted by the bearing to the housing along one direction, N, sampled at
-        ``fs_hz``.
+        ``fs_hz``; or C such forces side by side (filtered in one pass, each as alone).
     fs_hz : float
         Sample rate, Hz.
     path : HousingPath
@@ -130,7 +131,7 @@ def housing_acceleration(force_n, fs_hz, path):
 
     Returns
     -------
-    numpy.ndarray, shape (n,)
+    numpy.ndarray, shape of ``force_n``
         Acceleration along the same direction, m/s², same instants. The filter starts at rest
         under ``force_n[0]`` (a constant force gives zero acceleration). Modes above the
         force's Nyquist frequency are allowed (the force is interpolated) but are excited
@@ -145,22 +146,52 @@ def housing_acceleration(force_n, fs_hz, path):
     8.3
     """
     x = np.asarray(force_n, dtype=float)
-    if x.ndim != 1 or x.size < 1:
-        raise ParameterError(f"force_n must be a 1-D array with samples, got shape {x.shape}",
-                             param="force_n")
+    if x.ndim not in (1, 2) or x.shape[0] < 1:
+        raise ParameterError(f"force_n must be a 1-D array with samples (or 2-D, one force "
+                             f"per column), got shape {x.shape}", param="force_n")
     if not np.all(np.isfinite(x)):
         raise ParameterError("force_n must be finite (no NaN or inf)", param="force_n")
     fs = check_range("fs_hz", fs_hz, 0.0, lo_open=True, unit="Hz")
     k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs))
     # H(0) = 0: remove the first force sample, so the record starts at rest and the
     # zero padding of the interpolation continues that constant force
-    x = x - x[0]
-    xk = resample_poly(x, k, 1) if k > 1 else x      # Nyquist filter: keeps x at i·k
-    # every mode's biquad (sosfilt's) over xk, their sum kept at the original instants
+    # every mode's biquad (sosfilt's) over the force interpolated by k (a Nyquist filter:
+    # keeps x at i·k), their sum kept at the original instants
+    taps, before = _interpolation_phases(k)
+    n = x.shape[0]
+    signals = np.zeros((int(np.prod(x.shape[1:])), n + taps.shape[1] - 1))
+    signals[:, before:before + n] = (x - x[0]).reshape(n, -1).T
     sos = housing_sos(path, fs * k)
-    out = np.empty(x.size)
-    housing_modes_jit(xk, sos, k, np.empty((sos.shape[0], 2)), out)
-    return out
+    out = np.empty((signals.shape[0], n))
+    housing_path_jit(signals, taps, sos, np.empty((sos.shape[0], 2)),
+                     np.empty((k, HOUSING_BLOCK)), out)
+    return out[0] if x.ndim == 1 else out.T
+
+
+@functools.lru_cache(maxsize=16)
+def _interpolation_phases(k):
+    """``(taps, before)``: the FIR :func:`scipy.signal.resample_poly` interpolates by ``k``
+    with (its default: Kaiser window β = 5, ten zero crossings on each side, gain k), laid
+    out by phase for :func:`cmsim._kernels.housing_path_jit` — row t holds the taps of fast
+    sample j·k + t for the inputs j − before … j − before + D − 1 (zero where the filter has
+    none) — designed once per factor and read-only; ``[[1.0]]`` for k = 1."""
+    if k == 1:
+        taps = np.ones((1, 1))
+        before = 0
+    else:
+        half = 10 * k
+        h = firwin(2 * half + 1, 1.0 / k, window=("kaiser", 5.0))
+        h *= k
+        before = half // k                   # inputs j − before … j + after reach phase t
+        after = (k - 1 + half) // k
+        taps = np.zeros((k, before + after + 1))
+        for t in range(k):
+            for d in range(-before, after + 1):
+                tap = t + half - d * k       # the tap of input j + d at fast sample j·k + t
+                if 0 <= tap <= 2 * half:
+                    taps[t, d + before] = h[tap]
+    taps.setflags(write=False)
+    return taps, before
 
 
 def _kaiser_lowpass(fs_hz, fs_out_hz):
@@ -374,8 +405,10 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
                              "through the housing", param="run")
     if seed is None:
         seed = int(run.meta.get("seed", 0) or 0)
-    new = {f"accel_{b}_{d}": housing_acceleration(run[f"F_{b}_{d}"], fs_in, path)
-           for b in chosen for d in ("x", "y") if d in directions}
+    pairs = [(b, d) for b in chosen for d in ("x", "y") if d in directions]
+    accel = housing_acceleration(np.column_stack([run[f"F_{b}_{d}"] for b, d in pairs]),
+                                 fs_in, path)
+    new = {f"accel_{b}_{d}": accel[:, i].copy() for i, (b, d) in enumerate(pairs)}
 
     signals = {**run.signals, **new}
     t = np.asarray(run.t, dtype=float)
