@@ -13,9 +13,10 @@ machines):
    number of steps (random torque between the shipped tables, speed wobble through the
    speed-profile path, slip, each fault type's tables), CPU per record;
 4. one record's CPU time split by stage (mean over ``--records`` records of the spec, run
-   in this process after one warm-up record): plan and manifest row, model build, start
-   state, integration, anti-alias decimation, signals, housing path, other sensor work,
-   writing. The split is exclusive (a stage's time excludes the stages it calls);
+   in this process after one warm-up record, its memory kept as a pool worker keeps it:
+   :func:`cmsim.datasets.pool.keep_freed_memory`): plan and manifest row, model build,
+   start state, integration, anti-alias decimation, signals, housing path, other sensor
+   work, writing. The split is exclusive (a stage's time excludes the stages it calls);
 5. the per-process costs: Python start and imports, kernel loading from numba's cache;
 6. ``cmsim dataset`` on 1 and 2 workers (``generate_dataset``, fork, as the command line
    runs it): wall time, records per hour, CPU of all its processes per record
@@ -234,7 +235,9 @@ def bench_stages(spec, n, tmp):
     """Section 4: ``({stage: CPU s per record}, CPU s per record, wall s per record)``."""
     from cmsim.datasets.manifest import RECORDS_DIR, ROWS_DIR
     from cmsim.datasets import records
+    from cmsim.datasets.pool import keep_freed_memory
 
+    keep_freed_memory()                                # as a worker process runs its records
     out = Path(tmp) / "stages"
     for sub in (RECORDS_DIR, ROWS_DIR):
         (out / sub).mkdir(parents=True, exist_ok=True)
