@@ -4,11 +4,10 @@
 row-major block, each output summed tap by tap from 0.0 in the order
 :func:`scipy.signal.upfirdn` uses (its result bit for bit: there is no reassociation, and
 without fastmath no fused multiply-add), but with eight independent sums in flight instead of
-one, so the adds do not wait for each other: two outputs × four columns (one vector of four
-lanes), then eight outputs of each column left over. A column left over costs about 0.6 of a
-group of four (its loads are not contiguous), so a block of 4g + 1 columns is filtered as it
-is and one of 4g + 2 or 4g + 3 is cheaper padded with zero columns to a whole group
-(:meth:`~cmsim.dynamics.decimation.AntiAliasFilter.block_width`).
+one, so the adds do not wait for each other: two outputs × four columns, then eight outputs of
+each column left over (as cheap per column, so a block of any width is read as it is). The
+block is read through its flat view with unsigned indices: a signed index costs a
+negative-index test on every load, which made the loop three times slower.
 
 The numba rule of every kernel module of :mod:`cmsim.dynamics` (in full in
 :mod:`cmsim.dynamics._rhs_kernels`): ``@njit(cache=True)``, float64/int64 arrays and
@@ -17,6 +16,7 @@ scalars only, no Python objects, no random numbers, no allocation in the hot pat
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 #: Columns the kernel's main loop takes at once (the rest one by one).
@@ -24,21 +24,26 @@ FIR_LANES = 4
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def fir_decimate_jit(x, h_flip, step, out):
-    """``out[m, c] = Σ_j x[m·step + j, c]·h_flip[j]`` (j = 0 … N − 1, summed in that order).
+def fir_decimate_jit(x, n_cols, h_flip, step, out):
+    """``out[m, c] = Σ_j x[(m·step + j)·n_cols + c]·h_flip[j]`` (j = 0 … N − 1, summed in that
+    order).
 
-    ``x`` (L, C) C-contiguous, ``h_flip`` (N,) the taps reversed, ``out`` (n_out, C) with
-    ``(n_out − 1)·step + N <= L``.
+    ``x`` the flat view of a C-contiguous (L, n_cols) block, ``h_flip`` (N,) the taps
+    reversed, ``out`` (n_out, n_cols) with ``(n_out − 1)·step + N <= L``.
     """
     n_taps = h_flip.shape[0]
     n_out = out.shape[0]
-    n_cols = x.shape[1]
+    row = np.uint64(n_cols)
+    stride = np.uint64(step) * row                 # from one output's window to the next
+    one = np.uint64(1)
+    two = np.uint64(2)
+    three = np.uint64(3)
     full = n_cols - n_cols % FIR_LANES
     for c0 in range(0, full, FIR_LANES):
         m = 0
         while m < n_out:
-            i0 = m * step
-            i1 = i0 + step if m + 1 < n_out else i0
+            a = np.uint64(m) * stride + np.uint64(c0)
+            b = a + stride if m + 1 < n_out else a
             a0 = 0.0
             a1 = 0.0
             a2 = 0.0
@@ -49,14 +54,16 @@ def fir_decimate_jit(x, h_flip, step, out):
             b3 = 0.0
             for j in range(n_taps):
                 hj = h_flip[j]
-                a0 += x[i0 + j, c0] * hj
-                a1 += x[i0 + j, c0 + 1] * hj
-                a2 += x[i0 + j, c0 + 2] * hj
-                a3 += x[i0 + j, c0 + 3] * hj
-                b0 += x[i1 + j, c0] * hj
-                b1 += x[i1 + j, c0 + 1] * hj
-                b2 += x[i1 + j, c0 + 2] * hj
-                b3 += x[i1 + j, c0 + 3] * hj
+                a0 += x[a] * hj
+                a1 += x[a + one] * hj
+                a2 += x[a + two] * hj
+                a3 += x[a + three] * hj
+                b0 += x[b] * hj
+                b1 += x[b + one] * hj
+                b2 += x[b + two] * hj
+                b3 += x[b + three] * hj
+                a += row
+                b += row
             out[m, c0] = a0
             out[m, c0 + 1] = a1
             out[m, c0 + 2] = a2
@@ -67,18 +74,16 @@ def fir_decimate_jit(x, h_flip, step, out):
                 out[m + 1, c0 + 2] = b2
                 out[m + 1, c0 + 3] = b3
             m += 2
+    s2 = np.uint64(2) * stride
+    s3 = np.uint64(3) * stride
+    s4 = np.uint64(4) * stride
+    s5 = np.uint64(5) * stride
+    s6 = np.uint64(6) * stride
+    s7 = np.uint64(7) * stride
     for c in range(full, n_cols):
         m = 0
-        while m < n_out:
-            # outputs past the end read the first one's window again and are not written
-            i0 = m * step
-            i1 = i0 + step if m + 1 < n_out else i0
-            i2 = i0 + 2 * step if m + 2 < n_out else i0
-            i3 = i0 + 3 * step if m + 3 < n_out else i0
-            i4 = i0 + 4 * step if m + 4 < n_out else i0
-            i5 = i0 + 5 * step if m + 5 < n_out else i0
-            i6 = i0 + 6 * step if m + 6 < n_out else i0
-            i7 = i0 + 7 * step if m + 7 < n_out else i0
+        while m + 8 <= n_out:
+            a = np.uint64(m) * stride + np.uint64(c)
             a0 = 0.0
             a1 = 0.0
             a2 = 0.0
@@ -89,30 +94,31 @@ def fir_decimate_jit(x, h_flip, step, out):
             a7 = 0.0
             for j in range(n_taps):
                 hj = h_flip[j]
-                a0 += x[i0 + j, c] * hj
-                a1 += x[i1 + j, c] * hj
-                a2 += x[i2 + j, c] * hj
-                a3 += x[i3 + j, c] * hj
-                a4 += x[i4 + j, c] * hj
-                a5 += x[i5 + j, c] * hj
-                a6 += x[i6 + j, c] * hj
-                a7 += x[i7 + j, c] * hj
+                a0 += x[a] * hj
+                a1 += x[a + stride] * hj
+                a2 += x[a + s2] * hj
+                a3 += x[a + s3] * hj
+                a4 += x[a + s4] * hj
+                a5 += x[a + s5] * hj
+                a6 += x[a + s6] * hj
+                a7 += x[a + s7] * hj
+                a += row
             out[m, c] = a0
-            if m + 1 < n_out:
-                out[m + 1, c] = a1
-            if m + 2 < n_out:
-                out[m + 2, c] = a2
-            if m + 3 < n_out:
-                out[m + 3, c] = a3
-            if m + 4 < n_out:
-                out[m + 4, c] = a4
-            if m + 5 < n_out:
-                out[m + 5, c] = a5
-            if m + 6 < n_out:
-                out[m + 6, c] = a6
-            if m + 7 < n_out:
-                out[m + 7, c] = a7
+            out[m + 1, c] = a1
+            out[m + 2, c] = a2
+            out[m + 3, c] = a3
+            out[m + 4, c] = a4
+            out[m + 5, c] = a5
+            out[m + 6, c] = a6
+            out[m + 7, c] = a7
             m += 8
+        for m in range(m, n_out):
+            a = np.uint64(m) * stride + np.uint64(c)
+            acc = 0.0
+            for j in range(n_taps):
+                acc += x[a] * h_flip[j]
+                a += row
+            out[m, c] = acc
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)

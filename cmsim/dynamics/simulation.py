@@ -241,9 +241,9 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     runner = _Integrator(model, scheme, progress)
     m0 = 0                                        # next output sample to fill
     n_tail = 0                                    # fast samples not yet consumed, at buf[0:]
-    # the filtered columns side by side (padded as the filter reads them in place), in one
-    # buffer for the run: the tail a block leaves, then the next block
-    width = aa.block_width(qc.size + dc.size)
+    # the filtered columns side by side, in one buffer for the run: the tail a block leaves,
+    # then the next block
+    width = qc.size + dc.size
     chunk = DECIMATION_CHUNK_STEPS
     buf = np.zeros((2 * hl + k + chunk + 1, width))
     for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1, chunk):

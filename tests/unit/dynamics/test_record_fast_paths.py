@@ -63,11 +63,11 @@ def test_cage_only_slip_skips_the_ball_grid_bit_for_bit():
 
 
 @pytest.mark.parametrize("factor, width", [(3, 7), (2, 1), (5, 8), (3, 0), (3, 5), (4, 2),
-                                           (2, 9)])
+                                           (2, 9), (3, 6)])
 def test_anti_alias_kernel_is_upfirdn_bit_for_bit(factor, width):
     """The numba FIR gives :func:`scipy.signal.upfirdn`'s outputs exactly (the sums in the
-    same order), for any width (groups of four columns, a column left over on its own, two or
-    three padded to a group), a transposed (non-contiguous) block and a 1-D signal."""
+    same order), for any width (groups of four columns, then the columns left over one by
+    one, any number of outputs), a transposed (non-contiguous) block and a 1-D signal."""
     from scipy.signal import upfirdn
 
     from cmsim.dynamics.decimation import AntiAliasFilter
