@@ -27,6 +27,7 @@ the hot path.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 #: Input samples per block of :func:`housing_path_jit` (scratch ``xk`` of k rows of this
@@ -37,8 +38,10 @@ HOUSING_BLOCK = 512
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _interpolate_block(x, taps, j0, j1, xk):
     """``xk[t, j − j0] = Σ_d x[j + d]·taps[t, d]`` (d increasing) for j in [j0, j1): fast
-    sample j·k + t, ``x`` being the signal padded as :func:`housing_path_jit` says."""
+    sample j·k + t, ``x`` being the signal padded as :func:`housing_path_jit` says. Indices
+    are unsigned (no negative-index test on every load)."""
     n_phases, n_taps = taps.shape
+    one = np.uint64(1)
     for t in range(n_phases):
         g = taps[t]
         row = xk[t]
@@ -52,17 +55,18 @@ def _interpolate_block(x, taps, j0, j1, xk):
             a5 = 0.0
             a6 = 0.0
             a7 = 0.0
+            i = np.uint64(j)
             for d in range(n_taps):
-                gd = g[d]
-                i = j + d
+                gd = g[np.uint64(d)]
                 a0 += x[i] * gd
-                a1 += x[i + 1] * gd
-                a2 += x[i + 2] * gd
-                a3 += x[i + 3] * gd
-                a4 += x[i + 4] * gd
-                a5 += x[i + 5] * gd
-                a6 += x[i + 6] * gd
-                a7 += x[i + 7] * gd
+                a1 += x[i + one] * gd
+                a2 += x[i + np.uint64(2)] * gd
+                a3 += x[i + np.uint64(3)] * gd
+                a4 += x[i + np.uint64(4)] * gd
+                a5 += x[i + np.uint64(5)] * gd
+                a6 += x[i + np.uint64(6)] * gd
+                a7 += x[i + np.uint64(7)] * gd
+                i += one
             r = j - j0
             row[r] = a0
             row[r + 1] = a1
@@ -75,8 +79,10 @@ def _interpolate_block(x, taps, j0, j1, xk):
             j += 8
         for j in range(j, j1):
             acc = 0.0
+            i = np.uint64(j)
             for d in range(n_taps):
-                acc += x[j + d] * g[d]
+                acc += x[i] * g[np.uint64(d)]
+                i += one
             row[j - j0] = acc
 
 
@@ -88,29 +94,32 @@ def housing_path_jit(x, taps, sos, state, xk, out):
     ``taps`` (k, D) holds in row t the FIR's taps of fast sample j·k + t for the inputs
     j − b … j − b + D − 1 (zero outside the filter), ``x`` (C, n + D − 1) each signal after
     b zeros and before D − 1 − b (k = 1, D = 1, ``taps = [[1.0]]``: the signal itself).
-    ``state`` (n_modes, 2) holds the biquads' delays (zeroed here for each signal); ``xk``
-    (k, :data:`HOUSING_BLOCK`) a block's fast samples; ``out`` is (C, n).
+    ``state`` (C, n_modes, 2) holds the biquads' delays (zeroed here); ``xk``
+    (C, k, :data:`HOUSING_BLOCK`) a block's fast samples; ``out`` is (C, n). The signals'
+    biquads run interleaved, sample by sample, so one's adds need not wait for its previous
+    ones.
     """
     n_cols, n = out.shape
     k = taps.shape[0]
     n_modes = sos.shape[0]
     for c in range(n_cols):
-        xc = x[c]
         for s in range(n_modes):
-            state[s, 0] = 0.0
-            state[s, 1] = 0.0
-        for j0 in range(0, n, HOUSING_BLOCK):
-            j1 = min(j0 + HOUSING_BLOCK, n)
-            _interpolate_block(xc, taps, j0, j1, xk)
-            for jj in range(j1 - j0):
-                for t in range(k):
-                    v = xk[t, jj]
-                    keep = t == 0
+            state[c, s, 0] = 0.0
+            state[c, s, 1] = 0.0
+    for j0 in range(0, n, HOUSING_BLOCK):
+        j1 = min(j0 + HOUSING_BLOCK, n)
+        for c in range(n_cols):
+            _interpolate_block(x[c], taps, j0, j1, xk[c])
+        for jj in range(j1 - j0):
+            for t in range(k):
+                keep = t == 0
+                for c in range(n_cols):
+                    v = xk[c, t, jj]
                     acc = 0.0
                     for s in range(n_modes):
-                        y = sos[s, 0] * v + state[s, 0]
-                        state[s, 0] = sos[s, 1] * v - sos[s, 4] * y + state[s, 1]
-                        state[s, 1] = sos[s, 2] * v - sos[s, 5] * y
+                        y = sos[s, 0] * v + state[c, s, 0]
+                        state[c, s, 0] = sos[s, 1] * v - sos[s, 4] * y + state[c, s, 1]
+                        state[c, s, 1] = sos[s, 2] * v - sos[s, 5] * y
                         if keep:
                             acc = acc + y
                     if keep:

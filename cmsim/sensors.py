@@ -163,8 +163,8 @@ def housing_acceleration(force_n, fs_hz, path):
     signals[:, before:before + n] = (x - x[0]).reshape(n, -1).T
     sos = housing_sos(path, fs * k)
     out = np.empty((signals.shape[0], n))
-    housing_path_jit(signals, taps, sos, np.empty((sos.shape[0], 2)),
-                     np.empty((k, HOUSING_BLOCK)), out)
+    housing_path_jit(signals, taps, sos, np.empty((signals.shape[0], sos.shape[0], 2)),
+                     np.empty((signals.shape[0], k, HOUSING_BLOCK)), out)
     return out[0] if x.ndim == 1 else out.T
 
 
