@@ -389,13 +389,13 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     if not directions or any(d not in ("x", "y") for d in directions):
         raise ParameterError(f"directions must name x and/or y, got {directions!r}",
                              param="directions", allowed="x, y")
-    available = _force_bearings(run, directions)
     if bearings is None:
-        chosen = available
+        chosen = _force_bearings(run, directions)
     else:
         chosen = [bearings] if isinstance(bearings, str) else list(bearings)
         for b in chosen:
-            if b not in available:
+            if any(f"F_{b}_{d}" not in run.signals for d in directions):
+                available = _force_bearings(run, directions)
                 forces = ", ".join(f"F_{b}_{d}" for d in directions)
                 raise ParameterError(f"bearing {b!r} has no forces {forces} in the run; "
                                      f"available: {available}", param="bearings",
