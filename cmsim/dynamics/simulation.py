@@ -234,8 +234,8 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     first = n_warm * k - hl                       # first fast sample the filter reads
     last = (n_warm + n_rec - 1) * k + hl          # last one
     n_forces = len(model.output_force_names)
-    q_out = np.full((n_rec, n), np.nan)
-    d_out = np.full((n_rec, n_forces), np.nan)
+    q_out = np.full((n_rec, n), np.nan, order="F")       # signals are read column by column
+    d_out = np.full((n_rec, n_forces), np.nan, order="F")
     qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
     dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
     runner = _Integrator(model, scheme, progress)
