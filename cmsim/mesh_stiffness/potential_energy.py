@@ -38,6 +38,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass
@@ -317,7 +318,7 @@ def hertz_stiffness(pair):
     return math.pi * b / (2.0 * soft)
 
 
-def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=None):
+def tooth_compliance(profile, contact_radius_m, n_nodes=1001, thinned=None):
     """Compliance of one tooth loaded on its involute at the given radii.
 
     Parameters
@@ -328,12 +329,14 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=Non
         Contact radii on the involute, within [form radius, tip-rounding start], m.
     n_nodes : int
         Nodes of the beam integration.
-    half_thickness : callable, optional
-        h(u): half-thickness, m, of the section that carries the load at height u (m, array)
-        above the root chord; default the tooth's own,
-        ``profile.half_thickness_at(min(y0 + u, r_a))``. A cracked tooth passes its reduced
-        section (:func:`cmsim.faults.crack.cracked_tooth_compliance`); the foundation term
-        stays the healthy one.
+    thinned : callable, optional
+        ``thinned(h, y)``: the half-thickness, m, of the section that carries the load, from
+        the tooth's own h = ``profile.half_thickness_at(y)`` at the heights
+        y = min(y0 + u, r_a) of the beam's nodes (arrays of one shape); default the tooth's
+        own. A cracked tooth passes its reduced section
+        (:func:`cmsim.faults.crack.cracked_tooth_compliance`); the foundation term stays the
+        healthy one. The tooth's own sections at the nodes of a contact grid are then kept
+        (:func:`_tooth_sections`) for the next cracked tooth on the same grid.
 
     Returns
     -------
@@ -353,15 +356,44 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=Non
     x_c, y_c = r * np.sin(theta_c), r * np.cos(theta_c)
     a1 = alpha_r - theta_c
     y0 = profile.root_chord_y_m
-    if half_thickness is None:
+
+    def section(u):
+        y = np.minimum(y0 + u, profile.tip_radius_m)
+        return y, profile.half_thickness_at(y)
+
+    if thinned is None:
         def half_thickness(u):
-            return profile.half_thickness_at(np.minimum(y0 + u, profile.tip_radius_m))
+            return section(u)[1]
+    else:
+        kept = _tooth_sections(profile, r.tobytes(), int(n_nodes))
+
+        def half_thickness(u):
+            # a block of the beam's nodes is known by its rows and its first row's length
+            key = (u.shape, float(u[0, -1]))
+            if key not in kept:
+                kept[key] = tuple(_read_only(a) for a in section(u))
+            y, h = kept[key]
+            return thinned(h, y)
     bending, shear, axial = cantilever_compliance(
         half_thickness, y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio,
         gear.face_width_m, n_nodes=n_nodes)
     u_f = y_c - x_c * np.tan(a1) - y0      # force line meets the centreline below y_c
     foundation = fillet_foundation_compliance(profile, u_f, a1)
     return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
+
+
+@functools.lru_cache(maxsize=4)
+def _tooth_sections(profile, radii_bytes, n_nodes):
+    """``{block: (y, h)}``: the heights and the tooth's own half-thicknesses at the beam's
+    nodes of :func:`tooth_compliance` for one tooth, contact grid (float64 bytes) and number
+    of nodes, filled as blocks are met (read-only arrays; a few MB per grid). Every cracked
+    record of a dataset integrates the same tooth on the same grid with another crack."""
+    return {}
+
+
+def _read_only(a):
+    a.setflags(write=False)
+    return a
 
 
 # --------------------------------------------------------------------------- gear pair

@@ -151,3 +151,27 @@ def test_cracked_factor_with_the_healthy_pair_cached_is_unchanged():
         1.2e-3, math.pi / 4)
     ref = healthy.total / (healthy.hertz + healthy.driving.total + cracked.total)
     assert np.array_equal(first, ref) and np.array_equal(again, ref)
+
+
+def test_cracked_tooth_reuses_its_sections_bit_for_bit():
+    """A cracked tooth on a contact grid met before reads the tooth's own sections at the beam
+    nodes from the last crack: the same compliance, bit for bit, as computed afresh, and
+    another depth still gives another one."""
+    import math
+
+    from cmsim.faults import crack
+    from cmsim.mesh_stiffness import potential_energy
+
+    gear = cmsim.Rig.paper_2016().gears.driving
+    profile = crack.ToothProfile.from_gear(gear)
+    r = np.linspace(profile.form_radius_m, profile.tip_round_start_radius_m, 300)
+    fresh = {}
+    for depth in (0.8e-3, 1.6e-3):
+        potential_energy._tooth_sections.cache_clear()
+        fresh[depth] = crack.cracked_tooth_compliance(profile, r, depth, math.pi / 4)
+    for depth in (0.8e-3, 1.6e-3):
+        kept = crack.cracked_tooth_compliance(profile, r, depth, math.pi / 4)
+        for part in ("bending", "shear", "axial", "foundation"):
+            assert np.array_equal(getattr(kept, part), getattr(fresh[depth], part)), part
+    assert potential_energy._tooth_sections.cache_info().hits >= 2
+    assert not np.array_equal(fresh[0.8e-3].bending, fresh[1.6e-3].bending)
