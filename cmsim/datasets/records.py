@@ -141,11 +141,7 @@ def simulate_record(spec, index):
     meta : dict
         JSON-ready meta of the record.
     """
-    return _simulate_plan(spec, spec.record(index))
-
-
-def _simulate_plan(spec, plan):
-    """:func:`simulate_record` of a record already drawn (its :class:`RecordPlan`)."""
+    plan = spec.record(index)
     rig = spec.record_rig(plan)
     op = spec.record_operating_point(plan)
     profile = None
@@ -252,7 +248,7 @@ def run_record(spec, index, out_dir):
     row["pid"] = os.getpid()
     path = out / row["path"]
     try:
-        arrays, meta = _simulate_plan(spec, plan)
+        arrays, meta = simulate_record(spec, index)
     except Exception as exc:               # noqa: BLE001 - a failed record, the rest go on
         row.update(status="failed", error=" ".join(f"{type(exc).__name__}: {exc}".split()),
                    wall_s=time.perf_counter() - start)
