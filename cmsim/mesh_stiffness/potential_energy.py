@@ -148,7 +148,8 @@ class PairCompliance:
 
 # --------------------------------------------------------------------------- building blocks
 def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_rad,
-                          youngs_modulus_pa, poisson_ratio, face_width_m, n_nodes=1001):
+                          youngs_modulus_pa, poisson_ratio, face_width_m, n_nodes=1001, *,
+                          nodes=None):
     """Bending, shear and axial compliance of a non-uniform cantilever (eqs. 5-10 of [2]).
 
     The beam runs along u from its built-in section (u = 0) and has the rectangular section
@@ -181,6 +182,12 @@ def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_
     n_nodes : int
         Nodes of the composite Simpson rule on each [0, d] (made odd); exact for a uniform
         beam.
+    nodes : dict, optional
+        A store for the nodes and the terms that do not depend on the thickness (moment arm,
+        load angle), filled on the first call and read on the next ones: for one beam (the
+        same lengths, offsets, angles and ``n_nodes``) integrated with several thicknesses
+        (a tooth with cracks of several depths). Without it each block of load sections is
+        built and dropped in turn.
 
     Returns
     -------
@@ -209,23 +216,36 @@ def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_
     G = E / (2.0 * (1.0 + nu))
 
     t = np.linspace(0.0, 1.0, int(n_nodes))
+    if nodes is None:
+        blocks = _beam_blocks(d, e, a1, t)
+    else:
+        blocks = nodes.get("blocks") or nodes.setdefault("blocks",
+                                                         list(_beam_blocks(d, e, a1, t)))
     bending, shear, axial = (np.empty_like(d) for _ in range(3))
+    for sl, u, arm2, c2, s2 in blocks:
+        h = np.asarray(half_thickness_m(u), dtype=float) * np.ones_like(u)
+        if not (np.all(np.isfinite(h)) and np.all(h > 0.0)):
+            raise ParameterError("half_thickness_m must return finite values > 0 on the beam")
+        inv_a = 1.0 / (2.0 * h * face_width_m)
+        inv_i = 1.0 / (2.0 / 3.0 * h ** 3 * face_width_m)
+        bending[sl] = simpson(arm2 * inv_i, x=u, axis=1) / E
+        ja = simpson(inv_a, x=u, axis=1)
+        shear[sl] = _SHEAR_FACTOR * c2 * ja / G
+        axial[sl] = s2 * ja / E
+    return bending, shear, axial
+
+
+def _beam_blocks(d, e, a1, t):
+    """Blocks of :data:`_ROWS_PER_BLOCK` load sections of :func:`cantilever_compliance`:
+    ``(rows, u, arm², cos² α1, sin² α1)`` with the nodes u on [0, d] of every section and
+    the bending moment per unit load at them (read-only arrays)."""
     for lo in range(0, d.size, _ROWS_PER_BLOCK):
         sl = slice(lo, lo + _ROWS_PER_BLOCK)
         dd, ee = d[sl, None], e[sl, None]
         c, s = np.cos(a1[sl, None]), np.sin(a1[sl, None])
         u = dd * t                      # nodes on [0, d] for every load position
-        h = np.asarray(half_thickness_m(u), dtype=float) * np.ones_like(u)
-        if not (np.all(np.isfinite(h)) and np.all(h > 0.0)):
-            raise ParameterError("half_thickness_m must return finite values > 0 on the beam")
         arm = c * (dd - u) - ee * s     # bending moment per unit load at section u
-        inv_a = 1.0 / (2.0 * h * face_width_m)
-        inv_i = 1.0 / (2.0 / 3.0 * h ** 3 * face_width_m)
-        bending[sl] = simpson(arm * arm * inv_i, x=u, axis=1) / E
-        ja = simpson(inv_a, x=u, axis=1)
-        shear[sl] = _SHEAR_FACTOR * c[:, 0] ** 2 * ja / G
-        axial[sl] = s[:, 0] ** 2 * ja / E
-    return bending, shear, axial
+        yield sl, *(_read_only(a) for a in (u, arm * arm, c[:, 0] ** 2, s[:, 0] ** 2))
 
 
 def sainsot_coefficients(root_half_angle_rad, hf):
@@ -376,7 +396,7 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001, thinned=None):
             return thinned(h, y)
     bending, shear, axial = cantilever_compliance(
         half_thickness, y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio,
-        gear.face_width_m, n_nodes=n_nodes)
+        gear.face_width_m, n_nodes=n_nodes, nodes=None if thinned is None else kept)
     u_f = y_c - x_c * np.tan(a1) - y0      # force line meets the centreline below y_c
     foundation = fillet_foundation_compliance(profile, u_f, a1)
     return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
@@ -386,8 +406,10 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001, thinned=None):
 def _tooth_sections(profile, radii_bytes, n_nodes):
     """``{block: (y, h)}``: the heights and the tooth's own half-thicknesses at the beam's
     nodes of :func:`tooth_compliance` for one tooth, contact grid (float64 bytes) and number
-    of nodes, filled as blocks are met (read-only arrays; a few MB per grid). Every cracked
-    record of a dataset integrates the same tooth on the same grid with another crack."""
+    of nodes, filled as blocks are met, and the beam's nodes themselves (``"blocks"``, the
+    ``nodes`` of :func:`cantilever_compliance`); read-only arrays, about 8 MB for a grid of
+    257 contact points. Every cracked record of a dataset integrates the same tooth on the
+    same grid with another crack."""
     return {}
 
 

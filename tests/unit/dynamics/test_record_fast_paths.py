@@ -154,24 +154,39 @@ def test_cracked_factor_with_the_healthy_pair_cached_is_unchanged():
 
 
 def test_cracked_tooth_reuses_its_sections_bit_for_bit():
-    """A cracked tooth on a contact grid met before reads the tooth's own sections at the beam
-    nodes from the last crack: the same compliance, bit for bit, as computed afresh, and
-    another depth still gives another one."""
+    """A cracked tooth on a contact grid met before reads the beam's nodes and the tooth's
+    own sections at them from the last crack: the same compliance, bit for bit, as the beam
+    integrated afresh with the cracked section (the reference written as it was before the
+    store), and another depth still gives another one."""
     import math
 
     from cmsim.faults import crack
-    from cmsim.mesh_stiffness import potential_energy
+    from cmsim.mesh_stiffness import potential_energy as pe
+    from cmsim.mesh_stiffness.geometry import involute_half_angle
 
     gear = cmsim.Rig.paper_2016().gears.driving
     profile = crack.ToothProfile.from_gear(gear)
     r = np.linspace(profile.form_radius_m, profile.tip_round_start_radius_m, 300)
-    fresh = {}
-    for depth in (0.8e-3, 1.6e-3):
-        potential_energy._tooth_sections.cache_clear()
-        fresh[depth] = crack.cracked_tooth_compliance(profile, r, depth, math.pi / 4)
-    for depth in (0.8e-3, 1.6e-3):
-        kept = crack.cracked_tooth_compliance(profile, r, depth, math.pi / 4)
-        for part in ("bending", "shear", "axial", "foundation"):
-            assert np.array_equal(getattr(kept, part), getattr(fresh[depth], part)), part
-    assert potential_energy._tooth_sections.cache_info().hits >= 2
-    assert not np.array_equal(fresh[0.8e-3].bending, fresh[1.6e-3].bending)
+    nu = math.pi / 4
+    y0, y_s = profile.root_chord_y_m, crack.crack_start(profile)[0]
+    theta = involute_half_angle(r, gear.base_radius_m, gear.base_half_thickness_angle_rad)
+    x_c, y_c = r * np.sin(theta), r * np.cos(theta)
+    a1 = np.arccos(gear.base_radius_m / r) - theta
+    pe._tooth_sections.cache_clear()
+    results = {}
+    for depth in (0.8e-3, 1.6e-3, 0.8e-3):
+        h_q = crack.crack_tip_offset_m(profile, depth, nu)
+
+        def h_eff(u):
+            y = np.minimum(y0 + u, profile.tip_radius_m)
+            h = profile.half_thickness_at(y)
+            return np.where((y >= y_s) & (h > h_q), 0.5 * (h + h_q), h)
+
+        ref = pe.cantilever_compliance(h_eff, y_c - y0, x_c, a1, gear.youngs_modulus_pa,
+                                       gear.poisson_ratio, gear.face_width_m)
+        got = crack.cracked_tooth_compliance(profile, r, depth, nu)
+        for part, want in zip(("bending", "shear", "axial"), ref):
+            assert np.array_equal(getattr(got, part), want), (depth, part)
+        results[depth] = got.bending
+    assert pe._tooth_sections.cache_info().hits >= 2
+    assert not np.array_equal(results[0.8e-3], results[1.6e-3])
