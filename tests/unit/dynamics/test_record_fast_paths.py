@@ -190,3 +190,23 @@ def test_cracked_tooth_reuses_its_sections_bit_for_bit():
         results[depth] = got.bending
     assert pe._tooth_sections.cache_info().hits >= 2
     assert not np.array_equal(results[0.8e-3], results[1.6e-3])
+
+
+def test_mesh_stiffness_of_a_table_is_computed_once():
+    """A table's mesh stiffness over the mesh cycle (a run asks for it four times) is summed
+    once per pair and kept; the kept arrays are the ones summed afresh, read-only, and a
+    table derived from it (another stiffness) sums its own."""
+    import dataclasses
+
+    from cmsim.dynamics.tooth_contact import resolve_mesh
+
+    rig = cmsim.Rig.paper_2016()
+    table, _ = resolve_mesh(rig, None, 43.2)
+    first = table.mesh_stiffness(rig.gears)
+    assert table.mesh_stiffness(rig.gears) is first
+    fresh = table._mesh_cycle(rig.gears, 400)
+    assert all(np.array_equal(a, b) for a, b in zip(first, fresh))
+    assert not first[1].flags.writeable
+    stiffer = dataclasses.replace(table, stiffness_n_per_m=2.0 * table.stiffness_n_per_m)
+    assert stiffer.mean_mesh_stiffness(rig.gears) == pytest.approx(
+        2.0 * table.mean_mesh_stiffness(rig.gears), rel=1e-12)
