@@ -124,11 +124,24 @@ def fir_decimate_jit(x, n_cols, h_flip, step, out):
 @njit(cache=True, error_model="numpy", _nrt=False)
 def gather_columns_jit(states, diag, lo, q_cols, d_cols, buf, row0):
     """Copy rows ``lo:`` of the columns ``q_cols`` of ``states`` and ``d_cols`` of ``diag``
-    side by side into ``buf`` from row ``row0`` on (one pass over the rows, each read once)."""
+    side by side into ``buf`` from row ``row0`` on (one pass over the rows, each read once;
+    unsigned indices into the blocks' flat views, as :func:`fir_decimate_jit`)."""
     nq = q_cols.shape[0]
     nd = d_cols.shape[0]
-    for r in range(states.shape[0] - lo):
+    s_flat = states.reshape(states.size)
+    d_flat = diag.reshape(diag.size)
+    b_flat = buf.reshape(buf.size)
+    s_row = np.uint64(states.shape[1])
+    d_row = np.uint64(diag.shape[1])
+    b_row = np.uint64(buf.shape[1])
+    s = np.uint64(lo) * s_row
+    d = np.uint64(lo) * d_row
+    b = np.uint64(row0) * b_row
+    for _ in range(states.shape[0] - lo):
         for j in range(nq):
-            buf[row0 + r, j] = states[lo + r, q_cols[j]]
+            b_flat[b + np.uint64(j)] = s_flat[s + np.uint64(q_cols[j])]
         for j in range(nd):
-            buf[row0 + r, nq + j] = diag[lo + r, d_cols[j]]
+            b_flat[b + np.uint64(nq + j)] = d_flat[d + np.uint64(d_cols[j])]
+        s += s_row
+        d += d_row
+        b += b_row
