@@ -24,7 +24,7 @@ __all__ = ["atomic_write", "atomic_write_text", "atomic_write_bytes", "atomic_sa
 READ_ERRORS = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile)
 
 
-def _atomic(path, write):
+def _atomic(path, write, sync=True):
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -33,7 +33,8 @@ def _atomic(path, write):
             write(fh)
             fh.flush()
             os.fchmod(fh.fileno(), 0o666 & ~_umask())
-            os.fsync(fh.fileno())
+            if sync:
+                os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
         try:
@@ -58,14 +59,17 @@ def atomic_write(path, write):
     return _atomic(path, write)
 
 
-def atomic_write_bytes(path, data):
-    """Write ``data`` (bytes) to ``path`` atomically; return the path."""
-    return _atomic(path, lambda fh: fh.write(data))
+def atomic_write_bytes(path, data, sync=True):
+    """Write ``data`` (bytes) to ``path`` atomically; return the path. With ``sync=False``
+    the data is not forced to the disk before the rename: a crash of the machine (not of the
+    process) may then leave the file empty, for files another one can stand in for."""
+    return _atomic(path, lambda fh: fh.write(data), sync)
 
 
-def atomic_write_text(path, text):
-    """Write ``text`` (UTF-8) to ``path`` atomically; return the path."""
-    return atomic_write_bytes(path, text.encode("utf-8"))
+def atomic_write_text(path, text, sync=True):
+    """Write ``text`` (UTF-8) to ``path`` atomically; return the path (``sync``: as
+    :func:`atomic_write_bytes`)."""
+    return atomic_write_bytes(path, text.encode("utf-8"), sync)
 
 
 def atomic_savez(path, compressed=False, **arrays):

@@ -140,18 +140,19 @@ def check_range(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_ope
     ...     print(exc)
     mass_kg must be a number > 0 kg, got inf
     """
-    allowed = format_range(lo, hi, lo_open=lo_open, hi_open=hi_open, unit=unit)
+    def refuse(got):
+        allowed = format_range(lo, hi, lo_open=lo_open, hi_open=hi_open, unit=unit)
+        return ParameterError(f"{name} must be {allowed}, got {got}", param=name,
+                              allowed=allowed)
+
     if isinstance(value, bool):
-        raise ParameterError(f"{name} must be {allowed}, got {value!r}", param=name,
-                             allowed=allowed)
+        raise refuse(repr(value))
     try:
         v = float(value)
     except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be {allowed}, got {format_value(value)}",
-                             param=name, allowed=allowed) from None
+        raise refuse(format_value(value)) from None
     if not within(v, lo, hi, lo_open=lo_open, hi_open=hi_open):
-        raise ParameterError(f"{name} must be {allowed}, got {format_value(v)}", param=name,
-                             allowed=allowed)
+        raise refuse(format_value(v))
     return v
 
 

@@ -36,6 +36,7 @@ H(0) = 0).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import re
 from fractions import Fraction
@@ -43,7 +44,7 @@ from fractions import Fraction
 import numpy as np
 from scipy.signal import firwin, kaiserord, resample_poly
 
-from cmsim._kernels import housing_modes_jit
+from cmsim._kernels import HOUSING_BLOCK, housing_path_jit
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.errors import ParameterError, check_range
 from cmsim.rig import HousingPath
@@ -120,9 +121,9 @@ def housing_acceleration(force_n, fs_hz, path):
 
     Parameters
     ----------
-    force_n : array_like, shape (n,)
+    force_n : array_like, shape (n,) or (n, C)
         Force transmitted by the bearing to the housing along one direction, N, sampled at
-        ``fs_hz``.
+        ``fs_hz``; or C such forces side by side (filtered in one pass, each as alone).
     fs_hz : float
         Sample rate, Hz.
     path : HousingPath
@@ -130,7 +131,7 @@ def housing_acceleration(force_n, fs_hz, path):
 
     Returns
     -------
-    numpy.ndarray, shape (n,)
+    numpy.ndarray, shape of ``force_n``
         Acceleration along the same direction, m/s², same instants. The filter starts at rest
         under ``force_n[0]`` (a constant force gives zero acceleration). Modes above the
         force's Nyquist frequency are allowed (the force is interpolated) but are excited
@@ -145,22 +146,52 @@ def housing_acceleration(force_n, fs_hz, path):
     8.3
     """
     x = np.asarray(force_n, dtype=float)
-    if x.ndim != 1 or x.size < 1:
-        raise ParameterError(f"force_n must be a 1-D array with samples, got shape {x.shape}",
-                             param="force_n")
+    if x.ndim not in (1, 2) or x.shape[0] < 1:
+        raise ParameterError(f"force_n must be a 1-D array with samples (or 2-D, one force "
+                             f"per column), got shape {x.shape}", param="force_n")
     if not np.all(np.isfinite(x)):
         raise ParameterError("force_n must be finite (no NaN or inf)", param="force_n")
     fs = check_range("fs_hz", fs_hz, 0.0, lo_open=True, unit="Hz")
     k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs))
     # H(0) = 0: remove the first force sample, so the record starts at rest and the
     # zero padding of the interpolation continues that constant force
-    x = x - x[0]
-    xk = resample_poly(x, k, 1) if k > 1 else x      # Nyquist filter: keeps x at i·k
-    # every mode's biquad (sosfilt's) over xk, their sum kept at the original instants
+    # every mode's biquad (sosfilt's) over the force interpolated by k (a Nyquist filter:
+    # keeps x at i·k), their sum kept at the original instants
+    taps, before = _interpolation_phases(k)
+    n = x.shape[0]
+    signals = np.zeros((int(np.prod(x.shape[1:])), n + taps.shape[1] - 1))
+    signals[:, before:before + n] = (x - x[0]).reshape(n, -1).T
     sos = housing_sos(path, fs * k)
-    out = np.empty(x.size)
-    housing_modes_jit(xk, sos, k, np.empty((sos.shape[0], 2)), out)
-    return out
+    out = np.empty((signals.shape[0], n))
+    housing_path_jit(signals, taps, sos, np.empty((signals.shape[0], sos.shape[0], 2)),
+                     np.empty((signals.shape[0], k, HOUSING_BLOCK)), out)
+    return out[0] if x.ndim == 1 else out.T
+
+
+@functools.lru_cache(maxsize=16)
+def _interpolation_phases(k):
+    """``(taps, before)``: the FIR :func:`scipy.signal.resample_poly` interpolates by ``k``
+    with (its default: Kaiser window β = 5, ten zero crossings on each side, gain k), laid
+    out by phase for :func:`cmsim._kernels.housing_path_jit` — row t holds the taps of fast
+    sample j·k + t for the inputs j − before … j − before + D − 1 (zero where the filter has
+    none) — designed once per factor and read-only; ``[[1.0]]`` for k = 1."""
+    if k == 1:
+        taps = np.ones((1, 1))
+        before = 0
+    else:
+        half = 10 * k
+        h = firwin(2 * half + 1, 1.0 / k, window=("kaiser", 5.0))
+        h *= k
+        before = half // k                   # inputs j − before … j + after reach phase t
+        after = (k - 1 + half) // k
+        taps = np.zeros((k, before + after + 1))
+        for t in range(k):
+            for d in range(-before, after + 1):
+                tap = t + half - d * k       # the tap of input j + d at fast sample j·k + t
+                if 0 <= tap <= 2 * half:
+                    taps[t, d + before] = h[tap]
+    taps.setflags(write=False)
+    return taps, before
 
 
 def _kaiser_lowpass(fs_hz, fs_out_hz):
@@ -289,15 +320,16 @@ def tacho_signal(theta_rad, *, level_v=TACHO_LEVEL_V, pulse_width_rad=TACHO_PULS
     return np.where(np.mod(theta, 2.0 * math.pi) < width, float(level_v), 0.0)
 
 
-def _force_bearings(run):
-    """Bearings with both ``F_<b>_x`` and ``F_<b>_y`` in the run, in the run's order."""
+def _force_bearings(run, directions=("x", "y")):
+    """Bearings with ``F_<b>_<d>`` in the run for every direction d of ``directions``, in the
+    run's order."""
     found = {}
     for name in run.signals:
         m = _FORCE.fullmatch(name)
         if m:
             found.setdefault(m["b"], set()).add(m["d"])
     order = list(run.meta.get("rig") and run.rig.bearing_names or sorted(found))
-    return [b for b in order if found.get(b) == {"x", "y"}]
+    return [b for b in order if found.get(b, set()) >= set(directions)]
 
 
 def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearings=None,
@@ -307,8 +339,9 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     Parameters
     ----------
     run : Run
-        A run with bearing forces ``F_<bearing>_x``, ``F_<bearing>_y`` (N) and, for the tacho,
-        the input shaft's total rotation ``theta_1b1`` (rad).
+        A run with bearing forces ``F_<bearing>_x``, ``F_<bearing>_y`` (N; those of
+        ``directions``) and, for the tacho, the input shaft's total rotation ``theta_1b1``
+        (rad).
     path : HousingPath, optional
         Housing transfer path; default the run's rig's :attr:`~cmsim.rig.Rig.housing` (the
         documented defaults of :class:`~cmsim.rig.HousingPath` for a run without a rig).
@@ -320,7 +353,8 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     seed : int, optional
         Seed of the noise generator; default the run's ``meta["seed"]`` (else 0).
     bearings : sequence of str, optional
-        Bearings to instrument (``"1b1"``, ...); default every bearing with x and y forces.
+        Bearings to instrument (``"1b1"``, ...); default every bearing with the forces of
+        ``directions``.
     directions : sequence of {"x", "y"}
         Accelerometer directions on each bearing (default both).
 
@@ -351,27 +385,30 @@ def add_sensors(run, *, path=None, noise_rms=0.0, fs_hz=None, seed=None, bearing
     elif not isinstance(path, HousingPath):
         raise ParameterError(f"path must be a HousingPath, got {type(path).__name__}",
                              param="path")
-    available = _force_bearings(run)
+    directions = [directions] if isinstance(directions, str) else list(directions)
+    if not directions or any(d not in ("x", "y") for d in directions):
+        raise ParameterError(f"directions must name x and/or y, got {directions!r}",
+                             param="directions", allowed="x, y")
     if bearings is None:
-        chosen = available
+        chosen = _force_bearings(run, directions)
     else:
         chosen = [bearings] if isinstance(bearings, str) else list(bearings)
         for b in chosen:
-            if b not in available:
-                raise ParameterError(f"bearing {b!r} has no forces F_{b}_x, F_{b}_y in the run; "
+            if any(f"F_{b}_{d}" not in run.signals for d in directions):
+                available = _force_bearings(run, directions)
+                forces = ", ".join(f"F_{b}_{d}" for d in directions)
+                raise ParameterError(f"bearing {b!r} has no forces {forces} in the run; "
                                      f"available: {available}", param="bearings",
                                      allowed=str(available))
     if not chosen:
         raise ParameterError("the run has no bearing forces F_<bearing>_<x|y> to feel "
                              "through the housing", param="run")
-    directions = [directions] if isinstance(directions, str) else list(directions)
-    if not directions or any(d not in ("x", "y") for d in directions):
-        raise ParameterError(f"directions must name x and/or y, got {directions!r}",
-                             param="directions", allowed="x, y")
     if seed is None:
         seed = int(run.meta.get("seed", 0) or 0)
-    new = {f"accel_{b}_{d}": housing_acceleration(run[f"F_{b}_{d}"], fs_in, path)
-           for b in chosen for d in ("x", "y") if d in directions}
+    pairs = [(b, d) for b in chosen for d in ("x", "y") if d in directions]
+    accel = housing_acceleration(np.column_stack([run[f"F_{b}_{d}"] for b, d in pairs]),
+                                 fs_in, path)
+    new = {f"accel_{b}_{d}": accel[:, i].copy() for i, (b, d) in enumerate(pairs)}
 
     signals = {**run.signals, **new}
     t = np.asarray(run.t, dtype=float)

@@ -77,6 +77,11 @@ def json_default(obj):
 def write_row(out_dir, row):
     """Write one record's row as its sidecar ``rows/<record_id>.json`` (atomically).
 
+    The sidecar is not forced to the disk: the record's file, written and synced before it,
+    keeps the same row in its meta, and a sidecar a machine crash left empty is skipped and
+    the record adopted from its file (:func:`done_indices`); a failed record's lost row only
+    runs it again.
+
     Parameters
     ----------
     out_dir : str or Path
@@ -85,7 +90,7 @@ def write_row(out_dir, row):
         The manifest row.
     """
     atomic_write_text(Path(out_dir) / ROWS_DIR / f"{row['record_id']}.json",
-                      json.dumps(row, default=json_default, allow_nan=True))
+                      json.dumps(row, default=json_default, allow_nan=True), sync=False)
 
 
 def read_spec(out_dir):

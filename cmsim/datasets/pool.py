@@ -15,7 +15,8 @@ Interruptions
 Processes
     On Linux the pool forks (``start_method="fork"``) after the caller has loaded the numba
     kernels, so workers start at once and do not compile; elsewhere it spawns. A worker
-    exits on its own when its parent disappears (a killed run leaves no orphans).
+    exits on its own when its parent disappears (a killed run leaves no orphans), and keeps
+    the memory its tasks free for the next one (:func:`keep_freed_memory`).
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ from concurrent.futures.process import BrokenProcessPool
 from cmsim.errors import ParameterError, WorkersDied
 
 __all__ = ["run_tasks", "Interrupted", "POOL_RESTARTS", "START_METHODS", "default_start_method",
-           "check_workers", "check_start_method", "scheduler_client"]
+           "check_workers", "check_start_method", "scheduler_client", "keep_freed_memory"]
 
 #: Process start methods accepted by :func:`run_tasks`.
 START_METHODS = ("fork", "spawn", "forkserver")
@@ -77,6 +78,35 @@ def check_start_method(start_method):
 #: prctl option: signal to send this process when its parent dies (linux/prctl.h).
 _PR_SET_PDEATHSIG = 1
 
+#: mallopt parameters (glibc malloc.h) and the values a worker sets: blocks up to 32 MiB (the
+#: largest threshold every glibc accepts) come from the heap, and up to 1 GiB of free heap is
+#: kept instead of being handed back to the kernel.
+_M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
+_MMAP_THRESHOLD_BYTES = 32 << 20
+_TRIM_THRESHOLD_BYTES = 1 << 30
+
+
+def keep_freed_memory():
+    """Make this process's ``malloc`` keep the memory it frees for the next allocations
+    (glibc ``mallopt``); False where there is no glibc.
+
+    A task of a worker (a dataset record) allocates and frees tens of megabytes of arrays.
+    glibc hands blocks of that size back to the kernel when they are freed, so the next task
+    takes them again page by page: about 4000 page faults, 8-10 ms of kernel time per
+    one-second record, 6 % of its CPU. Kept, the pages are reused; the process's resident
+    memory stays at the peak of its largest task. Worker processes only: a user's own process
+    keeps glibc's defaults.
+    """
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):              # pragma: no cover - not glibc
+        return False
+    mallopt.argtypes = (ctypes.c_int, ctypes.c_int)
+    return bool(mallopt(_M_MMAP_THRESHOLD, _MMAP_THRESHOLD_BYTES)) \
+        and bool(mallopt(_M_TRIM_THRESHOLD, _TRIM_THRESHOLD_BYTES))
+
 
 def _watch_parent(parent_pid, period_s=0.5):
     """Exit this worker as soon as its parent is gone (killed run: no orphans left)."""
@@ -100,7 +130,9 @@ def _die_with_parent():
 
 def _worker_init(parent_pid):
     """Pool initializer: only the parent reacts to Ctrl-C/SIGTERM; the worker dies with the
-    parent (SIGKILL from the kernel on Linux, else a thread that watches it)."""
+    parent (SIGKILL from the kernel on Linux, else a thread that watches it) and keeps the
+    memory its tasks free (:func:`keep_freed_memory`)."""
+    keep_freed_memory()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if _die_with_parent():

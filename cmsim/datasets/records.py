@@ -97,17 +97,24 @@ def base_row(spec, plan):
     return row
 
 
+def _accelerometers(channels):
+    """``(bearings, directions)`` of a record's accelerometer channels, sorted: the housing
+    path feels the forces of every bearing along every direction of the two lists."""
+    accel = [c.split("_") for c in channels if c.startswith("accel_")]
+    return sorted({a[1] for a in accel}), sorted({a[2] for a in accel})
+
+
 def _simulated_channels(channels, machine=None):
-    """The simulated signals a record's channels are made from: an accelerometer needs both
-    force components of its bearing, the tacho the input shaft's rotation, a machine's
-    channel the force of its model signal's bearing."""
-    out = set()
+    """The simulated signals a record's channels are made from: the accelerometers need the
+    forces of their bearings along their directions (:func:`_accelerometers`), the tacho the
+    input shaft's rotation, a machine's channel the force of its model signal's bearing."""
+    bearings, directions = _accelerometers(channels)
+    out = {f"F_{b}_{d}" for b in bearings for d in directions}
     for c in channels:
         if machine is not None and c == machine.channel:
             out |= set(machine.force_signals)
         elif c.startswith("accel_"):
-            b = c.split("_")[1]
-            out |= {f"F_{b}_x", f"F_{b}_y"}
+            continue
         elif c == "tacho":
             out.add("theta_1b1")
         else:
@@ -153,11 +160,10 @@ def simulate_record(spec, index):
     if spec.machine is not None and (channels is None or spec.machine.channel in channels):
         run = spec.machine.sensor_channel(run, plan.sim_seed)
     if sensed:
-        accel = [c.split("_") for c in sensed if c.startswith("accel_")]
-        bearings = sorted({a[1] for a in accel}) or None
-        directions = sorted({a[2] for a in accel}) or ("x", "y")
+        bearings, directions = _accelerometers(sensed)
         run = add_sensors(run, path=rig.housing, noise_rms=plan.params["sensor_noise_m_s2"],
-                          seed=plan.sim_seed, bearings=bearings, directions=directions)
+                          seed=plan.sim_seed, bearings=bearings or None,
+                          directions=directions or ("x", "y"))
     t2 = time.perf_counter()
     key = fault_frequencies(rig, op, [plan.fault]) if plan.fault is not None else {}
     integration = float(run.meta["wall_s"])
@@ -176,7 +182,7 @@ def simulate_record(spec, index):
         return {"t": run.t, "source": np.asarray(run.source), **run.signals}, \
             {**run.meta, **record}
     meta = {"fs_hz": run.fs_hz, "t0_s": float(run.t[0]), "n_samples": int(run.t.size),
-            "rig": rig.to_dict(), "operating_point": run.meta["operating_point"],
+            "rig": run.meta["rig"], "operating_point": run.meta["operating_point"],
             "profile": None if profile is None else {"times_s": list(profile.times_s),
                                                      "speeds_rpm": list(profile.speeds_rpm)},
             "faults": [f.to_dict() for f in plan.faults], "substeps": run.meta.get("substeps"),

@@ -37,6 +37,7 @@ Seeds (one rule)
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import math
@@ -497,10 +498,19 @@ class DatasetSpec:
             out["machine"] = self.machine.to_dict()
         return out
 
+    @functools.cached_property
+    def _identity(self):
+        """``(digest, fields every record key shares)`` from one :meth:`to_dict`, computed
+        once (a spec is a frozen value) and carried with the spec to the workers."""
+        spec = self.to_dict()
+        return _hash(spec), {k: spec[k] for k in ("channels", "fs_hz", "duration_s",
+                                                  "warmup_s", "substeps", "mesh", "losses",
+                                                  "machine") if k in spec}
+
     @property
     def digest(self):
         """16-hex-digit hash of :meth:`to_dict` (stored with every record)."""
-        return _hash(self.to_dict())
+        return self._identity[0]
 
     def record_key(self, plan):
         """16-hex-digit hash of everything that makes a record's file: its plan, rig,
@@ -512,14 +522,11 @@ class DatasetSpec:
         plan : RecordPlan
             A record of this spec (:meth:`record`).
         """
-        spec = self.to_dict()
         return _hash({"id": plan.record_id, "seed": plan.sim_seed, "params": plan.params,
                       "rig": self.record_rig(plan).to_dict(),
                       "op": dataclasses.asdict(self.record_operating_point(plan)),
                       "faults": [f.to_dict() for f in plan.faults],
-                      **{k: spec[k] for k in ("channels", "fs_hz", "duration_s", "warmup_s",
-                                              "substeps", "mesh", "losses", "machine")
-                         if k in spec}})
+                      **self._identity[1]})
 
     def __eq__(self, other):
         if not isinstance(other, DatasetSpec):

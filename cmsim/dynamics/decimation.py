@@ -25,10 +25,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import firwin, kaiserord
 
-from cmsim.dynamics._decimation_kernels import FIR_LANES, fir_decimate_jit
+from cmsim.dynamics._decimation_kernels import fir_decimate_jit
 from cmsim.errors import ParameterError, check_range
 
-__all__ = ["AntiAliasFilter", "FIR_LANES"]
+__all__ = ["AntiAliasFilter"]
 
 
 @dataclass(frozen=True)
@@ -98,8 +98,7 @@ class AntiAliasFilter:
         ----------
         x : ndarray, shape (L, C)
             Input samples; row ``half_length + m·factor`` is output instant m. A C-contiguous
-            float64 block whose width is a multiple of :data:`FIR_LANES` (pad with zero
-            columns) is read in place; anything else is copied into one first.
+            float64 block is read in place; anything else is copied into one first.
 
         Returns
         -------
@@ -113,16 +112,11 @@ class AntiAliasFilter:
             x = x[:, None]
         hl = self.half_length
         n_out = max((x.shape[0] - 2 * hl - 1) // self.factor + 1, 0)
-        width = x.shape[1]
-        lanes = -(-width // FIR_LANES) * FIR_LANES
-        if lanes != width or not x.flags.c_contiguous:
-            padded = np.zeros((x.shape[0], lanes))
-            padded[:, :width] = x
-            x = padded
-        out = np.empty((n_out, lanes))
-        if n_out:
-            fir_decimate_jit(x, self._taps_flipped, int(self.factor), out)
-        out = out[:, :width]
+        x = np.ascontiguousarray(x)
+        out = np.empty((n_out, x.shape[1]))
+        if n_out and x.shape[1]:
+            fir_decimate_jit(x.reshape(-1), x.shape[1], self._taps_flipped, int(self.factor),
+                             out)
         return out[:, 0] if one else out
 
     def to_dict(self):

@@ -16,7 +16,7 @@ from cmsim.dynamics._decimation_kernels import gather_columns_jit
 from cmsim.dynamics._rhs_kernels import (PR_OMEGA, PR_THETA, integrate_jit,
                                          make_integrator_buffers, make_work, no_propagator)
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.decimation import FIR_LANES, AntiAliasFilter
+from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.dynamics.schemes import choose_scheme
 from cmsim.dynamics.model import build_model
 from cmsim.dynamics.profiles import SpeedProfile, kernel_profile
@@ -244,16 +244,16 @@ def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, pr
     first = n_warm * k - hl                       # first fast sample the filter reads
     last = (n_warm + n_rec - 1) * k + hl          # last one
     n_forces = len(model.output_force_names)
-    q_out = np.full((n_rec, n), np.nan)
-    d_out = np.full((n_rec, n_forces), np.nan)
+    q_out = np.full((n_rec, n), np.nan, order="F")       # signals are read column by column
+    d_out = np.full((n_rec, n_forces), np.nan, order="F")
     qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
     dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
     runner = _Integrator(model, scheme, progress, split)
     m0 = 0                                        # next output sample to fill
     n_tail = 0                                    # fast samples not yet consumed, at buf[0:]
-    # the filtered columns side by side, padded with zeros to the filter kernel's lanes, in
-    # one buffer for the run: the tail a block leaves, then the next block
-    width = -(-(qc.size + dc.size) // FIR_LANES) * FIR_LANES
+    # the filtered columns side by side, in one buffer for the run: the tail a block leaves,
+    # then the next block
+    width = qc.size + dc.size
     chunk = DECIMATION_CHUNK_STEPS
     buf = np.zeros((2 * hl + k + chunk + 1, width))
     for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1, chunk):

@@ -164,17 +164,14 @@ def cracked_tooth_compliance(profile, contact_radius_m, depth_m, angle_rad, n_no
     .. [2] S. Wu, M. J. Zuo, A. Parey, J. Sound Vib. 317 (2008) 608-624, eqs. (14)-(17).
     """
     q, nu = _check_crack(profile, depth_m, angle_rad)
-    y0 = profile.root_chord_y_m
     h_q = crack_tip_offset_m(profile, q, nu)
     y_s = crack_start(profile)[0]
 
-    def h_eff(u):
-        y = np.minimum(y0 + u, profile.tip_radius_m)
-        h = profile.half_thickness_at(y)
+    def h_eff(h, y):
         cut = (y >= y_s) & (h > h_q)                # thickness h + h_q behind the crack
         return np.where(cut, 0.5 * (h + h_q), h)
 
-    return tooth_compliance(profile, contact_radius_m, n_nodes=n_nodes, half_thickness=h_eff)
+    return tooth_compliance(profile, contact_radius_m, n_nodes=n_nodes, thinned=h_eff)
 
 
 @functools.lru_cache(maxsize=8)

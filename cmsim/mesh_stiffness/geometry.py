@@ -26,6 +26,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -251,6 +252,8 @@ class ToothProfile:
         Returns
         -------
         ToothProfile
+            Generated once per gear and ``n_points`` and shared (a profile is a value: its
+            arrays are read-only); every cracked-tooth record of a dataset asks for it.
 
         Raises
         ------
@@ -263,99 +266,7 @@ class ToothProfile:
         if isinstance(n_points, bool) or not isinstance(n_points, (int, np.integer)) \
                 or n_points < 16:
             raise ParameterError(f"n_points must be an integer >= 16, got {n_points!r}")
-        n_points = int(n_points)
-        n_small = max(16, n_points // 8)
-        rack = _Rack.of(gear)
-        rb, ra = gear.base_radius_m, gear.tip_radius_m
-        rf = gear.root_radius_m
-        psi_b = gear.base_half_thickness_angle_rad
-        rho_t = gear.tip_rounding_m
-
-        theta_f = rack.phi_bottom
-        if theta_f >= math.pi / gear.n_teeth:
-            raise ParameterError(
-                f"the root fillets of neighbouring teeth overlap (θ_f = {theta_f:.4f} rad >= "
-                f"π/Z = {math.pi / gear.n_teeth:.4f} rad); reduce rack_tip_radius_coef")
-
-        phi_end, undercut_depth = _fillet_end(rack, rb, psi_b)
-        phi = np.linspace(rack.phi_bottom, phi_end, n_points)
-        fx, fy = rack.fillet(phi)
-        r_form = float(np.hypot(fx[-1], fy[-1]))
-
-        # tip rounding, constructed on the generated flank: the point whose inward normal,
-        # offset by ρ, lands on the circle r_a − ρ (closed forms: tip_rounding_* helpers)
-        if rho_t > 0.0:
-            if ra - rho_t <= rb:
-                raise ParameterError("tip rounding too large: r_a − ρ must exceed r_b")
-
-            def miss(r):
-                x, y, nx, ny = rack.flank_at_radius(r)
-                return float(np.hypot(x + rho_t * nx, y + rho_t * ny)) - (ra - rho_t)
-
-            r_tr = brentq(miss, rb, ra, xtol=1e-15, rtol=1e-15)
-            x, y, nx, ny = rack.flank_at_radius(r_tr)
-            cx, cy = float(x + rho_t * nx), float(y + rho_t * ny)
-            theta_c = math.atan2(cx, cy)
-        else:
-            r_tr = ra
-            theta_c = float(involute_half_angle(ra, rb, psi_b))
-            cx, cy = ra * math.sin(theta_c), ra * math.cos(theta_c)
-        if theta_c <= 0.0:
-            raise ParameterError(
-                "the tip rounding does not fit on the tooth (pointed tooth): reduce "
-                "tip_radius_coef, rack_dedendum_coef or profile_shift")
-        if r_form >= r_tr:
-            raise ParameterError(
-                f"no involute left: form radius {r_form:g} m >= tip-rounding start {r_tr:g} m "
-                "(undercut too deep; increase profile_shift)")
-
-        # involute: envelope of the straight rack flank, from the form radius to r_tr
-        r_inv = np.linspace(r_form, r_tr, n_points)
-        ix, iy, _, _ = rack.flank_at_radius(r_inv)
-
-        # tip rounding arc about the centre, from the involute tangency to the tip circle
-        if rho_t > 0.0:
-            a0 = math.atan2(iy[-1] - cy, ix[-1] - cx)
-            a1 = math.atan2(cy, cx)
-            a1 = a0 + (a1 - a0 + math.pi) % (2 * math.pi) - math.pi
-            ang = np.linspace(a0, a1, n_small)
-            tx, ty = cx + rho_t * np.cos(ang), cy + rho_t * np.sin(ang)
-        else:
-            tx, ty = ix[-1:], iy[-1:]
-        # tip arc (right half, θ from θ_c to 0)
-        th_tip = np.linspace(theta_c, 0.0, n_small)
-        px, py = ra * np.sin(th_tip), ra * np.cos(th_tip)
-        # root arc (right half of the space, θ from π/Z down to θ_f)
-        th_root = np.linspace(math.pi / gear.n_teeth, theta_f, n_small)
-        qx, qy = rf * np.sin(th_root), rf * np.cos(th_root)
-
-        right = [("root", qx, qy), ("fillet", fx, fy), ("involute", ix, iy),
-                 ("tip_round", tx, ty), ("tip", px, py)]
-        xs, ys, labs = [], [], []
-        for k, (lab, x, y) in enumerate(right):
-            if k > 0:                     # drop the junction point shared with the previous
-                x, y = x[1:], y[1:]
-            xs.append(x)
-            ys.append(y)
-            labs.append(np.full(x.size, lab))
-        rx, ry, rl = np.concatenate(xs), np.concatenate(ys), np.concatenate(labs)
-        # counter-clockwise: right side upward, then the mirrored left side downward
-        lx, ly, ll = -rx[::-1][1:], ry[::-1][1:], rl[::-1][1:]
-        pts = np.column_stack([np.concatenate([rx, lx]), np.concatenate([ry, ly])])
-        labels = np.concatenate([rl, ll])
-        pts.setflags(write=False)
-        labels.setflags(write=False)
-
-        # half-thickness along the centreline, from the root chord to the apex
-        first = qx.size - 1             # the last root point is where the fillet starts
-        flank_y, flank_x = _lower_envelope(ry[first:], rx[first:])
-        flank_y.setflags(write=False)
-        flank_x.setflags(write=False)
-        return cls(gear=gear, points_m=pts, labels=labels, form_radius_m=r_form,
-                   tip_round_start_radius_m=float(r_tr), root_radius_m=rf,
-                   root_half_angle_rad=float(theta_f), undercut_depth_m=float(undercut_depth),
-                   tip_round_centre_m=(float(cx), float(cy)),
-                   _flank_y=flank_y, _flank_x=flank_x)
+        return _generated_profile(cls, gear, int(n_points))
 
     # ------------------------------------------------------------------ derived
     @property
@@ -440,6 +351,103 @@ class ToothProfile:
 
 
 # --------------------------------------------------------------------------- helpers
+@functools.lru_cache(maxsize=64)
+def _generated_profile(cls, gear, n_points):
+    """The body of :meth:`ToothProfile.from_gear` (checked arguments), memoised."""
+    n_small = max(16, n_points // 8)
+    rack = _Rack.of(gear)
+    rb, ra = gear.base_radius_m, gear.tip_radius_m
+    rf = gear.root_radius_m
+    psi_b = gear.base_half_thickness_angle_rad
+    rho_t = gear.tip_rounding_m
+
+    theta_f = rack.phi_bottom
+    if theta_f >= math.pi / gear.n_teeth:
+        raise ParameterError(
+            f"the root fillets of neighbouring teeth overlap (θ_f = {theta_f:.4f} rad >= "
+            f"π/Z = {math.pi / gear.n_teeth:.4f} rad); reduce rack_tip_radius_coef")
+
+    phi_end, undercut_depth = _fillet_end(rack, rb, psi_b)
+    phi = np.linspace(rack.phi_bottom, phi_end, n_points)
+    fx, fy = rack.fillet(phi)
+    r_form = float(np.hypot(fx[-1], fy[-1]))
+
+    # tip rounding, constructed on the generated flank: the point whose inward normal,
+    # offset by ρ, lands on the circle r_a − ρ (closed forms: tip_rounding_* helpers)
+    if rho_t > 0.0:
+        if ra - rho_t <= rb:
+            raise ParameterError("tip rounding too large: r_a − ρ must exceed r_b")
+
+        def miss(r):
+            x, y, nx, ny = rack.flank_at_radius(r)
+            return float(np.hypot(x + rho_t * nx, y + rho_t * ny)) - (ra - rho_t)
+
+        r_tr = brentq(miss, rb, ra, xtol=1e-15, rtol=1e-15)
+        x, y, nx, ny = rack.flank_at_radius(r_tr)
+        cx, cy = float(x + rho_t * nx), float(y + rho_t * ny)
+        theta_c = math.atan2(cx, cy)
+    else:
+        r_tr = ra
+        theta_c = float(involute_half_angle(ra, rb, psi_b))
+        cx, cy = ra * math.sin(theta_c), ra * math.cos(theta_c)
+    if theta_c <= 0.0:
+        raise ParameterError(
+            "the tip rounding does not fit on the tooth (pointed tooth): reduce "
+            "tip_radius_coef, rack_dedendum_coef or profile_shift")
+    if r_form >= r_tr:
+        raise ParameterError(
+            f"no involute left: form radius {r_form:g} m >= tip-rounding start {r_tr:g} m "
+            "(undercut too deep; increase profile_shift)")
+
+    # involute: envelope of the straight rack flank, from the form radius to r_tr
+    r_inv = np.linspace(r_form, r_tr, n_points)
+    ix, iy, _, _ = rack.flank_at_radius(r_inv)
+
+    # tip rounding arc about the centre, from the involute tangency to the tip circle
+    if rho_t > 0.0:
+        a0 = math.atan2(iy[-1] - cy, ix[-1] - cx)
+        a1 = math.atan2(cy, cx)
+        a1 = a0 + (a1 - a0 + math.pi) % (2 * math.pi) - math.pi
+        ang = np.linspace(a0, a1, n_small)
+        tx, ty = cx + rho_t * np.cos(ang), cy + rho_t * np.sin(ang)
+    else:
+        tx, ty = ix[-1:], iy[-1:]
+    # tip arc (right half, θ from θ_c to 0)
+    th_tip = np.linspace(theta_c, 0.0, n_small)
+    px, py = ra * np.sin(th_tip), ra * np.cos(th_tip)
+    # root arc (right half of the space, θ from π/Z down to θ_f)
+    th_root = np.linspace(math.pi / gear.n_teeth, theta_f, n_small)
+    qx, qy = rf * np.sin(th_root), rf * np.cos(th_root)
+
+    right = [("root", qx, qy), ("fillet", fx, fy), ("involute", ix, iy),
+             ("tip_round", tx, ty), ("tip", px, py)]
+    xs, ys, labs = [], [], []
+    for k, (lab, x, y) in enumerate(right):
+        if k > 0:                     # drop the junction point shared with the previous
+            x, y = x[1:], y[1:]
+        xs.append(x)
+        ys.append(y)
+        labs.append(np.full(x.size, lab))
+    rx, ry, rl = np.concatenate(xs), np.concatenate(ys), np.concatenate(labs)
+    # counter-clockwise: right side upward, then the mirrored left side downward
+    lx, ly, ll = -rx[::-1][1:], ry[::-1][1:], rl[::-1][1:]
+    pts = np.column_stack([np.concatenate([rx, lx]), np.concatenate([ry, ly])])
+    labels = np.concatenate([rl, ll])
+    pts.setflags(write=False)
+    labels.setflags(write=False)
+
+    # half-thickness along the centreline, from the root chord to the apex
+    first = qx.size - 1             # the last root point is where the fillet starts
+    flank_y, flank_x = _lower_envelope(ry[first:], rx[first:])
+    flank_y.setflags(write=False)
+    flank_x.setflags(write=False)
+    return cls(gear=gear, points_m=pts, labels=labels, form_radius_m=r_form,
+               tip_round_start_radius_m=float(r_tr), root_radius_m=rf,
+               root_half_angle_rad=float(theta_f), undercut_depth_m=float(undercut_depth),
+               tip_round_centre_m=(float(cx), float(cy)),
+               _flank_y=flank_y, _flank_x=flank_x)
+
+
 def _fillet_end(rack, rb, psi_b):
     """Roll angle where the fillet ends, and the undercut depth (m).
 

@@ -38,6 +38,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass
@@ -147,7 +148,8 @@ class PairCompliance:
 
 # --------------------------------------------------------------------------- building blocks
 def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_rad,
-                          youngs_modulus_pa, poisson_ratio, face_width_m, n_nodes=1001):
+                          youngs_modulus_pa, poisson_ratio, face_width_m, n_nodes=1001, *,
+                          nodes=None):
     """Bending, shear and axial compliance of a non-uniform cantilever (eqs. 5-10 of [2]).
 
     The beam runs along u from its built-in section (u = 0) and has the rectangular section
@@ -180,6 +182,12 @@ def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_
     n_nodes : int
         Nodes of the composite Simpson rule on each [0, d] (made odd); exact for a uniform
         beam.
+    nodes : dict, optional
+        A store for the nodes and the terms that do not depend on the thickness (moment arm,
+        load angle), filled on the first call and read on the next ones: for one beam (the
+        same lengths, offsets, angles and ``n_nodes``) integrated with several thicknesses
+        (a tooth with cracks of several depths). Without it each block of load sections is
+        built and dropped in turn.
 
     Returns
     -------
@@ -208,23 +216,36 @@ def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_
     G = E / (2.0 * (1.0 + nu))
 
     t = np.linspace(0.0, 1.0, int(n_nodes))
+    if nodes is None:
+        blocks = _beam_blocks(d, e, a1, t)
+    else:
+        blocks = nodes.get("blocks") or nodes.setdefault("blocks",
+                                                         list(_beam_blocks(d, e, a1, t)))
     bending, shear, axial = (np.empty_like(d) for _ in range(3))
+    for sl, u, arm2, c2, s2 in blocks:
+        h = np.asarray(half_thickness_m(u), dtype=float) * np.ones_like(u)
+        if not (np.all(np.isfinite(h)) and np.all(h > 0.0)):
+            raise ParameterError("half_thickness_m must return finite values > 0 on the beam")
+        inv_a = 1.0 / (2.0 * h * face_width_m)
+        inv_i = 1.0 / (2.0 / 3.0 * h ** 3 * face_width_m)
+        bending[sl] = simpson(arm2 * inv_i, x=u, axis=1) / E
+        ja = simpson(inv_a, x=u, axis=1)
+        shear[sl] = _SHEAR_FACTOR * c2 * ja / G
+        axial[sl] = s2 * ja / E
+    return bending, shear, axial
+
+
+def _beam_blocks(d, e, a1, t):
+    """Blocks of :data:`_ROWS_PER_BLOCK` load sections of :func:`cantilever_compliance`:
+    ``(rows, u, arm², cos² α1, sin² α1)`` with the nodes u on [0, d] of every section and
+    the bending moment per unit load at them (read-only arrays)."""
     for lo in range(0, d.size, _ROWS_PER_BLOCK):
         sl = slice(lo, lo + _ROWS_PER_BLOCK)
         dd, ee = d[sl, None], e[sl, None]
         c, s = np.cos(a1[sl, None]), np.sin(a1[sl, None])
         u = dd * t                      # nodes on [0, d] for every load position
-        h = np.asarray(half_thickness_m(u), dtype=float) * np.ones_like(u)
-        if not (np.all(np.isfinite(h)) and np.all(h > 0.0)):
-            raise ParameterError("half_thickness_m must return finite values > 0 on the beam")
         arm = c * (dd - u) - ee * s     # bending moment per unit load at section u
-        inv_a = 1.0 / (2.0 * h * face_width_m)
-        inv_i = 1.0 / (2.0 / 3.0 * h ** 3 * face_width_m)
-        bending[sl] = simpson(arm * arm * inv_i, x=u, axis=1) / E
-        ja = simpson(inv_a, x=u, axis=1)
-        shear[sl] = _SHEAR_FACTOR * c[:, 0] ** 2 * ja / G
-        axial[sl] = s[:, 0] ** 2 * ja / E
-    return bending, shear, axial
+        yield sl, *(_read_only(a) for a in (u, arm * arm, c[:, 0] ** 2, s[:, 0] ** 2))
 
 
 def sainsot_coefficients(root_half_angle_rad, hf):
@@ -317,7 +338,7 @@ def hertz_stiffness(pair):
     return math.pi * b / (2.0 * soft)
 
 
-def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=None):
+def tooth_compliance(profile, contact_radius_m, n_nodes=1001, thinned=None):
     """Compliance of one tooth loaded on its involute at the given radii.
 
     Parameters
@@ -328,12 +349,14 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=Non
         Contact radii on the involute, within [form radius, tip-rounding start], m.
     n_nodes : int
         Nodes of the beam integration.
-    half_thickness : callable, optional
-        h(u): half-thickness, m, of the section that carries the load at height u (m, array)
-        above the root chord; default the tooth's own,
-        ``profile.half_thickness_at(min(y0 + u, r_a))``. A cracked tooth passes its reduced
-        section (:func:`cmsim.faults.crack.cracked_tooth_compliance`); the foundation term
-        stays the healthy one.
+    thinned : callable, optional
+        ``thinned(h, y)``: the half-thickness, m, of the section that carries the load, from
+        the tooth's own h = ``profile.half_thickness_at(y)`` at the heights
+        y = min(y0 + u, r_a) of the beam's nodes (arrays of one shape); default the tooth's
+        own. A cracked tooth passes its reduced section
+        (:func:`cmsim.faults.crack.cracked_tooth_compliance`); the foundation term stays the
+        healthy one. The tooth's own sections at the nodes of a contact grid are then kept
+        (:func:`_tooth_sections`) for the next cracked tooth on the same grid.
 
     Returns
     -------
@@ -353,15 +376,46 @@ def tooth_compliance(profile, contact_radius_m, n_nodes=1001, half_thickness=Non
     x_c, y_c = r * np.sin(theta_c), r * np.cos(theta_c)
     a1 = alpha_r - theta_c
     y0 = profile.root_chord_y_m
-    if half_thickness is None:
+
+    def section(u):
+        y = np.minimum(y0 + u, profile.tip_radius_m)
+        return y, profile.half_thickness_at(y)
+
+    if thinned is None:
         def half_thickness(u):
-            return profile.half_thickness_at(np.minimum(y0 + u, profile.tip_radius_m))
+            return section(u)[1]
+    else:
+        kept = _tooth_sections(profile, r.tobytes(), int(n_nodes))
+
+        def half_thickness(u):
+            # a block of the beam's nodes is known by its rows and its first row's length
+            key = (u.shape, float(u[0, -1]))
+            if key not in kept:
+                kept[key] = tuple(_read_only(a) for a in section(u))
+            y, h = kept[key]
+            return thinned(h, y)
     bending, shear, axial = cantilever_compliance(
         half_thickness, y_c - y0, x_c, a1, gear.youngs_modulus_pa, gear.poisson_ratio,
-        gear.face_width_m, n_nodes=n_nodes)
+        gear.face_width_m, n_nodes=n_nodes, nodes=None if thinned is None else kept)
     u_f = y_c - x_c * np.tan(a1) - y0      # force line meets the centreline below y_c
     foundation = fillet_foundation_compliance(profile, u_f, a1)
     return ToothCompliance(bending=bending, shear=shear, axial=axial, foundation=foundation)
+
+
+@functools.lru_cache(maxsize=4)
+def _tooth_sections(profile, radii_bytes, n_nodes):
+    """``{block: (y, h)}``: the heights and the tooth's own half-thicknesses at the beam's
+    nodes of :func:`tooth_compliance` for one tooth, contact grid (float64 bytes) and number
+    of nodes, filled as blocks are met, and the beam's nodes themselves (``"blocks"``, the
+    ``nodes`` of :func:`cantilever_compliance`); read-only arrays, about 8 MB for a grid of
+    257 contact points. Every cracked record of a dataset integrates the same tooth on the
+    same grid with another crack."""
+    return {}
+
+
+def _read_only(a):
+    a.setflags(write=False)
+    return a
 
 
 # --------------------------------------------------------------------------- gear pair

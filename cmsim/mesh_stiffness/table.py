@@ -134,7 +134,17 @@ class MeshStiffnessTable:
         stiffness_n_per_m : ndarray, shape (n_points,)
             Sum of the pair stiffnesses in contact, N/m.
         pairs_in_contact : ndarray of int, shape (n_points,)
+            (Read-only arrays, computed once per table, pair and ``n_points``: a table is a
+            value, and a run asks for its mesh stiffness four times.)
         """
+        memo = self.__dict__.setdefault("_mesh_stiffness", {})
+        key = (pair, int(n_points))
+        if key not in memo:
+            memo[key] = tuple(_read_only(a) for a in self._mesh_cycle(pair, n_points))
+        return memo[key]
+
+    def _mesh_cycle(self, pair, n_points):
+        """The sums of :meth:`mesh_stiffness`."""
         s0, s1 = self.contact_range_m(pair)
         pb = pair.driving.base_pitch_m
         s = s0 + pb * np.arange(n_points) / n_points
@@ -193,3 +203,8 @@ class MeshStiffnessTable:
             info = json.loads(str(z["meta"]))
             return cls(z["position_m"], z["stiffness_n_per_m"], z["separation_m"],
                        info["base_radius_m"], info["method"], info["torque_nm"], info["meta"])
+
+
+def _read_only(a):
+    a.setflags(write=False)
+    return a

@@ -334,3 +334,17 @@ def test_standard_specs_parse():
     for path in sorted((ROOT / "datasets").glob("*.toml")):
         spec = DatasetSpec.load(path)
         assert len(spec) >= 1 and spec.channels
+
+
+@pytest.mark.parametrize("channels, simulated", [
+    (["accel_1b1_y", "accel_2b1_y", "dte_um", "tacho"],
+     ["F_1b1_y", "F_2b1_y", "dte_um", "theta_1b1"]),
+    (["accel_1b1_x", "accel_1b1_y", "accel_1b2_y"], ["F_1b1_x", "F_1b1_y", "F_1b2_x", "F_1b2_y"]),
+])
+def test_a_record_simulates_only_what_its_channels_are_made_from(channels, simulated):
+    """An accelerometer needs its bearing's force along its direction only (the housing path
+    takes the product of the bearings and directions of the record's accelerometers); every
+    simulated signal costs the anti-alias filter a column."""
+    from cmsim.datasets.records import _simulated_channels
+
+    assert _simulated_channels(channels) == simulated

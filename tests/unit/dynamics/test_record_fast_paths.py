@@ -64,11 +64,12 @@ def test_cage_only_slip_skips_the_ball_grid_bit_for_bit():
     assert not np.array_equal(fast_y, no_slip_y)
 
 
-@pytest.mark.parametrize("factor, width", [(3, 7), (2, 1), (5, 8), (3, 0)])
+@pytest.mark.parametrize("factor, width", [(3, 7), (2, 1), (5, 8), (3, 0), (3, 5), (4, 2),
+                                           (2, 9), (3, 6)])
 def test_anti_alias_kernel_is_upfirdn_bit_for_bit(factor, width):
     """The numba FIR gives :func:`scipy.signal.upfirdn`'s outputs exactly (the sums in the
-    same order), for any width (padded to the kernel's lanes), a transposed (non-contiguous)
-    block and a 1-D signal."""
+    same order), for any width (groups of four columns, then the columns left over one by
+    one, any number of outputs), a transposed (non-contiguous) block and a 1-D signal."""
     from scipy.signal import upfirdn
 
     from cmsim.dynamics.decimation import AntiAliasFilter
@@ -89,8 +90,9 @@ def test_anti_alias_kernel_is_upfirdn_bit_for_bit(factor, width):
 
 @pytest.mark.parametrize("fs_hz", [25_600.0, 12_000.0, 200_000.0])
 def test_housing_path_kernel_is_sosfilt_bit_for_bit(fs_hz):
-    """The housing path's fused kernel gives the sum of one ``sosfilt`` per mode, kept every
-    k-th sample, exactly (the reference written as it was before the kernel)."""
+    """The housing path's fused kernel gives the sum of one ``sosfilt`` per mode over the
+    force interpolated by ``resample_poly``, kept every k-th sample, exactly (the reference
+    written as it was before the kernel); forces side by side each as alone."""
     import math
 
     from scipy.signal import resample_poly, sosfilt
@@ -106,6 +108,9 @@ def test_housing_path_kernel_is_sosfilt_bit_for_bit(fs_hz):
     for section in housing_sos(path, fs_hz * k):
         ref += sosfilt(section[None, :], xk)
     assert np.array_equal(housing_acceleration(force, fs_hz, path), ref[::k])
+    both = housing_acceleration(np.column_stack([force[::-1], force]), fs_hz, path)
+    assert np.array_equal(both[:, 1], ref[::k])
+    assert np.array_equal(both[:, 0], housing_acceleration(force[::-1], fs_hz, path))
 
 
 def test_recorded_signals_are_those_of_the_full_run():
@@ -148,3 +153,62 @@ def test_cracked_factor_with_the_healthy_pair_cached_is_unchanged():
         1.2e-3, math.pi / 4)
     ref = healthy.total / (healthy.hertz + healthy.driving.total + cracked.total)
     assert np.array_equal(first, ref) and np.array_equal(again, ref)
+
+
+def test_cracked_tooth_reuses_its_sections_bit_for_bit():
+    """A cracked tooth on a contact grid met before reads the beam's nodes and the tooth's
+    own sections at them from the last crack: the same compliance, bit for bit, as the beam
+    integrated afresh with the cracked section (the reference written as it was before the
+    store), and another depth still gives another one."""
+    import math
+
+    from cmsim.faults import crack
+    from cmsim.mesh_stiffness import potential_energy as pe
+    from cmsim.mesh_stiffness.geometry import involute_half_angle
+
+    gear = cmsim.Rig.paper_2016().gears.driving
+    profile = crack.ToothProfile.from_gear(gear)
+    r = np.linspace(profile.form_radius_m, profile.tip_round_start_radius_m, 300)
+    nu = math.pi / 4
+    y0, y_s = profile.root_chord_y_m, crack.crack_start(profile)[0]
+    theta = involute_half_angle(r, gear.base_radius_m, gear.base_half_thickness_angle_rad)
+    x_c, y_c = r * np.sin(theta), r * np.cos(theta)
+    a1 = np.arccos(gear.base_radius_m / r) - theta
+    pe._tooth_sections.cache_clear()
+    results = {}
+    for depth in (0.8e-3, 1.6e-3, 0.8e-3):
+        h_q = crack.crack_tip_offset_m(profile, depth, nu)
+
+        def h_eff(u):
+            y = np.minimum(y0 + u, profile.tip_radius_m)
+            h = profile.half_thickness_at(y)
+            return np.where((y >= y_s) & (h > h_q), 0.5 * (h + h_q), h)
+
+        ref = pe.cantilever_compliance(h_eff, y_c - y0, x_c, a1, gear.youngs_modulus_pa,
+                                       gear.poisson_ratio, gear.face_width_m)
+        got = crack.cracked_tooth_compliance(profile, r, depth, nu)
+        for part, want in zip(("bending", "shear", "axial"), ref):
+            assert np.array_equal(getattr(got, part), want), (depth, part)
+        results[depth] = got.bending
+    assert pe._tooth_sections.cache_info().hits >= 2
+    assert not np.array_equal(results[0.8e-3], results[1.6e-3])
+
+
+def test_mesh_stiffness_of_a_table_is_computed_once():
+    """A table's mesh stiffness over the mesh cycle (a run asks for it four times) is summed
+    once per pair and kept; the kept arrays are the ones summed afresh, read-only, and a
+    table derived from it (another stiffness) sums its own."""
+    import dataclasses
+
+    from cmsim.dynamics.tooth_contact import resolve_mesh
+
+    rig = cmsim.Rig.paper_2016()
+    table, _ = resolve_mesh(rig, None, 43.2)
+    first = table.mesh_stiffness(rig.gears)
+    assert table.mesh_stiffness(rig.gears) is first
+    fresh = table._mesh_cycle(rig.gears, 400)
+    assert all(np.array_equal(a, b) for a, b in zip(first, fresh))
+    assert not first[1].flags.writeable
+    stiffer = dataclasses.replace(table, stiffness_n_per_m=2.0 * table.stiffness_n_per_m)
+    assert stiffer.mean_mesh_stiffness(rig.gears) == pytest.approx(
+        2.0 * table.mean_mesh_stiffness(rig.gears), rel=1e-12)

@@ -200,6 +200,12 @@ def test_add_sensors_maps_force_direction_to_accelerometer_direction():
     np.testing.assert_array_equal(x_only["accel_1b1_x"], out["accel_1b1_x"])
     with pytest.raises(ParameterError, match="directions"):
         add_sensors(run, path=ONE_MODE, directions=("z",))
+    # an accelerometer needs only the force along its direction (a dataset records no more)
+    x_forces = _run({"F_1b1_x": fx, "F_1b2_x": np.zeros(n)})
+    np.testing.assert_array_equal(
+        add_sensors(x_forces, path=ONE_MODE, directions="x")["accel_1b1_x"], out["accel_1b1_x"])
+    with pytest.raises(ParameterError, match="F_1b1_y"):
+        add_sensors(x_forces, path=ONE_MODE, bearings=["1b1"])
 
 
 def test_add_sensors_takes_the_path_from_the_run_rig_and_records_the_sensor(tmp_path):
