@@ -78,8 +78,9 @@ def cpu():
 # -- 2, 3: the integration alone -----------------------------------------------------------
 
 def record_steps(spec):
-    """``(integration step, steps of one record)`` as simulate takes them for the spec (the
-    step of the substeps chosen for its first record, warm-up and filter tails included)."""
+    """``(integration step, steps of one record, substeps, scheme)`` as simulate takes them
+    for the spec (the step and scheme chosen for its first record, warm-up and filter tails
+    included)."""
     from cmsim.dynamics.decimation import AntiAliasFilter
     from cmsim.datasets.records import simulate_record
     arrays, meta = simulate_record(spec, 0)
@@ -88,24 +89,25 @@ def record_steps(spec):
     n_rec = round(spec.duration_s * spec.fs_hz)
     hl = AntiAliasFilter(k, spec.fs_hz * k).half_length if k > 1 else 0
     n_warm = max(n_warm, math.ceil(hl / k))
-    return 1.0 / (spec.fs_hz * k), (n_warm + n_rec - 1) * k + hl + 1, k
+    return 1.0 / (spec.fs_hz * k), (n_warm + n_rec - 1) * k + hl + 1, k, meta["scheme"]
 
 
-def integration_cpu(model, h, n_steps, repeats):
-    """Least CPU time over ``repeats`` of the bare kernel over ``n_steps`` steps, s."""
+def integration_cpu(model, h, n_steps, repeats, scheme):
+    """Least CPU time over ``repeats`` of the bare kernel with ``scheme`` over ``n_steps``
+    steps, s."""
     from cmsim.dynamics import quasi_static_state
     from cmsim.dynamics.simulation import integrate
     y0 = np.concatenate([quasi_static_state(model, 0.0), np.zeros(model.n_dof)])
-    integrate(model, y0, 0.0, h, 3)
+    integrate(model, y0, 0.0, h, 3, scheme=scheme)
     best = math.inf
     for _ in range(repeats):
         t = cpu()
-        integrate(model, y0, 0.0, h, n_steps)
+        integrate(model, y0, 0.0, h, n_steps, scheme=scheme)
         best = min(best, cpu() - t)
     return best
 
 
-def bench_integration(spec, h, n_steps, repeats):
+def bench_integration(spec, h, n_steps, repeats, scheme):
     """Section 3: ``{variant: CPU s per record}`` (the healthy one first)."""
     import cmsim
     from cmsim.dynamics import build_model
@@ -146,7 +148,7 @@ def bench_integration(spec, h, n_steps, repeats):
     out = {}
     for _ in range(repeats):                # interleaved: the load of a shared machine drifts
         for name, m in variants.items():
-            out[name] = min(out.get(name, math.inf), integration_cpu(m, h, n_steps, 1))
+            out[name] = min(out.get(name, math.inf), integration_cpu(m, h, n_steps, 1, scheme))
     return out
 
 
@@ -348,13 +350,14 @@ def main(argv=None):
     print(f"CPU: {name}, {cores} cores usable; load average {load[0]:.2f} {load[1]:.2f} "
           f"{load[2]:.2f} (times below are CPU time unless marked wall)")
     spec = load_spec(args.spec, max(n_run, n_split + 1))
-    h, n_steps, k = record_steps(spec)
+    h, n_steps, k, scheme = record_steps(spec)
     print(f"spec {Path(args.spec).name}: {spec.fs_hz:g} Hz x {k} substeps = "
-          f"{1 / h:g} Hz integration, {n_steps} steps per {spec.duration_s:g}-s record")
+          f"{1 / h:g} Hz integration ({scheme}), {n_steps} steps per {spec.duration_s:g}-s "
+          f"record")
     res = {"cpu": name, "cores": cores, "load": load, "spec": Path(args.spec).name,
-           "steps_per_record": n_steps}
+           "steps_per_record": n_steps, "scheme": scheme}
 
-    variants = bench_integration(spec, h, n_steps, repeats + 1)
+    variants = bench_integration(spec, h, n_steps, repeats + 1, scheme)
     bound = next(iter(variants.values()))
     print(f"\nintegration bound: {bound * 1e3:.1f} ms CPU per healthy record "
           f"({n_steps * h / bound:.2f} x realtime, {bound / n_steps * 1e9:.0f} ns per step) "
