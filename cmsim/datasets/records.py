@@ -186,7 +186,7 @@ def simulate_record(spec, index):
             "profile": None if profile is None else {"times_s": list(profile.times_s),
                                                      "speeds_rpm": list(profile.speeds_rpm)},
             "faults": [f.to_dict() for f in plan.faults], "substeps": run.meta.get("substeps"),
-            "sim_wall_s": integration, **record}
+            "scheme": run.meta.get("scheme"), "sim_wall_s": integration, **record}
     return {c: np.asarray(run[c], dtype=np.float32) for c in channels}, meta
 
 
