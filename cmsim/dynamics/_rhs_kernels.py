@@ -336,7 +336,7 @@ def no_propagator(stages):
                             np.zeros(CHAIN_STATES))
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, inline="always", error_model="numpy")
 def _propagate_row_jit(X, which, x, row):
     """``x[row, idx] = back[which] @ x[row, idx]`` chain by chain, from the velocity entries
     only (the slope ``N`` has no position entries there: ``L`` carries the chains'
@@ -356,7 +356,7 @@ def _propagate_row_jit(X, which, x, row):
             x[row, X.idx[b, i]] = acc
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, inline="always", error_model="numpy")
 def _propagate_jit(X, which, x):
     """``x[idx] = ahead[which] @ x[idx]`` chain by chain (a state)."""
     tmp = X.tmp
@@ -423,10 +423,11 @@ def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, X, P, 
                     out_diag[m, i] = scratch[i]
                 if m == n_out - 1:
                     return -1
-            if n_ex > 0:
-                # L carries the exact chains' kinematics: N has no position entries there
-                # (c_0 = 0: no propagation)
-                _propagate_row_jit(X, 0, k, 0)
+            # L carries the exact chains' kinematics: N has no position entries there
+            # (c_0 = 0: no propagation)
+            for b in range(n_ex):
+                for i in range(X.size[b] // 2):
+                    k[0, X.idx[b, i]] = 0.0
             for st in range(1, ns):
                 for i in range(dim):
                     acc = y[i]
