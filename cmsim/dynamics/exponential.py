@@ -15,7 +15,10 @@ sample (:func:`exponential_split`). Whether that wins is measured, not assumed:
 at 25.6 kHz lawson-ode3 at 2 steps per sample misses the harmonics by 1.5 times what ode3 at
 its own 3 steps does, and rk4 (a wider stability interval, 4 stages) at 2 steps is both
 cheaper and 7 times more accurate; the exponential form pays where a linear chain is much
-stiffer than everything else (the step of rk4 still follows that chain).
+stiffer than everything else (the step of rk4 still follows that chain). ``lawson-rk4``
+with every chain in closed form takes one step per sample at 25.6 kHz (half rk4's
+evaluations) but misses the harmonics by 3.4-3.9 % (15 % in a run-up): the contacts it leaves
+explicit are then stepped at ω·h up to 1.5.
 
 References
 ----------

@@ -52,8 +52,8 @@ def test_order_conditions(name):
 
 def test_declared_orders():
     assert {k: v.order for k, v in SCHEMES.items()} == {"ode3": 3, "lawson-ode3": 3, "rk4": 4,
-                                                        "heun": 2}
-    assert [k for k, v in SCHEMES.items() if v.exponential] == ["lawson-ode3"]
+                                                        "lawson-rk4": 4, "heun": 2}
+    assert [k for k, v in SCHEMES.items() if v.exponential] == ["lawson-ode3", "lawson-rk4"]
 
 
 @pytest.mark.parametrize("name", sorted(SCHEMES))
