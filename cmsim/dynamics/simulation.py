@@ -376,10 +376,11 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     scheme : str
         ``"auto"`` (default: ode3 or rk4, whichever takes fewer right-hand-side evaluations
         per sample, :mod:`cmsim.dynamics.schemes`), ``"ode3"`` (Bogacki-Shampine),
-        ``"rk4"``, ``"heun"``, or ``"lawson-ode3"``: ode3 with the stiff linear chains of
-        the shafts in closed form (:mod:`cmsim.dynamics.exponential`; its step is set by
-        the rest of the model, and the run's meta lists the DOFs it integrated exactly,
-        ``exact_linear_dofs``). The run's meta records the scheme and steps taken.
+        ``"rk4"``, ``"heun"``, or ``"lawson-ode3"`` / ``"lawson-rk4"``: ode3 / rk4 with the
+        stiff linear chains of the shafts in closed form (:mod:`cmsim.dynamics.exponential`;
+        the step is set by the rest of the model, and the run's meta lists the DOFs
+        integrated exactly, ``exact_linear_dofs``). The run's meta records the scheme and
+        steps taken.
     mesh : None, str, MeshStiffnessTable, MeshTableSet or HybridMeshModel
         Tooth contact model: ``None`` (default) = the rig's hybrid FE + Weber–Banaschek
         tables at the run's torque (paper 001 §6.1, model B); ``"potential-energy"`` (paper
