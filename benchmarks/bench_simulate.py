@@ -10,8 +10,10 @@ Prints
    (vectorised over balls, pure-Python pair geometry). The NumPy RHS is checked against the
    kernel first, so both integrate the same equations.
 
-Run: ``python benchmarks/bench_simulate.py`` (about a minute). Each timing is the best of
-several repeats; the machines are noisy, so compare ratios, not absolute times.
+Run: ``python benchmarks/bench_simulate.py`` (about a minute). The three loops of 1-2 are
+timed in turns, in CPU time, several rounds; a ratio is the median of the rounds' ratios
+(with their range), so a machine that drifts between rounds moves both sides of each ratio;
+the absolute times are the best round. Compare ratios, not absolute times.
 """
 
 from __future__ import annotations
@@ -39,15 +41,6 @@ from bench_dataset import cpu_info  # the one CPU description of the benchmarks
 
 FS = 75_000.0
 REPEATS = 5
-
-
-def best_of(fn, repeats=REPEATS):
-    best = math.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 @njit(cache=True)
@@ -170,23 +163,12 @@ def main():
     h = 1.0 / FS
     n_steps = int(0.5 * FS)
 
-    # 1. our integration: realtime factor
-    integrate(model, y0, 0.0, h, 10)  # compile
-    ours = best_of(lambda: integrate(model, y0, 0.0, h, n_steps))
-    ours_per_step = ours / n_steps
-    print(f"realtime factor at 75 kHz (default rig, 100 N m): {h / ours_per_step:.2f} "
-          f"({ours_per_step * 1e9:.0f} ns per ode3 step)   [target >= 10]")
-
-    # 2a. bare dense linear ode3
+    # the three loops, timed in turns (our integration, a bare dense linear ode3, our kernel on
+    # the linear part only), CPU time, so each ratio pairs runs that met the same machine
     out = np.empty((n_steps, 2 * n))
     args = (model.kernel_params.minv, model.stiffness, model.damping, model.force, out)
-    dense_linear_ode3(y0, h, 10, *args)
-    dense = best_of(lambda: dense_linear_ode3(y0, h, n_steps, *args)) / n_steps
-    print(f"per-step cost / bare dense-linear numba ode3: {ours_per_step / dense:.2f} "
-          f"(baseline {dense * 1e9:.0f} ns per step)   [target <= 3]")
-    # 2b. our own integrator on the linear part only (no bearings, no mesh)
     P = model.kernel_params._replace(b_int=np.zeros((0, BI_SIZE), dtype=np.int64),
-                              m_int=np.zeros(MI_SIZE, dtype=np.int64))
+                                     m_int=np.zeros(MI_SIZE, dtype=np.int64))
     tab = SCHEMES["ode3"]
     diag = np.empty((n_steps, len(model.output_force_names)))
 
@@ -197,10 +179,33 @@ def main():
                                make_work(P), make_integrator_buffers(tab.b, 2 * n, diag.shape[1]),
                                out, diag, math.inf, math.inf, model.translational_mask)
         assert status == -1
+
+    loops = {"ours": lambda: integrate(model, y0, 0.0, h, n_steps),
+             "dense": lambda: dense_linear_ode3(y0, h, n_steps, *args),
+             "linear": linear_only}
+    integrate(model, y0, 0.0, h, 10)  # compile
+    dense_linear_ode3(y0, h, 10, *args)
     linear_only()
-    lin = best_of(linear_only) / n_steps
-    print(f"per-step cost / our kernel on the linear part only: {ours_per_step / lin:.2f} "
-          f"(baseline {lin * 1e9:.0f} ns per step)")
+    rounds = {k: [] for k in loops}
+    for _ in range(REPEATS):
+        for key, fn in loops.items():
+            start = time.process_time()
+            fn()
+            rounds[key].append((time.process_time() - start) / n_steps)
+    ours_per_step = min(rounds["ours"])
+    ours = ours_per_step * n_steps
+
+    def ratio(key):
+        r = sorted(a / b for a, b in zip(rounds["ours"], rounds[key]))
+        return f"{np.median(r):.2f} (rounds {r[0]:.2f}-{r[-1]:.2f})"
+
+    print(f"realtime factor at 75 kHz (default rig, 100 N m): {h / ours_per_step:.2f} "
+          f"({ours_per_step * 1e9:.0f} ns per ode3 step, CPU, best of {REPEATS})   "
+          "[target >= 10]")
+    print(f"per-step cost / bare dense-linear numba ode3: {ratio('dense')} "
+          f"(baseline {min(rounds['dense']) * 1e9:.0f} ns per step)   [target <= 3]")
+    print(f"per-step cost / our kernel on the linear part only: {ratio('linear')} "
+          f"(baseline {min(rounds['linear']) * 1e9:.0f} ns per step)")
 
     # 3. solve_ivp with a NumPy right-hand side of the same model
     rhs = numpy_rhs_factory(model)
