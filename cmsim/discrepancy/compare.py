@@ -74,6 +74,11 @@ LEVEL_SIGMA_DB = 6.0
 #: with an effect the catalogue misses sit at 2.9-4.8.
 UNEXPLAINED_CHI2_PER_FEATURE = 2.5
 
+#: Path-free with the record's unit known, the model's sensor noise is the record's own
+#: broadband floor (:func:`~cmsim.discrepancy.evaluator.record_floor`) rather than
+#: :data:`~cmsim.discrepancy.causes.NOMINAL_NOISE_RATIO` of the healthy model's RMS.
+RECORD_FLOOR = True
+
 #: The nominal models (see the module docstring).
 MODES = ("machine", "documented", "path-free")
 
@@ -246,7 +251,10 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
     else:
         mode = "documented" if record.path_documented else "path-free"
     seg_s, duration, names, F = _prepare(record, seg_s, max_segments)
-    ev = Evaluator(record, seg_s, seed, budget - 2 * SIM_SEEDS)   # held-out runs kept
+    # path-free with a known unit: the model's noise is the record's own floor (its SNR is
+    # the record's, not an assumed one); the held-out runs are kept out of the budget
+    ev = Evaluator(record, seg_s, seed, budget - 2 * SIM_SEEDS,
+                   floor=RECORD_FLOOR and mode == "path-free" and record.unit_scale is not None)
     fit_rows, held_rows = F[0::2], F[1::2]
     meas_fit = dict(zip(names, np.nanmean(fit_rows, axis=0)))
     meas_held = dict(zip(names, np.nanmean(held_rows, axis=0)))

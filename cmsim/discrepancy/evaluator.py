@@ -16,14 +16,16 @@ import warnings
 
 import numpy as np
 
+from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.features import N_SHAPE_BANDS, relative_features
 from cmsim.machine import model_force
 from cmsim.run import signal_info
 from cmsim.sensors import housing_acceleration
 
-__all__ = ["simulate_setup", "sensor_signal", "feature_floor", "path_free", "chi2",
-           "Evaluator", "Budget", "Z_CAP", "DB_FLOOR", "LOG_FLOOR", "LEVEL_REF"]
+__all__ = ["simulate_setup", "sensor_signal", "record_floor", "feature_floor", "path_free",
+           "chi2", "Evaluator", "Budget", "Z_CAP", "DB_FLOOR", "LOG_FLOOR", "LEVEL_REF",
+           "FLOOR_MEDIAN_HZ"]
 
 #: A feature adds at most Z_CAP² to the χ² (robust: a misfit the catalogue cannot mend, such
 #: as an unknown transfer path next to a fault, does not hide what another cause explains).
@@ -43,6 +45,11 @@ LEVEL_REF = 1.0
 #: against its wide median. The others compare a line with its own neighbourhood, or are
 #: statistics of the waveform.
 PATH_DEPENDENT = ("shape_", "level_db", "gmf", "raw_")
+
+#: Half-width of the running median that reads a record's broadband floor between its lines,
+#: Hz: wider than the spacing of any defect or mesh family read (a family's lines then hold
+#: well under half the bins of the window), narrow enough to follow the housing's resonances.
+FLOOR_MEDIAN_HZ = 250.0
 
 
 def feature_floor(name):
@@ -85,7 +92,48 @@ def _shaft_forces(force, fs, shaft_hz, terms, seed):
     return force * (1.0 + mod) + static * mod
 
 
-def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, seed):
+def record_floor(x, fs_hz, n):
+    """Gains that colour white noise into a record's broadband floor, for ``n``-sample signals.
+
+    The floor is the record's Welch power spectrum (segments of ``n`` samples, Hann) under a
+    running median of ± :data:`FLOOR_MEDIAN_HZ`, so its lines (shaft, defect and mesh
+    families) drop out and what is left is what lies between them: the background, the sensor
+    and whatever is random in the machine. Unit: the record's (m/s² once scaled).
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (m,)
+        Record, m >= n.
+    fs_hz : float
+        Sample rate, Hz.
+    n : int
+        Length of the signals the noise is drawn for, samples.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n // 2 + 1,)
+        Gain of each rfft bin: ``irfft(rfft(w) · gain, n)`` of unit white Gaussian ``w`` has
+        the floor's one-sided power spectral density.
+    """
+    from scipy.ndimage import median_filter
+    from scipy.signal import welch
+
+    x = np.asarray(x, dtype=float)
+    nper = int(min(n, x.size))
+    f, p = welch(x - x.mean(), fs_hz, window="hann", nperseg=nper)
+    half = max(1, int(round(FLOOR_MEDIAN_HZ / (f[1] - f[0]))))
+    floor = median_filter(p, size=2 * half + 1, mode="nearest")
+    fn = np.fft.rfftfreq(int(n), 1.0 / fs_hz)
+    return np.sqrt(np.interp(fn, f, floor) * fs_hz / 2.0)
+
+
+def _coloured(gain, n, seed):
+    w = np.random.default_rng(seed + 7919).standard_normal(int(n))
+    return np.fft.irfft(np.fft.rfft(w) * gain, int(n))
+
+
+def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, seed,
+                  floor=None):
     """Housing acceleration of a simulated force plus sensor noise (edges trimmed).
 
     Parameters
@@ -104,6 +152,10 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
         Reference RMS (None: the signal's own).
     seed : int
         Seed of the noise.
+    floor : numpy.ndarray, optional
+        Gains of :func:`record_floor`: the noise is the record's own broadband floor, m/s²,
+        times ``noise_ratio`` / :data:`~cmsim.discrepancy.causes.NOMINAL_NOISE_RATIO`
+        (``noise_ref_rms`` unused).
 
     Returns
     -------
@@ -111,12 +163,14 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
     """
     x = housing_acceleration(force - force.mean(), fs_hz, housing)[edge:edge + n]
     x = x - x.mean()
+    if floor is not None:
+        return x + noise_ratio / NOMINAL_NOISE_RATIO * _coloured(floor, x.size, seed)
     ref = float(np.std(x)) if noise_ref_rms is None else float(noise_ref_rms)
     rng = np.random.default_rng(seed + 7919)
     return x + noise_ratio * ref * rng.standard_normal(x.size)
 
 
-def _chain(setup, force, edge, n, fs, seed, noise_ref_rms):
+def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None):
     """The sensor signal of a simulated force through ``setup``'s shaft forces and chain."""
     force = _shaft_forces(force, fs, setup.op.shaft_hz, setup.shaft_forces, seed)
     if setup.machine is not None:
@@ -125,7 +179,7 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms):
                                            noise_gain=setup.background_gain,
                                            line_gain=setup.background_gain)
     return sensor_signal(force, edge, n, fs, setup.housing, setup.noise_ratio, noise_ref_rms,
-                         seed)
+                         seed, floor)
 
 
 def simulate_setup(setup, fs_hz, duration_s, model_signal, seed, noise_ref_rms=None):
@@ -205,9 +259,12 @@ class Evaluator:
         Base seed.
     budget : int
         Most simulations.
+    floor : bool
+        The sensor noise is the record's own broadband floor (:func:`record_floor`, scaled
+        to m/s²) instead of a share of the healthy model's RMS; needs the record's unit.
     """
 
-    def __init__(self, record, seg_s, seed, budget):
+    def __init__(self, record, seg_s, seed, budget, floor=False):
         self.record = record
         self.seg_s = seg_s
         self.seed = seed
@@ -221,6 +278,12 @@ class Evaluator:
         self.cache = {}
         self.ref_rms = None
         self.scale = record.unit_scale
+        self.floor = None
+        if floor:
+            if self.scale is None:
+                raise ParameterError("the record's floor needs its unit", param="floor")
+            self.floor = record_floor(record.signal * self.scale, self.fs,
+                                      int(round(seg_s * self.fs)))
 
     def _forces(self, setup, seed):
         key = (setup.dynamics_key(), seed)
@@ -250,7 +313,7 @@ class Evaluator:
         if self.ref_rms is None and setup.machine is None:  # the healthy level fixes the noise
             self.ref_rms = float(np.std(sensor_signal(*run, self.fs, setup.housing, 0.0,
                                                       None, seed)))
-        return _chain(setup, *run, self.fs, seed, self.ref_rms)
+        return _chain(setup, *run, self.fs, seed, self.ref_rms, self.floor)
 
     def row(self, setup, seed):
         """Features of one run of ``setup`` with simulation seed ``seed`` (None if it
