@@ -15,7 +15,12 @@
    * ``path-free`` — a rig built from metadata, whose housing path is a generic guess: only
      features free of the path are judged (families over their local floor in the
      demodulation band, sidebands over their carriers, statistics), and the result says
-     that the spectral shape was not.
+     that the spectral shape was not. When the record's unit is known, the model's sensor
+     noise is the record's own broadband floor (:data:`RECORD_FLOOR`): how far a family
+     stands over its floor depends on the signal-to-noise ratio in the demodulation band,
+     which is the record's to show, not the model's to assume (10 % of the healthy model's
+     RMS sat 70-80 dB under the MFPT records' floor, and the healthy model's ball passes
+     then read a BPFO envelope line of 26-34 dB that no real floor lets through).
 
 3. The model of a setup is simulated with :data:`SIM_SEEDS` seeds and its features
    averaged; every setup uses the same seeds (common random numbers). The model's own

@@ -4,8 +4,8 @@ features, and the robust χ² between two feature sets.
 A setup's bearing force (:func:`cmsim.machine.model_force`) is simulated once per seed and
 cached by its dynamics; what acts after the dynamics — the shaft forces of unbalance and
 misalignment, and the measurement chain (the rig's housing path and white sensor noise, or a
-calibrated machine's path and background) — is applied to the cached force without a new
-simulation. Features are :func:`cmsim.features.relative_features` (plus ``level_db`` when the
+calibrated machine's path and background; path-free, the record's own broadband floor,
+:func:`record_floor`) — is applied to the cached force without a new simulation. Features are :func:`cmsim.features.relative_features` (plus ``level_db`` when the
 record's unit is known), as the record's.
 """
 
@@ -122,7 +122,7 @@ def record_floor(x, fs_hz, n):
     nper = int(min(n, x.size))
     f, p = welch(x - x.mean(), fs_hz, window="hann", nperseg=nper)
     half = max(1, int(round(FLOOR_MEDIAN_HZ / (f[1] - f[0]))))
-    floor = median_filter(p, size=2 * half + 1, mode="nearest")
+    floor = median_filter(p, size=2 * half + 1, mode="mirror")
     fn = np.fft.rfftfreq(int(n), 1.0 / fs_hz)
     return np.sqrt(np.interp(fn, f, floor) * fs_hz / 2.0)
 
