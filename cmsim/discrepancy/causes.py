@@ -523,7 +523,9 @@ class TransferPathCause(Cause):
 
 @register_cause
 class NoiseCause(Cause):
-    """Sensor/background noise other than the model's (RMS relative to the healthy signal)."""
+    """Sensor/background noise other than the model's (RMS relative to the healthy signal;
+    path-free with the record's unit known, ``noise_ratio`` / :data:`NOMINAL_NOISE_RATIO` is
+    the factor on the record's own floor, :func:`~cmsim.discrepancy.evaluator.record_floor`)."""
     name = "noise"
     parameter = "noise_ratio"
     bounds = (0.005, 10.0)
