@@ -15,6 +15,8 @@ import math
 import warnings
 
 import numpy as np
+from scipy.ndimage import median_filter
+from scipy.signal import welch
 
 from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.errors import IntegrationDiverged, ParameterError
@@ -115,9 +117,6 @@ def record_floor(x, fs_hz, n):
         Gain of each rfft bin: ``irfft(rfft(w) · gain, n)`` of unit white Gaussian ``w`` has
         the floor's one-sided power spectral density.
     """
-    from scipy.ndimage import median_filter
-    from scipy.signal import welch
-
     x = np.asarray(x, dtype=float)
     nper = int(min(n, x.size))
     f, p = welch(x - x.mean(), fs_hz, window="hann", nperseg=nper)
