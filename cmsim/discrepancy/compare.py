@@ -257,9 +257,13 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         mode = "documented" if record.path_documented else "path-free"
     seg_s, duration, names, F = _prepare(record, seg_s, max_segments)
     # path-free with a known unit: the model's noise is the record's own floor (its SNR is
-    # the record's, not an assumed one); the held-out runs are kept out of the budget
-    ev = Evaluator(record, seg_s, seed, budget - 2 * SIM_SEEDS,
-                   floor=RECORD_FLOOR and mode == "path-free" and record.unit_scale is not None)
+    # the record's, not an assumed one), read on the fit segments only; the held-out runs
+    # are kept out of the budget
+    floor = None
+    if RECORD_FLOOR and mode == "path-free" and record.unit_scale is not None:
+        spans = segments(record.signal.size, record.fs_hz, seg_s, max_segments)[0::2]
+        floor = np.concatenate([record.signal[a:b] for a, b in spans])
+    ev = Evaluator(record, seg_s, seed, budget - 2 * SIM_SEEDS, floor=floor)
     fit_rows, held_rows = F[0::2], F[1::2]
     meas_fit = dict(zip(names, np.nanmean(fit_rows, axis=0)))
     meas_held = dict(zip(names, np.nanmean(held_rows, axis=0)))

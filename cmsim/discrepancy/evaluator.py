@@ -97,15 +97,17 @@ def _shaft_forces(force, fs, shaft_hz, terms, seed):
 def record_floor(x, fs_hz, n):
     """Gains that colour white noise into a record's broadband floor, for ``n``-sample signals.
 
-    The floor is the record's Welch power spectrum (segments of ``n`` samples, Hann) under a
-    running median of ± :data:`FLOOR_MEDIAN_HZ`, so its lines (shaft, defect and mesh
-    families) drop out and what is left is what lies between them: the background, the sensor
-    and whatever is random in the machine. Unit: the record's (m/s² once scaled).
+    The floor is the record's Welch power spectrum (consecutive segments of ``n`` samples,
+    Hann, no overlap: the fit segments of a comparison laid end to end, each its own
+    periodogram) under a running median of ± :data:`FLOOR_MEDIAN_HZ`, so its lines (shaft,
+    defect and mesh families) drop out and what is left is what lies between them: the
+    background, the sensor and whatever is random in the machine. Unit: the record's (m/s²
+    once scaled).
 
     Parameters
     ----------
     x : numpy.ndarray, shape (m,)
-        Record, m >= n.
+        Record (or its segments laid end to end), m >= n.
     fs_hz : float
         Sample rate, Hz.
     n : int
@@ -119,7 +121,7 @@ def record_floor(x, fs_hz, n):
     """
     x = np.asarray(x, dtype=float)
     nper = int(min(n, x.size))
-    f, p = welch(x - x.mean(), fs_hz, window="hann", nperseg=nper)
+    f, p = welch(x - x.mean(), fs_hz, window="hann", nperseg=nper, noverlap=0)
     half = max(1, int(round(FLOOR_MEDIAN_HZ / (f[1] - f[0]))))
     floor = median_filter(p, size=2 * half + 1, mode="mirror")
     fn = np.fft.rfftfreq(int(n), 1.0 / fs_hz)
@@ -258,12 +260,13 @@ class Evaluator:
         Base seed.
     budget : int
         Most simulations.
-    floor : bool
-        The sensor noise is the record's own broadband floor (:func:`record_floor`, scaled
-        to m/s²) instead of a share of the healthy model's RMS; needs the record's unit.
+    floor : numpy.ndarray, optional
+        Samples the sensor noise's floor is read from (:func:`record_floor`, scaled to m/s²:
+        the fit segments laid end to end) instead of a share of the healthy model's RMS;
+        needs the record's unit.
     """
 
-    def __init__(self, record, seg_s, seed, budget, floor=False):
+    def __init__(self, record, seg_s, seed, budget, floor=None):
         self.record = record
         self.seg_s = seg_s
         self.seed = seed
@@ -278,10 +281,10 @@ class Evaluator:
         self.ref_rms = None
         self.scale = record.unit_scale
         self.floor = None
-        if floor:
+        if floor is not None:
             if self.scale is None:
                 raise ParameterError("the record's floor needs its unit", param="floor")
-            self.floor = record_floor(record.signal * self.scale, self.fs,
+            self.floor = record_floor(np.asarray(floor, dtype=float) * self.scale, self.fs,
                                       int(round(seg_s * self.fs)))
 
     def _forces(self, setup, seed):
