@@ -465,9 +465,9 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     pinned = [p[0] for p in pins]
     own = []              # what the model's own lines put there is not background
     for f, a in lines:
-        if any(abs(f - g) <= 2.5 * df for g in pinned):
+        if any(_near(f, g, df) for g in pinned):
             continue
-        made = [fa for fa in force_lines if abs(fa[0] - f) <= 1.5 * df]
+        made = [fa for fa in force_lines if _near(f, fa[0], df)]
         if made:
             model_amp = float(np.interp(f, freq, gain)) * max(fa[1] for fa in made)
             a = math.sqrt(max(a * a - model_amp * model_amp, 0.0))
