@@ -24,7 +24,14 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    Its
    *gain* is pinned where a model line (GMF harmonics on a gear rig, the sensor bearing's
    ball pass on a bearing rig) stands in the record too (the ratio of the measured line to
-   the model's, interpolated in log frequency between such lines); where none does
+   the model's, interpolated in log frequency between such lines). Beyond the highest such
+   line (a bearing's ball pass pins only the first few hundred hertz, under the housing
+   band) the gain is read from the **modulation** of the record's broadband
+   (:func:`_modulation_pins`): the background is stationary, the model's force is
+   modulated at its bearing's defect frequencies, so the depth of that modulation in the
+   record over the force's is the share of the band's power the force makes through the
+   path — what splits the record's broadband between path × force and background, which
+   its spectrum alone cannot. Where neither reads it
    (a healthy ball bearing's ball pass is usually below the floor) the gain is that of the
    rig's nominal housing path averaged over 0.05-0.45·fs, lowered if that would show a model
    line the record does not, and the machine file says so: fault sizes read through such a
@@ -75,6 +82,8 @@ from scipy.stats import chi2 as chi2_dist
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.errors import ParameterError
 from cmsim.features import relative_features
+from cmsim.features.envelope import band_bank, envelope_lines
+from cmsim.features.lines import SLIP_TOLERANCE, line_window
 from cmsim.features.relative import segments
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine.background import Background, BackgroundLine
@@ -113,6 +122,19 @@ BROADBAND_SHARE = 0.5
 #: does not decide it. The twin's own spread is not in it: a twin made noisy by a wrong
 #: shape must not look nearer for it.
 MISFIT_CAP = 4.0
+#: Least significance of the model force's modulation at its sensor bearing's defect
+#: frequencies in a band (its excess over the noise of the squared-envelope spectrum, in
+#: standard deviations of that noise) for the band to read the path's gain
+#: (:func:`_modulation_pins`): the share goes as the root of the ratio of the record's excess
+#: to the force's, so 10σ leaves it 5 % of scatter from the force's side.
+FORCE_MODULATION_MIN_SIGMA = 10.0
+#: Most of a band's broadband power the model's force may make through the path: the
+#: background keeps at least 10 % of the floor (step 4).
+MAX_SHARE = 0.9
+#: Least significance of the record's modulation (its excess over the noise of the
+#: squared-envelope spectrum, in standard deviations of that noise) to read a share; under
+#: it the share is only bounded.
+MODULATION_MIN_SIGMA = 3.0
 #: Least power ratio of a shaft-order line over the noise beside it for its instantaneous
 #: frequency to tell the speed wobble (20 dB: the noise then adds under 0.5 % of the line's
 #: phase wander).
@@ -289,6 +311,129 @@ def _pins(shape, strong, lines, floor, pin_at, df, weak_family):
     return [p for p in pins if p not in dropped], bounds, dropped
 
 
+def _line_free(freq, psd):
+    """Mask of the bins of a PSD outside its narrow lines (those standing
+    :data:`LINE_MIN_DB` over the running median, with their Hann main lobe, ± 2 bins)."""
+    peak = psd > 10.0 ** (LINE_MIN_DB / 10.0) * _floor(freq, psd)
+    line = peak.copy()
+    for k in (1, 2):
+        line[k:] |= peak[:-k]
+        line[:-k] |= peak[k:]
+    return ~line
+
+
+def _cyclic_power(segs, fs, band, keep):
+    """Squared-envelope spectrum of segments band-passed to ``band`` (Hz): the FFT bins in
+    it that ``keep`` holds (the broadband: lines out), the squared modulus of their analytic
+    signal, its Hann power spectrum over its squared mean, averaged over the segments. A
+    band power modulated as e0·(1 + m cos 2πα t) reads m²/4 at α; a stationary noise adds no
+    line. ``(alpha_hz, power)``."""
+    n = segs[0].size
+    freq = np.fft.rfftfreq(n, 1.0 / fs)
+    idx = np.flatnonzero((freq >= band[0]) & (freq < band[1]) & keep)
+    w = np.hanning(n)
+    out = []
+    for x in segs:
+        z = np.zeros(n, dtype=complex)
+        z[idx] = np.fft.fft(x)[idx]
+        e = np.abs(np.fft.ifft(z)) ** 2
+        out.append(np.abs(np.fft.rfft((e - e.mean()) * w)) ** 2
+                   / max(float(e.mean()) * float(w.sum()), 1e-300) ** 2)
+    return freq, np.mean(out, axis=0)
+
+
+def _modulation(alpha, power, cyclic):
+    """Per cyclic frequency of ``cyclic``: (excess, noise, bins) of the squared-envelope
+    power ``power`` in the line's bins (the line rule with
+    :data:`~cmsim.features.lines.SLIP_TOLERANCE`, a bin counted once) over the mean level
+    ``noise`` of the bins around it (± max(6 bins, a quarter of its frequency)) that no line
+    holds."""
+    windows = [line_window(alpha, a, SLIP_TOLERANCE) for a in cyclic]
+    held = np.zeros(alpha.size, dtype=bool)
+    for win in windows:
+        if win is not None:
+            held |= win
+    out, counted = [], np.zeros(alpha.size, dtype=bool)
+    for a, win in zip(cyclic, windows):
+        bins = np.zeros(alpha.size, dtype=bool) if win is None else win & ~counted
+        counted |= bins
+        near = (np.abs(alpha - a) <= max(6 * alpha[1], 0.25 * a)) & ~held
+        noise = float(np.mean(power[near])) if np.any(near) else 0.0
+        k = int(np.count_nonzero(bins))
+        out.append((float(np.sum(power[bins])) - noise * k, noise, k))
+    return out
+
+
+def _sigma(mods, n_segments):
+    """Standard deviation of the summed excess of :func:`_modulation` rows ``mods`` under
+    noise alone: a bin of the average of K segments' powers scatters by its level over √K."""
+    return math.sqrt(sum(noise ** 2 * k for _, noise, k in mods) / n_segments)
+
+
+def _modulation_pins(shape, spectra, fs, freqs, bearing, above_hz):
+    """(pins, bounds, shares) of the path's gain read from the model force's modulation, in
+    the bands of :func:`~cmsim.features.envelope.band_bank` beyond ``above_hz`` (the
+    highest model line pinning the path) and below the force's anti-alias passband.
+
+    The background (coloured noise and lines) is stationary; the model's force is not: its
+    broadband power is modulated at its bearing's defect frequencies (ball pass through the
+    load zone). In a band where the record is the force through the path (power P_H) plus a
+    background (P_B), the modulation depth of the record's band power is that of the force
+    through the path times the share s = P_H / (P_H + P_B): the ratio of the two
+    squared-envelope lines is s² — the split between path × force and background, which
+    the record's spectrum alone cannot tell. The force's modulation is read through the
+    path's ``shape`` (its gain cancels), the record's with its lines out; a band reads only
+    where the force's lines stand :data:`FORCE_MODULATION_MIN_SIGMA` over their noise; the share is
+    read where the record's excess is :data:`MODULATION_MIN_SIGMA` over its noise, else
+    bounded by that, and is at most :data:`MAX_SHARE`. The gain correction of the band is
+    then √(s · record's broadband power / (shape² · force's broadband power)) over it.
+
+    The bank's bands (fs/8 wide) hold the sidebands of every defect frequency of a bearing
+    several times over and leave the envelope spectrum of a 0.5-s segment enough bins to
+    average; the share is read at that resolution (fs/16 between band centres) while the
+    path's shape keeps its own (:data:`PATH_SMOOTHING_OCTAVE`).
+    """
+    if bearing not in freqs.bearing_names:
+        return [], [], []
+    freq, floor, pf_floor = spectra["freq"], spectra["floor"], spectra["pf_floor"]
+    cyclic = sorted({ln.frequency_hz for ln in envelope_lines(freqs.bearing(bearing))
+                     if ln.family != "shaft" and ln.frequency_hz > 0})
+    source = TransferPath("shape", tuple(freq), tuple(np.maximum(shape, 1e-30)))
+    forces = [source.apply(force, fs)[edge:edge + n] for force, edge, n in spectra["forces"]]
+    top = AntiAliasFilter.passband * 0.5 * fs
+    pins, bounds, shares = [], [], []
+    for lo, hi in band_bank(fs):
+        centre = math.sqrt(lo * hi)
+        if centre <= max(above_hz, HOUSING_BAND_LOW * fs) or centre > top:
+            continue
+        usable = [a for a in cyclic if a < 0.5 * (hi - lo)]
+        alpha, p_force = _cyclic_power(forces, fs, (lo, hi), spectra["force_keep"])
+        force_mod = _modulation(alpha, p_force, usable)
+        kept = [i for i, (ex, noise, k) in enumerate(force_mod)
+                if k and ex >= FORCE_MODULATION_MIN_SIGMA * _sigma([(ex, noise, k)],
+                                                                   len(forces))]
+        if not kept:
+            continue
+        _, p_rec = _cyclic_power(spectra["fit"], fs, (lo, hi), spectra["keep"])
+        rec_mod = _modulation(alpha, p_rec, usable)
+        ex_f = sum(force_mod[i][0] for i in kept)
+        ex_r = sum(rec_mod[i][0] for i in kept)
+        sigma = _sigma([rec_mod[i] for i in kept], len(spectra["fit"]))
+        sel = (freq >= lo) & (freq < hi)
+        scale = math.sqrt(float(np.sum(floor[sel])) / float(np.sum(shape[sel] ** 2
+                                                                    * pf_floor[sel])))
+        if ex_r >= MODULATION_MIN_SIGMA * sigma:
+            share = min(math.sqrt(ex_r / ex_f), MAX_SHARE)
+            pins.append((centre, math.sqrt(share) * scale))
+            shares.append((lo, hi, share))
+        else:
+            share = math.sqrt(MODULATION_MIN_SIGMA * sigma / ex_f)
+            if share < MAX_SHARE:
+                bounds.append((centre, math.sqrt(share) * scale))
+                shares.append((lo, hi, -share))
+    return pins, bounds, shares
+
+
 def _misfit(names, twin_rows, rows, spread):
     """(z, z_model) of the twin's mean feature against the mean of the baseline ``rows``:
     over the baseline's segment-to-segment spread, and over that and the twin's own spread
@@ -345,10 +490,20 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
                      "the model's: the gain they imply would show another harmonic of that "
                      "family, which the record does not have")
     band = (freq >= 0.05 * fs) & (freq <= 0.45 * fs)
+    mod_pins, mod_bounds, shares = _modulation_pins(
+        shape, spectra, fs, freqs, bearing, max((p[0] for p in pins), default=0.0))
+    bounds = bounds + mod_bounds
     if pins:
-        points = sorted(pins)
         notes.append(f"path gain pinned by {len(pins)} model line(s) the record shows "
-                     f"({', '.join(f'{p[0]:.1f}' for p in points[:8])} Hz)")
+                     f"({', '.join(f'{p[0]:.1f}' for p in sorted(pins)[:8])} Hz)")
+    if shares:
+        notes.append("path gain read from the modulation of the record's broadband at the "
+                     "sensor bearing's defect frequencies, over the model force's, in "
+                     f"{len(shares)} band(s): share of the broadband the model's force makes "
+                     + ", ".join(f"{lo:.0f}-{hi:.0f} Hz {'≤ ' if sh < 0 else ''}{abs(sh):.2f}"
+                                 for lo, hi, sh in shares))
+    if pins or mod_pins:
+        points = sorted(pins + mod_pins)
     else:
         nominal = np.abs(rig.housing.accelerance(freq[band]))
         scale = ref.unit_scale if ref.unit_scale is not None else 1.0
@@ -368,13 +523,13 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
 
     corr = correction(points)
     capped = [(fb, gb) for fb, gb in bounds if corr[int(round(fb / df))] > gb]
-    if capped:                  # model lines the record does not show cap the path there
+    if capped:     # model lines, or modulation, the record does not show cap the path there
         corr = correction(points + capped)
-        notes.append(f"path gain capped at {len(capped)} model line(s) the record does not "
-                     f"show ({', '.join(f'{f:.1f}' for f, _ in sorted(capped)[:6])} Hz), 10 "
-                     "dB under its floor there")
+        notes.append(f"path gain capped at {len(capped)} frequencies where the record does "
+                     f"not show the model's lines or modulation "
+                     f"({', '.join(f'{f:.1f}' for f, _ in sorted(capped)[:6])} Hz)")
     gain = shape * corr
-    if not pins:      # a prior gain must keep the model's broadband under the record's floor
+    if not (pins or mod_pins):   # a prior gain must keep the model's broadband under the floor
         gain = np.minimum(gain, np.sqrt(BROADBAND_SHARE * floor / pf_floor))
     unit = str((ref.meta.get("sensor") or {}).get("unit") or "")
     path = TransferPath(f"F_{bearing}_{signal_info(ref.model_signal).direction}",
@@ -524,12 +679,12 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     lines, floor = _lines_and_floor(freq, psd, len(fit))
 
     # 2. the nominal model's force
-    forces = []
-    for s in range(n_seeds):
-        force, edge, n = model_force(rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
-        forces.append(force[edge:edge + n])
+    force_runs = [model_force(rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
+                  for s in range(n_seeds)]
+    twin_forces = [model_force(rig, op, ref.model_signal, fs, seg_s,
+                               seed + 1 + 7777 * (s + n_seeds)) for s in range(N_TWIN_SEEDS)]
+    forces = [force[edge:edge + n] for force, edge, n in force_runs]
     _, pf = _power_spectrum(forces, fs)
-    amp_f = np.sqrt(pf * df * 2.0)                 # a line's amplitude at its bin (approx.)
 
     # 3-4. the path and the background, read twice: the path's shape that of the
     # background, or of the background over the model's broadband force; its gain pinned
@@ -540,9 +695,11 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
               if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
               * pf_floor[int(round(f / df))]]
     spectra = {"freq": freq, "floor": floor, "pf_floor": pf_floor, "lines": lines,
-               "force_lines": force_lines, "strong": strong}
+               "force_lines": force_lines, "strong": strong,
+               "fit": fit, "keep": _line_free(freq, psd),
+               "forces": force_runs + twin_forces, "force_keep": _line_free(freq, pf)}
 
-    # 5. the baseline's spread, the twin's forces
+    # 5. the baseline's spread
     bearings = list(rig.bearing_names)
     names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale)
     # a feature a segment cannot read (a line beyond its resolution) is NaN there; one no
@@ -551,8 +708,6 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     spread = {k: (float(np.nanmean(all_rows[:, i])), float(np.nanstd(all_rows[:, i], ddof=1)))
               for i, k in enumerate(names) if seen[i]}
     fit_rows, held_rows = all_rows[:len(fit)], all_rows[len(fit):]
-    twin_forces = [model_force(rig, op, ref.model_signal, fs, seg_s,
-                               seed + 1 + 7777 * (s + n_seeds)) for s in range(N_TWIN_SEEDS)]
 
     wobble = _speed_wobble(np.concatenate([r.signal for r in records]), fs, freqs.fr1_hz)
     longest = max(records, key=lambda r: r.signal.size).signal
