@@ -383,9 +383,11 @@ def _modulation_pins(shape, spectra, fs, freqs, bearing, above_hz):
     squared-envelope lines is s² — the split between path × force and background, which
     the record's spectrum alone cannot tell. The force's modulation is read through the
     path's ``shape`` (its gain cancels), the record's with its lines out; a band reads only
-    where the force's lines stand :data:`FORCE_MODULATION_MIN_SIGMA` over their noise; the share is
-    read where the record's excess is :data:`MODULATION_MIN_SIGMA` over its noise, else
-    bounded by that, and is at most :data:`MAX_SHARE`. The gain correction of the band is
+    where the force's lines stand :data:`FORCE_MODULATION_MIN_SIGMA` over their noise and
+    would stand :data:`MODULATION_MIN_SIGMA` over the record's (were the record all force,
+    the band could tell a share from none); the share is read where the record's excess is
+    :data:`MODULATION_MIN_SIGMA` over its noise, else bounded by that, and is at most
+    :data:`MAX_SHARE`. The gain correction of the band is
     then √(s · record's broadband power / (shape² · force's broadband power)) over it.
 
     The bank's bands (fs/8 wide) hold the sidebands of every defect frequency of a bearing
@@ -419,6 +421,8 @@ def _modulation_pins(shape, spectra, fs, freqs, bearing, above_hz):
         ex_f = sum(force_mod[i][0] for i in kept)
         ex_r = sum(rec_mod[i][0] for i in kept)
         sigma = _sigma([rec_mod[i] for i in kept], len(spectra["fit"]))
+        if ex_f < MODULATION_MIN_SIGMA * sigma:
+            continue     # the force's modulation would not stand out of the record's noise
         sel = (freq >= lo) & (freq < hi)
         scale = math.sqrt(float(np.sum(floor[sel])) / float(np.sum(shape[sel] ** 2
                                                                     * pf_floor[sel])))
