@@ -6,9 +6,9 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
 
 1. **Spectrum and lines.** The averaged power spectrum (Hann) of the segments; its narrow
    lines are the bins standing :data:`LINE_MIN_DB` over a running median of ±
-   :data:`FLOOR_HALF_WIDTH_HZ` (lines have no width there, the broadband has); that
-   median, raised by its known bias on an averaged periodogram (0.5-1.6 dB), is the
-   **background spectrum** B(f), blind to the skirts a wobbling line spreads.
+   :data:`FLOOR_HALF_WIDTH_HZ` (lines have no width there, the broadband has); the running
+   mean with the lines' bins masked is the smooth **background spectrum** B(f) (a running
+   median alone would sit 0.3-1.6 dB under the mean of a noisy estimate).
 2. **Model force.** The nominal (healthy) model at the record's operating point is
    simulated for :data:`N_SEEDS` seeds; its force spectrum gives the lines the model makes
    (GMF harmonics, the ball pass of the sensor's bearing: those standing 20 dB over the
@@ -77,7 +77,6 @@ from dataclasses import replace
 
 import numpy as np
 from scipy.ndimage import median_filter
-from scipy.stats import chi2 as chi2_dist
 
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.errors import ParameterError
@@ -164,20 +163,15 @@ def _window_bins(freq):
 
 def _floor(freq, psd):
     """Running median of the PSD over ± :data:`FLOOR_HALF_WIDTH_HZ`: blind to lines, but
-    biased low on a noisy estimate (what line detection needs; :func:`_lines_and_floor`
-    corrects the level)."""
+    biased low on a noisy estimate (what line detection needs, not the level)."""
     return np.maximum(median_filter(psd, size=_window_bins(freq), mode="nearest"), 1e-300)
 
 
-def _lines_and_floor(freq, psd, n_avg):
+def _lines_and_floor(freq, psd):
     """(lines, floor): the narrow lines [(frequency, amplitude)] standing
     :data:`LINE_MIN_DB` over the running median, strongest first, and the broadband floor —
-    the running median over ± :data:`FLOOR_HALF_WIDTH_HZ` raised by its bias on a PSD
-    averaged over ``n_avg`` Hann segments (each bin a χ² of 2·n_avg degrees of freedom
-    about its mean: the median sits 1.6 dB under it for one segment, 0.5 dB for three).
-    A running mean would count the skirts a wobbling line spreads beside its main lobe
-    (7 dB over the broadband beside the 5th mesh harmonic of a gear baseline with a 0.2 %
-    speed wobble), and the twin would then put that much noise beside every mesh line."""
+    the running mean of the PSD with the lines' bins replaced by the median (unbiased: the
+    power of a line too weak to be called stays in the broadband)."""
     df = freq[1] - freq[0]
     med = _floor(freq, psd)
     ratio = psd / med
@@ -193,8 +187,10 @@ def _lines_and_floor(freq, psd, n_avg):
                           max(2, math.ceil(LINE_TOLERANCE * freq[i] / df)))
         owner[bins] = len(spans)
         spans.append((i, bins))
-    dof = 2.0 * max(int(n_avg), 1)
-    floor = np.maximum(med * dof / chi2_dist.median(dof), 1e-300)
+    k = _window_bins(freq)
+    masked = np.where(owner >= 0, med, psd)
+    floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
+                                   mode="valid"), 1e-300)
     kept = []
     for i, bins in spans:
         over = np.maximum(psd[bins] - floor[bins], 0.0)
@@ -680,7 +676,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     # 1. the record: spectrum, its lines, the smooth background spectrum
     freq, psd = _power_spectrum(fit, fs)
     df = freq[1] - freq[0]
-    lines, floor = _lines_and_floor(freq, psd, len(fit))
+    lines, floor = _lines_and_floor(freq, psd)
 
     # 2. the nominal model's force
     force_runs = [model_force(rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
@@ -694,7 +690,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     # background, or of the background over the model's broadband force; its gain pinned
     # by the model lines the record shows and bounded by those it does not show. Of the two,
     # the one whose twin is nearer the fit segments is kept.
-    force_lines, pf_floor = _lines_and_floor(freq, pf, len(forces))
+    force_lines, pf_floor = _lines_and_floor(freq, pf)
     strong = [(f, a) for f, a in force_lines
               if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
               * pf_floor[int(round(f / df))]]
