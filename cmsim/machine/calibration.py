@@ -373,7 +373,9 @@ def _modulation_pins(shape, spectra, fs, freqs, bearing, above_hz):
 
     The background (coloured noise and lines) is stationary; the model's force is not: its
     broadband power is modulated at its bearing's defect frequencies (ball pass through the
-    load zone). In a band where the record is the force through the path (power P_H) plus a
+    load zone; its shaft's own lines are left out: unbalance, run-out and the motor modulate
+    a real machine's broadband at the shaft rate, which the model does not). In a band
+    where the record is the force through the path (power P_H) plus a
     background (P_B), the modulation depth of the record's band power is that of the force
     through the path times the share s = P_H / (P_H + P_B): the ratio of the two
     squared-envelope lines is s² — the split between path × force and background, which
