@@ -19,30 +19,45 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    demodulation band where the background resonates, Randall & Antoni 2011). A 1/12-octave
    smoothing resolves resonances down to about 3 % damping (half-power width 2ζf ≥ f/16)
    and averages the spectral estimate over enough bins to leave a ±0.5 dB scatter. Below
-   :data:`HOUSING_BAND_LOW`·fs the path falls as f² (stiffness-controlled). Its
+   :data:`HOUSING_BAND_LOW`·fs the path falls as f² (stiffness-controlled); read over the
+   model's force, it is held above the force's anti-alias passband (:func:`_path_shape`).
+   Its
    *gain* is pinned where a model line (GMF harmonics on a gear rig, the sensor bearing's
    ball pass on a bearing rig) stands in the record too (the ratio of the measured line to
-   the model's, interpolated in log frequency between such lines); where none does
+   the model's, interpolated in log frequency between such lines). Beyond the highest such
+   line (a bearing's ball pass pins only the first few hundred hertz, under the housing
+   band) the gain is read from the **modulation** of the record's broadband
+   (:func:`_modulation_pins`): the background is stationary, the model's force is
+   modulated at its bearing's defect frequencies, so the depth of that modulation in the
+   record over the force's is the share of the band's power the force makes through the
+   path — what splits the record's broadband between path × force and background, which
+   its spectrum alone cannot. Where neither reads it
    (a healthy ball bearing's ball pass is usually below the floor) the gain is that of the
    rig's nominal housing path averaged over 0.05-0.45·fs, lowered if that would show a model
    line the record does not, and the machine file says so: fault sizes read through such a
    path carry that uncertainty. Where the background is not the path's (white sensor noise
    under a model's lines) the pins read alike through the background *over the model's
-   broadband force* instead: of the two shapes, the one that keeps more pins with less
-   scatter is taken (the background's on a tie). A gearbox's mesh harmonics are always the
+   broadband force* instead. Both shapes are read to the end (path, background): the one
+   that keeps more pins is kept, on as many the one whose twin is nearer the *fit*
+   segments' features (:data:`MISFIT_CAP`; pins below :data:`HOUSING_BAND_LOW`·fs, all a
+   bearing baseline has, cannot tell the shapes apart, both falling as f² there, and the
+   scatter of their corrections chose by rounding), and with no pin at all the
+   background's own (a twin matches a healthy record's broadband through either).
+   A gearbox's mesh harmonics are always the
    model's lines; a healthy bearing's ball-pass line is disowned when the gain it implies
    would show another harmonic the record lacks (:func:`_pins`).
 4. **Background.** The coloured noise is B(f) less what the model's broadband force puts
    there through the path (at least 10 % of B); the lines are the measured lines less what
-   the model's own lines put there through the path (powers subtracted), each filed as an
-   order of the input or output shaft when it sits on one (so it follows the speed), else
-   at its frequency (the mains, other machines).
+   the model's own lines put there through the path (powers subtracted, the lines matched
+   within :data:`LINE_TOLERANCE` as the pins are), each filed as an order of the input or
+   output shaft when it sits on one (so it follows the speed), else at its frequency (the
+   mains, other machines).
 5. **Spread and fit quality.** :func:`cmsim.features.relative_features` of every baseline
-   segment give each feature's mean and segment-to-segment spread; the twin (model force →
-   path + background, :data:`N_TWIN_SEEDS` new seeds, a segment each) is compared with the
-   held-out segments feature by feature: z = (twin − baseline) / spread, and, since one
-   record is one realisation of the model's random parts (cage phases, slip) while the twin
-   averages several, also over √(spread² + the twin's own spread²).
+   segment give each feature's mean and segment-to-segment spread; the kept twin (model
+   force → path + background, :data:`N_TWIN_SEEDS` new seeds, a segment each) is compared
+   with the held-out segments feature by feature: z = (twin − baseline) / spread, and,
+   since one record is one realisation of the model's random parts (cage phases, slip)
+   while the twin averages several, also over √(spread² + the twin's own spread²).
 
 The operating point is the record's (speed read from the signal); the speed wobble is the
 relative RMS of the strongest shaft-order line's instantaneous frequency, less what the noise
@@ -63,8 +78,11 @@ from dataclasses import replace
 import numpy as np
 from scipy.ndimage import median_filter
 
+from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.errors import ParameterError
 from cmsim.features import relative_features
+from cmsim.features.envelope import band_bank, envelope_lines
+from cmsim.features.lines import SLIP_TOLERANCE, line_window
 from cmsim.features.relative import segments
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine.background import Background, BackgroundLine
@@ -98,6 +116,24 @@ PIN_CONSISTENCY = 2.0
 #: Most of the record's broadband power the model's own broadband force may account for
 #: through the path, at any frequency: the rest is the machine's background.
 BROADBAND_SHARE = 0.5
+#: Cap on a feature's z (over the baseline's segment-to-segment spread) in the misfit that
+#: chooses the path's shape: a feature the twin misses by far counts as 4σ, so one feature
+#: does not decide it. The twin's own spread is not in it: a twin made noisy by a wrong
+#: shape must not look nearer for it.
+MISFIT_CAP = 4.0
+#: Least significance of the model force's modulation at its sensor bearing's defect
+#: frequencies in a band (its excess over the noise of the squared-envelope spectrum, in
+#: standard deviations of that noise) for the band to read the path's gain
+#: (:func:`_modulation_pins`): the share goes as the root of the ratio of the record's excess
+#: to the force's, so 10σ leaves it 5 % of scatter from the force's side.
+FORCE_MODULATION_MIN_SIGMA = 10.0
+#: Most of a band's broadband power the model's force may make through the path: the
+#: background keeps at least 10 % of the floor (step 4).
+MAX_SHARE = 0.9
+#: Least significance of the record's modulation (its excess over the noise of the
+#: squared-envelope spectrum, in standard deviations of that noise) to read a share; under
+#: it the share is only bounded.
+MODULATION_MIN_SIGMA = 3.0
 #: Least power ratio of a shaft-order line over the noise beside it for its instantaneous
 #: frequency to tell the speed wobble (20 dB: the noise then adds under 0.5 % of the line's
 #: phase wander).
@@ -142,7 +178,6 @@ def _lines_and_floor(freq, psd):
     thr = 10.0 ** (LINE_MIN_DB / 10.0)
     peaks = [i for i in range(2, psd.size - 2) if ratio[i] > thr and freq[i] >= 2.0
              and psd[i] >= psd[i - 1] and psd[i] >= psd[i + 1]]
-    k = _window_bins(freq)
     owner = np.full(psd.size, -1)        # the line each bin belongs to
     spans = []
     for i in sorted(peaks, key=lambda j: -psd[j]):
@@ -152,6 +187,7 @@ def _lines_and_floor(freq, psd):
                           max(2, math.ceil(LINE_TOLERANCE * freq[i] / df)))
         owner[bins] = len(spans)
         spans.append((i, bins))
+    k = _window_bins(freq)
     masked = np.where(owner >= 0, med, psd)
     floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
                                    mode="valid"), 1e-300)
@@ -223,14 +259,24 @@ def _model_lines(freqs, bearing):
     return []
 
 
-def _path_shape(freq, power, fs):
+def _path_shape(freq, power, fs, over_force=False):
     """A path's shape from a power spectrum: its root, smoothed over
-    :data:`PATH_SMOOTHING_OCTAVE`, falling as f² below :data:`HOUSING_BAND_LOW`·fs."""
+    :data:`PATH_SMOOTHING_OCTAVE`, falling as f² below :data:`HOUSING_BAND_LOW`·fs; a
+    spectrum ``over_force`` (the record's over the model force's) is held above the force's
+    anti-alias passband (:class:`~cmsim.dynamics.decimation.AntiAliasFilter`, 0.8 of the
+    Nyquist frequency): the force falls there by its filter, and the ratio would read a
+    path rising to the Nyquist frequency that lifts what the force has left there (the
+    twin's demodulation band then went to the top 500 Hz on a bearing baseline whose own
+    band is 1-2 kHz)."""
     df = freq[1] - freq[0]
     shape = np.sqrt(np.exp(smooth_log(np.log(np.maximum(power, 1e-300)), freq,
                                       PATH_SMOOTHING_OCTAVE)))
     i_low = int(np.searchsorted(freq, HOUSING_BAND_LOW * fs))
     shape[:i_low] = shape[i_low] * (np.maximum(freq[:i_low], df) / freq[i_low]) ** 2
+    if over_force:
+        i_high = min(int(np.searchsorted(freq, AntiAliasFilter.passband * 0.5 * fs)),
+                     freq.size - 1)
+        shape[i_high:] = shape[i_high]
     return shape
 
 
@@ -261,9 +307,252 @@ def _pins(shape, strong, lines, floor, pin_at, df, weak_family):
     return [p for p in pins if p not in dropped], bounds, dropped
 
 
-def _scatter(pins):
-    """Spread of the pins' gain corrections, natural-log RMS about their mean (0 for < 2)."""
-    return float(np.std(np.log([p[1] for p in pins]))) if len(pins) >= 2 else 0.0
+def _line_free(freq, psd):
+    """Mask of the bins of a PSD outside its narrow lines (those standing
+    :data:`LINE_MIN_DB` over the running median, with their Hann main lobe, ± 2 bins)."""
+    peak = psd > 10.0 ** (LINE_MIN_DB / 10.0) * _floor(freq, psd)
+    line = peak.copy()
+    for k in (1, 2):
+        line[k:] |= peak[:-k]
+        line[:-k] |= peak[k:]
+    return ~line
+
+
+def _cyclic_power(segs, fs, band, keep):
+    """Squared-envelope spectrum of segments band-passed to ``band`` (Hz): the FFT bins in
+    it that ``keep`` holds (the broadband: lines out), the squared modulus of their analytic
+    signal, its Hann power spectrum over its squared mean, averaged over the segments. A
+    band power modulated as e0·(1 + m cos 2πα t) reads m²/4 at α; a stationary noise adds no
+    line. ``(alpha_hz, power)``."""
+    n = segs[0].size
+    freq = np.fft.rfftfreq(n, 1.0 / fs)
+    idx = np.flatnonzero((freq >= band[0]) & (freq < band[1]) & keep)
+    w = np.hanning(n)
+    out = []
+    for x in segs:
+        z = np.zeros(n, dtype=complex)
+        z[idx] = np.fft.fft(x)[idx]
+        e = np.abs(np.fft.ifft(z)) ** 2
+        out.append(np.abs(np.fft.rfft((e - e.mean()) * w)) ** 2
+                   / max(float(e.mean()) * float(w.sum()), 1e-300) ** 2)
+    return freq, np.mean(out, axis=0)
+
+
+def _modulation(alpha, power, cyclic):
+    """Per cyclic frequency of ``cyclic``: (excess, noise, bins) of the squared-envelope
+    power ``power`` in the line's bins (the line rule with
+    :data:`~cmsim.features.lines.SLIP_TOLERANCE`, a bin counted once) over the mean level
+    ``noise`` of the bins around it (± max(6 bins, a quarter of its frequency)) that no line
+    holds."""
+    windows = [line_window(alpha, a, SLIP_TOLERANCE) for a in cyclic]
+    held = np.zeros(alpha.size, dtype=bool)
+    for win in windows:
+        if win is not None:
+            held |= win
+    out, counted = [], np.zeros(alpha.size, dtype=bool)
+    for a, win in zip(cyclic, windows):
+        bins = np.zeros(alpha.size, dtype=bool) if win is None else win & ~counted
+        counted |= bins
+        near = (np.abs(alpha - a) <= max(6 * alpha[1], 0.25 * a)) & ~held
+        noise = float(np.mean(power[near])) if np.any(near) else 0.0
+        k = int(np.count_nonzero(bins))
+        out.append((float(np.sum(power[bins])) - noise * k, noise, k))
+    return out
+
+
+def _sigma(mods, n_segments):
+    """Standard deviation of the summed excess of :func:`_modulation` rows ``mods`` under
+    noise alone: a bin of the average of K segments' powers scatters by its level over √K."""
+    return math.sqrt(sum(noise ** 2 * k for _, noise, k in mods) / n_segments)
+
+
+def _modulation_pins(shape, spectra, fs, freqs, bearing, above_hz):
+    """(pins, bounds, shares) of the path's gain read from the model force's modulation, in
+    the bands of :func:`~cmsim.features.envelope.band_bank` beyond ``above_hz`` (the
+    highest model line pinning the path) and below the force's anti-alias passband.
+
+    The background (coloured noise and lines) is stationary; the model's force is not: its
+    broadband power is modulated at its bearing's defect frequencies (ball pass through the
+    load zone; its shaft's own lines are left out: unbalance, run-out and the motor modulate
+    a real machine's broadband at the shaft rate, which the model does not). In a band
+    where the record is the force through the path (power P_H) plus a
+    background (P_B), the modulation depth of the record's band power is that of the force
+    through the path times the share s = P_H / (P_H + P_B): the ratio of the two
+    squared-envelope lines is s² — the split between path × force and background, which
+    the record's spectrum alone cannot tell. The force's modulation is read through the
+    path's ``shape`` (its gain cancels), the record's with its lines out; a band reads only
+    where the force's lines stand :data:`FORCE_MODULATION_MIN_SIGMA` over their noise and
+    would stand :data:`MODULATION_MIN_SIGMA` over the record's (were the record all force,
+    the band could tell a share from none); the share is read where the record's excess is
+    :data:`MODULATION_MIN_SIGMA` over its noise, else bounded by that, and is at most
+    :data:`MAX_SHARE`. The gain correction of the band is
+    then √(s · record's broadband power / (shape² · force's broadband power)) over it.
+
+    The bank's bands (fs/8 wide) hold the sidebands of every defect frequency of a bearing
+    several times over and leave the envelope spectrum of a 0.5-s segment enough bins to
+    average; the share is read at that resolution (fs/16 between band centres) while the
+    path's shape keeps its own (:data:`PATH_SMOOTHING_OCTAVE`).
+    """
+    if bearing not in freqs.bearing_names:
+        return [], [], []
+    freq, floor, pf_floor = spectra["freq"], spectra["floor"], spectra["pf_floor"]
+    cyclic = sorted({ln.frequency_hz for ln in envelope_lines(freqs.bearing(bearing))
+                     if ln.family != "shaft" and ln.frequency_hz > 0})
+    source = TransferPath("shape", tuple(freq), tuple(np.maximum(shape, 1e-30)))
+    forces = [source.apply(force, fs)[edge:edge + n] for force, edge, n in spectra["forces"]]
+    top = AntiAliasFilter.passband * 0.5 * fs
+    pins, bounds, shares = [], [], []
+    for lo, hi in band_bank(fs):
+        centre = math.sqrt(lo * hi)
+        if centre <= max(above_hz, HOUSING_BAND_LOW * fs) or centre > top:
+            continue
+        usable = [a for a in cyclic if a < 0.5 * (hi - lo)]
+        alpha, p_force = _cyclic_power(forces, fs, (lo, hi), spectra["force_keep"])
+        force_mod = _modulation(alpha, p_force, usable)
+        kept = [i for i, (ex, noise, k) in enumerate(force_mod)
+                if k and ex >= FORCE_MODULATION_MIN_SIGMA * _sigma([(ex, noise, k)],
+                                                                   len(forces))]
+        if not kept:
+            continue
+        _, p_rec = _cyclic_power(spectra["fit"], fs, (lo, hi), spectra["keep"])
+        rec_mod = _modulation(alpha, p_rec, usable)
+        ex_f = sum(force_mod[i][0] for i in kept)
+        ex_r = sum(rec_mod[i][0] for i in kept)
+        sigma = _sigma([rec_mod[i] for i in kept], len(spectra["fit"]))
+        if ex_f < MODULATION_MIN_SIGMA * sigma:
+            continue     # the force's modulation would not stand out of the record's noise
+        sel = (freq >= lo) & (freq < hi)
+        scale = math.sqrt(float(np.sum(floor[sel])) / float(np.sum(shape[sel] ** 2
+                                                                    * pf_floor[sel])))
+        if ex_r >= MODULATION_MIN_SIGMA * sigma:
+            share = min(math.sqrt(ex_r / ex_f), MAX_SHARE)
+            pins.append((centre, math.sqrt(share) * scale))
+            shares.append((lo, hi, share))
+        else:
+            share = math.sqrt(MODULATION_MIN_SIGMA * sigma / ex_f)
+            if share < MAX_SHARE:
+                bounds.append((centre, math.sqrt(share) * scale))
+                shares.append((lo, hi, -share))
+    return pins, bounds, shares
+
+
+def _misfit(names, twin_rows, rows, spread):
+    """(z, z_model) of the twin's mean feature against the mean of the baseline ``rows``:
+    over the baseline's segment-to-segment spread, and over that and the twin's own spread
+    (one record is one realisation of the model's random parts; the twin averages several)."""
+    z, z_model = {}, {}
+    for i, k in enumerate(names):
+        if k in spread and spread[k][1] > 0:
+            a, b = np.nanmean(twin_rows[:, i]), np.nanmean(rows[:, i])
+            if math.isfinite(a) and math.isfinite(b):
+                z[k] = float((a - b) / spread[k][1])
+                model = float(np.nanstd(twin_rows[:, i], ddof=1))
+                z_model[k] = float((a - b) / math.hypot(spread[k][1], model))
+    return z, z_model
+
+
+def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
+    """(path, background, notes, pins kept) of one reading of the path's shape: the
+    background's own (``forced`` False) or the background over the model's broadband
+    force.
+
+    Parameters
+    ----------
+    forced : bool
+        Which shape.
+    spectra : dict
+        ``freq``, ``floor`` (the record's broadband PSD), ``pf_floor`` (the model force's),
+        ``lines`` (the record's), ``force_lines`` and ``strong`` (the model force's, and
+        those standing :data:`MODEL_LINE_MIN_DB` over its floor).
+    fs : float
+        Sample rate, Hz.
+    freqs : cmsim.frequencies.RigFrequencies
+        The rig's frequencies at the record's speed.
+    bearing : str
+        The sensor's bearing.
+    shaft_hz : (float, float)
+        Input and output shaft rates, Hz.
+    ref : MeasuredRecord
+        The first baseline (rig, unit, metadata).
+    longest : numpy.ndarray
+        The longest baseline signal (the background lines' frequencies are read on it).
+    """
+    freq, floor, pf_floor = spectra["freq"], spectra["floor"], spectra["pf_floor"]
+    lines, force_lines = spectra["lines"], spectra["force_lines"]
+    df = freq[1] - freq[0]
+    rig = ref.rig
+    notes = []
+    shape = _path_shape(freq, floor / pf_floor if forced else floor, fs, forced)
+    pins, bounds, dropped = _pins(shape, spectra["strong"], lines, floor,
+                                  _model_lines(freqs, bearing), df,
+                                  weak_family=not freqs.gmf_hz)
+    if dropped:
+        notes.append(f"{len(dropped)} line(s) of the record at a model line's frequency "
+                     f"({', '.join(f'{p[0]:.1f}' for p in dropped[:4])} Hz) not taken as "
+                     "the model's: the gain they imply would show another harmonic of that "
+                     "family, which the record does not have")
+    band = (freq >= 0.05 * fs) & (freq <= 0.45 * fs)
+    mod_pins, mod_bounds, shares = _modulation_pins(
+        shape, spectra, fs, freqs, bearing, max((p[0] for p in pins), default=0.0))
+    bounds = bounds + mod_bounds
+    if pins:
+        notes.append(f"path gain pinned by {len(pins)} model line(s) the record shows "
+                     f"({', '.join(f'{p[0]:.1f}' for p in sorted(pins)[:8])} Hz)")
+    if shares:
+        notes.append("path gain read from the modulation of the record's broadband at the "
+                     "sensor bearing's defect frequencies, over the model force's, in "
+                     f"{len(shares)} band(s): share of the broadband the model's force makes "
+                     + ", ".join(f"{lo:.0f}-{hi:.0f} Hz {'≤ ' if sh < 0 else ''}{abs(sh):.2f}"
+                                 for lo, hi, sh in shares))
+    if pins or mod_pins:
+        points = sorted(pins + mod_pins)
+    else:
+        nominal = np.abs(rig.housing.accelerance(freq[band]))
+        scale = ref.unit_scale if ref.unit_scale is not None else 1.0
+        g = math.exp(float(np.mean(np.log(nominal / scale)) - np.mean(np.log(shape[band]))))
+        points = [(float(freq[band][0]), g), (float(freq[band][-1]), g)]
+        notes.append("path gain not identifiable on this baseline (no model line stands out "
+                     "in it): the rig's nominal housing path averaged over 0.05-0.45·fs; "
+                     "fault sizes read through it carry that uncertainty")
+        if ref.unit_scale is None:
+            notes.append("sensor unit unknown: the path is in sensor unit per N with the "
+                         "nominal housing's accelerance taken as 1 unit = 1 m/s²")
+
+    def correction(pts):
+        pts = sorted(pts)
+        f_, c_ = np.array([p[0] for p in pts]), np.log([p[1] for p in pts])
+        return np.exp(np.interp(np.log(np.maximum(freq, df)), np.log(f_), c_))
+
+    corr = correction(points)
+    capped = [(fb, gb) for fb, gb in bounds if corr[int(round(fb / df))] > gb]
+    if capped:     # model lines, or modulation, the record does not show cap the path there
+        corr = correction(points + capped)
+        notes.append(f"path gain capped at {len(capped)} frequencies where the record does "
+                     f"not show the model's lines or modulation "
+                     f"({', '.join(f'{f:.1f}' for f, _ in sorted(capped)[:6])} Hz)")
+    gain = shape * corr
+    if not (pins or mod_pins):   # a prior gain must keep the model's broadband under the floor
+        gain = np.minimum(gain, np.sqrt(BROADBAND_SHARE * floor / pf_floor))
+    unit = str((ref.meta.get("sensor") or {}).get("unit") or "")
+    path = TransferPath(f"F_{bearing}_{signal_info(ref.model_signal).direction}",
+                        tuple(freq), tuple(np.maximum(gain, 1e-30)), unit)
+
+    # the background: the rest of the broadband, and the lines the model does not make
+    noise = np.maximum(floor - gain ** 2 * pf_floor, 0.1 * floor)
+    pinned = [p[0] for p in pins]
+    own = []              # what the model's own lines put there is not background
+    for f, a in lines:
+        if any(_near(f, g, df) for g in pinned):
+            continue
+        made = [fa for fa in force_lines if _near(f, fa[0], df)]
+        if made:
+            model_amp = float(np.interp(f, freq, gain)) * max(fa[1] for fa in made)
+            a = math.sqrt(max(a * a - model_amp * model_amp, 0.0))
+        if a > 0.0:
+            own.append((f, a))
+    fine, fine_df = _refined(own, longest, fs, df)
+    bg_lines = [BackgroundLine(*_classify(f, shaft_hz, fine_df), a) for f, a in fine]
+    return path, Background(tuple(freq), tuple(noise), tuple(bg_lines)), notes, len(pins)
 
 
 def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
@@ -392,105 +681,27 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     lines, floor = _lines_and_floor(freq, psd)
 
     # 2. the nominal model's force
-    forces = []
-    for s in range(n_seeds):
-        force, edge, n = model_force(rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
-        forces.append(force[edge:edge + n])
+    force_runs = [model_force(rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
+                  for s in range(n_seeds)]
+    twin_forces = [model_force(rig, op, ref.model_signal, fs, seg_s,
+                               seed + 1 + 7777 * (s + n_seeds)) for s in range(N_TWIN_SEEDS)]
+    forces = [force[edge:edge + n] for force, edge, n in force_runs]
     _, pf = _power_spectrum(forces, fs)
-    amp_f = np.sqrt(pf * df * 2.0)                 # a line's amplitude at its bin (approx.)
 
-    # 3. the path: its shape (that of the background, or of the background over the
-    # model's broadband force, whichever the model lines read alike), its gain pinned by the
-    # model lines the record shows and bounded by those it does not show
+    # 3-4. the path and the background, read twice: the path's shape that of the
+    # background, or of the background over the model's broadband force; its gain pinned
+    # by the model lines the record shows and bounded by those it does not show. Of the two,
+    # the one whose twin is nearer the fit segments is kept.
     force_lines, pf_floor = _lines_and_floor(freq, pf)
     strong = [(f, a) for f, a in force_lines
               if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
               * pf_floor[int(round(f / df))]]
-    pin_at = _model_lines(freqs, bearing)
-    readings = []
-    for forced in (False, True):
-        shape = _path_shape(freq, floor / pf_floor if forced else floor, fs)
-        pins, bounds, dropped = _pins(shape, strong, lines, floor, pin_at, df,
-                                      weak_family=not freqs.gmf_hz)
-        readings.append((len(pins), -_scatter(pins), not forced, shape, pins, bounds,
-                         dropped))
-    *_, own_shape, shape, pins, bounds, dropped = max(readings, key=lambda r: r[:3])
-    if not own_shape:
-        notes.append("path shape: the background over the model's broadband force (the "
-                     "model lines the record shows read alike through it, not through the "
-                     "background's own shape): the record's broadband is the model's force")
-    if dropped:
-        notes.append(f"{len(dropped)} line(s) of the record at a model line's frequency "
-                     f"({', '.join(f'{p[0]:.1f}' for p in dropped[:4])} Hz) not taken as "
-                     "the model's: the gain they imply would show another harmonic of that "
-                     "family, which the record does not have")
-    band = (freq >= 0.05 * fs) & (freq <= 0.45 * fs)
-    if pins:
-        points = sorted(pins)
-        notes.append(f"path gain pinned by {len(pins)} model line(s) the record shows "
-                     f"({', '.join(f'{p[0]:.1f}' for p in points[:8])} Hz)")
-    else:
-        nominal = np.abs(rig.housing.accelerance(freq[band]))
-        scale = ref.unit_scale if ref.unit_scale is not None else 1.0
-        g = math.exp(float(np.mean(np.log(nominal / scale)) - np.mean(np.log(shape[band]))))
-        points = [(float(freq[band][0]), g), (float(freq[band][-1]), g)]
-        notes.append("path gain not identifiable on this baseline (no model line stands out "
-                     "in it): the rig's nominal housing path averaged over 0.05-0.45·fs; "
-                     "fault sizes read through it carry that uncertainty")
-        if ref.unit_scale is None:
-            notes.append("sensor unit unknown: the path is in sensor unit per N with the "
-                         "nominal housing's accelerance taken as 1 unit = 1 m/s²")
+    spectra = {"freq": freq, "floor": floor, "pf_floor": pf_floor, "lines": lines,
+               "force_lines": force_lines, "strong": strong,
+               "fit": fit, "keep": _line_free(freq, psd),
+               "forces": force_runs + twin_forces, "force_keep": _line_free(freq, pf)}
 
-    def correction(pts):
-        pts = sorted(pts)
-        f_, c_ = np.array([p[0] for p in pts]), np.log([p[1] for p in pts])
-        return np.exp(np.interp(np.log(np.maximum(freq, df)), np.log(f_), c_))
-
-    corr = correction(points)
-    capped = [(fb, gb) for fb, gb in bounds if corr[int(round(fb / df))] > gb]
-    if capped:                  # model lines the record does not show cap the path there
-        corr = correction(points + capped)
-        notes.append(f"path gain capped at {len(capped)} model line(s) the record does not "
-                     f"show ({', '.join(f'{f:.1f}' for f, _ in sorted(capped)[:6])} Hz), 10 "
-                     "dB under its floor there")
-    gain = shape * corr
-    if not pins:      # a prior gain must keep the model's broadband under the record's floor
-        gain = np.minimum(gain, np.sqrt(BROADBAND_SHARE * floor / pf_floor))
-    unit = str((ref.meta.get("sensor") or {}).get("unit") or "")
-    path = TransferPath(f"F_{bearing}_{signal_info(ref.model_signal).direction}",
-                        tuple(freq), tuple(np.maximum(gain, 1e-30)), unit)
-
-    # 4. the background: the rest of the broadband, and the lines the model does not make
-    noise = np.maximum(floor - gain ** 2 * pf_floor, 0.1 * floor)
-    pinned = [p[0] for p in pins]
-    own = []              # what the model's own lines put there is not background
-    for f, a in lines:
-        if any(abs(f - g) <= 2.5 * df for g in pinned):
-            continue
-        made = [fa for fa in force_lines if abs(fa[0] - f) <= 1.5 * df]
-        if made:
-            model_amp = float(np.interp(f, freq, gain)) * max(fa[1] for fa in made)
-            a = math.sqrt(max(a * a - model_amp * model_amp, 0.0))
-        if a > 0.0:
-            own.append((f, a))
-    longest = max(records, key=lambda r: r.signal.size).signal
-    fine, fine_df = _refined(own, longest, fs, df)
-    bg_lines = [BackgroundLine(*_classify(f, shaft_hz, fine_df), a) for f, a in fine]
-    background = Background(tuple(freq), tuple(noise), tuple(bg_lines))
-
-    wobble = _speed_wobble(np.concatenate([r.signal for r in records]), fs, freqs.fr1_hz)
-    machine = Machine(
-        name=name or (ref.record_id or "machine"), rig=rig, channel=ref.channel,
-        model_signal=ref.model_signal, fs_hz=fs, op=op, path=path, background=background,
-        unit=path.unit, unit_scale=ref.unit_scale, components=dict(ref.components),
-        segment_s=seg_s, speed_wobble=wobble,
-        calibrated_on=tuple(f"{r.record_id or r.path or 'record'}"
-                            + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
-                               if r.meta.get("span_s") else "")
-                            + " (even segments fit, odd held out)" for r in records),
-        notes=tuple(notes))
-
-    # 5. the baseline's spread and the twin on the held-out segments
+    # 5. the baseline's spread
     bearings = list(rig.bearing_names)
     names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale)
     # a feature a segment cannot read (a line beyond its resolution) is NaN there; one no
@@ -498,21 +709,49 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     seen = np.sum(np.isfinite(all_rows), axis=0) >= 2
     spread = {k: (float(np.nanmean(all_rows[:, i])), float(np.nanstd(all_rows[:, i], ddof=1)))
               for i, k in enumerate(names) if seen[i]}
-    held_rows = all_rows[len(fit):]
-    twin = []
-    for s in range(N_TWIN_SEEDS):
-        force, edge, n = model_force(rig, op, ref.model_signal, fs, seg_s,
-                                     seed + 1 + 7777 * (s + n_seeds))
-        twin.append(machine.sensor_signal(force, edge, n, seed + 31 * s))
-    _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale)
-    z, z_model = {}, {}
-    for i, k in enumerate(names):
-        if k in spread and spread[k][1] > 0:
-            a, b = np.nanmean(twin_rows[:, i]), np.nanmean(held_rows[:, i])
-            if math.isfinite(a) and math.isfinite(b):
-                z[k] = float((a - b) / spread[k][1])
-                model = float(np.nanstd(twin_rows[:, i], ddof=1))
-                z_model[k] = float((a - b) / math.hypot(spread[k][1], model))
+    fit_rows, held_rows = all_rows[:len(fit)], all_rows[len(fit):]
+
+    wobble = _speed_wobble(np.concatenate([r.signal for r in records]), fs, freqs.fr1_hz)
+    longest = max(records, key=lambda r: r.signal.size).signal
+    candidates = []
+    for forced in (False, True):
+        path, background, chain_notes, n_pins = _reading(forced, spectra, fs, freqs, bearing,
+                                                         shaft_hz, ref, longest)
+        machine = Machine(
+            name=name or (ref.record_id or "machine"), rig=rig, channel=ref.channel,
+            model_signal=ref.model_signal, fs_hz=fs, op=op, path=path, background=background,
+            unit=path.unit, unit_scale=ref.unit_scale, components=dict(ref.components),
+            segment_s=seg_s, speed_wobble=wobble,
+            calibrated_on=tuple(f"{r.record_id or r.path or 'record'}"
+                                + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
+                                   if r.meta.get("span_s") else "")
+                                + " (even segments fit, odd held out)" for r in records),
+            notes=tuple(notes + chain_notes))
+        twin = [machine.sensor_signal(force, edge, n, seed + 31 * s)
+                for s, (force, edge, n) in enumerate(twin_forces)]
+        _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale)
+        z_fit, _ = _misfit(names, twin_rows, fit_rows, spread)
+        score = float(np.mean([min(v * v, MISFIT_CAP ** 2) for v in z_fit.values()])) \
+            if z_fit else 0.0
+        candidates.append((-n_pins, score, forced, machine, twin_rows))
+    if not any(c[0] for c in candidates):
+        # no model line pins the path: its gain is a prior, and a twin can match a healthy
+        # record's broadband through either shape, so the fit does not tell them apart
+        _, score, forced, machine, twin_rows = candidates[0]
+        why = "no model line pins the path"
+    else:
+        (neg_pins, score, forced, machine, twin_rows), other = sorted(candidates,
+                                                                      key=lambda c: c[:3])
+        why = (f"it keeps more pins ({-neg_pins} against {-other[0]})"
+               if neg_pins != other[0] else
+               f"its twin's misfit on the fit segments, chi2 per feature with z capped at "
+               f"{MISFIT_CAP:g}, {score:.2f} against {other[1]:.2f} for the other shape")
+    shape_words = ("the background over the model's broadband force" if forced
+                   else "the background's own")
+    machine = replace(machine, notes=machine.notes + (f"path shape: {shape_words} ({why})",))
+
+    # 6. the twin on the held-out segments
+    z, z_model = _misfit(names, twin_rows, held_rows, spread)
     worst = max(z, key=lambda k: abs(z[k])) if z else None
     worst_m = max(z_model, key=lambda k: abs(z_model[k])) if z_model else None
     quality = {"z": z, "worst_feature": worst,

@@ -127,7 +127,9 @@ class TransferPath:
         return minimum_phase_fir(grid, self.gain, fs_hz)
 
     def apply(self, force, fs_hz, frequency_factor=1.0):
-        """The sensor signal of a force (mean removed), causal, same length and instants.
+        """The sensor signal of a force, causal, same length and instants; the filter starts
+        at rest under the first sample (as :func:`cmsim.sensors.housing_acceleration`), so a
+        record does not start with the step from zero to its first force.
 
         Parameters
         ----------
@@ -144,7 +146,7 @@ class TransferPath:
             Sensor unit.
         """
         x = np.asarray(force, dtype=float)
-        x = x - x.mean()
+        x = x - x[0]
         return oaconvolve(x, self.fir(fs_hz, frequency_factor))[: x.size]
 
     def to_dict(self):

@@ -170,3 +170,69 @@ def test_a_sharp_mode_twin_keeps_the_record_s_statistics(resonant_case):
     q = m.fit_quality
     assert abs(q["z_with_model_spread"]["kurtosis_log"]) < 4.0
     assert q["chi2_per_feature_with_model_spread"] < 2.0, q["worst_feature_with_model_spread"]
+
+
+@pytest.fixture(scope="module")
+def bearing_case():
+    """A ball-bearing machine (the benchmark's CWRU-like rig at 12 kHz, 5 s as half of a CWRU
+    record) whose housing has two modes in its band, read with a white sensor noise half as
+    strong as the path's mean response there: the model's force makes about a third of the
+    broadband between the modes and most of it on them, and its ball pass pins the path
+    only under 500 Hz, below the housing band."""
+    from cmsim.discrepancy.synthetic import cwru_like_rig
+    rig, fs = cwru_like_rig(), 12_000.0
+    op = OperatingPoint(1797.0, radial_load_n=98.0665)
+    f = np.linspace(0.0, fs / 2, 1201)
+    shape = sum((f / f0) ** 2 / np.sqrt((1 - (f / f0) ** 2) ** 2 + (2 * z * f / f0) ** 2)
+                for f0, z in ((1500.0, 0.05), (3300.0, 0.04)))
+    path = TransferPath("F_1b1_y", tuple(f), tuple(1e-3 * np.maximum(shape, 1e-4)), "g")
+    force, edge, n = model_force(rig, op, "accel_1b1_y", fs, 5.0, 13)
+    y = path.apply(force, fs)[edge:edge + n]
+    fy = np.fft.rfftfreq(n, 1.0 / fs)
+    p = 2.0 * np.abs(np.fft.rfft(y)) ** 2 / (fs * n)
+    level = 0.5 * float(np.mean(p[(fy >= 0.1 * fs) & (fy <= 0.35 * fs)]))
+    noise = Background((0.0, fs / 2), (level, level), ())
+    y = y + noise.synthesize(n, fs, (op.shaft_hz, op.shaft_hz), np.random.default_rng(5))
+    run = Run(np.arange(n) / fs, {"acc": y}, {"fs_hz": fs}, source="measured")
+    record = record_from_run(run, "acc", rig, op, model_signal="accel_1b1_y")
+    forces = [model_force(rig, op, "accel_1b1_y", fs, 0.5, 50 + k) for k in range(4)]
+    return path, noise, forces, calibrate([record], seg_s=0.5, seed=7)
+
+
+def _band_powers(path, forces, fs, band):
+    """Power the forces make through ``path`` in ``band``, mean PSD."""
+    out = []
+    for force, edge, n in forces:
+        y = path.apply(force, fs)[edge:edge + n]
+        fy, w = np.fft.rfftfreq(n, 1.0 / fs), np.hanning(n)
+        p = 2.0 * np.abs(np.fft.rfft(y * w)) ** 2 / (fs * np.sum(w ** 2))
+        out.append(np.mean(p[(fy >= band[0]) & (fy < band[1])]))
+    return float(np.mean(out))
+
+
+def test_the_split_between_path_and_background_is_recovered_across_the_housing_band(
+        bearing_case):
+    """Where no model line pins the path (above the ball pass's harmonics), the share of the
+    broadband the model's force makes is read from the modulation of the record's band
+    power at the bearing's defect frequencies: in every band of the bank within the housing
+    band, the power the force makes through the fitted path and the background's power are
+    the true ones within 3 dB. (The share is read on five 0.5-s segments: read at 3σ over
+    the noise of their squared-envelope spectrum it scatters by a third in s², ±1.5 dB; the
+    force's modulation is read through the path's shape, which weights a band as the
+    record's broadband does, not as the path alone, up to 1 dB where the background
+    dominates. Held at the ball pass's pins, as before, the path's power was 11-35 dB
+    under the truth in these bands on the benchmark's bearing machines.)"""
+    from cmsim.features.envelope import band_bank
+    path, noise, forces, m = bearing_case
+    fs = m.fs_hz
+    assert any("modulation" in n for n in m.notes), m.notes
+    rows = []
+    for lo, hi in band_bank(fs):
+        if math.sqrt(lo * hi) > 0.4 * fs:
+            continue
+        got = _band_powers(m.path, forces, fs, (lo, hi))
+        true = _band_powers(path, forces, fs, (lo, hi))
+        f = np.linspace(lo, hi, 50)
+        bg = float(np.mean(np.interp(f, m.background.freq_hz, m.background.psd)))
+        rows.append((lo, hi, 10 * math.log10(got / true), 10 * math.log10(bg / noise.psd[0])))
+    assert all(abs(dp) < 3.0 and abs(db) < 3.0 for *_, dp, db in rows), rows
