@@ -5,8 +5,9 @@ A setup's bearing force (:func:`cmsim.machine.model_force`) is simulated once pe
 cached by its dynamics; what acts after the dynamics — the shaft forces of unbalance and
 misalignment, and the measurement chain (the rig's housing path and white sensor noise, or a
 calibrated machine's path and background; path-free, the record's own broadband floor,
-:func:`record_floor`) — is applied to the cached force without a new simulation. Features are :func:`cmsim.features.relative_features` (plus ``level_db`` when the
-record's unit is known), as the record's.
+:func:`record_floor`) — is applied to the cached force without a new simulation. Features
+are :func:`cmsim.features.relative_features` (plus ``level_db`` when the record's unit is
+known), as the record's.
 """
 
 from __future__ import annotations
