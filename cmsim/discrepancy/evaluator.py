@@ -16,8 +16,6 @@ import math
 import warnings
 
 import numpy as np
-from scipy.ndimage import median_filter
-from scipy.signal import welch
 
 from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.errors import IntegrationDiverged, ParameterError
@@ -25,6 +23,7 @@ from cmsim.features import N_SHAPE_BANDS, relative_features
 from cmsim.machine import model_force
 from cmsim.run import signal_info
 from cmsim.sensors import housing_acceleration
+from cmsim.spectra.floor import running_median_floor, segment_psd
 
 __all__ = ["simulate_setup", "sensor_signal", "record_floor", "feature_floor", "path_free",
            "chi2", "Evaluator", "Budget", "Z_CAP", "DB_FLOOR", "LOG_FLOOR", "LEVEL_REF",
@@ -98,10 +97,11 @@ def _shaft_forces(force, fs, shaft_hz, terms, seed):
 def record_floor(x, fs_hz, n):
     """Gains that colour white noise into a record's broadband floor, for ``n``-sample signals.
 
-    The floor is the record's Welch power spectrum (consecutive segments of ``n`` samples,
-    Hann, no overlap: the fit segments of a comparison laid end to end, each its own
-    periodogram) under a running median of ± :data:`FLOOR_MEDIAN_HZ`, so its lines (shaft,
-    defect and mesh families) drop out and what is left is what lies between them: the
+    The floor is the record's power spectrum (:func:`cmsim.spectra.floor.segment_psd` of
+    consecutive segments of ``n`` samples: the fit segments of a comparison laid end to end,
+    each its own periodogram) under a running median of ± :data:`FLOOR_MEDIAN_HZ`
+    (:func:`~cmsim.spectra.floor.running_median_floor`, mirrored at its ends), so its lines
+    (shaft, defect and mesh families) drop out and what is left is what lies between them: the
     background, the sensor and whatever is random in the machine. Unit: the record's (m/s²
     once scaled).
 
@@ -121,12 +121,13 @@ def record_floor(x, fs_hz, n):
         the floor's one-sided power spectral density.
     """
     x = np.asarray(x, dtype=float)
-    nper = int(min(n, x.size))
-    f, p = welch(x - x.mean(), fs_hz, window="hann", nperseg=nper, noverlap=0)
-    half = max(1, int(round(FLOOR_MEDIAN_HZ / (f[1] - f[0]))))
-    floor = median_filter(p, size=2 * half + 1, mode="mirror")
-    fn = np.fft.rfftfreq(int(n), 1.0 / fs_hz)
-    return np.sqrt(np.interp(fn, f, floor) * fs_hz / 2.0)
+    n = int(n)
+    nper = min(n, x.size)
+    freq, psd = segment_psd([x[i:i + nper] for i in range(0, x.size - nper + 1, nper)],
+                            fs_hz)
+    floor = running_median_floor(freq, psd, FLOOR_MEDIAN_HZ, mode="mirror")
+    fn = np.fft.rfftfreq(n, 1.0 / fs_hz)
+    return np.sqrt(np.interp(fn, freq, floor) * fs_hz / 2.0)
 
 
 def _coloured(gain, n, seed):

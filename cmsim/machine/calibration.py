@@ -76,7 +76,6 @@ import math
 from dataclasses import replace
 
 import numpy as np
-from scipy.ndimage import median_filter
 
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.errors import ParameterError
@@ -89,6 +88,7 @@ from cmsim.machine.background import Background, BackgroundLine
 from cmsim.machine.machine import Machine, model_force
 from cmsim.machine.path import TransferPath, smooth_log
 from cmsim.run import signal_info
+from cmsim.spectra.floor import median_window_bins, running_median_floor, segment_psd
 
 __all__ = ["calibrate", "SEGMENT_S", "N_SEEDS", "LINE_MIN_DB", "FLOOR_HALF_WIDTH_HZ",
            "PATH_SMOOTHING_OCTAVE", "MAX_LINES", "feature_rows"]
@@ -148,23 +148,16 @@ LINE_TOLERANCE = 0.004
 HOUSING_BAND_LOW = 0.04
 
 
-def _power_spectrum(segs, fs):
-    """(freq, one-sided PSD averaged over segments) with a Hann window, unit²/Hz."""
-    n = segs[0].size
-    w = np.hanning(n)
-    p = np.mean([np.abs(np.fft.rfft((s - s.mean()) * w)) ** 2 for s in segs], axis=0)
-    return np.fft.rfftfreq(n, 1.0 / fs), 2.0 * p / (fs * np.sum(w ** 2))
-
-
 def _window_bins(freq):
     """Odd number of bins of the ± :data:`FLOOR_HALF_WIDTH_HZ` running windows."""
-    return max(5, 2 * int(round(FLOOR_HALF_WIDTH_HZ / (freq[1] - freq[0]))) + 1)
+    return median_window_bins(freq, FLOOR_HALF_WIDTH_HZ)
 
 
 def _floor(freq, psd):
-    """Running median of the PSD over ± :data:`FLOOR_HALF_WIDTH_HZ`: blind to lines, but
-    biased low on a noisy estimate (what line detection needs, not the level)."""
-    return np.maximum(median_filter(psd, size=_window_bins(freq), mode="nearest"), 1e-300)
+    """Running median of the PSD over ± :data:`FLOOR_HALF_WIDTH_HZ` (end bins repeated):
+    blind to lines, but biased low on a noisy estimate (what line detection needs, not the
+    level)."""
+    return running_median_floor(freq, psd, FLOOR_HALF_WIDTH_HZ, mode="nearest")
 
 
 def _lines_and_floor(freq, psd):
@@ -676,7 +669,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
              "model assumes (the load is not identified from a healthy record)"]
 
     # 1. the record: spectrum, its lines, the smooth background spectrum
-    freq, psd = _power_spectrum(fit, fs)
+    freq, psd = segment_psd(fit, fs)
     df = freq[1] - freq[0]
     lines, floor = _lines_and_floor(freq, psd)
 
@@ -686,7 +679,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     twin_forces = [model_force(rig, op, ref.model_signal, fs, seg_s,
                                seed + 1 + 7777 * (s + n_seeds)) for s in range(N_TWIN_SEEDS)]
     forces = [force[edge:edge + n] for force, edge, n in force_runs]
-    _, pf = _power_spectrum(forces, fs)
+    _, pf = segment_psd(forces, fs)
 
     # 3-4. the path and the background, read twice: the path's shape that of the
     # background, or of the background over the model's broadband force; its gain pinned
