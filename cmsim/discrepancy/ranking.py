@@ -303,7 +303,9 @@ def fit(top, nominal, nuis, ev):
     for p in cause.params:
         lo, hi = p.bounds
         fwd, back = (math.log, math.exp) if p.log_scale else (float, float)
-        states = {}
+        # the point the fit starts from (a probe, or the grid of refine) is one of the values
+        # tried: it may stay the best, and then the reported range must hold it
+        states = {float(fwd(values[p.name])): (best_c, best_st, values[p.name])}
 
         def objective(u, p=p, states=states):
             v = p.clamp(back(u))
@@ -324,7 +326,7 @@ def fit(top, nominal, nuis, ev):
         if n_fit >= 3 or cause.force_level:
             minimize_scalar(objective, bounds=(a, b), method="bounded",
                             options={"maxiter": max(n_fit, 8), "xatol": 0.02})
-        if states:
+        if len(states) > 1:
             c, st, v = min(states.values(), key=lambda s: s[0])
             within = [s[2] for s in states.values() if s[0] <= c + SEVERITY_DELTA_CHI2]
             ranges[p.name] = (min(within), max(within))

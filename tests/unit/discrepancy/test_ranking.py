@@ -4,7 +4,10 @@ Tier (a) closed form: rows with given per-feature evidence, no simulation; each 
 module docstring is a case that another rule would decide the other way.
 """
 
+import math
 from types import SimpleNamespace
+
+import pytest
 
 from cmsim.discrepancy.causes import STATISTICS
 from cmsim.discrepancy.ranking import (FAR_MARGIN, MIN_DELTA_CHI2, MIN_SIGNATURE_DELTA_CHI2,
@@ -95,3 +98,45 @@ def test_a_reshaping_cause_blocks_a_fault_by_what_it_does_to_the_family_not_the_
     outer = _outer(30.0)
     assert load["per_feature"]["kurtosis_log"] + 15.0 > outer["delta_chi2"]
     assert decide([load, outer], "1b1", 300.0)[0]["name"] == "bearing_outer_race"
+
+
+def test_the_reported_range_holds_the_reported_value():
+    """A probe that stays the best of every value the fit tries is the value reported, and
+    its range holds it (the range was once read from the fit's own points only: "0.1 mm
+    (0.063-0.075 mm)")."""
+    from dataclasses import dataclass
+
+    from cmsim.discrepancy.causes import Cause, ModelSetup
+    from cmsim.discrepancy.ranking import SEVERITY_DELTA_CHI2, fit
+    from cmsim.rig import OperatingPoint, Rig
+
+    @dataclass(frozen=True)
+    class Setup(ModelSetup):
+        size_m: float = 0.0
+
+    class Defect(Cause):
+        name = "test_defect"
+        parameter = "size_m"
+        bounds = (1e-4, 2e-3)
+
+        def apply(self, setup, value, component):
+            from dataclasses import replace
+            return replace(setup, size_m=value)
+
+    def chi2(setup):
+        # a dip at the probe narrower than the grid's spacing, outside the bracket the grid
+        # gives Brent; a wide shallow minimum elsewhere
+        u = math.log(setup.size_m)
+        return min(1e6 * (u - math.log(1.5e-3)) ** 2, 12.0 + 100.0 * (u - math.log(4e-4)) ** 2)
+
+    nuis = SimpleNamespace(seeds=(0, 1), fit=lambda st: (chi2(st), st))
+    ev = SimpleNamespace(budget=100, count=0)
+    nominal = Setup(rig=Rig.paper_2016(), op=OperatingPoint(1000.0, 100.0))
+    start = Defect().extend(nominal, {"size_m": 1.5e-3}, None)
+    top = {"cause": Defect(), "component": None, "probe": {"size_m": 1.5e-3},
+           "chi2": chi2(start), "setup": start}
+    values, ranges, st = fit(top, nominal, nuis, ev)
+    lo, hi = ranges["size_m"]
+    assert values["size_m"] == pytest.approx(1.5e-3)
+    assert lo <= values["size_m"] <= hi
+    assert chi2(st) <= SEVERITY_DELTA_CHI2
