@@ -312,11 +312,14 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         except Budget:
             break
     ranked.sort(key=lambda r: r["chi2"])
-    for r in [r for r in ranked if not r["cause"].post_dynamics][:REFINE_TOP]:
-        try:
+    leaders = [r for r in ranked if not r["cause"].post_dynamics][:REFINE_TOP]
+    try:
+        for r in leaders:
             refine(r, nominal, nuis)
-        except Budget:
-            break
+        if leaders:                     # the best of them also between the grid's points
+            refine(min(leaders, key=lambda r: r["chi2"]), nominal, nuis, dense=True)
+    except Budget:
+        pass
     for r in ranked:
         r["features"] = ev.features(r["setup"], seeds)
         evidence(r, chi_of, f_nom_fit, cols)

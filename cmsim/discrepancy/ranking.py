@@ -163,14 +163,24 @@ def rank(cause, nominal, nuis, ev):
     return out
 
 
-def refine(r, nominal, nuis):
+def refine(r, nominal, nuis, dense=False):
     """Re-rank the leading cause ``r`` (a row of :func:`rank`) at its best over a coarse
     grid of each parameter's bounds, extending ``nominal`` with the chain refitted by
-    ``nuis`` (the probes may miss a severity far from them); the fit starts from there."""
+    ``nuis`` (the probes may miss a severity far from them); the fit starts from there.
+
+    ``dense`` adds the grid's midpoints (the coarse points are cached by their dynamics and
+    cost no new simulation): a record's χ² can fall in a valley narrower than the coarse
+    grid's step, a factor 2.1 over the load's bounds — a radial load 4.5 times the
+    documented one reads χ² 22 at 4.5, 55 at 3.5 and 99 at 5, but 168 at the grid's 2.9
+    (the loaded balls' contact stiffness moves the bearing's modes across the housing's).
+    """
     cause, comp = r["cause"], r["component"]
     for p in cause.params:
         fwd, back = (math.log, math.exp) if p.log_scale else (float, float)
-        for u in np.linspace(fwd(p.bounds[0]), fwd(p.bounds[1]), FIT_GRID):
+        grid = np.linspace(fwd(p.bounds[0]), fwd(p.bounds[1]), FIT_GRID)
+        if dense:
+            grid = np.concatenate([grid, 0.5 * (grid[:-1] + grid[1:])])
+        for u in grid:
             values = {**r["probe"], p.name: p.clamp(back(u))}
             try:
                 chi, st = nuis.fit(cause.extend(nominal, values, comp))
@@ -322,6 +332,10 @@ def fit(top, nominal, nuis, ev):
         vals = [objective(u) for u in grid]
         i = int(np.argmin(vals))
         a, b = grid[max(i - 1, 0)], grid[min(i + 1, FIT_GRID - 1)]
+        u0 = fwd(values[p.name])
+        if best_c < vals[i]:          # the start lies in a valley the grid steps over
+            a = max([u for u in grid if u < u0], default=grid[0])
+            b = min([u for u in grid if u > u0], default=grid[-1])
         n_fit = (ev.budget - ev.count) // max(len(nuis.seeds), 1)
         if n_fit >= 3 or cause.force_level:
             minimize_scalar(objective, bounds=(a, b), method="bounded",
