@@ -5,7 +5,8 @@
   (:class:`Nuisances`).
 * **Probes.** Each cause is simulated at its probe values on each component it may sit on,
   and the :data:`REFINE_TOP` best model causes are re-ranked over a coarse grid of their
-  bounds.
+  bounds, the best of them also at the grid's midpoints (a χ² valley can be narrower than
+  the grid's step).
 * **Evidence on its own signature.** A cause's evidence is Δχ² = χ²(nominal) − χ²(cause)
   summed over the features its signature moves (:meth:`Cause.judged_on
   <cmsim.discrepancy.causes.Cause.judged_on>`: a bearing defect's families, a tooth fault's
