@@ -19,13 +19,11 @@
   clearance does to it is that fault. A record's kurtosis names no fault: a fault whose family
   got no nearer (a defect on a bearing whose families the record does not show, a family the
   model makes worse) is not named on the statistics alone. Of the faults that stand out, the
-  one with the most evidence on its own signature leads, and each other one is set against
-  it on the union of their two families (:func:`head_to_head`): where two families' lines
-  meet, only that evidence tells which fault makes both.
+  one with the most evidence on its own signature wins.
 * **The nearest bearing.** A bearing cause on a bearing other than the sensor's wins only
   with :data:`FAR_MARGIN` times the evidence of the same cause on the sensor's bearing.
-* **Near ties.** A runner-up within :data:`NEAR_TIE` of the winner's evidence (between
-  faults: on the union of their families) is reported beside it.
+* **Near ties.** A runner-up of the same kind within :data:`NEAR_TIE` of the winner's
+  evidence is reported beside it.
 * **Fit.** The named cause's parameters are fitted (coarse grid over the bounds, then
   bounded Brent in log scale) within the budget; the range of each over which χ² stays
   within :data:`SEVERITY_DELTA_CHI2` of its best is reported with it.
