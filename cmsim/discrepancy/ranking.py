@@ -225,8 +225,8 @@ def decide(ranked, sensor_bearing, chi_nominal):
     Faults (causes with a signature) are decided first: of those whose evidence reaches
     :data:`MIN_SIGNATURE_DELTA_CHI2` and whose family's evidence is positive and exceeds a
     nameable reshaping cause's Δχ² on the family's features, the strongest on its own
-    signature, preferring the sensor's bearing (:data:`FAR_MARGIN`), and then each other
-    cause against it on the union of their families (:func:`head_to_head`); without one, the reshaping cause with the largest evidence,
+    signature wins, preferring the sensor's
+    bearing (:data:`FAR_MARGIN`); without one, the reshaping cause with the largest evidence,
     if it reaches :data:`MIN_DELTA_CHI2` and removes :data:`MIN_SCORE` of the nominal χ².
 
     Parameters
@@ -275,45 +275,13 @@ def decide(ranked, sensor_bearing, chi_nominal):
             elif r["delta_chi2"] > prev["delta_chi2"]:
                 best[key] = r
         pool = sorted(best.values(), key=lambda r: -r["delta_chi2"])
-        top = pool[0]
-        for r in pool[1:]:                # two faults: on what tells them apart
-            mine, theirs = head_to_head(top, r)
-            if theirs > mine:
-                top = r
-        ties = [r for r in pool if r is not top
-                and head_to_head(top, r)[1] >= NEAR_TIE * head_to_head(top, r)[0]]
-        return top, ties
-    pool = sorted(reshaping, key=lambda r: -r["delta_chi2"])
+    else:
+        pool = sorted(reshaping, key=lambda r: -r["delta_chi2"])
     if not pool:
         return None, []
     top = pool[0]
     ties = [r for r in pool[1:] if r["delta_chi2"] >= NEAR_TIE * top["delta_chi2"]]
     return top, ties
-
-
-def head_to_head(a, b):
-    """Evidence of two faults on the features that tell them apart, the union of their
-    families: ``(Δχ² of a, Δχ² of b)``.
-
-    A fault is judged on its own signature to stand out; between two that do, each one's
-    own signature alone can mislead where their lines meet: an inner-race defect's lower
-    shaft-rate sideband (BPFI − fr) can fall within the line tolerance of the same bearing's
-    2·BSF, so the inner race's record lifts the ball's family and the ball's simulation
-    gains there, while it cannot make the inner race's BPFI lines; over both families the
-    inner race explains more.
-
-    Parameters
-    ----------
-    a, b : dict
-        Rows of :func:`rank` with :func:`evidence` filled.
-
-    Returns
-    -------
-    (float, float)
-    """
-    union = set(a["family"]) | set(b["family"])
-    return (sum(a["per_feature"][k] for k in union),
-            sum(b["per_feature"][k] for k in union))
 
 
 def fit(top, nominal, nuis, ev):

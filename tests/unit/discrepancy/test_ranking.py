@@ -140,22 +140,3 @@ def test_the_reported_range_holds_the_reported_value():
     assert values["size_m"] == pytest.approx(1.5e-3)
     assert lo <= values["size_m"] <= hi
     assert chi2(st) <= SEVERITY_DELTA_CHI2
-
-
-def test_between_two_faults_the_union_of_their_families_decides():
-    # the inner race's lower shaft sideband falls on a line of the other family: its record
-    # lifts that family, and the other fault's simulation gains more on its own signature
-    # (56 against 45); the inner race's simulation makes that line too, and its own BPFI line
-    # the other cannot make: over both families 95 against 56
-    other = _row("bearing_outer_race", {"env_bpfo_1b1_h1_db": 56.0}, "env_bpfo_1b1", "1b1")
-    inner = _row("bearing_inner_race", {"env_bpfi_1b1_h1_db": 45.0, "env_bpfo_1b1_h1_db": 50.0},
-                 "env_bpfi_1b1", "1b1")
-    assert other["delta_chi2"] > inner["delta_chi2"]
-    top, ties = decide([other, inner], "1b1", 300.0)
-    assert top["name"] == "bearing_inner_race" and ties == []
-    # when the inner race does not make the other family's line, its own signature is all
-    # it has, and the other fault wins as before
-    inner = _row("bearing_inner_race", {"env_bpfi_1b1_h1_db": 45.0}, "env_bpfi_1b1", "1b1")
-    top, ties = decide([other, inner], "1b1", 300.0)
-    assert top["name"] == "bearing_outer_race" and [t["name"] for t in ties] == [
-        "bearing_inner_race"]
