@@ -200,7 +200,12 @@ def test_inner_race_is_found_sized_and_the_gain_is_positive():
     "sideband of its BPFI (148.2 - 29.95 = 118.2 Hz) sits within 1 % of the bearing's 2xBSF "
     "(119.4 Hz), so the ball's signature gains 56 against the inner race's 45 (0.797 of it, "
     "just under a near tie); over every feature the inner race explains twice as much (279 "
-    "against 129), but a cause is judged on its own signature"))
+    "against 129), but a cause is judged on its own signature. Tried and reverted (2026-11-26): "
+    "judging two faults that stand out on the union of their families names it, but turns "
+    "the real CWRU OR007_at6_0 against its machine into an inner race (the inner race's "
+    "simulation moves the BPFO columns by 49, more than the outer race's 43, through the "
+    "envelope floor, with no line shared); counting only columns whose lines meet within "
+    "2 % finds the fan-end BPFO +- fr (121.4 Hz) on the same 2xBSF and names an outer race"))
 def test_inner_race_on_the_far_bearing_whose_sideband_falls_on_2bsf():
     h, c = _hidden("bearing_inner_race", 1000)
     assert h.component == "fan_end"
