@@ -172,8 +172,8 @@ def refine(r, nominal, nuis, dense=False):
     ``dense`` adds the grid's midpoints (the coarse points are cached by their dynamics and
     cost no new simulation): a record's χ² can fall in a valley narrower than the coarse
     grid's step, a factor 2.1 over the load's bounds — a radial load 4.5 times the
-    documented one reads χ² 22 at 4.5, 55 at 3.5 and 99 at 5, but 168 at the grid's 2.9
-    (the loaded balls' contact stiffness moves the bearing's modes across the housing's).
+    documented one reads χ² 22 at 4.5, 55 at 3.5 and 99 at 5, but 168 at 3.0, by the grid's
+    2.9 (why the valley is that narrow was not examined).
     """
     cause, comp = r["cause"], r["component"]
     for p in cause.params:
