@@ -30,6 +30,8 @@ from collections import Counter, defaultdict
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from _decisions import spy_on_decisions
+
 from cmsim.discrepancy import compare
 from cmsim.discrepancy.angle_domain import EFFECTS as ANGLE_EFFECTS
 from cmsim.discrepancy.angle_domain import GEAR_ONLY, draw_machine, write_machine
@@ -61,31 +63,10 @@ def _angle_case(eff, s, folder):
             severity, "drive_end" if effect and effect.startswith("bearing") else None)
 
 
-def _spy_on_decisions():
-    """Keep what :func:`~cmsim.discrepancy.ranking.decide` was given (each ranked cause's
-    evidence per feature and signature), so that thresholds can be replayed on the rows."""
-    import importlib
-    cm = importlib.import_module("cmsim.discrepancy.compare")
-    original = cm.decide
-    seen = {}
-
-    def decide(ranked, sensor_bearing, chi_nominal):
-        seen["decide"] = {
-            "sensor_bearing": sensor_bearing, "chi_nominal": chi_nominal,
-            "ranked": [{"name": r["name"], "component": r["component"],
-                        "fault": r["cause"].signature is not None,
-                        "delta_chi2": r["delta_chi2"], "judged_on": r["judged_on"],
-                        "per_feature": r["per_feature"]} for r in ranked]}
-        return original(ranked, sensor_bearing, chi_nominal)
-
-    cm.decide = decide
-    return seen
-
-
 def one(job):
     """Generate and compare one record; the row of the report."""
     eff, s, budget, generator, with_machine = job
-    seen = _spy_on_decisions()
+    seen = spy_on_decisions()
     effect = None if eff.startswith("none") else eff
     with tempfile.TemporaryDirectory() as tmp:
         record, baseline, value, component = (_model_case(eff, s) if generator == "model"

@@ -26,6 +26,8 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from _decisions import spy_on_decisions
+
 from cmsim.discrepancy import compare
 from cmsim.machine import Machine, calibrate
 from cmsim.measured import data_root, read_record
@@ -68,8 +70,10 @@ def one(job):
                    ("worst_feature", "worst_z", "chi2_per_feature")}
         if is_baseline:
             rec = _half(rec, "second")
+    seen = spy_on_decisions()
     t1 = time.perf_counter()
     c = compare(rec, machine=machine).to_dict()
+    c["decide"] = seen.get("decide")
     c.pop("spectra", None)
     c["wall_s"] = time.perf_counter() - t1
     c["calibration"] = quality
