@@ -316,7 +316,8 @@ def fit(top, nominal, nuis, ev):
         fwd, back = (math.log, math.exp) if p.log_scale else (float, float)
         # the point the fit starts from (a probe, or the grid of refine) is one of the values
         # tried: it may stay the best, and then the reported range must hold it
-        states = {float(fwd(values[p.name])): (best_c, best_st, values[p.name])}
+        u0 = float(fwd(values[p.name]))
+        states = {u0: (best_c, best_st, values[p.name])}
 
         def objective(u, p=p, states=states):
             v = p.clamp(back(u))
@@ -333,7 +334,6 @@ def fit(top, nominal, nuis, ev):
         vals = [objective(u) for u in grid]
         i = int(np.argmin(vals))
         a, b = grid[max(i - 1, 0)], grid[min(i + 1, FIT_GRID - 1)]
-        u0 = fwd(values[p.name])
         if best_c < vals[i]:          # the start lies in a valley the grid steps over
             a = max([u for u in grid if u < u0], default=grid[0])
             b = min([u for u in grid if u > u0], default=grid[-1])
