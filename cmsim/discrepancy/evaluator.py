@@ -20,7 +20,7 @@ import numpy as np
 from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.features import N_SHAPE_BANDS, relative_features
-from cmsim.machine import model_force
+from cmsim.machine import Background, model_force
 from cmsim.run import signal_info
 from cmsim.sensors import housing_acceleration
 from cmsim.spectra.floor import running_median_floor, segment_psd
@@ -95,7 +95,7 @@ def _shaft_forces(force, fs, shaft_hz, terms, seed):
 
 
 def record_floor(x, fs_hz, n):
-    """Gains that colour white noise into a record's broadband floor, for ``n``-sample signals.
+    """A record's broadband floor, read on segments of ``n`` samples, as a background.
 
     The floor is the record's power spectrum (:func:`cmsim.spectra.floor.segment_psd` of
     consecutive segments of ``n`` samples: the fit segments of a comparison laid end to end,
@@ -116,23 +116,17 @@ def record_floor(x, fs_hz, n):
 
     Returns
     -------
-    numpy.ndarray, shape (n // 2 + 1,)
-        Gain of each rfft bin: ``irfft(rfft(w) · gain, n)`` of unit white Gaussian ``w`` has
-        the floor's one-sided power spectral density.
+    cmsim.machine.Background
+        The floor as a background without lines: its
+        :meth:`~cmsim.machine.Background.noise` draws noise of that one-sided density.
     """
     x = np.asarray(x, dtype=float)
     n = int(n)
     nper = min(n, x.size)
     freq, psd = segment_psd([x[i:i + nper] for i in range(0, x.size - nper + 1, nper)],
                             fs_hz)
-    floor = running_median_floor(freq, psd, FLOOR_MEDIAN_HZ, mode="mirror")
-    fn = np.fft.rfftfreq(n, 1.0 / fs_hz)
-    return np.sqrt(np.interp(fn, freq, floor) * fs_hz / 2.0)
-
-
-def _coloured(gain, n, seed):
-    w = np.random.default_rng(seed + 7919).standard_normal(int(n))
-    return np.fft.irfft(np.fft.rfft(w) * gain, int(n))
+    return Background(tuple(freq), tuple(running_median_floor(freq, psd, FLOOR_MEDIAN_HZ,
+                                                              mode="mirror")))
 
 
 def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, seed,
@@ -155,9 +149,9 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
         Reference RMS (None: the signal's own).
     seed : int
         Seed of the noise.
-    floor : numpy.ndarray, optional
-        Gains of :func:`record_floor`: the noise is the record's own broadband floor, m/s²,
-        times ``noise_ratio`` / :data:`~cmsim.discrepancy.causes.NOMINAL_NOISE_RATIO`
+    floor : cmsim.machine.Background, optional
+        A record's floor (:func:`record_floor`): the noise is drawn from it, m/s², times
+        ``noise_ratio`` / :data:`~cmsim.discrepancy.causes.NOMINAL_NOISE_RATIO`
         (``noise_ref_rms`` unused).
 
     Returns
@@ -166,10 +160,10 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
     """
     x = housing_acceleration(force - force.mean(), fs_hz, housing)[edge:edge + n]
     x = x - x.mean()
-    if floor is not None:
-        return x + noise_ratio / NOMINAL_NOISE_RATIO * _coloured(floor, x.size, seed)
-    ref = float(np.std(x)) if noise_ref_rms is None else float(noise_ref_rms)
     rng = np.random.default_rng(seed + 7919)
+    if floor is not None:
+        return x + floor.noise(x.size, fs_hz, rng, noise_ratio / NOMINAL_NOISE_RATIO)
+    ref = float(np.std(x)) if noise_ref_rms is None else float(noise_ref_rms)
     return x + noise_ratio * ref * rng.standard_normal(x.size)
 
 

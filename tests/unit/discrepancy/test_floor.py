@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from cmsim.discrepancy.evaluator import _coloured, record_floor
+from cmsim.discrepancy.evaluator import record_floor
 
 FS = 12000.0
 
@@ -21,8 +21,8 @@ def test_floor_reads_the_noise_between_the_lines_and_gives_it_back():
     lines = sum(5.0 * np.cos(2 * math.pi * k * 81.0 * t) for k in range(1, 40))
     x = sigma * rng.standard_normal(t.size) + lines
     n = int(0.5 * FS)
-    gain = record_floor(x, FS, n)
-    density = gain ** 2 * 2.0 / FS               # back to the one-sided PSD
+    floor = record_floor(x, FS, n)
+    density = np.asarray(floor.psd)              # one-sided PSD
     assert np.median(density) == pytest.approx(2 * sigma ** 2 / FS, rel=0.1)
-    noise = _coloured(gain, n, 0)
+    noise = floor.noise(n, FS, np.random.default_rng(0))
     assert float(np.std(noise)) == pytest.approx(sigma, rel=0.1)
