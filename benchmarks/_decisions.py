@@ -15,7 +15,6 @@ nominal χ² per feature) cannot be replayed from these rows.
 import importlib
 import json
 import sys
-from types import SimpleNamespace
 
 
 def spy_on_decisions():
@@ -45,15 +44,13 @@ def spy_on_decisions():
 
 def replay(recorded):
     """(finding or None, near ties) of the current rule on one recorded ``"decide"`` dict."""
-    from cmsim.discrepancy.causes import CAUSES, STATISTICS
+    from cmsim.discrepancy.causes import CAUSES
     from cmsim.discrepancy.ranking import decide
     ranked = []
     for r in recorded["ranked"]:
-        cause = CAUSES[r["name"]]
-        family = ([k for k in r["judged_on"] if k not in STATISTICS]
-                  if cause.signature is not None else [])
-        ranked.append({**r, "family": family,
-                       "cause": SimpleNamespace(signature=cause.signature, kind=cause.kind)})
+        cause = CAUSES[r["name"]]()
+        ranked.append({**r, "cause": cause,
+                       "family": cause.family(r["judged_on"], r["component"])})
     top, ties = decide(ranked, recorded["sensor_bearing"], recorded["chi_nominal"])
     return (None if top is None else top["name"]), [t["name"] for t in ties]
 
