@@ -52,7 +52,15 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    within :data:`LINE_TOLERANCE` as the pins are), each filed as an order of the input or
    output shaft when it sits on one (so it follows the speed), else at its frequency (the
    mains, other machines).
-5. **Spread and fit quality.** :func:`cmsim.features.relative_features` of every baseline
+5. **Bearing clearance.** A healthy ball bearing under load makes a comb of ball-pass lines
+   (varying compliance) whose level its clearance sets: strong with a clearance (fewer
+   balls loaded), weak in line contact or under a preload. A machine's clearance is rarely
+   documented, and a model comb the record lacks beside a mesh harmonic cannot be taken out
+   by a smooth path (at 20 N m the default rig's sixth ball pass sits 5 Hz from its GMF).
+   Steps 2-4 are read for the documented clearance and for each of
+   :data:`CLEARANCE_CANDIDATES_M`; another is kept only when its twin is nearer the fit
+   segments by :data:`CLEARANCE_EVIDENCE` (capped misfit) and no farther uncapped.
+6. **Spread and fit quality.** :func:`cmsim.features.relative_features` of every baseline
    segment give each feature's mean and segment-to-segment spread; the kept twin (model
    force → path + background, :data:`N_TWIN_SEEDS` new seeds, a segment each) is compared
    with the held-out segments feature by feature: z = (twin − baseline) / spread, and,
@@ -146,6 +154,20 @@ LINE_TOLERANCE = 0.004
 #: path is taken stiffness-controlled (accelerance ∝ f², the ω²/k of a structure below its
 #: first mode); the background there (rocking, the motor, the mains) does not shape it.
 HOUSING_BAND_LOW = 0.04
+#: Bearing clearances tried besides the documented one, m: line contact and a light preload
+#: (:meth:`Rig.with_clearance <cmsim.rig.Rig.with_clearance>`; negative is a preload).
+CLEARANCE_CANDIDATES_M = (0.0, -5e-6)
+#: Factor by which another clearance's twin must be nearer the fit segments (capped misfit,
+#: :data:`MISFIT_CAP`) than the documented clearance's to replace it: the documented value is
+#: the prior, and a twin's misfit on ~5 segments scatters by some tens of percent.
+CLEARANCE_EVIDENCE = 1.5
+
+
+def _clearance_words(c):
+    """A clearance in words: "15 µm clearance", "line contact", "5 µm preload"."""
+    if c == 0.0:
+        return "line contact (no clearance)"
+    return f"{abs(c) * 1e6:g} µm {'clearance' if c > 0 else 'preload'}"
 
 
 def _window_bins(freq):
@@ -673,28 +695,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     df = freq[1] - freq[0]
     lines, floor = _lines_and_floor(freq, psd)
 
-    # 2. the nominal model's force
-    force_runs = [model_force(rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
-                  for s in range(n_seeds)]
-    twin_forces = [model_force(rig, op, ref.model_signal, fs, seg_s,
-                               seed + 1 + 7777 * (s + n_seeds)) for s in range(N_TWIN_SEEDS)]
-    forces = [force[edge:edge + n] for force, edge, n in force_runs]
-    _, pf = segment_psd(forces, fs)
-
-    # 3-4. the path and the background, read twice: the path's shape that of the
-    # background, or of the background over the model's broadband force; its gain pinned
-    # by the model lines the record shows and bounded by those it does not show. Of the two,
-    # the one whose twin is nearer the fit segments is kept.
-    force_lines, pf_floor = _lines_and_floor(freq, pf)
-    strong = [(f, a) for f, a in force_lines
-              if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
-              * pf_floor[int(round(f / df))]]
-    spectra = {"freq": freq, "floor": floor, "pf_floor": pf_floor, "lines": lines,
-               "force_lines": force_lines, "strong": strong,
-               "fit": fit, "keep": _line_free(freq, psd),
-               "forces": force_runs + twin_forces, "force_keep": _line_free(freq, pf)}
-
-    # 5. the baseline's spread
+    # 6. the baseline's spread (each reading of steps 2-5 is scored against it)
     bearings = list(rig.bearing_names)
     names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale)
     # a feature a segment cannot read (a line beyond its resolution) is NaN there; one no
@@ -706,42 +707,99 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
 
     wobble = _speed_wobble(np.concatenate([r.signal for r in records]), fs, freqs.fr1_hz)
     longest = max(records, key=lambda r: r.signal.size).signal
-    candidates = []
-    for forced in (False, True):
-        path, background, chain_notes, n_pins = _reading(forced, spectra, fs, freqs, bearing,
-                                                         shaft_hz, ref, longest)
-        machine = Machine(
-            name=name or (ref.record_id or "machine"), rig=rig, channel=ref.channel,
-            model_signal=ref.model_signal, fs_hz=fs, op=op, path=path, background=background,
-            unit=path.unit, unit_scale=ref.unit_scale, components=dict(ref.components),
-            segment_s=seg_s, speed_wobble=wobble,
-            calibrated_on=tuple(f"{r.record_id or r.path or 'record'}"
-                                + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
-                                   if r.meta.get("span_s") else "")
-                                + " (even segments fit, odd held out)" for r in records),
-            notes=tuple(notes + chain_notes))
-        twin = [machine.sensor_signal(force, edge, n, seed + 31 * s)
-                for s, (force, edge, n) in enumerate(twin_forces)]
-        _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale)
-        z_fit, _ = _misfit(names, twin_rows, fit_rows, spread)
-        score = float(np.mean([min(v * v, MISFIT_CAP ** 2) for v in z_fit.values()])) \
-            if z_fit else 0.0
-        candidates.append((-n_pins, score, forced, machine, twin_rows))
-    if not any(c[0] for c in candidates):
-        # no model line pins the path: its gain is a prior, and a twin can match a healthy
-        # record's broadband through either shape, so the fit does not tell them apart
-        _, score, forced, machine, twin_rows = candidates[0]
-        why = "no model line pins the path"
+    baseline = {"freq": freq, "floor": floor, "lines": lines, "fit": fit,
+                "keep": _line_free(freq, psd)}
+
+    def twin_on(model_rig):
+        """Steps 2-4 on one model rig: (capped misfit, chi2 per feature, machine, twin's
+        feature rows), the misfits the twin's against the fit segments."""
+        # 2. the nominal model's force
+        force_runs = [model_force(model_rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
+                      for s in range(n_seeds)]
+        twin_forces = [model_force(model_rig, op, ref.model_signal, fs, seg_s,
+                                   seed + 1 + 7777 * (s + n_seeds)) for s in range(N_TWIN_SEEDS)]
+        forces = [force[edge:edge + n] for force, edge, n in force_runs]
+        _, pf = segment_psd(forces, fs)
+
+        # 3-4. the path and the background, read twice: the path's shape that of the
+        # background, or of the background over the model's broadband force; its gain
+        # pinned by the model lines the record shows and bounded by those it does not show.
+        # Of the two, the one whose twin is nearer the fit segments is kept.
+        force_lines, pf_floor = _lines_and_floor(freq, pf)
+        strong = [(f, a) for f, a in force_lines
+                  if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
+                  * pf_floor[int(round(f / df))]]
+        spectra = dict(baseline, pf_floor=pf_floor, force_lines=force_lines, strong=strong,
+                       forces=force_runs + twin_forces, force_keep=_line_free(freq, pf))
+        candidates = []
+        for forced in (False, True):
+            path, background, chain_notes, n_pins = _reading(forced, spectra, fs, freqs,
+                                                             bearing, shaft_hz, ref, longest)
+            machine = Machine(
+                name=name or (ref.record_id or "machine"), rig=model_rig,
+                channel=ref.channel, model_signal=ref.model_signal, fs_hz=fs, op=op,
+                path=path, background=background, unit=path.unit,
+                unit_scale=ref.unit_scale, components=dict(ref.components), segment_s=seg_s,
+                speed_wobble=wobble,
+                calibrated_on=tuple(f"{r.record_id or r.path or 'record'}"
+                                    + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
+                                       if r.meta.get("span_s") else "")
+                                    + " (even segments fit, odd held out)" for r in records),
+                notes=tuple(notes + chain_notes))
+            twin = [machine.sensor_signal(force, edge, n, seed + 31 * s)
+                    for s, (force, edge, n) in enumerate(twin_forces)]
+            _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale)
+            z_fit, _ = _misfit(names, twin_rows, fit_rows, spread)
+            score = float(np.mean([min(v * v, MISFIT_CAP ** 2) for v in z_fit.values()])) \
+                if z_fit else 0.0
+            chi2_fit = float(np.mean([v * v for v in z_fit.values()])) if z_fit else 0.0
+            candidates.append((-n_pins, score, forced, machine, twin_rows, chi2_fit))
+        if not any(c[0] for c in candidates):
+            # no model line pins the path: its gain is a prior, and a twin can match a
+            # healthy record's broadband through either shape, so the fit does not tell
+            # them apart
+            _, score, forced, machine, twin_rows, chi2_fit = candidates[0]
+            why = "no model line pins the path"
+        else:
+            (neg_pins, score, forced, machine, twin_rows, chi2_fit), other = sorted(
+                candidates, key=lambda c: c[:3])
+            why = (f"it keeps more pins ({-neg_pins} against {-other[0]})"
+                   if neg_pins != other[0] else
+                   f"its twin's misfit on the fit segments, chi2 per feature with z capped at "
+                   f"{MISFIT_CAP:g}, {score:.2f} against {other[1]:.2f} for the other shape")
+        shape_words = ("the background over the model's broadband force" if forced
+                       else "the background's own")
+        machine = replace(machine, notes=machine.notes + (f"path shape: {shape_words} ({why})",))
+        return score, chi2_fit, machine, twin_rows
+
+    # 5. the bearings' clearance: a healthy bearing's ball passes under load (varying
+    # compliance) make a comb of lines whose level the clearance sets, and a baseline shows
+    # it or not; the documented clearance is kept unless another one's twin is nearer the
+    # fit segments by CLEARANCE_EVIDENCE (capped) and no farther uncapped
+    readings = [(rig, twin_on(rig))]
+    documented = {b.clearance_m for s in rig.shafts for b in (s.bearing_1, s.bearing_2)}
+    for c in CLEARANCE_CANDIDATES_M:
+        if documented != {c}:
+            other = rig.with_clearance(c)
+            readings.append((other, twin_on(other)))
+    first = readings[0][1]
+    better = [(reading[0], model_rig, reading) for model_rig, reading in readings[1:]
+              if reading[0] * CLEARANCE_EVIDENCE <= first[0] and reading[1] <= first[1]]
+    if better:
+        _, chosen, (score, _, machine, twin_rows) = min(better, key=lambda b: b[0])
+        c = chosen.shafts[0].bearing_1.clearance_m
+        machine = replace(machine, notes=machine.notes + (
+            f"bearing clearance: {_clearance_words(c)} instead of the documented "
+            f"{', '.join(_clearance_words(d) for d in sorted(documented))}: its twin's "
+            f"misfit on the fit segments (chi2 per feature with z capped at {MISFIT_CAP:g}) "
+            f"is {score:.2f} against {first[0]:.2f} (a healthy bearing's ball-pass comb, "
+            "which the clearance sets, stands in the record as it does in this twin)",))
     else:
-        (neg_pins, score, forced, machine, twin_rows), other = sorted(candidates,
-                                                                      key=lambda c: c[:3])
-        why = (f"it keeps more pins ({-neg_pins} against {-other[0]})"
-               if neg_pins != other[0] else
-               f"its twin's misfit on the fit segments, chi2 per feature with z capped at "
-               f"{MISFIT_CAP:g}, {score:.2f} against {other[1]:.2f} for the other shape")
-    shape_words = ("the background over the model's broadband force" if forced
-                   else "the background's own")
-    machine = replace(machine, notes=machine.notes + (f"path shape: {shape_words} ({why})",))
+        score, _, machine, twin_rows = first
+        machine = replace(machine, notes=machine.notes + (
+            f"bearing clearance: the documented "
+            f"{', '.join(_clearance_words(d) for d in sorted(documented))} kept (no other "
+            f"clearance's twin nearer the fit segments by {CLEARANCE_EVIDENCE:g}x)",))
 
     # 6. the twin on the held-out segments
     z, z_model = _misfit(names, twin_rows, held_rows, spread)
