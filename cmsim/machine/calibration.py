@@ -792,8 +792,8 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
             f"bearing clearance: {_clearance_words(c)} instead of the documented "
             f"{', '.join(_clearance_words(d) for d in sorted(documented))}: its twin's "
             f"misfit on the fit segments (chi2 per feature with z capped at {MISFIT_CAP:g}) "
-            f"is {score:.2f} against {first[0]:.2f} (a healthy bearing's ball-pass comb, "
-            "which the clearance sets, stands in the record as it does in this twin)",))
+            f"is {score:.2f} against {first[0]:.2f} (the clearance sets the level of a healthy "
+            "bearing's ball-pass comb and how many balls carry the load)",))
     else:
         score, _, machine, twin_rows = first
         machine = replace(machine, notes=machine.notes + (

@@ -236,3 +236,40 @@ def test_the_split_between_path_and_background_is_recovered_across_the_housing_b
         bg = float(np.mean(np.interp(f, m.background.freq_hz, m.background.psd)))
         rows.append((lo, hi, 10 * math.log10(got / true), 10 * math.log10(bg / noise.psd[0])))
     assert all(abs(dp) < 3.0 and abs(db) < 3.0 for *_, dp, db in rows), rows
+
+
+def _clearances(machine):
+    return {b.clearance_m for s in machine.rig.shafts for b in (s.bearing_1, s.bearing_2)}
+
+
+def test_the_documented_clearance_is_kept_when_the_record_has_it(case, bearing_case):
+    """Gear and bearing baselines made at the documented clearance keep it (another is
+    taken only on 1.5x less misfit): the twin's rig is the record's."""
+    for m, documented in ((case[3], 1.5e-5), (bearing_case[3], 5e-6)):
+        assert _clearances(m) == {documented}
+        assert any(n.startswith("bearing clearance: the documented") for n in m.notes)
+
+
+def test_a_preloaded_machine_s_clearance_is_read_from_its_baseline():
+    """A bearing machine whose bearings are preloaded (5 µm) while the metadata's rig says
+    5 µm of clearance: the documented clearance's twin shows a ball-pass comb the record
+    lacks; the calibration replaces it by no clearance at all and says so, and its twin
+    is nearer the held-out segments than the documented one's."""
+    from cmsim.discrepancy.synthetic import cwru_like_rig
+    rig, fs = cwru_like_rig(), 12_000.0
+    op = OperatingPoint(1797.0, radial_load_n=98.0665)
+    f = np.linspace(0.0, fs / 2, 1201)
+    shape = sum((f / f0) ** 2 / np.sqrt((1 - (f / f0) ** 2) ** 2 + (2 * z * f / f0) ** 2)
+                for f0, z in ((1500.0, 0.05), (3300.0, 0.04)))
+    path = TransferPath("F_1b1_y", tuple(f), tuple(1e-3 * np.maximum(shape, 1e-4)), "g")
+    force, edge, n = model_force(rig.with_clearance(-5e-6), op, "accel_1b1_y", fs, 5.0, 13)
+    y = path.apply(force, fs)[edge:edge + n]
+    noise = Background((0.0, fs / 2), (1e-12, 1e-12), ())
+    y = y + noise.synthesize(n, fs, (op.shaft_hz, op.shaft_hz), np.random.default_rng(5))
+    run = Run(np.arange(n) / fs, {"acc": y}, {"fs_hz": fs}, source="measured")
+    record = record_from_run(run, "acc", rig, op, model_signal="accel_1b1_y")
+    m = calibrate([record], seg_s=0.5, seed=7)
+    assert max(_clearances(m)) <= 0.0, _clearances(m)
+    assert any(n.startswith("bearing clearance:") and "instead of the documented 5 µm"
+               in n for n in m.notes), m.notes
+    assert m.fit_quality["chi2_per_feature"] < 2.0
