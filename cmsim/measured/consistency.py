@@ -47,6 +47,7 @@ from cmsim.errors import ParameterError
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
 from cmsim.spectra.kurtogram import kurtogram
+from cmsim.spectra.lines import line_window
 
 __all__ = ["LineFamily", "FamilyVerdict", "line_families", "line_prominence_db",
            "exclusive_contrast_db", "family_ratio", "lowest_fundamental", "family_verdicts",
@@ -57,6 +58,11 @@ __all__ = ["LineFamily", "FamilyVerdict", "line_families", "line_prominence_db",
 #: Half-width of the window a line is looked for in, relative to its frequency (a nominal
 #: speed and an induction motor's slip differ by about 1 %; bearings slip 1-2 %).
 LINE_TOLERANCE = 0.015
+
+#: Bins beyond that tolerance on each side of the window (the one line rule,
+#: :func:`cmsim.spectra.lines.line_window`, at 2 bins: a stated rate four times the true one
+#: puts the low lines a few bins from 0, where the rule's 1.5 bins miss the Hann lobe's top).
+LINE_WINDOW_BINS = 2.0
 
 #: Lines between the stated ones standing within this of the stated lines, dB, make the
 #: lower fundamental the true one.
@@ -151,7 +157,8 @@ def line_families(frequencies):
 
 def line_prominence_db(freq, log_amp, f_hz):
     """Prominence of the line nearest ``f_hz``: the largest bin within ±:data:`LINE_TOLERANCE`
-    over the median of its ±10 % (>= 25 bins), dB; NaN outside the spectrum.
+    ± :data:`LINE_WINDOW_BINS` (:func:`cmsim.spectra.lines.line_window`) over the median of
+    its ±10 % (>= 25 bins), dB; NaN outside the spectrum.
 
     Parameters
     ----------
@@ -163,11 +170,11 @@ def line_prominence_db(freq, log_amp, f_hz):
         Line frequency, Hz.
     """
     df = freq[1]
-    lo = int(np.floor(f_hz * (1 - LINE_TOLERANCE) / df)) - 1
-    hi = int(np.ceil(f_hz * (1 + LINE_TOLERANCE) / df)) + 2
-    if lo < 2 or hi >= log_amp.size:
+    sel = line_window(freq, f_hz, LINE_TOLERANCE, LINE_WINDOW_BINS)
+    idx = np.flatnonzero(sel) if sel is not None else np.empty(0, int)
+    if idx.size == 0 or idx[0] < 2 or idx[-1] >= log_amp.size - 1:
         return float("nan")
-    j = lo + int(np.argmax(log_amp[lo:hi]))
+    j = int(idx[0] + np.argmax(log_amp[idx]))
     w = max(25, int(round(0.1 * f_hz / df)))
     return float(20.0 * (log_amp[j] - np.median(log_amp[max(j - w, 1):j + w + 1])))
 
