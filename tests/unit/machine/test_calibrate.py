@@ -248,28 +248,37 @@ def test_the_documented_clearance_is_kept_when_the_record_has_it(case, bearing_c
     for m, documented in ((case[3], 1.5e-5), (bearing_case[3], 5e-6)):
         assert _clearances(m) == {documented}
         assert any(n.startswith("bearing clearance: the documented") for n in m.notes)
+    assert any("nearer the fit segments by 1.5x" in n for n in case[3].notes)
 
 
-def test_a_preloaded_machine_s_clearance_is_read_from_its_baseline():
-    """A bearing machine whose bearings are preloaded (5 µm) while the metadata's rig says
-    5 µm of clearance: the documented clearance's twin shows a ball-pass comb the record
-    lacks; the calibration replaces it by no clearance at all and says so, and its twin
-    is nearer the held-out segments than the documented one's."""
-    from cmsim.discrepancy.synthetic import cwru_like_rig
-    rig, fs = cwru_like_rig(), 12_000.0
-    op = OperatingPoint(1797.0, radial_load_n=98.0665)
-    f = np.linspace(0.0, fs / 2, 1201)
-    shape = sum((f / f0) ** 2 / np.sqrt((1 - (f / f0) ** 2) ** 2 + (2 * z * f / f0) ** 2)
-                for f0, z in ((1500.0, 0.05), (3300.0, 0.04)))
-    path = TransferPath("F_1b1_y", tuple(f), tuple(1e-3 * np.maximum(shape, 1e-4)), "g")
-    force, edge, n = model_force(rig.with_clearance(-5e-6), op, "accel_1b1_y", fs, 5.0, 13)
-    y = path.apply(force, fs)[edge:edge + n]
-    noise = Background((0.0, fs / 2), (1e-12, 1e-12), ())
-    y = y + noise.synthesize(n, fs, (op.shaft_hz, op.shaft_hz), np.random.default_rng(5))
-    run = Run(np.arange(n) / fs, {"acc": y}, {"fs_hz": fs}, source="measured")
-    record = record_from_run(run, "acc", rig, op, model_signal="accel_1b1_y")
-    m = calibrate([record], seg_s=0.5, seed=7)
-    assert max(_clearances(m)) <= 0.0, _clearances(m)
-    assert any(n.startswith("bearing clearance:") and "instead of the documented 5 µm"
+def test_a_preloaded_gearbox_s_clearance_is_read_from_its_baseline():
+    """A gearbox whose bearings are preloaded (5 µm) while its rig file says 15 µm of
+    clearance: the documented clearance's twin shows a ball-pass comb the record lacks, and
+    beside the pinned GMF harmonics the path cannot take it out; the calibration replaces
+    the clearance by none at all or a preload, says so, and its twin is about as near the
+    held-out segments as the twin of a rig file that states the true preload."""
+    rig = Rig.paper_2016()
+    path = _true_path()
+    force, edge, n = model_force(rig.with_clearance(-5e-6), OP, "accel_1b1_y", FS,
+                                 DURATION_S, 11)
+    y = path.apply(force, FS)[edge:edge + n]
+    f = np.asarray(path.freq_hz)
+    background = Background(tuple(f), tuple(2e-9 * (np.asarray(path.gain) / 0.002) ** 2), ())
+    y = y + background.synthesize(n, FS, (OP.shaft_hz, OP.shaft_hz), np.random.default_rng(3))
+    run = Run(np.arange(n) / FS, {"acc": y}, {"fs_hz": FS}, source="measured")
+    record = record_from_run(run, "acc", rig, OP, model_signal="accel_1b1_y")
+    m = calibrate([record], seg_s=0.5, seed=5)
+    assert max(_clearances(m)) <= 0.0, (_clearances(m), m.notes)
+    assert any(n.startswith("bearing clearance:") and "instead of the documented 15 µm"
                in n for n in m.notes), m.notes
-    assert m.fit_quality["chi2_per_feature"] < 2.0
+    # as near the held-out segments as a twin told the true preload
+    told = calibrate([record_from_run(run, "acc", rig.with_clearance(-5e-6), OP,
+                                      model_signal="accel_1b1_y")], seg_s=0.5, seed=5)
+    assert _clearances(told) == {-5e-6}
+    assert m.fit_quality["chi2_per_feature_with_model_spread"] < \
+        1.5 * told.fit_quality["chi2_per_feature_with_model_spread"]
+
+
+def test_a_bearing_rig_keeps_its_documented_clearance(bearing_case):
+    """On a bearing rig the clearance is not read (its ball pass pins the path)."""
+    assert any("a bearing rig's clearance is not read" in n for n in bearing_case[3].notes)
