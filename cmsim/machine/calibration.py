@@ -699,7 +699,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     df = freq[1] - freq[0]
     lines, floor = _lines_and_floor(freq, psd)
 
-    # 6. the baseline's spread (each reading of steps 2-5 is scored against it)
+    # the baseline's spread (step 6; each reading of steps 2-5 below is scored against it)
     bearings = list(rig.bearing_names)
     names, all_rows = feature_rows(fit + held, fs, freqs, bearings, ref.unit_scale)
     # a feature a segment cannot read (a line beyond its resolution) is NaN there; one no
