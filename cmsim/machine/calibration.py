@@ -713,6 +713,10 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     longest = max(records, key=lambda r: r.signal.size).signal
     baseline = {"freq": freq, "floor": floor, "lines": lines, "fit": fit,
                 "keep": _line_free(freq, psd)}
+    calibrated_on = tuple(f"{r.record_id or r.path or 'record'}"
+                          + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
+                             if r.meta.get("span_s") else "")
+                          + " (even segments fit, odd held out)" for r in records)
 
     def twin_on(model_rig):
         """Steps 2-4 on one model rig: (capped misfit, chi2 per feature, machine, twin's
@@ -744,11 +748,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
                 channel=ref.channel, model_signal=ref.model_signal, fs_hz=fs, op=op,
                 path=path, background=background, unit=path.unit,
                 unit_scale=ref.unit_scale, components=dict(ref.components), segment_s=seg_s,
-                speed_wobble=wobble,
-                calibrated_on=tuple(f"{r.record_id or r.path or 'record'}"
-                                    + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
-                                       if r.meta.get("span_s") else "")
-                                    + " (even segments fit, odd held out)" for r in records),
+                speed_wobble=wobble, calibrated_on=calibrated_on,
                 notes=tuple(notes + chain_notes))
             twin = [machine.sensor_signal(force, edge, n, seed + 31 * s)
                     for s, (force, edge, n) in enumerate(twin_forces)]
@@ -780,18 +780,15 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     # (varying compliance) make a comb of lines whose level the clearance sets, and a
     # baseline shows it or not; the documented clearance is kept unless another one's twin
     # is nearer the fit segments by CLEARANCE_EVIDENCE (capped) and no farther uncapped
-    readings = [(rig, twin_on(rig))]
+    first = twin_on(rig)
     documented = {b.clearance_m for s in rig.shafts for b in (s.bearing_1, s.bearing_2)}
-    for c in CLEARANCE_CANDIDATES_M if rig.gears is not None else ():
-        if documented != {c}:
-            other = rig.with_clearance(c)
-            readings.append((other, twin_on(other)))
-    first = readings[0][1]
-    better = [(reading[0], model_rig, reading) for model_rig, reading in readings[1:]
+    tried = [(c, twin_on(rig.with_clearance(c)))
+             for c in (CLEARANCE_CANDIDATES_M if rig.gears is not None else ())
+             if documented != {c}]
+    better = [(c, reading) for c, reading in tried
               if reading[0] * CLEARANCE_EVIDENCE <= first[0] and reading[1] <= first[1]]
     if better:
-        _, chosen, (score, _, machine, twin_rows) = min(better, key=lambda b: b[0])
-        c = chosen.shafts[0].bearing_1.clearance_m
+        c, (score, _, machine, twin_rows) = min(better, key=lambda cr: cr[1][0])
         machine = replace(machine, notes=machine.notes + (
             f"bearing clearance: {_clearance_words(c)} instead of the documented "
             f"{', '.join(_clearance_words(d) for d in sorted(documented))}: its twin's "
@@ -801,7 +798,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     else:
         score, _, machine, twin_rows = first
         why = (f"no other clearance's twin nearer the fit segments by {CLEARANCE_EVIDENCE:g}x"
-               if len(readings) > 1 else "a bearing rig's clearance is not read")
+               if tried else "a bearing rig's clearance is not read")
         machine = replace(machine, notes=machine.notes + (
             f"bearing clearance: the documented "
             f"{', '.join(_clearance_words(d) for d in sorted(documented))} kept ({why})",))
