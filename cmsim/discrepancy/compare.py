@@ -204,6 +204,30 @@ def _prepare(record, seg_s, max_segments):
     return seg_s, duration, names, F
 
 
+def _calibration_misfit(machine, name):
+    """The twin's bias on feature ``name`` as its calibration measured it (sensor unit of the
+    feature), the baseline's spread where the calibration could not read it.
+
+    The held-out difference d = z·spread (twin's mean over its segments minus the held-out
+    segments' mean) holds the bias and the scatter of the two means, of variance
+    spread²/n_held + twin spread²/n_twin (the twin's spread read back from z over the
+    combined spread, ``z_with_model_spread``); what the scatter explains is not bias. Taking
+    the whole |d| for it widened a well-fitted feature's σ by the baseline's spread and more
+    (a 5th GMF harmonic's sidebands, whose spread is 4 dB, by 10 dB at z = 2.4).
+    """
+    q = machine.fit_quality
+    base = machine.spread.get(name, (0.0, 0.0))[1]
+    z = (q.get("z") or {}).get(name)
+    if z is None or not math.isfinite(z):
+        return base
+    z_m = (q.get("z_with_model_spread") or {}).get(name)
+    n_held, n_twin = q.get("held_out_segments"), q.get("twin_segments")
+    if not (z_m and math.isfinite(z_m) and n_held and n_twin):
+        return abs(z) * base
+    twin_over_base = max((z / z_m) ** 2 - 1.0, 0.0)     # twin spread² / spread²
+    return base * math.sqrt(max(z * z - 1.0 / n_held - twin_over_base / n_twin, 0.0))
+
+
 def _check_machine(record, machine):
     """The machine must be the record's: same channel, sample rate and bearings."""
     if machine.channel != record.channel:
@@ -286,9 +310,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
     for k in cols:
         v_seed = float(np.nanvar([r[k] for r in var_rows], ddof=1))
         if mode == "machine":
-            z = (machine.fit_quality.get("z") or {}).get(k)
-            base = machine.spread.get(k, (0.0, 0.0))[1]
-            misfit = abs(z) * base if z is not None and math.isfinite(z) else base
+            misfit = _calibration_misfit(machine, k)
             floor = 0.5 * feature_floor(k)
         else:
             misfit = 0.0

@@ -355,3 +355,32 @@ def test_the_finding_reads_as_an_engineer_says_it():
     assert "at the bound" in describe("bearing_ball", "drive_end", {"size_m": hi}, {})
     assert describe("none", None, {}, {}).startswith("no departure")
     assert "no cause" in describe("unexplained", None, {}, {})
+
+
+def _twin_misfits(bias, twin_sd, trials=3000, n_held=5, n_twin=6, seed=0):
+    """Misfits :func:`_calibration_misfit` reads back from calibrations of one feature
+    whose twin is off by ``bias`` (baseline spread 1), drawn as calibrate measures them."""
+    from types import SimpleNamespace
+    from cmsim.discrepancy.compare import _calibration_misfit
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(trials):
+        base = rng.standard_normal(2 * n_held)          # fit and held-out segments
+        twin = bias + twin_sd * rng.standard_normal(n_twin)
+        spread, model = np.std(base, ddof=1), np.std(twin, ddof=1)
+        d = twin.mean() - base[1::2].mean()
+        machine = SimpleNamespace(spread={"f": (0.0, spread)}, fit_quality={
+            "z": {"f": d / spread}, "z_with_model_spread": {"f": d / math.hypot(spread, model)},
+            "held_out_segments": n_held, "twin_segments": n_twin})
+        out.append(_calibration_misfit(machine, "f"))
+    return np.array(out)
+
+
+def test_the_calibration_misfit_is_the_twins_bias_not_the_scatter_of_its_means():
+    """A twin that is right (no bias) adds far less than the scatter of the held-out
+    difference to σ (the whole |d| added it all); a twin off by 3 spreads reads about 3."""
+    scatter = 1.0 / 5 + 2.0 ** 2 / 6               # variance of d with no bias
+    right = _twin_misfits(0.0, 2.0)
+    assert np.mean(right ** 2) < 0.6 * scatter       # 0.54 with the clip at 0
+    off = _twin_misfits(3.0, 2.0)
+    assert 0.85 * 9.0 < np.mean(off ** 2) < 1.15 * 9.0
