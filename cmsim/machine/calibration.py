@@ -7,8 +7,10 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
 1. **Spectrum and lines.** The averaged power spectrum (Hann) of the segments; its narrow
    lines are the bins standing :data:`LINE_MIN_DB` over a running median of ±
    :data:`FLOOR_HALF_WIDTH_HZ` (lines have no width there, the broadband has); the running
-   mean with the lines' bins masked is the smooth **background spectrum** B(f) (a running
-   median alone would sit 0.3-1.6 dB under the mean of a noisy estimate).
+   mean of the bins no line holds — nor a line's skirt, a bin standing that high beyond a
+   line's main lobe — is the smooth **background spectrum** B(f) (a running median alone
+   would sit 0.3-1.6 dB under the mean of a noisy estimate, and 6 dB over it beside a
+   speed-wobbled mesh harmonic that fills half its window).
 2. **Model force.** The nominal (healthy) model at the record's operating point is
    simulated for :data:`N_SEEDS` seeds; its force spectrum gives the lines the model makes
    (GMF harmonics, the ball pass of the sensor's bearing: those standing 20 dB over the
