@@ -6,8 +6,9 @@ every k-th sample of their sum, for several forces in one call, a block of
 :data:`HOUSING_BLOCK` input samples at a time (its interpolated samples stay in the cache and
 are never stored whole).
 
-* The interpolation is :func:`scipy.signal.resample_poly`'s (``up = k``, ``down = 1``, its
-  output cut to the input's instants) with the same sums in the same order: fast sample
+* The interpolation is :func:`scipy.signal.resample_poly`'s (``up = k``, ``down = 1``, with
+  :func:`cmsim.sensors.interpolation_filter` for its window, its output cut to the input's
+  instants) with the same sums in the same order: fast sample
   m = j·k + t is ``0.0 + Σ_i x[i]·h[m + half − i·k]`` over the inputs i near j, i
   increasing. Each phase t reads its taps as one row (zero where the filter has none) and
   the signal padded with zeros; like the zero taps ``resample_poly`` pads its own filter

@@ -97,13 +97,14 @@ def test_housing_path_kernel_is_sosfilt_bit_for_bit(fs_hz):
 
     from scipy.signal import resample_poly, sosfilt
 
-    from cmsim.sensors import STEPS_PER_MODE_PERIOD, housing_acceleration, housing_sos
+    from cmsim.sensors import (STEPS_PER_MODE_PERIOD, housing_acceleration, housing_sos,
+                               interpolation_filter)
 
     path = cmsim.Rig.paper_2016().housing
     force = np.random.default_rng(7).standard_normal(4_001) * 300.0 + 1e3
     k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs_hz))
     x = force - force[0]
-    xk = resample_poly(x, k, 1) if k > 1 else x
+    xk = resample_poly(x, k, 1, window=interpolation_filter(k) / k) if k > 1 else x
     ref = np.zeros_like(xk)
     for section in housing_sos(path, fs_hz * k):
         ref += sosfilt(section[None, :], xk)
