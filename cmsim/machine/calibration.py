@@ -7,10 +7,8 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
 1. **Spectrum and lines.** The averaged power spectrum (Hann) of the segments; its narrow
    lines are the bins standing :data:`LINE_MIN_DB` over a running median of ±
    :data:`FLOOR_HALF_WIDTH_HZ` (lines have no width there, the broadband has); the running
-   mean of the bins no line holds — nor a line's skirt, a bin standing that high beyond a
-   line's main lobe — is the smooth **background spectrum** B(f) (a running median alone
-   would sit 0.3-1.6 dB under the mean of a noisy estimate, and 6 dB over it beside a
-   speed-wobbled mesh harmonic that fills half its window).
+   mean with the lines' bins masked is the smooth **background spectrum** B(f) (a running
+   median alone would sit 0.3-1.6 dB under the mean of a noisy estimate).
 2. **Model force.** The nominal (healthy) model at the record's operating point is
    simulated for :data:`N_SEEDS` seeds; its force spectrum gives the lines the model makes
    (GMF harmonics, the ball pass of the sensor's bearing: those standing 20 dB over the
@@ -188,18 +186,11 @@ def _floor(freq, psd):
     return running_median_floor(freq, psd, FLOOR_HALF_WIDTH_HZ, mode="nearest")
 
 
-def _lines_and_floor(freq, psd, measured=True):
+def _lines_and_floor(freq, psd):
     """(lines, floor): the narrow lines [(frequency, amplitude)] standing
     :data:`LINE_MIN_DB` over the running median, strongest first, and the broadband floor —
-    the running mean of the bins no line holds (unbiased: the power of a line too weak to be
-    called stays in the broadband; where a window holds only lines, the median).
-
-    On a ``measured`` spectrum a line's skirt beyond its bins is line too: a speed wobble
-    spreads a mesh harmonic over ±10 Hz, 40 dB over the floor, and a stationary background
-    would smear it over the ± :data:`FLOOR_HALF_WIDTH_HZ` window (+6 dB over ±35 Hz of the
-    5th GMF harmonic of a model gearbox's record, burying its shaft-rate sidebands). A model
-    force's leakage between its lines is what the force puts in those bins, through the
-    path too: it stays in the force's floor."""
+    the running mean of the PSD with the lines' bins replaced by the median (unbiased: the
+    power of a line too weak to be called stays in the broadband)."""
     df = freq[1] - freq[0]
     med = _floor(freq, psd)
     ratio = psd / med
@@ -215,17 +206,10 @@ def _lines_and_floor(freq, psd, measured=True):
                           max(2, math.ceil(LINE_TOLERANCE * freq[i] / df)))
         owner[bins] = len(spans)
         spans.append((i, bins))
-    # a measured line's skirt: the bins standing LINE_MIN_DB over the median (by chance once
-    # in a thousand); the median itself sits 6 dB high beside a line filling half its window
-    free = ((owner < 0) & ((ratio <= thr) | (not measured))).astype(float)
     k = _window_bins(freq)
-
-    def running_sum(a):
-        return np.convolve(np.pad(a, k // 2, mode="edge"), np.ones(k), mode="valid")
-
-    n_free = running_sum(free)
-    mean = running_sum(psd * free) / np.maximum(n_free, 1.0)
-    floor = np.maximum(np.where(n_free > 0, mean, med), 1e-300)
+    masked = np.where(owner >= 0, med, psd)
+    floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
+                                   mode="valid"), 1e-300)
     kept = []
     for i, bins in spans:
         over = np.maximum(psd[bins] - floor[bins], 0.0)
@@ -749,7 +733,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
         # background, or of the background over the model's broadband force; its gain
         # pinned by the model lines the record shows and bounded by those it does not show.
         # Of the two, the one whose twin is nearer the fit segments is kept.
-        force_lines, pf_floor = _lines_and_floor(freq, pf, measured=False)
+        force_lines, pf_floor = _lines_and_floor(freq, pf)
         strong = [(f, a) for f, a in force_lines
                   if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
                   * pf_floor[int(round(f / df))]]
