@@ -233,8 +233,28 @@ NAMED = {"bearing_outer_race": 2.0, "bearing_ball": 2.0, "clearance": 2.0,
 MIN_NAMED_GAIN = 0.25
 
 
+#: Effects the documented model does not name on seed 1000 since the housing's response far
+#: under its modes is right (the force's interpolation folded images onto the shaft rates,
+#: 18 dB high at 30 Hz): a strict xfail says when that changes.
+NOT_NAMED = {
+    "noise": "a 2.5x sensor noise and the housing modes moved x2.2 read alike now that the "
+             "lowest shape bands hold the noise, not folded images (delta chi2 124.6 against "
+             "126.3; reported as a near tie)",
+    "misalignment": "a 2x/1x force of 0.66 of the static load at 60/30 Hz sits (f/f_n)^2, "
+                    "-65 dB, under the mass line of the rig's 2.5-5.5 kHz housing modes: its "
+                    "lines move by < 0.2 chi2 and only the kurtosis departs (a record's "
+                    "kurtosis names no fault); the rig's housing has no support mode near "
+                    "the shaft rates",
+}
+
+
+def _not_named(effect):
+    return pytest.param(effect, marks=pytest.mark.xfail(reason=NOT_NAMED[effect], strict=True)) \
+        if effect in NOT_NAMED else effect
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("effect", sorted(NAMED))
+@pytest.mark.parametrize("effect", [_not_named(e) for e in sorted(NAMED)])
 def test_hidden_effect_is_named(effect):
     h, c = _hidden(effect, 1000)
     assert c.finding == effect
@@ -245,7 +265,7 @@ def test_hidden_effect_is_named(effect):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("effect", ["unbalance", "misalignment"])
+@pytest.mark.parametrize("effect", ["unbalance", _not_named("misalignment")])
 def test_hidden_shaft_force_is_named(effect):
     """A rotating shaft force of 0.66 of the static load (seed 1000) is named, and the fit
     lowers the held-out χ²: its family (the 1x/2x lines) moves towards the record, and the
