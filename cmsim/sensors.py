@@ -192,8 +192,9 @@ def interpolation_filter(k):
 @functools.lru_cache(maxsize=16)
 def _interpolation_phases(k):
     """``(taps, before)``: :func:`interpolation_filter` laid out by phase for
-    :func:`cmsim._kernels.housing_path_jit` — row t holds the taps of fast sample j·k + t for the inputs j − before … j − before + D − 1 (zero where the filter has
-    none) — designed once per factor and read-only; ``[[1.0]]`` for k = 1."""
+    :func:`cmsim._kernels.housing_path_jit` — row t holds the taps of fast sample j·k + t
+    for the inputs j − before … j − before + D − 1 (zero where the filter has none) —
+    designed once per factor and read-only; ``[[1.0]]`` for k = 1."""
     if k == 1:
         taps = np.ones((1, 1))
         before = 0
