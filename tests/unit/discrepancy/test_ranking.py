@@ -10,8 +10,8 @@ from types import SimpleNamespace
 import pytest
 
 from cmsim.discrepancy.causes import STATISTICS
-from cmsim.discrepancy.ranking import (FAR_MARGIN, MIN_DELTA_CHI2, MIN_SIGNATURE_DELTA_CHI2,
-                                       NEAR_TIE, decide)
+from cmsim.discrepancy.ranking import (FAR_MARGIN, MIN_DELTA_CHI2, MIN_FAMILY_DELTA_CHI2,
+                                       MIN_SIGNATURE_DELTA_CHI2, NEAR_TIE, decide)
 
 FEATURES = ["env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "env_bpfi_1b1_h1_db", "shape_b3_db",
             "shape_b4_db", "kurtosis_log"]
@@ -89,6 +89,15 @@ def test_a_fault_is_not_named_on_the_shared_statistics_alone():
     worse = _row("bearing_inner_race", {"kurtosis_log": 40.0, "env_bpfi_1b1_h1_db": -5.0},
                  "env_bpfi_1b1", "1b1")
     assert decide([worse], "1b1", 300.0)[0] is None
+    # nor when its family moved by a rounding error (a misalignment on a load mismatch: its
+    # 1x/2x lines +0.00, the kurtosis and crest 16.8)
+    still = _row("bearing_inner_race", {"kurtosis_log": 40.0, "env_bpfi_1b1_h1_db": 1e-3},
+                 "env_bpfi_1b1", "1b1")
+    assert decide([still], "1b1", 300.0)[0] is None
+    moved = _row("bearing_inner_race", {"kurtosis_log": 40.0,
+                                        "env_bpfi_1b1_h1_db": MIN_FAMILY_DELTA_CHI2},
+                 "env_bpfi_1b1", "1b1")
+    assert decide([moved], "1b1", 300.0)[0]["name"] == "bearing_inner_race"
 
 
 def test_a_reshaping_cause_blocks_a_fault_by_what_it_does_to_the_family_not_the_kurtosis():
