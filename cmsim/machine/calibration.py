@@ -525,6 +525,15 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
                                  for lo, hi, sh in shares))
     if pins or mod_pins:
         points = sorted(pins + mod_pins)
+        lowest = points[0][0]
+        if lowest > 2.0 * max(shaft_hz):
+            # no model line the record shows pins the shaft orders' band: the model makes no
+            # shaft line, and the baseline's own are background
+            notes.append(f"path gain under {lowest:.0f} Hz not read from the baseline (its "
+                         f"lowest pin): held at that pin's correction on the assumed shape "
+                         f"(f² under {HOUSING_BAND_LOW * fs:.0f} Hz); unbalance and "
+                         "misalignment, whose lines sit at the shaft rates, are judged "
+                         "through that assumption")
     else:
         nominal = np.abs(rig.housing.accelerance(freq[band]))
         scale = ref.unit_scale if ref.unit_scale is not None else 1.0

@@ -61,6 +61,15 @@ def test_the_path_is_recovered_where_the_record_pins_it(case):
     np.testing.assert_array_less(np.abs(20 * np.log10(got / true)), 1.5)
 
 
+def test_the_machine_file_says_the_path_at_the_shaft_rates_is_not_read(case):
+    """The lowest pin is the GMF (467 Hz); the model makes no shaft line and the baseline's
+    own are background, so the path at the shaft rates is an assumption, and said to be."""
+    _, _, _, m = case
+    note = [n for n in m.notes if n.startswith("path gain under")]
+    assert len(note) == 1 and "unbalance and misalignment" in note[0]
+    assert "466 Hz" in note[0] or "467 Hz" in note[0], note[0]
+
+
 def test_the_background_level_is_recovered_in_the_housing_band(case):
     """The coloured noise's PSD within 1.5 dB (median over 0.1-0.4·fs) of the true one, the
     model's own broadband force through the path being a small share there."""
