@@ -15,9 +15,8 @@
   :data:`MIN_SIGNATURE_DELTA_CHI2`, and whose *family* (its signature without the statistics
   every impulsive fault moves, :data:`~cmsim.discrepancy.causes.STATISTICS`) moved towards the
   record, by :data:`MIN_FAMILY_DELTA_CHI2` at least and by more than any reshaping cause that
-  could be named moves the same features, wins
-  over the reshaping causes: what stands out in a fault family beyond what a load or a
-  clearance does to it is that fault. A record's kurtosis names no fault: a fault whose family
+  could be named moves the same features, wins over the reshaping causes: what stands out
+  in a fault family beyond what a load or a clearance does to it is that fault. A record's kurtosis names no fault: a fault whose family
   got no nearer (a defect on a bearing whose families the record does not show, a family the
   model makes worse) is not named on the statistics alone. Of the faults that stand out, the
   one with the most evidence on its own signature wins.
@@ -43,8 +42,7 @@ from cmsim.errors import ParameterError
 
 __all__ = ["Nuisances", "rank", "refine", "fit", "decide", "nuisance_params",
            "MIN_DELTA_CHI2", "MIN_SIGNATURE_DELTA_CHI2", "MIN_FAMILY_DELTA_CHI2", "MIN_SCORE",
-           "FIT_GRID",
-           "REFINE_TOP", "FAR_MARGIN", "NEAR_TIE", "SEVERITY_DELTA_CHI2"]
+           "FIT_GRID", "REFINE_TOP", "FAR_MARGIN", "NEAR_TIE", "SEVERITY_DELTA_CHI2"]
 
 #: Least evidence (Δχ² over every feature, fit segments) for a cause that reshapes the
 #: spectrum to be named.
@@ -263,8 +261,8 @@ def decide(ranked, sensor_bearing, chi_nominal):
         # its family moved towards the record, beyond what a reshaping cause that could be
         # named makes of the same features (the shared statistics tell no fault from another)
         own = sum(r["per_feature"][k] for k in r["family"])
-        return own >= MIN_FAMILY_DELTA_CHI2 and all(own > sum(o["per_feature"][k] for k in r["family"])
-                                 for o in reshaping)
+        return own >= MIN_FAMILY_DELTA_CHI2 and all(
+            own > sum(o["per_feature"][k] for k in r["family"]) for o in reshaping)
 
     faults = [r for r in ranked if r["cause"].signature is not None
               and r["delta_chi2"] >= MIN_SIGNATURE_DELTA_CHI2 and stands_out(r)]

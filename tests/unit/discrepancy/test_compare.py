@@ -10,13 +10,14 @@ import json
 import math
 import shutil
 import wave
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from cmsim.discrepancy import CAUSES, Cause, compare, register_cause
 from cmsim.discrepancy.causes import applicable_causes
-from cmsim.discrepancy.compare import DEFAULT_BUDGET
+from cmsim.discrepancy.compare import DEFAULT_BUDGET, _calibration_misfit
 from cmsim.discrepancy.ranking import MIN_SIGNATURE_DELTA_CHI2
 from cmsim.measured import RECORDING_KEYS, data_root, estimate_shaft_hz, read_record
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
@@ -380,8 +381,6 @@ def test_the_finding_reads_as_an_engineer_says_it():
 def _twin_misfits(bias, twin_sd, trials=3000, n_held=5, n_twin=6, seed=0):
     """Misfits :func:`_calibration_misfit` reads back from calibrations of one feature
     whose twin is off by ``bias`` (baseline spread 1), drawn as calibrate measures them."""
-    from types import SimpleNamespace
-    from cmsim.discrepancy.compare import _calibration_misfit
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(trials):
