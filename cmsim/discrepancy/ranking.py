@@ -16,10 +16,11 @@
   every impulsive fault moves, :data:`~cmsim.discrepancy.causes.STATISTICS`) moved towards the
   record, by :data:`MIN_FAMILY_DELTA_CHI2` at least and by more than any reshaping cause that
   could be named moves the same features, wins over the reshaping causes: what stands out
-  in a fault family beyond what a load or a clearance does to it is that fault. A record's kurtosis names no fault: a fault whose family
-  got no nearer (a defect on a bearing whose families the record does not show, a family the
-  model makes worse) is not named on the statistics alone. Of the faults that stand out, the
-  one with the most evidence on its own signature wins.
+  in a fault family beyond what a load or a clearance does to it is that fault. A record's
+  kurtosis names no fault: a fault whose family got no nearer (a defect on a bearing whose
+  families the record does not show, a family the model makes worse) is not named on the
+  statistics alone. Of the faults that stand out, the one with the most evidence on its own
+  signature wins.
 * **The nearest bearing.** A bearing cause on a bearing other than the sensor's wins only
   with :data:`FAR_MARGIN` times the evidence of the same cause on the sensor's bearing.
 * **Near ties.** A runner-up of the same kind within :data:`NEAR_TIE` of the winner's
