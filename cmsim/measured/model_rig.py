@@ -1,9 +1,10 @@
 """The model of a measured record from its metadata: rig, operating point, characteristic lines.
 
 * :func:`model_rig` — the rig the model simulates for a record: with gear tooth counts, the
-  paper rig with those counts (nothing else of the gears is documented); else a rotor of
-  :data:`DEFAULT_ROTOR_MASS_KG` on the documented bearings (bearing ``1b1`` = the one the
-  sensor sits near). What was assumed is returned as notes.
+  paper rig with those counts and the documented bearings at their shafts' nodes (the
+  paper's 209 where none is documented); else a rotor of :data:`DEFAULT_ROTOR_MASS_KG` on
+  the documented bearings (bearing ``1b1`` = the one the sensor sits near). What was
+  assumed is returned as notes.
 * :func:`documented_frequencies` — the characteristic frequencies of the documented geometry
   at a speed (bearing keys as in the metadata): what a diagnosis is given.
 * :func:`model_operating_point` — the operating point the model runs at: the documented
@@ -31,7 +32,9 @@ DEFAULT_ROTOR_MASS_KG = 10.0
 DEFAULT_CLEARANCE_M = 5e-6
 
 
-def _bearing(geom):
+def _bearing(geom, like=None):
+    """The model bearing of a documented geometry; with ``like``, that bearing's clearance,
+    masses and damping (a gear rig's undocumented properties), else the defaults."""
     try:
         n = int(geom["n_balls"])
         d = float(geom["ball_diameter_mm"]) * 1e-3
@@ -39,7 +42,12 @@ def _bearing(geom):
     except (KeyError, TypeError, ValueError):
         raise ParameterError(f"bearing geometry needs n_balls, ball_diameter_mm and "
                              f"pitch_diameter_mm, got {geom!r}", param="geometry.bearings")
-    return RollingBearing.from_pitch(n, d, pd_, clearance_m=DEFAULT_CLEARANCE_M)
+    if like is None:
+        return RollingBearing.from_pitch(n, d, pd_, clearance_m=DEFAULT_CLEARANCE_M)
+    g = RollingBearing.from_pitch(n, d, pd_)
+    return replace(like, **{k: getattr(g, k) for k in (
+        "n_balls", "ball_diameter_m", "inner_raceway_diameter_m", "outer_raceway_diameter_m",
+        "inner_groove_radius_m", "outer_groove_radius_m")})
 
 
 def _gear_stages(geometry):
@@ -47,14 +55,30 @@ def _gear_stages(geometry):
             if s.get("input_teeth") and s.get("output_teeth")]
 
 
-def _gear_rig(stage):
-    """Paper rig with the documented tooth counts (other gear data undocumented)."""
+def _gear_rig(stage, bearings, near):
+    """Paper rig with the documented tooth counts (other gear data undocumented) and the
+    documented bearings: on each shaft (``shaft``: ``input``, the default, or ``output``)
+    in the metadata's order, the sensor's first, at nodes b1 then b2; a node with no
+    documented bearing keeps the paper's. Returns the rig and node → metadata key."""
     base = Rig.paper_2016()
     g = base.gears
     z1, z2 = int(stage["input_teeth"]), int(stage["output_teeth"])
     pair = replace(g, driving=replace(g.driving, n_teeth=z1),
                    driven=replace(g.driven, n_teeth=z2))
-    return replace(base, gears=pair)
+    keys = sorted(bearings, key=lambda k: k != near)
+    shafts, names = [], {}
+    for i, (shaft, which) in enumerate(zip(base.shafts, ("input", "output"))):
+        on = [k for k in keys if (bearings[k] or {}).get("shaft", "input") == which]
+        if len(on) > 2:
+            raise ParameterError(f"metadata.json documents {len(on)} bearings on the {which} "
+                                 f"shaft ({', '.join(on)}); a gear rig's shaft has two",
+                                 param="geometry.bearings", allowed="at most 2 per shaft")
+        nodes = {}
+        for node, key in zip(("bearing_1", "bearing_2"), on):
+            nodes[node] = _bearing(bearings[key], like=getattr(shaft, node))
+            names[f"{i + 1}b{node[-1]}"] = key
+        shafts.append(replace(shaft, **nodes))
+    return replace(base, gears=pair, shafts=tuple(shafts)), names
 
 
 #: What to do when nothing states a recording's geometry (the start of the message).
@@ -90,9 +114,14 @@ def model_rig(geometry, near=None):
     bearings = geometry.get("bearings") or {}
     gears = _gear_stages(geometry)
     if gears:
-        return _gear_rig(gears[0]), {"1G1": "input gear", "2G1": "output gear"}, \
-            ["gear data beyond tooth counts undocumented: the paper rig's gears and 209 "
-             "bearings with the documented tooth counts"]
+        rig, names = _gear_rig(gears[0], bearings, near)
+        kept = [n for n in rig.bearing_names if n not in names]
+        notes = ["gear data beyond tooth counts undocumented: the paper rig's gears with the "
+                 "documented tooth counts"]
+        if kept:
+            notes.append(f"bearing{'s' if len(kept) > 1 else ''} {', '.join(kept)} "
+                         "undocumented: the paper rig's 209")
+        return rig, {"1G1": "input gear", "2G1": "output gear", **names}, notes
     if not bearings:
         raise ParameterError(f"{NO_GEOMETRY}; metadata.json states neither bearing geometry "
                              f"nor gear tooth counts", param="geometry",

@@ -366,9 +366,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
 
     direction = str(sensor.get("direction", "")).lower()
     axis = "x" if ("horizontal" in direction or "3 o'clock" in direction) else "y"
-    bearing = "1b1"
-    if rig.gears is None:
-        bearing = next((b for b, key in components.items() if key == near), "1b1")
+    bearing = next((b for b in rig.bearing_names if components.get(b) == near), "1b1")
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
               {"fs_hz": fs, "channel": channel, "sensor": sensor or None,
