@@ -7,8 +7,13 @@ Line rule (:func:`line_window`, :func:`line_amplitude`)
     :data:`EXACT_TOLERANCE` (0) or :data:`SLIP_TOLERANCE` (2 %).
 
 Band rule (:func:`demodulation_band`)
-    The band for envelope analysis is the kurtogram's best band
-    (:func:`cmsim.spectra.kurtogram.kurtogram`) of width at least
+    The band for envelope analysis is the best band of the kurtogram
+    (:func:`cmsim.spectra.kurtogram.kurtogram`) of the signal's linear-prediction residual
+    (:func:`~cmsim.spectra.kurtogram.prediction_residual`: the discrete part — mesh
+    harmonics and sidebands, shaft orders, the mains — removed first, as the bearing
+    diagnostics tutorial's procedure does; a gearbox's beating mesh harmonics otherwise make
+    a wide band round them the most "impulsive" one, over the band where the impacts ring),
+    of width at least
     :data:`~cmsim.spectra.kurtogram.FAULT_BANDWIDTH_FACTOR` × the highest defect fundamental
     of the bearings read (max of BPFO, BPFI, 2·BSF, FTF: :func:`highest_fault_hz`; a band of
     width B carries modulations up to about B/2 on both sides of its carrier, so a defect
@@ -35,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.spectra.kurtogram import FAULT_BANDWIDTH_FACTOR, kurtogram
+from cmsim.spectra.kurtogram import FAULT_BANDWIDTH_FACTOR, kurtogram, prediction_residual
 from cmsim.spectra.lines import (EXACT_TOLERANCE, LINE_HALF_WIDTH_BINS, SLIP_TOLERANCE,
                                  line_amplitude, line_window)
 
@@ -92,7 +97,8 @@ def demodulation_band(x, fs_hz, max_fault_hz):
     fs = float(fs_hz)
     f_max = min(float(max_fault_hz), MAX_FAULT_FRACTION * fs)
     try:
-        lo, hi = kurtogram(x, fs, max_fault_hz=f_max if f_max > 0 else None).band_hz
+        lo, hi = kurtogram(prediction_residual(x), fs,
+                           max_fault_hz=f_max if f_max > 0 else None).band_hz
     except ParameterError:
         return FALLBACK_BAND[0] * fs, FALLBACK_BAND[1] * fs
     if hi - lo < NARROW_BAND_FRACTION * fs:

@@ -108,7 +108,11 @@ def test_envelope_beats_chance_on_bearing_faults(bearing_set):
     m = ev.metrics
     assert m["n_failed"] == 0 and m["n_scored"] == 15
     assert m["accuracy"] >= m["chance_accuracy"] + 0.3, m
-    assert m["auc"]["healthy"] >= 0.9, m["auc"]      # the fault score separates healthy
+    # the fault score separates healthy from every defect above detection (the 0.05-mm ones
+    # score like healthy records: their order among those is a coin flip)
+    healthy = max(r.fault_score for r in _by_label(ev, "healthy"))
+    assert all(r.fault_score > 3.0 * healthy for r in ev.records
+               if r.true_label != "healthy" and r.severity >= 2e-4), m
     for cls in ("outer_race", "inner_race", "ball"):
         # one-vs-rest over all 15 records; the smallest defect (0.05 mm) is below detection
         assert m["auc"][cls] > 0.5, (cls, m["auc"])
