@@ -166,3 +166,55 @@ def test_kurtogram_band_edges_within_rounding_snap_to_zero_and_nyquist():
     assert k.band_hz == (0.0, 2000.0 + 2e-13)
     kw.update(centre_hz=24414.0 - 500.0 - 1e-12, bandwidth_hz=1000.0)
     assert Kurtogram(**kw).band_hz[1] == 24414.0
+
+
+def _gearbox_with_a_bearing_defect(seed):
+    """Six mesh harmonics of 540 Hz, amplitude- (60 %) and phase-modulated at the 24.5-Hz
+    shaft rate (their beating in a wide band looks impulsive), over weak impacts at 118.7 Hz
+    ringing a 4-kHz resonance, and white noise; 12 kHz, 0.5 s."""
+    fs, n = 12_000.0, 6000
+    t = np.arange(n) / fs
+    fr, gmf = 24.5, 22 * 24.5
+    env = 1.0 + 0.6 * np.cos(2 * np.pi * fr * t)
+    pm = 0.25 * np.sin(2 * np.pi * fr * t)
+    gear = sum(0.7 ** k * np.cos(2 * np.pi * (k + 1) * gmf * t + (k + 1) * pm)
+               for k in range(6)) * env
+    wn, zeta = 2 * np.pi * 4000.0, 0.05
+    th = np.arange(int(0.01 * fs)) / fs
+    h = np.exp(-zeta * wn * th) * np.sin(wn * np.sqrt(1 - zeta ** 2) * th)
+    hits = np.zeros(n)
+    hits[np.round(np.arange(0.003, 0.5, 1 / 118.7) * fs).astype(int)] = 1.0
+    impacts = np.convolve(hits, h)[:n]
+    rng = np.random.default_rng(seed)
+    return fs, gear + 0.35 * impacts / np.abs(impacts).max() + 0.1 * rng.standard_normal(n)
+
+
+def test_the_band_rule_reads_past_a_gearbox_discrete_part_to_the_impacts():
+    """Closed form of the linear predictor: steady lines are predictable, impacts are not.
+    The mesh lines stand > 30 dB over their neighbourhood in the signal and < 6 dB in the
+    residual of a 128th-order predictor; the kurtogram of the
+    signal itself picks the beating mesh harmonics' band, the band rule (the residual's) the
+    resonance where the impacts ring."""
+    from cmsim.features.lines import demodulation_band
+    from cmsim.spectra.kurtogram import prediction_residual
+
+    fs, x = _gearbox_with_a_bearing_defect(seed=0)
+    e = prediction_residual(x, orders=(128,))
+    gmf = 22 * 24.5
+    for v, least, most in ((x, 30.0, np.inf), (e, -np.inf, 6.0)):
+        f, p = spectral_density(v, fs)
+        for k in (1, 2, 3):
+            i = np.argmin(np.abs(f - k * gmf))
+            floor = np.median(p[(np.abs(f - k * gmf) > 60) & (np.abs(f - k * gmf) < 250)])
+            assert least < 10 * np.log10(p[i] / floor) < most, k
+    for seed in range(3):
+        fs, x = _gearbox_with_a_bearing_defect(seed)
+        lo, hi = kurtogram(x, fs, max_fault_hz=118.7).band_hz
+        assert hi < 3000.0                                  # the mesh band wins on the signal
+        lo, hi = demodulation_band(x, fs, 118.7)
+        assert lo < 4000.0 < hi                             # the band rule reads the impacts
+
+
+def spectral_density(x, fs):
+    from scipy.signal import welch
+    return welch(x, fs, nperseg=1024)
