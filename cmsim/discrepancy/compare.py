@@ -30,8 +30,9 @@
 4. Causes are ranked and decided on the evidence their own signature moves
    (:mod:`cmsim.discrepancy.ranking`); the finding is a named cause, ``none`` (nothing
    departs from the model beyond its uncertainty), or ``unexplained`` (the record departs
-   from the model — χ² per feature above :data:`UNEXPLAINED_CHI2_PER_FEATURE` — in ways no
-   cause explains; the features where it departs are listed).
+   from the model — χ² per feature above :data:`UNEXPLAINED_CHI2_PER_FEATURE`, or against
+   a machine one feature :data:`ALARM_Z` σ from its twin — in ways no cause explains; the
+   features where it departs are listed).
 5. The finding's parameters are fitted within the budget; the nominal and the fitted model
    are re-simulated with new seeds and compared on the held-out segments: ``gain.before``
    and ``gain.after`` are χ² per feature there, beside the baseline's own level (1 by
@@ -57,7 +58,7 @@ from cmsim.features import segment_features, segments
 from cmsim.features.relative import shape_band_edges
 
 __all__ = ["Comparison", "compare", "describe", "DEFAULT_BUDGET", "SIM_SEEDS", "VAR_SEEDS",
-           "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "MODES"]
+           "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "ALARM_Z", "MODES"]
 
 #: Default budget of simulations (model runs: ranking, fit and the held-out re-simulations).
 DEFAULT_BUDGET = 140
@@ -78,6 +79,15 @@ LEVEL_SIGMA_DB = 6.0
 #: correlated, so the χ² of independent features would understate the spread), records
 #: with an effect the catalogue misses sit at 2.9-4.8.
 UNEXPLAINED_CHI2_PER_FEATURE = 2.5
+
+#: Against a machine, a record with one feature this many σ from its twin departs from the
+#: baseline whatever the others read: σ holds the baseline's own segment-to-segment spread,
+#: the twin's scatter and its calibration misfit, and χ² caps a feature at Z_CAP, so a
+#: shaft line 12 dB over the baseline's (z 14; 4 times the force, the classic alarm of a
+#: trend) moved χ²/feature by 0.4 and read ``none`` when no cause could make that line.
+#: Records with no hidden effect reach |z| 5.2 (benchmarks/bench_compare.py, both
+#: generators, 7 records through a machine; real healthy halves 1.2-2.0).
+ALARM_Z = 8.0
 
 #: Path-free with the record's unit known, the model's sensor noise is the record's own
 #: broadband floor (:func:`~cmsim.discrepancy.evaluator.record_floor`) rather than
@@ -361,7 +371,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         component = _component_name(record, top["component"])
         params, ranges, fitted = fit(top, nominal, nuis, ev)
         top["fitted"] = params
-    elif chi_nom / max(n_eff, 1e-9) > UNEXPLAINED_CHI2_PER_FEATURE:
+    elif chi_nom / max(n_eff, 1e-9) > UNEXPLAINED_CHI2_PER_FEATURE or (
+            mode == "machine" and discrepancies and abs(discrepancies[0]["z"]) >= ALARM_Z):
         finding = "unexplained"
     # held-out: re-simulate nominal and fitted with new seeds
     ev.budget = budget

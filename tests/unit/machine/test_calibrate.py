@@ -10,6 +10,7 @@ the baseline's own spread on the segments it did not fit.
 """
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -291,3 +292,31 @@ def test_a_preloaded_gearbox_s_clearance_is_read_from_its_baseline():
 def test_a_bearing_rig_keeps_its_documented_clearance(bearing_case):
     """On a bearing rig the clearance is not read (its ball pass pins the path)."""
     assert any("a bearing rig's clearance is not read" in n for n in bearing_case[3].notes)
+
+
+def test_a_shaft_line_far_over_the_baseline_s_departs_though_no_cause_makes_it(case):
+    """The record of the calibrated machine with its 1× line 4 times the baseline's (12 dB:
+    the alarm of a trend) and no cause that could make that line: not ``none`` but
+    ``unexplained``, the line named among the departures; the same machine's record with
+    its own line reads ``none``."""
+    from cmsim.discrepancy import compare
+
+    rig, path, background, m = case
+    force, edge, n = model_force(rig, OP, "accel_1b1_y", FS, 2.0, 29)
+    y = path.apply(force, FS)[edge:edge + n]
+    found = {}
+    for gain in (1.0, 4.0):
+        lines = (replace(LINES[0], amplitude=gain * LINES[0].amplitude),) + LINES[1:]
+        bg = replace(background, lines=lines)
+        x = y + bg.synthesize(n, FS, (OP.shaft_hz, OP.shaft_hz), np.random.default_rng(17))
+        run = Run(np.arange(n) / FS, {"acc": x}, {"fs_hz": FS}, source="measured")
+        c = compare(record_from_run(run, "acc", rig, OP, model_signal="accel_1b1_y"),
+                    machine=m, causes=[], seed=3)
+        found[gain] = c
+    assert found[1.0].finding == "none", found[1.0].discrepancies[:3]
+    alarm = found[4.0]
+    assert alarm.finding == "unexplained", alarm.discrepancies[:3]
+    assert alarm.discrepancies[0]["feature"] == "raw_fr_h1_db"
+    assert alarm.discrepancies[0]["z"] >= 8.0
+    assert "raw_fr_h1_db" in alarm.departures
+    assert alarm.chi2_per_feature < 2.5          # the χ² rule alone would have said none
