@@ -62,7 +62,7 @@ from cmsim.spectra._checks import (WINDOWS, band, positive_int, sampling_rate, s
                                    spectrum_arrays)
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
-from cmsim.spectra.kurtogram import kurtogram
+from cmsim.spectra.kurtogram import kurtogram, prediction_residual
 from cmsim.spectra.order import order_spectrum
 
 __all__ = ["FamilyTemplate", "TEMPLATES", "FAMILY_KEYS", "PEAK_KINDS", "find_peaks",
@@ -322,7 +322,8 @@ def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=No
     kind : {"amplitude", "envelope", "order"}
         ``"amplitude"``: :func:`~cmsim.spectra.amplitude.amplitude_spectrum`;
         ``"envelope"``: :func:`~cmsim.spectra.envelope.envelope_spectrum` in ``band_hz``
-        (default: the kurtogram's band); ``"order"``:
+        (default: the best band of the kurtogram of the signal's linear-prediction residual,
+        as the band rule reads it); ``"order"``:
         :func:`~cmsim.spectra.order.order_spectrum`, with families divided by ``fr``.
     band_hz : tuple of float, optional
         Demodulation band for ``kind="envelope"``, Hz.
@@ -361,7 +362,8 @@ def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=No
         f, a = amplitude_spectrum(x, fs, window=window)
     elif kind == "envelope":
         x = signal_1d(x)
-        bnd = kurtogram(x, fs).band_hz if band_hz is None else band("band_hz", band_hz, fs)
+        bnd = (kurtogram(prediction_residual(x), fs).band_hz if band_hz is None
+               else band("band_hz", band_hz, fs))
         f, a = envelope_spectrum(x, fs, bnd, window=window)
     else:
         if "fr" not in fam:
