@@ -34,6 +34,10 @@ def test_a_worker_reuses_the_memory_its_tasks_free(method):
     run_tasks(_page_faults_of_a_task, [(i, ()) for i in range(4)],
               lambda key, n: faults.append(n), workers=1, start_method=method)
     # the first task takes the arrays' 2304 pages; the next ones reuse them (glibc's defaults
-    # hand them back to the kernel: 1500-2300 faults for every task)
-    assert faults[0] > 2000
+    # hand them back to the kernel: 1500-2300 faults for every task). A forked worker starts
+    # with its parent's heap: when the parent already holds that much freed memory the first
+    # task finds it mapped (2 faults, in about one run in two in a test process), so only a
+    # spawned worker, which starts empty, shows the measurement sees fresh pages.
+    if method == "spawn":
+        assert faults[0] > 2000
     assert max(faults[1:]) < 100
