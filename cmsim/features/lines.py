@@ -8,8 +8,8 @@ Line rule (:func:`line_window`, :func:`line_amplitude`)
 
 Band rule (:func:`demodulation_band`)
     The band for envelope analysis is the best band of the kurtogram
-    (:func:`cmsim.spectra.kurtogram.kurtogram`) of the signal's linear-prediction residual
-    (:func:`~cmsim.spectra.kurtogram.prediction_residual`: the discrete part — mesh
+    (:func:`cmsim.spectra.kurtogram.residual_kurtogram`) of the signal's linear-prediction
+    residual (:func:`~cmsim.spectra.kurtogram.prediction_residual`: the discrete part — mesh
     harmonics and sidebands, shaft orders, the mains — removed first, as the bearing
     diagnostics tutorial's procedure does; a gearbox's beating mesh harmonics otherwise make
     a wide band round them the most "impulsive" one, over the band where the impacts ring),
@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.spectra.kurtogram import FAULT_BANDWIDTH_FACTOR, kurtogram, prediction_residual
+from cmsim.spectra.kurtogram import FAULT_BANDWIDTH_FACTOR, residual_kurtogram
 from cmsim.spectra.lines import (EXACT_TOLERANCE, LINE_HALF_WIDTH_BINS, SLIP_TOLERANCE,
                                  line_amplitude, line_window)
 
@@ -97,8 +97,7 @@ def demodulation_band(x, fs_hz, max_fault_hz):
     fs = float(fs_hz)
     f_max = min(float(max_fault_hz), MAX_FAULT_FRACTION * fs)
     try:
-        lo, hi = kurtogram(prediction_residual(x), fs,
-                           max_fault_hz=f_max if f_max > 0 else None).band_hz
+        lo, hi = residual_kurtogram(x, fs, max_fault_hz=f_max if f_max > 0 else None).band_hz
     except ParameterError:
         return FALLBACK_BAND[0] * fs, FALLBACK_BAND[1] * fs
     if hi - lo < NARROW_BAND_FRACTION * fs:

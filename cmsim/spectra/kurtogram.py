@@ -43,6 +43,7 @@ from cmsim.errors import ParameterError, check_range
 from cmsim.spectra._checks import positive_int, sampling_rate, signal_1d
 
 __all__ = ["Kurtogram", "spectral_kurtosis", "kurtogram", "prediction_residual",
+           "residual_kurtogram",
            "FAULT_BANDWIDTH_FACTOR", "DEFAULT_MIN_BANDWIDTH_HZ", "PREDICTION_ORDERS"]
 
 #: Fewest STFT segments accepted for one SK estimate.
@@ -113,6 +114,28 @@ def prediction_residual(x, orders=PREDICTION_ORDERS):
         if k > best_k:
             best, best_k = e, k
     return best
+
+
+def residual_kurtogram(x, fs, **kwargs):
+    """The kurtogram the band rule reads: that of :func:`prediction_residual` of ``x``.
+
+    Every default envelope band of cmsim is its best band
+    (:func:`cmsim.features.lines.demodulation_band`, the spectrum of a run, peak labels).
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Signal, any unit; finite.
+    fs : float
+        Sampling rate, Hz.
+    **kwargs
+        Keywords of :func:`kurtogram`.
+
+    Returns
+    -------
+    Kurtogram
+    """
+    return kurtogram(prediction_residual(x), fs, **kwargs)
 
 
 def _stft_moments(x, fs, nperseg, overlap):

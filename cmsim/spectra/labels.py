@@ -62,7 +62,7 @@ from cmsim.spectra._checks import (WINDOWS, band, positive_int, sampling_rate, s
                                    spectrum_arrays)
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
-from cmsim.spectra.kurtogram import kurtogram, prediction_residual
+from cmsim.spectra.kurtogram import residual_kurtogram
 from cmsim.spectra.order import order_spectrum
 
 __all__ = ["FamilyTemplate", "TEMPLATES", "FAMILY_KEYS", "PEAK_KINDS", "find_peaks",
@@ -362,8 +362,10 @@ def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=No
         f, a = amplitude_spectrum(x, fs, window=window)
     elif kind == "envelope":
         x = signal_1d(x)
-        bnd = (kurtogram(prediction_residual(x), fs).band_hz if band_hz is None
-               else band("band_hz", band_hz, fs))
+        if band_hz is None:
+            bnd = residual_kurtogram(x, fs).band_hz
+        else:
+            bnd = band("band_hz", band_hz, fs)
         f, a = envelope_spectrum(x, fs, bnd, window=window)
     else:
         if "fr" not in fam:

@@ -20,7 +20,7 @@ from cmsim.spectra._checks import band as check_band
 from cmsim.spectra._checks import positive_int
 from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
-from cmsim.spectra.kurtogram import kurtogram, prediction_residual
+from cmsim.spectra.kurtogram import residual_kurtogram
 from cmsim.spectra.labels import PEAK_KINDS, label_peaks
 from cmsim.spectra.order import order_spectrum
 
@@ -152,9 +152,9 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         Signal name, one of ``run.names``.
     kind : {"amplitude", "envelope", "order"}
         Amplitude spectrum of the record, envelope spectrum (band ``band_hz``, default the
-        best of the kurtogram of its linear-prediction residual, as the band rule of
-        :mod:`cmsim.features.lines` reads it), or order spectrum (the shaft angle from the run's ``tacho`` when it has
-        one, so a run-up's lines stay at their orders; else from the nominal shaft speed).
+        best of :func:`~cmsim.spectra.kurtogram.residual_kurtogram`, as the band rule reads
+        it), or order spectrum (the shaft angle from the run's ``tacho`` when it has one, so
+        a run-up's lines stay at their orders; else from the nominal shaft speed).
     band_hz : tuple of float, optional
         Demodulation band (lo, hi) in Hz, 0 <= lo < hi <= fs/2; only for ``kind="envelope"``.
     max_hz : float, optional
@@ -202,7 +202,7 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         lab_f, lab_fam, scale = f, fam, 1.0
     elif kind == "envelope":
         if band_hz is None:
-            kg = kurtogram(prediction_residual(x), fs)      # the band rule's reading
+            kg = residual_kurtogram(x, fs)
             band_used = tuple(float(b) for b in kg.band_hz)
             extra["kurtosis"] = float(kg.kurtosis_max)
         else:

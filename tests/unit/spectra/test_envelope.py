@@ -8,6 +8,7 @@ its repetition rate in the envelope spectrum of the resonance band; a band narro
 
 import numpy as np
 import pytest
+from scipy.signal import welch
 
 from cmsim.errors import ParameterError
 from cmsim.spectra import (bandpass, envelope, envelope_spectrum, kurtogram,
@@ -192,9 +193,9 @@ def _gearbox_with_a_bearing_defect(seed):
 def test_the_band_rule_reads_past_a_gearbox_discrete_part_to_the_impacts():
     """Closed form of the linear predictor: steady lines are predictable, impacts are not.
     The mesh lines stand > 30 dB over their neighbourhood in the signal and < 6 dB in the
-    residual of a 128th-order predictor; the kurtogram of the
-    signal itself picks the beating mesh harmonics' band, the band rule (the residual's) the
-    resonance where the impacts ring."""
+    residual of a 128th-order predictor; the kurtogram of the signal itself picks the
+    beating mesh harmonics' band, the band rule (the residual's) the resonance where the
+    impacts ring."""
     from cmsim.features.lines import demodulation_band
     from cmsim.spectra.kurtogram import prediction_residual
 
@@ -202,7 +203,7 @@ def test_the_band_rule_reads_past_a_gearbox_discrete_part_to_the_impacts():
     e = prediction_residual(x, orders=(128,))
     gmf = 22 * 24.5
     for v, least, most in ((x, 30.0, np.inf), (e, -np.inf, 6.0)):
-        f, p = spectral_density(v, fs)
+        f, p = welch(v, fs, nperseg=1024)
         for k in (1, 2, 3):
             i = np.argmin(np.abs(f - k * gmf))
             floor = np.median(p[(np.abs(f - k * gmf) > 60) & (np.abs(f - k * gmf) < 250)])
@@ -213,8 +214,3 @@ def test_the_band_rule_reads_past_a_gearbox_discrete_part_to_the_impacts():
         assert hi < 3000.0                                  # the mesh band wins on the signal
         lo, hi = demodulation_band(x, fs, 118.7)
         assert lo < 4000.0 < hi                             # the band rule reads the impacts
-
-
-def spectral_density(x, fs):
-    from scipy.signal import welch
-    return welch(x, fs, nperseg=1024)
