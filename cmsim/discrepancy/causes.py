@@ -76,7 +76,7 @@ class ModelSetup:
         Factor on the machine's background (1: as calibrated).
     shaft_forces : tuple of (float, float)
         (shaft order, relative amplitude): a rotating force laid on the bearing force after
-        the dynamics, ``F·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
+        the dynamics, ``F̄ + (F − F̄)·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
         misalignment: order 2); quasi-static, the shaft rate being far below the modes.
     """
 

@@ -82,16 +82,21 @@ def path_free(name):
 
 def _shaft_forces(force, fs, shaft_hz, terms, seed):
     """``force`` with the rotating shaft forces ``terms`` ((order, relative amplitude) …)
-    laid on it: F·(1 + Σ a cos(kθ + φ)) + Σ a·|F̄|·cos(kθ + φ)."""
+    laid on it: F̄ + (F − F̄)·(1 + m) + L·m, m = Σ a cos(kθ + φ), L = max(|F̄|, std F): the
+    rotating force (amplitude a·L at order k) and the load it swings modulating the
+    dynamic force. (Modulating the whole force, F·(1 + m) + L·m, cancelled the rotating
+    force under a negative static load, F̄ = −L: an unbalance of three times the load moved
+    the 1× line by 0.0 dB.)"""
     if not terms:
         return force
     t = np.arange(force.size) / fs
-    static = max(abs(float(force.mean())), float(np.std(force)))
+    mean = float(force.mean())
+    static = max(abs(mean), float(np.std(force)))
     phase = np.random.default_rng([int(seed), 65537]).uniform(0.0, 2.0 * math.pi)
     mod = np.zeros_like(force)
     for k, a in terms:
         mod += a * np.cos(2.0 * math.pi * k * shaft_hz * t + k * phase)
-    return force * (1.0 + mod) + static * mod
+    return mean + (force - mean) * (1.0 + mod) + static * mod
 
 
 def record_floor(x, fs_hz, n):
@@ -167,9 +172,18 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
     return x + noise_ratio * ref * rng.standard_normal(x.size)
 
 
-def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None):
-    """The sensor signal of a simulated force through ``setup``'s shaft forces and chain."""
-    force = _shaft_forces(force, fs, setup.op.shaft_hz, setup.shaft_forces, seed)
+def _shaft_rate(setup, bearing):
+    """Rotation frequency of the shaft ``bearing`` (``1b1``, ``2b2`` ...) sits on, Hz."""
+    fr = setup.op.shaft_hz
+    if setup.rig.gears is not None and bearing.startswith("2"):
+        fr /= setup.rig.gears.ratio
+    return fr
+
+
+def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="1b1"):
+    """The sensor signal of a simulated force (on ``bearing``) through ``setup``'s shaft
+    forces (at the rate of that bearing's shaft) and chain."""
+    force = _shaft_forces(force, fs, _shaft_rate(setup, bearing), setup.shaft_forces, seed)
     if setup.machine is not None:
         return setup.machine.sensor_signal(force, edge, n, seed, speed_rpm=setup.op.speed_rpm,
                                            frequency_factor=setup.frequency_factor,
@@ -203,7 +217,8 @@ def simulate_setup(setup, fs_hz, duration_s, model_signal, seed, noise_ref_rms=N
     """
     force, edge, n = model_force(setup.rig, setup.op, model_signal, fs_hz, duration_s, seed,
                                  faults=setup.faults, mixed_friction=setup.mixed_friction)
-    return _chain(setup, force, edge, n, max(fs_hz, 1e3), seed, noise_ref_rms)
+    return _chain(setup, force, edge, n, max(fs_hz, 1e3), seed, noise_ref_rms,
+                  bearing=signal_info(model_signal).component)
 
 
 def weight(name):
@@ -311,7 +326,8 @@ class Evaluator:
         if self.ref_rms is None and setup.machine is None:  # the healthy level fixes the noise
             self.ref_rms = float(np.std(sensor_signal(*run, self.fs, setup.housing, 0.0,
                                                       None, seed)))
-        return _chain(setup, *run, self.fs, seed, self.ref_rms, self.floor)
+        return _chain(setup, *run, self.fs, seed, self.ref_rms, self.floor,
+                      bearing=self.sensor_bearing)
 
     def row(self, setup, seed):
         """Features of one run of ``setup`` with simulation seed ``seed`` (None if it
