@@ -81,14 +81,14 @@ def path_free(name):
 
 
 def _shaft_forces(force, fs, shaft_hz, terms, seed):
-    """``force`` with the rotating shaft forces ``terms`` ((order, relative amplitude) …)
-    laid on it: F̄ + (F − F̄)·(1 + m) + L·m, m = Σ a cos(kθ + φ), L = max(|F̄|, std F): the
-    rotating force (amplitude a·L at order k) and the load it swings modulating the
-    dynamic force. (Modulating the whole force, F·(1 + m) + L·m, cancelled the rotating
-    force under a negative static load, F̄ = −L: an unbalance of three times the load moved
-    the 1× line by 0.0 dB.)"""
+    """(modulated force, rotating forces) of the rotating shaft forces ``terms`` ((order,
+    relative amplitude) …) on ``force``: the dynamic force modulated by the load they swing,
+    F̄ + (F − F̄)·(1 + Σ a cos(kθ + kφ)), and the forces themselves, (order, a·L, kφ) each,
+    L = max(|F̄|, std F). (Modulating the whole force, F·(1 + m) + L·m, cancelled the
+    rotating force under a negative static load, F̄ = −L: an unbalance of three times the
+    load moved the 1× line by 0.0 dB.)"""
     if not terms:
-        return force
+        return force, ()
     t = np.arange(force.size) / fs
     mean = float(force.mean())
     static = max(abs(mean), float(np.std(force)))
@@ -96,7 +96,17 @@ def _shaft_forces(force, fs, shaft_hz, terms, seed):
     mod = np.zeros_like(force)
     for k, a in terms:
         mod += a * np.cos(2.0 * math.pi * k * shaft_hz * t + k * phase)
-    return mean + (force - mean) * (1.0 + mod) + static * mod
+    return mean + (force - mean) * (1.0 + mod), tuple((k, a * static, k * phase)
+                                                      for k, a in terms)
+
+
+def _rotating(n, fs, shaft_hz, rotating):
+    """The rotating forces of :func:`_shaft_forces` as a signal of ``n`` samples, N."""
+    t = np.arange(n) / fs
+    out = np.zeros(n)
+    for k, amp, phase in rotating:
+        out += amp * np.cos(2.0 * math.pi * k * shaft_hz * t + phase)
+    return out
 
 
 def record_floor(x, fs_hz, n):
@@ -183,12 +193,16 @@ def _shaft_rate(setup, bearing):
 def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="1b1"):
     """The sensor signal of a simulated force (on ``bearing``) through ``setup``'s shaft
     forces (at the rate of that bearing's shaft) and chain."""
-    force = _shaft_forces(force, fs, _shaft_rate(setup, bearing), setup.shaft_forces, seed)
-    if setup.machine is not None:
+    fr = _shaft_rate(setup, bearing)
+    force, rotating = _shaft_forces(force, fs, fr, setup.shaft_forces, seed)
+    if setup.machine is not None:   # a machine's rotating forces have gains of their own
         return setup.machine.sensor_signal(force, edge, n, seed, speed_rpm=setup.op.speed_rpm,
                                            frequency_factor=setup.frequency_factor,
                                            noise_gain=setup.background_gain,
-                                           line_gain=setup.background_gain)
+                                           line_gain=setup.background_gain,
+                                           rotating=(fr, rotating) if rotating else None)
+    if rotating:
+        force = force + _rotating(force.size, fs, fr, rotating)
     return sensor_signal(force, edge, n, fs, setup.housing, setup.noise_ratio, noise_ref_rms,
                          seed, floor)
 

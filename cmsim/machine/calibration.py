@@ -158,13 +158,13 @@ LINE_TOLERANCE = 0.004
 #: path is taken stiffness-controlled (accelerance ∝ f², the ω²/k of a structure below its
 #: first mode); the background there (rocking, the motor, the mains) does not shape it.
 HOUSING_BAND_LOW = 0.04
-#: Balance grade G = e·Ω (mm/s) the baseline's rotor is taken to have when its shaft-rate
-#: line pins the path there (:func:`_shaft_pins`): ISO 21940-11 G 6.3, the grade of
+#: Balance grade G = e·Ω (mm/s) the baseline's rotor is taken to have, its shaft-rate line
+#: being its residual unbalance (:func:`_shaft_gains`): ISO 21940-11 G 6.3, the grade of
 #: electric motors, pumps, fans and gear wheels of general machinery.
 BALANCE_GRADE_MM_S = 6.3
-#: Shaft orders at which a baseline's lines pin the path (:func:`_shaft_pins`): those of
-#: unbalance (1×) and misalignment (2×, 3×).
-SHAFT_PIN_ORDERS = 3
+#: Shaft orders whose baseline lines give a rotating force's gain (:func:`_shaft_gains`):
+#: those of unbalance (1×) and misalignment (2×, 3×).
+SHAFT_ORDERS = 3
 #: Bearing clearances tried besides the documented one, m: line contact and a light preload
 #: (:meth:`Rig.with_clearance <cmsim.rig.Rig.with_clearance>`; negative is a preload).
 CLEARANCE_CANDIDATES_M = (0.0, -5e-6)
@@ -462,25 +462,29 @@ def _modulation_pins(shape, spectra, fs, freqs, bearing, above_hz):
     return pins, bounds, shares
 
 
-def _shaft_pins(shape, spectra, rig, bearing, shaft_hz, df):
-    """(pins, force N, share of the static load) of the path at the orders 1 to
-    :data:`SHAFT_PIN_ORDERS` of the sensor bearing's shaft, read from the baseline's lines
-    there; no pins without such lines.
+def _shaft_gains(lines, rig, bearing, shaft_hz, df, forces):
+    """({order: gain}, force N, share of the static load): the gains, sensor unit per N,
+    from a rotating force at the orders 1 to :data:`SHAFT_ORDERS` of the sensor bearing's
+    shaft to the sensor, read from the baseline's lines there (an order without a line gets
+    none: the path's own gain there is used).
 
-    No model line reads the path at the shaft orders (the model makes none), yet an
-    unbalance or a misalignment is judged there: held on the assumed f² shape from the
-    lowest pin hundreds of hertz up, an unbalance of three times the static load moved the
-    twin's 1× line by 0.0 dB where a real machine's grows 12 dB. A baseline's shaft-rate
-    line is its residual unbalance through the path, so the path's gain there is that line
-    over the force of a residual unbalance of grade :data:`BALANCE_GRADE_MM_S`, e·Ω
-    (ISO 21940-11): m·e·Ω² = m·G·Ω on the rotor, half of it on each of its shaft's bearings
-    (both correction planes allotted alike), m the shaft's masses in the model (its gear or
-    rotor and its bearing nodes). What drives a healthy machine's 2× and 3× lines (residual
-    misalignment, run-out, a coupling) has no grade, and is taken as a force of the same
-    magnitude: an unbalance or a misalignment is then sized as a trend against the
-    baseline's own lines at its orders, which is what practice reads, rather than through a
-    path that nothing in the baseline pins. The static load the force is a share of is the
-    model force's, the level an unbalance cause's relative amplitude refers to.
+    The model makes no shaft line, so no model line reads the path there, yet an unbalance
+    or a misalignment is judged there: held on the path's assumed f² shape from its lowest
+    pin hundreds of hertz up, an unbalance of three times the static load moved the twin's
+    1× line by 0.0 dB where a real machine's grows 12 dB. A baseline's shaft-rate line is
+    its residual unbalance through the machine, so the gain at 1× is that line over the
+    force of a residual unbalance of grade :data:`BALANCE_GRADE_MM_S`, e·Ω (ISO 21940-11):
+    m·e·Ω² = m·G·Ω on the rotor, half of it on each of its shaft's bearings (both correction
+    planes allotted alike), m the shaft's masses in the model (its gear or rotor and its
+    bearing nodes). What drives a healthy machine's 2× and 3× lines (residual misalignment,
+    run-out, a coupling) has no grade, and is taken as a force of the same magnitude: an
+    unbalance or a misalignment is then sized as a trend against the baseline's own lines
+    at its orders, which is what practice reads. These gains carry only the rotating
+    forces (a sinusoid at a shaft order: a gain is all of its path that a spectrum sees);
+    interpolated into the structural path they lifted it over a decade below its lowest
+    pin, where the model's own lines then took the mains line for theirs. The static load
+    the force is a share of is the model force's, the level an unbalance cause's relative
+    amplitude refers to.
     """
     shaft = int(bearing.split("b")[0]) - 1
     fr = shaft_hz[min(shaft, len(shaft_hz) - 1)]
@@ -489,27 +493,30 @@ def _shaft_pins(shape, spectra, rig, bearing, shaft_hz, df):
               if rig.gears is not None else s.rotor.mass_kg)
     mass = centre + s.bearing_1.mass_kg + s.bearing_2.mass_kg
     force = 0.5 * mass * BALANCE_GRADE_MM_S * 1e-3 * 2.0 * math.pi * fr
-    forces = [x[edge:edge + n] for x, edge, n in spectra["forces"]]
-    static = float(np.mean([max(abs(float(x.mean())), float(np.std(x))) for x in forces]))
-    pins = []
-    for k in range(1, SHAFT_PIN_ORDERS + 1):
-        match = [(f, a) for f, a in spectra["lines"] if _near(f, k * fr, df)]
-        if match and k * fr > 0.0:
-            f, amp = max(match, key=lambda fa: fa[1])
-            pins.append((f, amp / force / shape[int(round(f / df))]))
-    return pins, force, force / static
+    static = float(np.mean([max(abs(float(x[e:e + n].mean())), float(np.std(x[e:e + n])))
+                            for x, e, n in forces]))
+    gains = {}
+    for k in range(1, SHAFT_ORDERS + 1):
+        match = [a for f, a in lines if _near(f, k * fr, df)]
+        if match and fr > 0.0:
+            gains[k] = max(match) / force
+    return gains, force, force / static
 
 
-def _shaft_words(shaft, up_to):
-    """The machine file's note on a path pinned at the shaft orders (:func:`_shaft_pins`)."""
-    pins, force, share = shaft
-    return (f"path gain at the shaft orders ({', '.join(f'{p[0]:.2f}' for p in pins)} Hz) "
-            f"read from the baseline's lines there, each taken as the response to a residual "
-            f"force of an unbalance of grade G {BALANCE_GRADE_MM_S:g} (ISO 21940-11; "
-            f"{force:.3g} N on this bearing, {share:.2g} of its static load), interpolated to "
-            f"{up_to:.0f} Hz under the record's broadband: an unbalance or a misalignment is "
-            "sized as a trend against the baseline's own lines at its orders (a rotor "
-            f"balanced to G 2.5 reads {BALANCE_GRADE_MM_S / 2.5:.1f}× too large)")
+def _shaft_words(shaft, fr):
+    """The machine file's note on the shaft-order gains (:func:`_shaft_gains`)."""
+    gains, force, share = shaft
+    if not gains:
+        return ("no shaft-order line in the baseline: the rotating forces of unbalance and "
+                "misalignment reach the sensor through the path's assumed shape there")
+    return (f"rotating forces reach the sensor at the shaft orders "
+            f"({', '.join(f'{k}× {k * fr:.2f} Hz' for k in sorted(gains))}) through gains "
+            f"read from the baseline's lines there, each taken as the response to the force "
+            f"of a residual unbalance of grade G {BALANCE_GRADE_MM_S:g} (ISO 21940-11; "
+            f"{force:.3g} N on this bearing, {share:.2g} of its static load): an unbalance or "
+            "a misalignment is sized as a trend against the baseline's own lines at its "
+            f"orders (a rotor balanced to G 2.5 reads {BALANCE_GRADE_MM_S / 2.5:.1f}× too "
+            "large)")
 
 
 def _misfit(names, twin_rows, rows, spread):
@@ -580,24 +587,17 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
                      f"{len(shares)} band(s): share of the broadband the model's force makes "
                      + ", ".join(f"{lo:.0f}-{hi:.0f} Hz {'≤ ' if sh < 0 else ''}{abs(sh):.2f}"
                                  for lo, hi, sh in shares))
-    shaft = ([], 0.0, 0.0)
     if pins or mod_pins:
         points = sorted(pins + mod_pins)
         lowest = points[0][0]
         if lowest > 2.0 * max(shaft_hz):
             # no model line the record shows pins the shaft orders' band: the model makes no
             # shaft line, and the baseline's own are background
-            shaft = _shaft_pins(shape, spectra, ref.rig, bearing, shaft_hz, df)
-            if shaft[0]:
-                points = sorted(points + shaft[0])
-                notes.append(_shaft_words(shaft, lowest))
-            else:
-                notes.append(f"path gain under {lowest:.0f} Hz not read from the baseline "
-                             f"(its lowest pin, and no shaft-order line in it): held at that "
-                             f"pin's correction on the assumed shape (f² under "
-                             f"{HOUSING_BAND_LOW * fs:.0f} Hz); unbalance and misalignment, "
-                             "whose lines sit at the shaft orders, are judged through that "
-                             "assumption")
+            notes.append(f"path gain under {lowest:.0f} Hz not read from the baseline (its "
+                         f"lowest pin): held at that pin's correction on the assumed shape "
+                         f"(f² under {HOUSING_BAND_LOW * fs:.0f} Hz); the rotating forces of "
+                         "unbalance and misalignment reach the sensor at the shaft orders "
+                         "through gains of their own (shaft_gain)")
     else:
         nominal = np.abs(rig.housing.accelerance(freq[band]))
         scale = ref.unit_scale if ref.unit_scale is not None else 1.0
@@ -609,10 +609,6 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
         if ref.unit_scale is None:
             notes.append("sensor unit unknown: the path is in sensor unit per N with the "
                          "nominal housing's accelerance taken as 1 unit = 1 m/s²")
-        shaft = _shaft_pins(shape, spectra, ref.rig, bearing, shaft_hz, df)
-        if shaft[0]:
-            notes.append(_shaft_words(shaft, points[0][0]))
-            points = sorted(points + shaft[0])
 
     def correction(pts):
         pts = sorted(pts)
@@ -629,9 +625,6 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
     gain = shape * corr
     if not (pins or mod_pins):   # a prior gain must keep the model's broadband under the floor
         gain = np.minimum(gain, np.sqrt(BROADBAND_SHARE * floor / pf_floor))
-    elif shaft[0]:               # so must the gain interpolated up from the shaft orders
-        low = (freq > shaft[0][-1][0]) & (freq < min(p[0] for p in pins + mod_pins))
-        gain[low] = np.minimum(gain[low], np.sqrt(BROADBAND_SHARE * floor[low] / pf_floor[low]))
     unit = str((ref.meta.get("sensor") or {}).get("unit") or "")
     path = TransferPath(f"F_{bearing}_{signal_info(ref.model_signal).direction}",
                         tuple(freq), tuple(np.maximum(gain, 1e-30)), unit)
@@ -770,6 +763,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     freqs = rig_frequencies(rig, op)
     bearing = signal_info(ref.model_signal).component
     shaft_hz = (freqs.fr1_hz, freqs.fr2_hz if freqs.fr2_hz is not None else freqs.fr1_hz)
+    fr = shaft_hz[min(int(bearing.split("b")[0]) - 1, 1)]      # the sensor bearing's shaft
     notes = [f"operating point: {op.speed_rpm:.2f} rpm from the record; torque "
              f"{op.torque_nm:g} N m and radial load {op.radial_load_n:g} N as the record's "
              "model assumes (the load is not identified from a healthy record)"]
@@ -819,17 +813,19 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
                   * pf_floor[int(round(f / df))]]
         spectra = dict(baseline, pf_floor=pf_floor, force_lines=force_lines, strong=strong,
                        forces=force_runs + twin_forces, force_keep=_line_free(freq, pf))
+        shaft = _shaft_gains(lines, model_rig, bearing, shaft_hz, df, force_runs)
         candidates = []
         for forced in (False, True):
             path, background, chain_notes, n_pins = _reading(forced, spectra, fs, freqs,
                                                              bearing, shaft_hz, ref, longest)
             machine = Machine(
                 name=name or (ref.record_id or "machine"), rig=model_rig,
+                shaft_gain=shaft[0],
                 channel=ref.channel, model_signal=ref.model_signal, fs_hz=fs, op=op,
                 path=path, background=background, unit=path.unit,
                 unit_scale=ref.unit_scale, components=dict(ref.components), segment_s=seg_s,
                 speed_wobble=wobble, calibrated_on=calibrated_on,
-                notes=tuple(notes + chain_notes))
+                notes=tuple(notes + chain_notes + [_shaft_words(shaft, fr)]))
             twin = [machine.sensor_signal(force, edge, n, seed + 31 * s)
                     for s, (force, edge, n) in enumerate(twin_forces)]
             _, twin_rows = feature_rows(twin, fs, freqs, bearings, ref.unit_scale)

@@ -115,6 +115,11 @@ class Machine:
     speed_wobble : float or None
         Relative RMS of the input speed's slow fluctuation seen on the baseline (None: not
         identifiable on it, no shaft order standing out of its noise).
+    shaft_gain : dict
+        Order of the sensor bearing's shaft → gain from a rotating force at that order (an
+        unbalance, a misalignment) to the sensor, sensor unit per N, read from the
+        baseline's line there (:func:`~cmsim.machine.calibration.calibrate`); an order not
+        listed takes the path's gain.
     spread : dict
         Feature name → (mean, std) over the baseline's segments.
     fit_quality : dict
@@ -139,6 +144,7 @@ class Machine:
     components: dict = field(default_factory=dict)
     segment_s: float = 0.5
     speed_wobble: float | None = None
+    shaft_gain: dict = field(default_factory=dict)
     spread: dict = field(default_factory=dict)
     fit_quality: dict = field(default_factory=dict)
     calibrated_on: tuple = ()
@@ -151,7 +157,7 @@ class Machine:
         return (fr1, fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1)
 
     def sensor_signal(self, force, edge, n, seed, *, speed_rpm=None, frequency_factor=1.0,
-                      noise_gain=1.0, line_gain=1.0):
+                      noise_gain=1.0, line_gain=1.0, rotating=None):
         """The machine's sensor signal of a model force (:func:`model_force`'s output).
 
         Parameters
@@ -168,6 +174,10 @@ class Machine:
             Scale of the path's frequencies (1 as calibrated).
         noise_gain, line_gain : float
             Factors on the background noise and lines (1 as calibrated).
+        rotating : (float, sequence of (int, float, float)), optional
+            Rotating forces at shaft orders, not in ``force``: the shaft's rate (Hz) and
+            (order, amplitude N, phase rad) of each, ``A·cos(2π·k·fr·t + φ)`` with t = 0 at
+            the force's first sample; each reaches the sensor through :attr:`shaft_gain`.
 
         Returns
         -------
@@ -175,12 +185,24 @@ class Machine:
             Sensor unit.
         """
         y = self.path.apply(force, self.fs_hz, frequency_factor)[edge:edge + n]
+        if rotating is not None:
+            fr, terms = rotating
+            t = (edge + np.arange(n)) / self.fs_hz
+            for k, amp, phase in terms:
+                y = y + self.rotating_gain(k, fr) * amp * np.cos(2.0 * np.pi * k * fr * t
+                                                                 + phase)
         fr1 = (self.op.speed_rpm if speed_rpm is None else speed_rpm) / 60.0
         fr2 = fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1
         rng = np.random.default_rng([int(seed), 104729])
         y = y + self.background.synthesize(n, self.fs_hz, (fr1, fr2), rng, noise_gain,
                                            line_gain)
         return y - y.mean()
+
+    def rotating_gain(self, order, shaft_hz):
+        """Gain from a rotating force at ``order`` of a shaft turning at ``shaft_hz`` to the
+        sensor, sensor unit per N: :attr:`shaft_gain`'s, else the path's at that frequency."""
+        gain = self.shaft_gain.get(int(order))
+        return float(gain) if gain else float(self.path.magnitude(order * shaft_hz))
 
     @property
     def force_signals(self):
@@ -232,6 +254,7 @@ class Machine:
                         "segment_s": self.segment_s,
                         "speed_wobble": -1.0 if self.speed_wobble is None else self.speed_wobble,
                         "components": dict(self.components),
+                        "shaft_gain": {str(k): float(v) for k, v in self.shaft_gain.items()},
                         "calibrated_on": list(self.calibrated_on), "notes": list(self.notes)},
             "operating": {"speed_rpm": self.op.speed_rpm, "torque_nm": self.op.torque_nm,
                           "radial_load_n": self.op.radial_load_n,
@@ -274,6 +297,7 @@ class Machine:
                 components=dict(m.get("components", {})),
                 segment_s=float(m.get("segment_s", 0.5)),
                 speed_wobble=None if wobble < 0 else wobble,
+                shaft_gain={int(k): float(v) for k, v in m.get("shaft_gain", {}).items()},
                 spread={k: (float(v[0]), float(v[1])) for k, v in data.get("spread", {}).items()},
                 fit_quality=dict(data.get("fit_quality", {})),
                 calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())))

@@ -71,6 +71,26 @@ def test_the_machine_file_says_the_path_at_the_shaft_rates_is_not_read(case):
     assert "466 Hz" in note[0] or "467 Hz" in note[0], note[0]
 
 
+def test_a_rotating_force_is_read_against_the_baseline_residual_unbalance(case):
+    """The gain of a rotating force at the input shaft's 1× and 2× is the baseline's line
+    there over the force of a G 6.3 residual unbalance, m·G·Ω/2 on each bearing (m: the
+    driving gear and the shaft's bearing nodes); none at 3× (no line), where the path's own
+    gain is used; the machine file says so, and keeps the gains."""
+    rig, _, _, m = case
+    shaft = rig.shafts[0]
+    mass = rig.gears.driving.mass_kg + shaft.bearing_1.mass_kg + shaft.bearing_2.mass_kg
+    fr = OP.shaft_hz
+    force = 0.5 * mass * 6.3e-3 * 2.0 * math.pi * fr
+    assert sorted(m.shaft_gain) == [1, 2]
+    for line in LINES[:2]:
+        got = m.rotating_gain(int(line.value), fr)
+        assert abs(20 * math.log10(got * force / line.amplitude)) < 1.0, line
+    assert m.rotating_gain(3, fr) == pytest.approx(float(m.path.magnitude(3 * fr)))
+    note = [n for n in m.notes if n.startswith("rotating forces reach the sensor")]
+    assert len(note) == 1 and "G 6.3" in note[0] and f"{force:.3g} N" in note[0], m.notes
+    assert Machine.from_dict(m.to_dict()).shaft_gain == m.shaft_gain
+
+
 def test_the_background_level_is_recovered_in_the_housing_band(case):
     """The coloured noise's PSD within 1.5 dB (median over 0.1-0.4·fs) of the true one, the
     model's own broadband force through the path being a small share there."""
