@@ -1,0 +1,50 @@
+"""Rotating shaft forces of unbalance and misalignment laid on a bearing force (issue 25).
+
+Tier: closed form — a force of static level F̄ (either sign: a bearing's reaction points
+either way) with a dynamic part: the unbalance of relative amplitude a adds a line of
+a·|F̄| at the shaft rate and swings the dynamic part by (1 + a·cos θ); through a machine the
+line reaches the sensor through the machine's own gain at that order.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from cmsim.discrepancy.evaluator import _rotating, _shaft_forces
+from cmsim.machine import Background, Machine, TransferPath
+from cmsim.rig import OperatingPoint, Rig
+
+FS = 10_000.0
+FR = 25.0
+
+
+def _line(x, f):
+    """Amplitude of the line at ``f`` (an integer number of cycles in ``x``)."""
+    t = np.arange(x.size) / FS
+    return 2.0 * abs(np.mean(x * np.exp(-2j * math.pi * f * t)))
+
+
+@pytest.mark.parametrize("static", [100.0, -100.0])
+def test_an_unbalance_adds_its_line_whatever_the_sign_of_the_load(static):
+    t = np.arange(int(FS)) / FS
+    dynamic = 5.0 * np.cos(2 * math.pi * 400.0 * t)
+    modulated, rotating = _shaft_forces(static + dynamic, FS, FR, ((1, 0.3),), seed=4)
+    total = modulated + _rotating(t.size, FS, FR, rotating)
+    assert _line(total, FR) == pytest.approx(0.3 * 100.0, rel=1e-3)
+    # the dynamic part swings with the load: sidebands of 0.3/2 of its 5 N at 400 ± 25 Hz
+    for f in (375.0, 425.0):
+        assert _line(total, f) == pytest.approx(0.15 * 5.0, rel=1e-3)
+    assert float(np.mean(modulated)) == pytest.approx(static, abs=1e-9)
+
+
+def test_through_a_machine_the_line_takes_the_machine_gain_at_its_order():
+    rig = Rig.paper_2016()
+    path = TransferPath("F_1b1_y", (0.0, FS / 2), (1e-3, 1e-3), "g")
+    quiet = Background((0.0, FS / 2), (1e-30, 1e-30))
+    m = Machine("m", rig, "acc", "accel_1b1_y", FS, OperatingPoint(FR * 60.0, 50.0), path,
+                quiet, shaft_gain={1: 4e-2})
+    n = int(FS)
+    y = m.sensor_signal(np.zeros(n), 0, n, 0, rotating=(FR, ((1, 30.0, 0.0), (2, 10.0, 0.0))))
+    assert _line(y, FR) == pytest.approx(4e-2 * 30.0, rel=1e-3)       # its own gain
+    assert _line(y, 2 * FR) == pytest.approx(1e-3 * 10.0, rel=1e-3)    # the path's
