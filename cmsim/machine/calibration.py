@@ -51,7 +51,11 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    the model's own lines put there through the path (powers subtracted, the lines matched
    within :data:`LINE_TOLERANCE` as the pins are), each filed as an order of the input or
    output shaft when it sits on one (so it follows the speed), else at its frequency (the
-   mains, other machines).
+   mains, other machines). The **rotating forces** of an unbalance or a misalignment reach
+   the sensor at the sensor bearing's shaft orders 1-3 through gains of their own: the
+   baseline's line at each order over the force of a residual unbalance of grade
+   :data:`BALANCE_GRADE_MM_S` (:func:`_shaft_gains`), so that they are sized as a trend
+   against the baseline's own lines.
 5. **Bearing clearance.** A healthy ball bearing under load makes a comb of ball-pass lines
    (varying compliance) whose level its clearance sets: strong with a clearance (fewer
    balls loaded), weak in line contact or under a preload. A machine's clearance is rarely
@@ -470,8 +474,9 @@ def _shaft_gains(lines, rig, bearing, shaft_hz, df, forces):
 
     The model makes no shaft line, so no model line reads the path there, yet an unbalance
     or a misalignment is judged there: held on the path's assumed f² shape from its lowest
-    pin hundreds of hertz up, an unbalance of three times the static load moved the twin's
-    1× line by 0.0 dB where a real machine's grows 12 dB. A baseline's shaft-rate line is
+    pin hundreds of hertz up, an unbalance of twice the static load lifted the twin's 1×
+    line by at most 0.9 dB (the angle generator's bearing machine of seed 0) where the
+    drawn machine's grows 12 dB. A baseline's shaft-rate line is
     its residual unbalance through the machine, so the gain at 1× is that line over the
     force of a residual unbalance of grade :data:`BALANCE_GRADE_MM_S`, e·Ω (ISO 21940-11):
     m·e·Ω² = m·G·Ω on the rotor, half of it on each of its shaft's bearings (both correction
