@@ -340,3 +340,74 @@ def test_a_shaft_line_far_over_the_baseline_s_departs_though_no_cause_makes_it(c
     assert alarm.discrepancies[0]["z"] >= 8.0
     assert "raw_fr_h1_db" in alarm.departures
     assert alarm.chi2_per_feature < 2.5          # the χ² rule alone would have said none
+
+
+def _unbalanced(rig, op, path, background, fs, seed, factor):
+    """A record of a machine (``path``, ``background``) whose 1× background line is ``factor``
+    times its own (3 s)."""
+    force, edge, n = model_force(rig, op, "accel_1b1_y", fs, 3.0, seed)
+    y = path.apply(force, fs)[edge:edge + n]
+    lines = tuple(replace(ln, amplitude=factor * ln.amplitude)
+                  if (ln.reference, ln.value) == ("input", 1.0) else ln
+                  for ln in background.lines)
+    y = y + replace(background, lines=lines).synthesize(
+        n, fs, (op.shaft_hz, op.shaft_hz), np.random.default_rng(seed + 1))
+    run = Run(np.arange(n) / fs, {"acc": y}, {"fs_hz": fs}, source="measured")
+    return record_from_run(run, "acc", rig, op, model_signal="accel_1b1_y")
+
+
+def _share(machine):
+    """The residual unbalance's share of the static load, from the machine file's note."""
+    note = next(n for n in machine.notes if n.startswith("rotating forces reach the sensor"))
+    return float(note.split(" of its static load")[0].rsplit(", ", 1)[1])
+
+
+def test_a_hidden_unbalance_through_the_machine_is_named_and_sized_as_a_trend():
+    """A ball-bearing machine (the CWRU-like rig) whose baseline has a 1× line 40 dB over
+    its floor; its record with that line 4 times as strong, against the shaft-force causes:
+    ``unbalance``, its rotating force reaching the sensor through the machine's gain at 1×
+    (the baseline's line over a G 6.3 residual unbalance), so its size is 3-3.9 residual
+    unbalances (in phase 3, at a random phase √15): in units of the static load, that many
+    times the share the machine file's note gives (within ×1.5). Through the path's gain
+    at 1× (its f² below the lowest pin, 5.9 times lower) it took the cause's bound, 2.0."""
+    from cmsim.discrepancy import compare
+    from cmsim.discrepancy.causes import CAUSES
+    from cmsim.discrepancy.synthetic import cwru_like_rig
+
+    rig, fs = cwru_like_rig(), 12_000.0
+    op = OperatingPoint(1797.0, radial_load_n=98.0665)
+    f = np.linspace(0.0, fs / 2, 1201)
+    shape = sum((f / f0) ** 2 / np.sqrt((1 - (f / f0) ** 2) ** 2 + (2 * z * f / f0) ** 2)
+                for f0, z in ((1500.0, 0.05), (3300.0, 0.04)))
+    path = TransferPath("F_1b1_y", tuple(f), tuple(1e-3 * np.maximum(shape, 1e-4)), "g")
+    level = 1e-9                                                   # g²/Hz, white
+    line = BackgroundLine("input", 1.0, 100.0 * math.sqrt(2.0 * level * 2.0))  # 40 dB, 2-Hz bins
+    background = Background((0.0, fs / 2), (level, level), (line,))
+    m = calibrate([_unbalanced(rig, op, path, background, fs, 13, 1.0)], seg_s=0.5, seed=7)
+    assert sorted(m.shaft_gain) == [1]
+    c = compare(_unbalanced(rig, op, path, background, fs, 29, 4.0), machine=m,
+                causes=[CAUSES["unbalance"](), CAUSES["misalignment"]()], seed=3)
+    assert c.finding == "unbalance", c.causes[:3]
+    ratio = c.parameters["relative_amplitude"] / _share(m)
+    assert 3.0 / 1.5 <= ratio <= 1.5 * 15 ** 0.5, ratio     # through the path's f²: 16.7
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "finding (issue 25): on the paper's gear rig at 50 N m a G 6.3 residual unbalance of the "
+    "driving gear's shaft is 0.506 N, 0.0024 of its bearing's static load (203 N), so a 1x "
+    "line 4 times the baseline's asks for a relative amplitude of about 0.008, under the "
+    "unbalance cause's lower bound 0.02 (8 residual unbalances, +18 dB): the cause makes "
+    "the record worse (delta chi2 -8) and it reads unexplained. The bounds and probes were "
+    "set on bearing rigs (share 0.1); through a machine an unbalance's size would better be "
+    "counted in residual unbalances."))
+def test_a_hidden_unbalance_on_a_loaded_gear_shaft_is_named(case):
+    """The calibrated gearbox's record with its 1× line 4 times the baseline's, against the
+    shaft-force causes: ``unbalance``."""
+    from cmsim.discrepancy import compare
+    from cmsim.discrepancy.causes import CAUSES
+
+    rig, path, background, m = case
+    record = _unbalanced(rig, OP, path, background, FS, 29, 4.0)
+    c = compare(record, machine=m, causes=[CAUSES["unbalance"](), CAUSES["misalignment"]()],
+                seed=3)
+    assert c.finding == "unbalance", c.causes[:3]
