@@ -37,7 +37,7 @@ from cmsim.faults import (BallDefect, Eccentricity, InnerRaceDefect, OuterRaceDe
 from cmsim.rig import HousingPath, OperatingPoint, Rig
 
 __all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
-           "MACHINE_NUISANCES", "machine_nuisances", "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO",
+           "MACHINE_NUISANCES", "register_cause", "applicable_causes", "NOMINAL_NOISE_RATIO",
            "STATISTICS"]
 
 #: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
@@ -572,18 +572,3 @@ MACHINE_NUISANCES = (
     Nuisance("noise", NOMINAL_NOISE_RATIO, (0.08, 0.125),
              tuple(float(v) for v in (0.02, 0.05, 0.08, 0.1, 0.125, 0.2, 0.35, 0.6, 1.0))),
 )
-
-
-def machine_nuisances(machine):
-    """The chain's nuisances against ``machine``: :data:`MACHINE_NUISANCES`, with the path's
-    frequencies held where model lines pinned its gain (``machine.pinned_hz``). A pin reads
-    the gain at a line's own frequency, and the lines the record lacks beside it cap the path
-    there, so a pinned mesh harmonic stands on a narrow peak of the path: scaled by 3 % the
-    peak left its carrier and lifted the sidebands against it — the third mesh sideband
-    features of a healthy gearbox twin by 3-5.5 dB, as much as a tooth fault (model
-    generator, seed 0) lifted them in the record, so the nuisance took the fault's evidence.
-    A path change beyond the pins is still the ``transfer_path`` cause."""
-    if not machine.pinned_hz:
-        return MACHINE_NUISANCES
-    path, *rest = MACHINE_NUISANCES
-    return (replace(path, prior=(1.0, 1.0)), *rest)

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmsim.discrepancy.causes import (CAUSES, NUISANCES, machine_nuisances, ModelSetup,
+from cmsim.discrepancy.causes import (CAUSES, MACHINE_NUISANCES, NUISANCES, ModelSetup,
                                       applicable_causes)
 from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, feature_floor,
                                          path_free, weight)
@@ -333,7 +333,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         return chi2(meas_fit, features, sigma, which)
 
     nuis = Nuisances(ev, lambda f: chi_of(f, cols), seeds,
-                     machine_nuisances(machine) if mode == "machine" else NUISANCES)
+                     MACHINE_NUISANCES if mode == "machine" else NUISANCES)
     chi_nom, setup_nom = nuis.fit(nominal)
     f_nom_fit = ev.features(setup_nom, seeds)
     cands = list(causes) if causes is not None else applicable_causes(rig)

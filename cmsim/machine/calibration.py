@@ -649,8 +649,7 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
             own.append((f, a))
     fine, fine_df = _refined(own, longest, fs, df)
     bg_lines = [BackgroundLine(*_classify(f, shaft_hz, fine_df), a) for f, a in fine]
-    return (path, Background(tuple(freq), tuple(noise), tuple(bg_lines)), notes,
-            tuple(sorted(p[0] for p in pins)))
+    return path, Background(tuple(freq), tuple(noise), tuple(bg_lines)), notes, len(pins)
 
 
 def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
@@ -822,12 +821,11 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
         shaft = _shaft_gains(lines, model_rig, bearing, shaft_hz, df, force_runs)
         candidates = []
         for forced in (False, True):
-            path, background, chain_notes, pinned = _reading(forced, spectra, fs, freqs,
+            path, background, chain_notes, n_pins = _reading(forced, spectra, fs, freqs,
                                                              bearing, shaft_hz, ref, longest)
-            n_pins = len(pinned)
             machine = Machine(
                 name=name or (ref.record_id or "machine"), rig=model_rig,
-                shaft_gain=shaft[0], pinned_hz=pinned,
+                shaft_gain=shaft[0],
                 channel=ref.channel, model_signal=ref.model_signal, fs_hz=fs, op=op,
                 path=path, background=background, unit=path.unit,
                 unit_scale=ref.unit_scale, components=dict(ref.components), segment_s=seg_s,

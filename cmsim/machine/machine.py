@@ -120,9 +120,6 @@ class Machine:
         unbalance, a misalignment) to the sensor, sensor unit per N, read from the
         baseline's line there (:func:`~cmsim.machine.calibration.calibrate`); an order not
         listed takes the path's gain.
-    pinned_hz : tuple of float
-        Frequencies of the model lines the record showed, where the path's gain was read
-        (empty: the gain is a prior or read from the broadband's modulation).
     spread : dict
         Feature name → (mean, std) over the baseline's segments.
     fit_quality : dict
@@ -148,7 +145,6 @@ class Machine:
     segment_s: float = 0.5
     speed_wobble: float | None = None
     shaft_gain: dict = field(default_factory=dict)
-    pinned_hz: tuple = ()
     spread: dict = field(default_factory=dict)
     fit_quality: dict = field(default_factory=dict)
     calibrated_on: tuple = ()
@@ -259,7 +255,6 @@ class Machine:
                         "speed_wobble": -1.0 if self.speed_wobble is None else self.speed_wobble,
                         "components": dict(self.components),
                         "shaft_gain": {str(k): float(v) for k, v in self.shaft_gain.items()},
-                        "pinned_hz": [float(f) for f in self.pinned_hz],
                         "calibrated_on": list(self.calibrated_on), "notes": list(self.notes)},
             "operating": {"speed_rpm": self.op.speed_rpm, "torque_nm": self.op.torque_nm,
                           "radial_load_n": self.op.radial_load_n,
@@ -303,7 +298,6 @@ class Machine:
                 segment_s=float(m.get("segment_s", 0.5)),
                 speed_wobble=None if wobble < 0 else wobble,
                 shaft_gain={int(k): float(v) for k, v in m.get("shaft_gain", {}).items()},
-                pinned_hz=tuple(float(f) for f in m.get("pinned_hz", ())),
                 spread={k: (float(v[0]), float(v[1])) for k, v in data.get("spread", {}).items()},
                 fit_quality=dict(data.get("fit_quality", {})),
                 calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())))
