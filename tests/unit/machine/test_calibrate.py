@@ -202,6 +202,19 @@ def test_a_sharp_mode_twin_keeps_the_record_s_statistics(resonant_case):
     assert q["chi2_per_feature_with_model_spread"] < 2.0, q["worst_feature_with_model_spread"]
 
 
+def _bearing_machine():
+    """(rig, fs, op, path) of a ball-bearing machine: the benchmark's CWRU-like rig at
+    12 kHz and 1797 rpm, its housing two modes (1.5 kHz, 5 %; 3.3 kHz, 4 %)."""
+    from cmsim.discrepancy.synthetic import cwru_like_rig
+    rig, fs = cwru_like_rig(), 12_000.0
+    op = OperatingPoint(1797.0, radial_load_n=98.0665)
+    f = np.linspace(0.0, fs / 2, 1201)
+    shape = sum((f / f0) ** 2 / np.sqrt((1 - (f / f0) ** 2) ** 2 + (2 * z * f / f0) ** 2)
+                for f0, z in ((1500.0, 0.05), (3300.0, 0.04)))
+    return rig, fs, op, TransferPath("F_1b1_y", tuple(f),
+                                     tuple(1e-3 * np.maximum(shape, 1e-4)), "g")
+
+
 @pytest.fixture(scope="module")
 def bearing_case():
     """A ball-bearing machine (the benchmark's CWRU-like rig at 12 kHz, 5 s as half of a CWRU
@@ -209,13 +222,7 @@ def bearing_case():
     strong as the path's mean response there: the model's force makes about a third of the
     broadband between the modes and most of it on them, and its ball pass pins the path
     only under 500 Hz, below the housing band."""
-    from cmsim.discrepancy.synthetic import cwru_like_rig
-    rig, fs = cwru_like_rig(), 12_000.0
-    op = OperatingPoint(1797.0, radial_load_n=98.0665)
-    f = np.linspace(0.0, fs / 2, 1201)
-    shape = sum((f / f0) ** 2 / np.sqrt((1 - (f / f0) ** 2) ** 2 + (2 * z * f / f0) ** 2)
-                for f0, z in ((1500.0, 0.05), (3300.0, 0.04)))
-    path = TransferPath("F_1b1_y", tuple(f), tuple(1e-3 * np.maximum(shape, 1e-4)), "g")
+    rig, fs, op, path = _bearing_machine()
     force, edge, n = model_force(rig, op, "accel_1b1_y", fs, 5.0, 13)
     y = path.apply(force, fs)[edge:edge + n]
     fy = np.fft.rfftfreq(n, 1.0 / fs)
@@ -372,14 +379,8 @@ def test_a_hidden_unbalance_through_the_machine_is_named_and_sized_as_a_trend():
     at 1× (its f² below the lowest pin, 5.9 times lower) it took the cause's bound, 2.0."""
     from cmsim.discrepancy import compare
     from cmsim.discrepancy.causes import CAUSES
-    from cmsim.discrepancy.synthetic import cwru_like_rig
 
-    rig, fs = cwru_like_rig(), 12_000.0
-    op = OperatingPoint(1797.0, radial_load_n=98.0665)
-    f = np.linspace(0.0, fs / 2, 1201)
-    shape = sum((f / f0) ** 2 / np.sqrt((1 - (f / f0) ** 2) ** 2 + (2 * z * f / f0) ** 2)
-                for f0, z in ((1500.0, 0.05), (3300.0, 0.04)))
-    path = TransferPath("F_1b1_y", tuple(f), tuple(1e-3 * np.maximum(shape, 1e-4)), "g")
+    rig, fs, op, path = _bearing_machine()
     level = 1e-9                                                   # g²/Hz, white
     line = BackgroundLine("input", 1.0, 100.0 * math.sqrt(2.0 * level * 2.0))  # 40 dB, 2-Hz bins
     background = Background((0.0, fs / 2), (level, level), (line,))
