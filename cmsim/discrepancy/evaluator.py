@@ -20,6 +20,7 @@ import numpy as np
 from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.features import N_SHAPE_BANDS, relative_features
+from cmsim.frequencies import rig_frequencies
 from cmsim.machine import Background, model_force
 from cmsim.run import signal_info
 from cmsim.sensors import housing_acceleration
@@ -182,18 +183,10 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
     return x + noise_ratio * ref * rng.standard_normal(x.size)
 
 
-def _shaft_rate(setup, bearing):
-    """Rotation frequency of the shaft ``bearing`` (``1b1``, ``2b2`` ...) sits on, Hz."""
-    fr = setup.op.shaft_hz
-    if setup.rig.gears is not None and bearing.startswith("2"):
-        fr /= setup.rig.gears.ratio
-    return fr
-
-
 def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="1b1"):
     """The sensor signal of a simulated force (on ``bearing``) through ``setup``'s shaft
     forces (at the rate of that bearing's shaft) and chain."""
-    fr = _shaft_rate(setup, bearing)
+    fr = rig_frequencies(setup.rig, setup.op).bearing(bearing).shaft_hz
     force, rotating = _shaft_forces(force, fs, fr, setup.shaft_forces, seed)
     if setup.machine is not None:   # a machine's rotating forces have gains of their own
         return setup.machine.sensor_signal(force, edge, n, seed, speed_rpm=setup.op.speed_rpm,

@@ -466,10 +466,10 @@ def _modulation_pins(shape, spectra, fs, freqs, bearing, above_hz):
     return pins, bounds, shares
 
 
-def _shaft_gains(lines, rig, bearing, shaft_hz, df, forces):
+def _shaft_gains(lines, rig, bearing, fr, df, forces):
     """({order: gain}, force N, share of the static load): the gains, sensor unit per N,
     from a rotating force at the orders 1 to :data:`SHAFT_ORDERS` of the sensor bearing's
-    shaft to the sensor, read from the baseline's lines there (an order without a line gets
+    shaft (turning at ``fr`` Hz) to the sensor, read from the baseline's lines there (an order without a line gets
     none: the path's own gain there is used).
 
     The model makes no shaft line, so no model line reads the path there, yet an unbalance
@@ -491,8 +491,7 @@ def _shaft_gains(lines, rig, bearing, shaft_hz, df, forces):
     the force is a share of is the model force's, the level an unbalance cause's relative
     amplitude refers to.
     """
-    shaft = int(bearing.split("b")[0]) - 1
-    fr = shaft_hz[min(shaft, len(shaft_hz) - 1)]
+    shaft = int(bearing.split("b")[0]) - 1                # node "<shaft>b<k>"
     s = rig.shafts[shaft]
     centre = ((rig.gears.driving if shaft == 0 else rig.gears.driven).mass_kg
               if rig.gears is not None else s.rotor.mass_kg)
@@ -768,7 +767,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     freqs = rig_frequencies(rig, op)
     bearing = signal_info(ref.model_signal).component
     shaft_hz = (freqs.fr1_hz, freqs.fr2_hz if freqs.fr2_hz is not None else freqs.fr1_hz)
-    fr = shaft_hz[min(int(bearing.split("b")[0]) - 1, 1)]      # the sensor bearing's shaft
+    fr = freqs.bearing(bearing).shaft_hz                       # the sensor bearing's shaft
     notes = [f"operating point: {op.speed_rpm:.2f} rpm from the record; torque "
              f"{op.torque_nm:g} N m and radial load {op.radial_load_n:g} N as the record's "
              "model assumes (the load is not identified from a healthy record)"]
@@ -818,7 +817,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
                   * pf_floor[int(round(f / df))]]
         spectra = dict(baseline, pf_floor=pf_floor, force_lines=force_lines, strong=strong,
                        forces=force_runs + twin_forces, force_keep=_line_free(freq, pf))
-        shaft = _shaft_gains(lines, model_rig, bearing, shaft_hz, df, force_runs)
+        shaft = _shaft_gains(lines, model_rig, bearing, fr, df, force_runs)
         candidates = []
         for forced in (False, True):
             path, background, chain_notes, n_pins = _reading(forced, spectra, fs, freqs,
