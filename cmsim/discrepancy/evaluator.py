@@ -21,7 +21,7 @@ from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.features import N_SHAPE_BANDS, relative_features
 from cmsim.frequencies import rig_frequencies
-from cmsim.machine import Background, model_force
+from cmsim.machine import Background, model_force, rotating_force, static_load
 from cmsim.run import signal_info
 from cmsim.sensors import housing_acceleration
 from cmsim.spectra.floor import running_median_floor, segment_psd
@@ -90,24 +90,11 @@ def _shaft_forces(force, fs, shaft_hz, terms, seed):
     load moved the 1× line by 0.0 dB.)"""
     if not terms:
         return force, ()
-    t = np.arange(force.size) / fs
-    mean = float(force.mean())
-    static = max(abs(mean), float(np.std(force)))
+    mean, static = float(force.mean()), static_load(force)
     phase = np.random.default_rng([int(seed), 65537]).uniform(0.0, 2.0 * math.pi)
-    mod = np.zeros_like(force)
-    for k, a in terms:
-        mod += a * np.cos(2.0 * math.pi * k * shaft_hz * t + k * phase)
+    mod = rotating_force(force.size, fs, shaft_hz, [(k, a, k * phase) for k, a in terms])
     return mean + (force - mean) * (1.0 + mod), tuple((k, a * static, k * phase)
                                                       for k, a in terms)
-
-
-def _rotating(n, fs, shaft_hz, rotating):
-    """The rotating forces of :func:`_shaft_forces` as a signal of ``n`` samples, N."""
-    t = np.arange(n) / fs
-    out = np.zeros(n)
-    for k, amp, phase in rotating:
-        out += amp * np.cos(2.0 * math.pi * k * shaft_hz * t + phase)
-    return out
 
 
 def record_floor(x, fs_hz, n):
@@ -195,7 +182,7 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="
                                            line_gain=setup.background_gain,
                                            rotating=(fr, rotating) if rotating else None)
     if rotating:
-        force = force + _rotating(force.size, fs, fr, rotating)
+        force = force + rotating_force(force.size, fs, fr, rotating)
     return sensor_signal(force, edge, n, fs, setup.housing, setup.noise_ratio, noise_ref_rms,
                          seed, floor)
 

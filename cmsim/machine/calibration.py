@@ -101,7 +101,7 @@ from cmsim.features.lines import SLIP_TOLERANCE, line_window
 from cmsim.features.relative import segments
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine.background import Background, BackgroundLine
-from cmsim.machine.machine import Machine, model_force
+from cmsim.machine.machine import Machine, model_force, static_load
 from cmsim.machine.path import TransferPath, smooth_log
 from cmsim.run import signal_info
 from cmsim.spectra.floor import median_window_bins, running_median_floor, segment_psd
@@ -497,8 +497,7 @@ def _shaft_gains(lines, rig, bearing, fr, df, forces):
               if rig.gears is not None else s.rotor.mass_kg)
     mass = centre + s.bearing_1.mass_kg + s.bearing_2.mass_kg
     force = 0.5 * mass * BALANCE_GRADE_MM_S * 1e-3 * 2.0 * math.pi * fr
-    static = float(np.mean([max(abs(float(x[e:e + n].mean())), float(np.std(x[e:e + n])))
-                            for x, e, n in forces]))
+    static = float(np.mean([static_load(x[e:e + n]) for x, e, n in forces]))
     gains = {}
     for k in range(1, SHAFT_ORDERS + 1):
         match = [a for f, a in lines if _near(f, k * fr, df)]

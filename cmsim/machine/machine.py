@@ -34,7 +34,8 @@ from cmsim.rig import OperatingPoint, Rig
 from cmsim.rig.codec import drop_none
 from cmsim.run import signal_info
 
-__all__ = ["Machine", "model_force", "MACHINE_FORMAT_VERSION", "EDGE_S"]
+__all__ = ["Machine", "model_force", "static_load", "rotating_force",
+           "MACHINE_FORMAT_VERSION", "EDGE_S"]
 
 #: Version written in a machine file; :meth:`Machine.load` refuses other versions.
 MACHINE_FORMAT_VERSION = 1
@@ -79,6 +80,40 @@ def model_force(rig, op, model_signal, fs_hz, duration_s, seed, *, faults=(),
     edge = int(round(EDGE_S * run.fs_hz))
     n = int(round(duration_s * run.fs_hz))
     return np.asarray(run[name], dtype=float)[: n + 2 * edge], edge, n
+
+
+def static_load(force):
+    """The load a shaft force's relative amplitude refers to: max(|mean|, std) of a bearing
+    force, N (its static part, or its swing where that is larger)."""
+    force = np.asarray(force, dtype=float)
+    return max(abs(float(force.mean())), float(np.std(force)))
+
+
+def rotating_force(n, fs_hz, shaft_hz, terms, start=0):
+    """Rotating forces at shaft orders as a signal: Σ A·cos(2π·k·fr·t + φ) over ``terms``
+    ((order k, amplitude A, phase φ) …), on ``n`` samples from sample ``start`` (t = 0 at
+    sample 0).
+
+    Parameters
+    ----------
+    n : int
+        Samples.
+    fs_hz, shaft_hz : float
+        Sample rate and the shaft's rate, Hz.
+    terms : sequence of (int, float, float)
+        Order, amplitude (any unit), phase (rad).
+    start : int
+        Index of the first sample.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+    """
+    t = (start + np.arange(n)) / fs_hz
+    out = np.zeros(n)
+    for k, amp, phase in terms:
+        out += amp * np.cos(2.0 * np.pi * k * shaft_hz * t + phase)
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -187,10 +222,8 @@ class Machine:
         y = self.path.apply(force, self.fs_hz, frequency_factor)[edge:edge + n]
         if rotating is not None:
             fr, terms = rotating
-            t = (edge + np.arange(n)) / self.fs_hz
-            for k, amp, phase in terms:
-                y = y + self.rotating_gain(k, fr) * amp * np.cos(2.0 * np.pi * k * fr * t
-                                                                 + phase)
+            y = y + rotating_force(n, self.fs_hz, fr, [(k, self.rotating_gain(k, fr) * amp, ph)
+                                                       for k, amp, ph in terms], start=edge)
         fr1 = (self.op.speed_rpm if speed_rpm is None else speed_rpm) / 60.0
         fr2 = fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1
         rng = np.random.default_rng([int(seed), 104729])

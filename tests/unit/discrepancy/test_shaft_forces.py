@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from cmsim.discrepancy.evaluator import _rotating, _shaft_forces
-from cmsim.machine import Background, Machine, TransferPath
+from cmsim.discrepancy.evaluator import _shaft_forces
+from cmsim.machine import Background, Machine, TransferPath, rotating_force
 from cmsim.rig import OperatingPoint, Rig
 
 FS = 10_000.0
@@ -30,7 +30,7 @@ def test_an_unbalance_adds_its_line_whatever_the_sign_of_the_load(static):
     t = np.arange(int(FS)) / FS
     dynamic = 5.0 * np.cos(2 * math.pi * 400.0 * t)
     modulated, rotating = _shaft_forces(static + dynamic, FS, FR, ((1, 0.3),), seed=4)
-    total = modulated + _rotating(t.size, FS, FR, rotating)
+    total = modulated + rotating_force(t.size, FS, FR, rotating)
     assert _line(total, FR) == pytest.approx(0.3 * 100.0, rel=1e-3)
     # the dynamic part swings with the load: sidebands of 0.3/2 of its 5 N at 400 ± 25 Hz
     for f in (375.0, 425.0):
