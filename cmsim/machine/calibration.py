@@ -158,6 +158,9 @@ WOBBLE_MIN_SNR = 100.0
 #: far a line may wander from its mean (a speed wobble moves every line in proportion to
 #: its frequency: ±9 Hz at 2.3 kHz, within the Hann main lobe below 1 kHz at 2-Hz bins).
 LINE_TOLERANCE = 0.004
+#: Shaft-rate sidebands each side of a mesh harmonic whose lines are taken for the mesh's
+#: own (:func:`_classify`): those the features read (``sb23``: ±2, ±3).
+MESH_FAMILY_SIDEBANDS = 3
 #: Lower edge of a housing's resonant band, as a share of the sample rate: below it the
 #: path is taken stiffness-controlled (accelerance ∝ f², the ω²/k of a structure below its
 #: first mode); the background there (rocking, the motor, the mains) does not shape it.
@@ -266,15 +269,30 @@ def _near(f, g, df):
     return abs(f - g) <= max(1.5 * df, LINE_TOLERANCE * g)
 
 
-def _classify(f, shaft_hz, fine_df):
+def _classify(f, shaft_hz, fine_df, gmf_hz=None):
     """(reference, value) of a background line read at the whole record's resolution
     ``fine_df``: an order of a shaft when it sits on one within a bin (or 0.1 %), else a
     fixed frequency (the mains and its sub-harmonics sit within a few tenths of a hertz of
-    a 4-pole motor's shaft orders, and only the fine bins tell them apart)."""
+    a 4-pole motor's shaft orders, and only the fine bins tell them apart). On a gear rig
+    (mesh frequency ``gmf_hz``), a line among a mesh harmonic's shaft-rate sidebands
+    (:data:`MESH_FAMILY_SIDEBANDS` of the slower shaft each side) is the nearest order
+    within :data:`LINE_TOLERANCE`: those are the mesh's own lines, order-locked, and a speed
+    wobble moves them k·Z times a shaft order's excursion (a 588-Hz mesh line under a 0.3 %
+    wobble of the baseline read 586.7 Hz at the fine resolution, was taken for a fixed
+    line, and the twin's mesh tracking locked on it instead of the model's harmonics)."""
     for ref, rate in zip(("input", "output"), shaft_hz):
         k = round(f / rate)
         if k >= 1 and abs(f - k * rate) <= max(fine_df, 1e-3 * f):
             return ref, float(k)
+    if gmf_hz:
+        slow = min(shaft_hz)
+        h = round(f / gmf_hz)
+        if h >= 1 and abs(f - h * gmf_hz) <= (MESH_FAMILY_SIDEBANDS + 0.5) * slow:
+            ref, rate = min(zip(("input", "output"), shaft_hz),
+                            key=lambda rr: abs(f - round(f / rr[1]) * rr[1]))
+            k = round(f / rate)
+            if abs(f - k * rate) <= LINE_TOLERANCE * f:
+                return ref, float(k)
     return "fixed", f
 
 
@@ -646,7 +664,8 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
         if a > 0.0:
             own.append((f, a))
     fine, fine_df = _refined(own, longest, fs, df)
-    bg_lines = [BackgroundLine(*_classify(f, shaft_hz, fine_df), a) for f, a in fine]
+    bg_lines = [BackgroundLine(*_classify(f, shaft_hz, fine_df, freqs.gmf_hz), a)
+                for f, a in fine]
     return path, Background(tuple(freq), tuple(noise), tuple(bg_lines)), notes, len(pins)
 
 

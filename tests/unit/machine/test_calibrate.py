@@ -153,6 +153,22 @@ def test_speed_wobble_is_read_where_a_shaft_order_stands_out(relative, noise, ex
         assert got == pytest.approx(expected, abs=0.08 * 0.01)
 
 
+@pytest.mark.parametrize("f, expected", [
+    (586.7, ("input", 21.0)),     # the mesh line (21 × 28 Hz) read 0.2 % low under a wobble
+    (613.9, ("input", 22.0)),     # its +1× sideband
+    (1166.9, ("output", 119.0)),  # 2 × GMF − the output shaft's rate, 0.2 % low
+    (120.0, ("fixed", 120.0)),    # the mains' 2nd harmonic, far from any mesh harmonic
+    (600.5, ("fixed", 600.5)),    # between sidebands, off every order by over 0.4 %
+])
+def test_a_line_of_the_mesh_family_is_an_order_though_a_wobble_moved_it(f, expected):
+    from cmsim.machine.calibration import _classify
+    shaft_hz, gmf = (28.0, 28.0 * 21 / 60), 588.0
+    assert _classify(f, shaft_hz, 0.33, gmf) == pytest.approx(expected)
+    # without a gear mesh the tight tolerance holds: a line 0.2 % off an order is fixed
+    if f == 586.7:
+        assert _classify(f, shaft_hz, 0.33) == ("fixed", f)
+
+
 @pytest.fixture(scope="module")
 def resonant_case():
     """A gearbox whose housing has one sharp mode (2 % damping) on the 5th mesh harmonic,
