@@ -180,7 +180,6 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="
                                            frequency_factor=setup.frequency_factor,
                                            noise_gain=setup.background_gain,
                                            line_gain=setup.background_gain,
-                                           white_noise=setup.white_noise,
                                            rotating=(fr, rotating) if rotating else None)
     if rotating:
         force = force + rotating_force(force.size, fs, fr, rotating)
