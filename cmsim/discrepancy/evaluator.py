@@ -83,11 +83,11 @@ def path_free(name):
 
 def _shaft_forces(force, fs, shaft_hz, terms, seed):
     """(modulated force, rotating forces) of the rotating shaft forces ``terms`` ((order,
-    relative amplitude) …) on ``force``: the dynamic force modulated by the load they swing,
-    F̄ + (F − F̄)·(1 + Σ a cos(kθ + kφ)), and the forces themselves, (order, a·L, kφ) each,
-    L = max(|F̄|, std F). (Modulating the whole force, F·(1 + m) + L·m, cancelled the
-    rotating force under a negative static load, F̄ = −L: an unbalance of three times the
-    load moved the 1× line by 0.0 dB.)"""
+    relative amplitude) …) on ``force``: the dynamic force modulated by the load they
+    swing, F̄ + (F − F̄)·(1 + Σ a cos(kθ + kφ)), and the forces themselves,
+    (order, a·L, kφ) each, L = :func:`~cmsim.machine.static_load` of F. (Modulating the
+    whole force, F·(1 + m) + L·m, cancelled the rotating force under a negative static load,
+    F̄ = −L: an unbalance of three times the load moved the 1× line by 0.0 dB.)"""
     if not terms:
         return force, ()
     mean, static = float(force.mean()), static_load(force)
