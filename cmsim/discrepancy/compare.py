@@ -214,28 +214,33 @@ def _prepare(record, seg_s, max_segments):
     return seg_s, duration, names, F
 
 
-def _calibration_misfit(machine, name):
-    """The twin's bias on feature ``name`` as its calibration measured it (sensor unit of the
-    feature), the baseline's spread where the calibration could not read it.
+def _calibration_bias(machine, name):
+    """(bias, σ of the bias) of the twin on feature ``name`` as its calibration measured it
+    (sensor unit of the feature): the twin's mean minus the held-out baseline segments'.
 
-    The held-out difference d = z·spread (twin's mean over its segments minus the held-out
-    segments' mean) holds the bias and the scatter of the two means, of variance
-    spread²/n_held + twin spread²/n_twin (the twin's spread read back from z over the
-    combined spread, ``z_with_model_spread``); what the scatter explains is not bias. Taking
-    the whole |d| for it widened a well-fitted feature's σ by the baseline's spread and more
-    (a 5th GMF harmonic's sidebands, whose spread is 4 dB, by 10 dB at z = 2.4).
+    A twin that misses a feature of its own baseline by a fixed amount (a waveform statistic
+    it cannot reproduce, an envelope line its background hides) misses it on every record
+    of the machine: the record is read against the twin's prediction moved by that bias, a
+    trend against the baseline as practice reads it. Widening σ by the bias instead muted
+    every feature the twin misses, and those are the features a fault moves (a gear twin's
+    kurtosis off by a hundred of its baseline's spreads judged nothing). The bias is known
+    to the scatter of the two means it was read from, of variance spread²/n_held + twin
+    spread²/n_twin (the twin's spread read back from z over the combined spread,
+    ``z_with_model_spread``): that is its σ. Where the calibration could not read it, no
+    bias and the baseline's spread (or the whole difference, when the twin's spread is
+    unknown).
     """
     q = machine.fit_quality
     base = machine.spread.get(name, (0.0, 0.0))[1]
     z = (q.get("z") or {}).get(name)
     if z is None or not math.isfinite(z):
-        return base
+        return 0.0, base
     z_m = (q.get("z_with_model_spread") or {}).get(name)
     n_held, n_twin = q.get("held_out_segments"), q.get("twin_segments")
     if not (z_m and math.isfinite(z_m) and n_held and n_twin):
-        return abs(z) * base
+        return 0.0, abs(z) * base
     twin_over_base = max((z / z_m) ** 2 - 1.0, 0.0)     # twin spread² / spread²
-    return base * math.sqrt(max(z * z - 1.0 / n_held - twin_over_base / n_twin, 0.0))
+    return z * base, base * math.sqrt(1.0 / n_held + twin_over_base / n_twin)
 
 
 def _check_machine(record, machine):
@@ -316,21 +321,24 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         not_judged = sorted({k.split("_")[0] + "_*" if k.startswith("shape_") else k
                              for k in cols if not path_free(k)})
         cols = [k for k in cols if path_free(k)]
-    sigma = {}
+    sigma, bias = {}, {}
     for k in cols:
         v_seed = float(np.nanvar([r[k] for r in var_rows], ddof=1))
         if mode == "machine":
-            misfit = _calibration_misfit(machine, k)
+            bias[k], known = _calibration_bias(machine, k)
             floor = 0.5 * feature_floor(k)
         else:
-            misfit = 0.0
+            bias[k], known = 0.0, 0.0
             floor = LEVEL_SIGMA_DB if k == "level_db" else feature_floor(k)
         sigma[k] = math.sqrt(v_seed * (1.0 + 1.0 / SIM_SEEDS)
-                             + spread[k] ** 2 * 2.0 / F.shape[0] + misfit ** 2 + floor ** 2)
+                             + spread[k] ** 2 * 2.0 / F.shape[0] + known ** 2 + floor ** 2)
+    # the record as the twin sees it: its features moved by the twin's calibrated bias
+    seen_fit = {k: meas_fit[k] + bias[k] for k in cols}
+    seen_held = {k: meas_held[k] + bias[k] for k in cols}
     n_eff = sum(weight(k) for k in cols)
 
     def chi_of(features, which):
-        return chi2(meas_fit, features, sigma, which)
+        return chi2(seen_fit, features, sigma, which)
 
     nuis = Nuisances(ev, lambda f: chi_of(f, cols), seeds,
                      MACHINE_NUISANCES if mode == "machine" else NUISANCES)
@@ -360,8 +368,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
 
     edges = shape_band_edges(record.fs_hz, 1.0 / seg_s)
     discrepancies = sorted(
-        ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k],
-          "sigma": sigma[k], "z": (meas_fit[k] - f_nom_fit[k]) / sigma[k],
+        ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k] - bias[k],
+          "sigma": sigma[k], "z": (seen_fit[k] - f_nom_fit[k]) / sigma[k],
           **_band_of(k, edges)} for k in cols),
         key=lambda d: -abs(d["z"]))
     top, ties = decide(ranked, ev.sensor_bearing, chi_nom)
@@ -379,7 +387,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
     held_seeds = ev.seeds(SIM_SEEDS, seed + 1)
 
     def held(setup):
-        return chi2(meas_held, ev.features(setup, held_seeds), sigma, cols) / n_eff
+        return chi2(seen_held, ev.features(setup, held_seeds), sigma, cols) / n_eff
 
     before = held(setup_nom)
     after = before if fitted is setup_nom else held(fitted)

@@ -17,7 +17,7 @@ import pytest
 
 from cmsim.discrepancy import CAUSES, Cause, compare, register_cause
 from cmsim.discrepancy.causes import applicable_causes
-from cmsim.discrepancy.compare import DEFAULT_BUDGET, _calibration_misfit
+from cmsim.discrepancy.compare import DEFAULT_BUDGET, _calibration_bias
 from cmsim.discrepancy.ranking import MIN_SIGNATURE_DELTA_CHI2
 from cmsim.measured import RECORDING_KEYS, data_root, estimate_shaft_hz, read_record
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
@@ -383,8 +383,8 @@ def test_the_finding_reads_as_an_engineer_says_it():
     assert "no cause" in describe("unexplained", None, {}, {})
 
 
-def _twin_misfits(bias, twin_sd, trials=3000, n_held=5, n_twin=6, seed=0):
-    """Misfits :func:`_calibration_misfit` reads back from calibrations of one feature
+def _twin_biases(bias, twin_sd, trials=3000, n_held=5, n_twin=6, seed=0):
+    """(bias, σ) pairs :func:`_calibration_bias` reads back from calibrations of one feature
     whose twin is off by ``bias`` (baseline spread 1), drawn as calibrate measures them."""
     rng = np.random.default_rng(seed)
     out = []
@@ -396,15 +396,16 @@ def _twin_misfits(bias, twin_sd, trials=3000, n_held=5, n_twin=6, seed=0):
         machine = SimpleNamespace(spread={"f": (0.0, spread)}, fit_quality={
             "z": {"f": d / spread}, "z_with_model_spread": {"f": d / math.hypot(spread, model)},
             "held_out_segments": n_held, "twin_segments": n_twin})
-        out.append(_calibration_misfit(machine, "f"))
+        out.append(_calibration_bias(machine, "f"))
     return np.array(out)
 
 
-def test_the_calibration_misfit_is_the_twins_bias_not_the_scatter_of_its_means():
-    """A twin that is right (no bias) adds far less than the scatter of the held-out
-    difference to σ (the whole |d| added it all); a twin off by 3 spreads reads about 3."""
-    scatter = 1.0 / 5 + 2.0 ** 2 / 6               # variance of d with no bias
-    right = _twin_misfits(0.0, 2.0)
-    assert np.mean(right ** 2) < 0.6 * scatter       # 0.54 with the clip at 0
-    off = _twin_misfits(3.0, 2.0)
-    assert 0.85 * 9.0 < np.mean(off ** 2) < 1.15 * 9.0
+def test_the_calibration_bias_is_read_back_with_the_scatter_of_its_means():
+    """A twin off by 3 spreads reads a bias of 3 on average; the σ it states is the scatter
+    of that read-back (the two means' scatter, 1/5 + 2²/6), whether or not the twin is off."""
+    scatter = 1.0 / 5 + 2.0 ** 2 / 6               # variance of d
+    for true in (0.0, 3.0):
+        got = _twin_biases(true, 2.0)
+        assert abs(np.mean(got[:, 0]) - true) < 0.1
+        assert 0.8 * scatter < np.var(got[:, 0]) < 1.2 * scatter
+        assert 0.8 * scatter < np.mean(got[:, 1] ** 2) < 1.25 * scatter
