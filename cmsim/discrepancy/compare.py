@@ -7,9 +7,11 @@
 2. **The nominal model** is one of three, and the result says which:
 
    * ``machine`` — a calibrated machine (:mod:`cmsim.machine`): the model's forces through
-     the machine's path plus its background; every feature is judged, each with the
-     baseline's own segment-to-segment spread and the calibration's held-out misfit in its
-     uncertainty, and the chain is refitted only within ±3 % / ±25 %;
+     the machine's path plus its background; every feature is judged, the record read
+     against the twin moved by the bias its calibration measured on held-out baseline
+     segments (a trend against the baseline), each with the baseline's own
+     segment-to-segment spread and the scatter of that bias in its uncertainty, and the
+     chain is refitted only within ±3 % / ±25 %;
    * ``documented`` — the rig's own housing path (a rig the user gave, or a record made
      through it): every feature, the chain refitted within an uncalibrated prior;
    * ``path-free`` — a rig built from metadata, whose housing path is a generic guess: only
@@ -25,8 +27,8 @@
 3. The model of a setup is simulated with :data:`SIM_SEEDS` seeds and its features
    averaged; every setup uses the same seeds (common random numbers). The model's own
    spread is measured on :data:`VAR_SEEDS` runs of the nominal model; with the record's
-   spread, a floor (and the machine's calibration misfit) it is each feature's σ, and
-   χ² = Σ w·min(((measured − simulated)/σ)², Z_CAP²).
+   spread, a floor (and the scatter of a machine's calibrated bias) it is each feature's σ,
+   and χ² = Σ w·min(((measured − simulated)/σ)², Z_CAP²).
 4. Causes are ranked and decided on the evidence their own signature moves
    (:mod:`cmsim.discrepancy.ranking`); the finding is a named cause, ``none`` (nothing
    departs from the model beyond its uncertainty), or ``unexplained`` (the record departs
@@ -82,8 +84,8 @@ UNEXPLAINED_CHI2_PER_FEATURE = 2.5
 
 #: Against a machine, a record with one feature this many σ from its twin departs from the
 #: baseline whatever the others read: σ holds the baseline's own segment-to-segment spread,
-#: the twin's scatter and its calibration misfit, and χ² caps a feature at Z_CAP, so a
-#: shaft line 12 dB over the baseline's (z 14; 4 times the force, the classic alarm of a
+#: the twin's scatter and that of its calibrated bias, and χ² caps a feature at Z_CAP, so
+#: a shaft line 12 dB over the baseline's (z 14; 4 times the force, the classic alarm of a
 #: trend) moved χ²/feature by 0.4 and read ``none`` when no cause could make that line.
 #: Records with no hidden effect reach |z| 5.2 (benchmarks/bench_compare.py, both
 #: generators, 7 records through a machine; real healthy halves 1.2-2.0).
