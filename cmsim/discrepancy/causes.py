@@ -490,12 +490,13 @@ class TorqueMismatchCause(Cause):
     name = "torque_mismatch"
     parameter = "load_factor"
     bounds = (0.15, 6.0)
-    #: The centres of four equal log cells of the bounds (each a factor 2.5 wide): every
-    #: load within 1.6× of a probe. A bearing's ball-pass comb sets its features by which
-    #: balls carry the load, so its χ² valley is narrow (a radial load 4.5 times the
-    #: documented one reads χ² 22 at 4.5, 55 at 3.5, 168 at 3.0): probed at 0.3 and 3.0
-    #: only, a load of 4.3 read worse than the nominal at its probe and was never refined.
-    probes = (0.24, 0.6, 1.5, 3.8)
+    #: A bearing's ball-pass comb sets its features by which balls carry the load, so the
+    #: load's χ² valley is narrow, about ±20 % around the true factor against a machine's
+    #: twin (a radial load 4.5 times the documented one reads χ² 22 at 4.5, 55 at 3.5, 99
+    #: at 5, 168 at 3.0): a load 2.5-6 times the documented one is probed every 1.5×, so
+    #: it lies within 1.33× of a probe. Probed at 3.8 alone, a factor 3.2 read worse than
+    #: the nominal and was never refined; at 3.0 alone, a factor 4.3.
+    probes = (0.3, 3.0, 4.5)
 
     def apply(self, setup, value, component):
         op = setup.op
