@@ -491,11 +491,12 @@ class TorqueMismatchCause(Cause):
     parameter = "load_factor"
     bounds = (0.15, 6.0)
     #: A bearing's ball-pass comb sets its features by which balls carry the load, so the
-    #: load's χ² valley is narrow, about ±20 % around the true factor against a machine's
-    #: twin (a radial load 4.5 times the documented one reads χ² 22 at 4.5, 55 at 3.5, 99
-    #: at 5, 168 at 3.0): a load 2.5-6 times the documented one is probed every 1.5×, so
-    #: it lies within 1.33× of a probe. Probed at 3.8 alone, a factor 3.2 read worse than
-    #: the nominal and was never refined; at 3.0 alone, a factor 4.3.
+    #: load's χ² valley is narrow (:func:`~cmsim.discrepancy.ranking.refine` measured χ² 22
+    #: at 4.5 times the documented load, 55 at 3.5, 99 at 5, 168 at 3.0), about ±20 %
+    #: against a machine's twin, whose σ holds only the scatter of its calibrated bias: a
+    #: load 2.5-6 times the documented one is probed every 1.5×, within 1.33× of a probe.
+    #: With 3.8 the highest probe a factor 3.2 read worse than the nominal there and was
+    #: never refined; with 3.0 the highest, a factor 4.3.
     probes = (0.3, 3.0, 4.5)
 
     def apply(self, setup, value, component):

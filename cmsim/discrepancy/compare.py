@@ -327,13 +327,14 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
     for k in cols:
         v_seed = float(np.nanvar([r[k] for r in var_rows], ddof=1))
         if mode == "machine":
-            bias[k], known = _calibration_bias(machine, k)
+            bias[k], bias_sigma = _calibration_bias(machine, k)
             floor = 0.5 * feature_floor(k)
         else:
-            bias[k], known = 0.0, 0.0
+            bias[k], bias_sigma = 0.0, 0.0
             floor = LEVEL_SIGMA_DB if k == "level_db" else feature_floor(k)
         sigma[k] = math.sqrt(v_seed * (1.0 + 1.0 / SIM_SEEDS)
-                             + spread[k] ** 2 * 2.0 / F.shape[0] + known ** 2 + floor ** 2)
+                             + spread[k] ** 2 * 2.0 / F.shape[0] + bias_sigma ** 2
+                             + floor ** 2)
     # the record as the twin sees it: its features moved by the twin's calibrated bias
     seen_fit = {k: meas_fit[k] + bias[k] for k in cols}
     seen_held = {k: meas_held[k] + bias[k] for k in cols}
