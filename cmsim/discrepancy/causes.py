@@ -571,11 +571,16 @@ NUISANCES = (
 )
 
 #: Against a calibrated machine: its path within ±3 % (temperature, mounting) and its
-#: background within ±25 % (the noise as the fraction :data:`NOMINAL_NOISE_RATIO` of 1).
+#: background within ±25 % (the noise as the fraction :data:`NOMINAL_NOISE_RATIO` of 1);
+#: released (the ``noise`` cause) up to 60 times the baseline's background (+36 dB: a
+#: loose sensor or a neighbour as loud as the machine over a background 20-30 dB under it;
+#: the grid stopped at 10 times, under the noise the benchmark hides, and the noise cause
+#: lost to a preload that silences the machine's comb).
 MACHINE_NUISANCES = (
     Nuisance("transfer_path", 1.0, (0.97, 1.03),
              tuple(float(v) for v in (0.5, 0.65, 0.8, 0.9, 0.97, 1.0, 1.03, 1.1, 1.25, 1.5,
                                       2.0))),
     Nuisance("noise", NOMINAL_NOISE_RATIO, (0.08, 0.125),
-             tuple(float(v) for v in (0.02, 0.05, 0.08, 0.1, 0.125, 0.2, 0.35, 0.6, 1.0))),
+             tuple(float(v) for v in (0.02, 0.05, 0.08, 0.1, 0.125, 0.2, 0.35, 0.6, 1.0,
+                                      1.8, 3.2, 6.0))),
 )
