@@ -47,14 +47,9 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    model's lines; a healthy bearing's ball-pass line is disowned when the gain it implies
    would show another harmonic the record lacks (:func:`_pins`).
 4. **Background.** The coloured noise is B(f) less what the model's broadband force puts
-   there through the path (at least 1 − :data:`MAX_SHARE` of B); the lines are the measured
-   lines the model does not make (matched within :data:`LINE_TOLERANCE` as the pins are):
-   one at a model line's frequency is the model's unless it stands more than
-   :data:`PIN_CONSISTENCY` over it through the path, and then only the excess power is
-   background. A smooth path misses a bearing twin's comb by -8 to +3 dB line by line
-   (measured on a simulated machine); that misfit filed as a background line stays when a
-   cause silences the comb (a preload), which the machine would not do. Each is filed as an
-   order of the input or
+   there through the path (at least 10 % of B); the lines are the measured lines less what
+   the model's own lines put there through the path (powers subtracted, the lines matched
+   within :data:`LINE_TOLERANCE` as the pins are), each filed as an order of the input or
    output shaft when it sits on one (so it follows the speed), else at its frequency (the
    mains, other machines). The **rotating forces** of an unbalance or a misalignment reach
    the sensor at the sensor bearing's shaft orders 1-3 through gains of their own: the
@@ -131,10 +126,8 @@ PATH_SMOOTHING_OCTAVE = 1.0 / 12.0
 MAX_LINES = 300
 #: Least height of a model line over the model force's own floor to pin the path, dB.
 MODEL_LINE_MIN_DB = 20.0
-#: Most a record's line may stand over what the model makes at its frequency (6 dB) before
-#: it is taken for another line at that frequency: a pinned gain over the lowest bound set by
-#: the model lines the record does not show (:func:`_pins`), and a line at a model line's
-#: frequency over that line through the path (step 4: within it, the model's own).
+#: Most a pinned gain may exceed the lowest bound set by model lines the record does not
+#: show (6 dB) before the record's line is taken for another line at that frequency.
 PIN_CONSISTENCY = 2.0
 #: Most of the record's broadband power the model's own broadband force may account for
 #: through the path, at any frequency: the rest is the machine's background.
@@ -658,7 +651,7 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
                         tuple(freq), tuple(np.maximum(gain, 1e-30)), unit)
 
     # the background: the rest of the broadband, and the lines the model does not make
-    noise = np.maximum(floor - gain ** 2 * pf_floor, (1.0 - MAX_SHARE) * floor)
+    noise = np.maximum(floor - gain ** 2 * pf_floor, 0.1 * floor)
     pinned = [p[0] for p in pins]
     own = []              # what the model's own lines put there is not background
     for f, a in lines:
@@ -667,10 +660,9 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
         made = [fa for fa in force_lines if _near(f, fa[0], df)]
         if made:
             model_amp = float(np.interp(f, freq, gain)) * max(fa[1] for fa in made)
-            if a <= PIN_CONSISTENCY * model_amp:
-                continue    # the model's line, its level off by the path's error there
-            a = math.sqrt(a * a - model_amp * model_amp)
-        own.append((f, a))
+            a = math.sqrt(max(a * a - model_amp * model_amp, 0.0))
+        if a > 0.0:
+            own.append((f, a))
     fine, fine_df = _refined(own, longest, fs, df)
     bg_lines = [BackgroundLine(*_classify(f, shaft_hz, fine_df, freqs.gmf_hz), a)
                 for f, a in fine]
