@@ -47,11 +47,11 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    model's lines; a healthy bearing's ball-pass line is disowned when the gain it implies
    would show another harmonic the record lacks (:func:`_pins`).
 4. **Background.** The coloured noise is B(f) less what the model's broadband force puts
-   there through the path (at least 10 % of B); the lines are the measured lines less what
-   the model's own lines put there through the path (powers subtracted, the lines matched
-   within :data:`LINE_TOLERANCE` as the pins are), each filed as an order of the input or
-   output shaft when it sits on one (so it follows the speed), else at its frequency (the
-   mains, other machines). The **rotating forces** of an unbalance or a misalignment reach
+   there through the path (at least 1 − :data:`MAX_SHARE` of B); the lines are the measured
+   lines less what the model's own lines put there through the path (powers subtracted, the
+   lines matched within :data:`LINE_TOLERANCE` as the pins are), each filed as an order of
+   the input or output shaft when it sits on one (so it follows the speed), else at its
+   frequency (the mains, other machines). The **rotating forces** of an unbalance or a misalignment reach
    the sensor at the sensor bearing's shaft orders 1-3 through gains of their own: the
    baseline's line at each order over the force of a residual unbalance of grade
    :data:`BALANCE_GRADE_MM_S` (:func:`_shaft_gains`), so that they are sized as a trend
@@ -651,7 +651,7 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
                         tuple(freq), tuple(np.maximum(gain, 1e-30)), unit)
 
     # the background: the rest of the broadband, and the lines the model does not make
-    noise = np.maximum(floor - gain ** 2 * pf_floor, 0.1 * floor)
+    noise = np.maximum(floor - gain ** 2 * pf_floor, (1.0 - MAX_SHARE) * floor)
     pinned = [p[0] for p in pins]
     own = []              # what the model's own lines put there is not background
     for f, a in lines:
