@@ -455,3 +455,24 @@ def test_the_twin_s_calibrated_bias_moves_the_record_it_does_not_widen_sigma(cas
     top = c.discrepancies[0]
     assert top["feature"] == "kurtosis_log"
     assert top["z"] > 8.0 and top["sigma"] < 0.1      # the record reads 0.5 over the twin
+
+
+def test_a_background_thirty_times_the_baseline_s_is_named_noise_and_sized(case):
+    """The calibrated gearbox's record with its background (coloured noise and lines) 30
+    times the baseline's (+30 dB: a loose sensor, a loud neighbour), against the noise
+    cause: ``noise``, sized about 30 times the nominal share (noise ratio 3.0 within a
+    factor 2). The search against a machine stopped at 10 times; the noise was sized at
+    that bound."""
+    from cmsim.discrepancy import compare
+    from cmsim.discrepancy.causes import CAUSES, NOMINAL_NOISE_RATIO
+
+    rig, path, background, m = case
+    force, edge, n = model_force(rig, OP, "accel_1b1_y", FS, 3.0, 29)
+    y = path.apply(force, FS)[edge:edge + n] + background.synthesize(
+        n, FS, (OP.shaft_hz, OP.shaft_hz), np.random.default_rng(30), 30.0, 30.0)
+    run = Run(np.arange(n) / FS, {"acc": y}, {"fs_hz": FS}, source="measured")
+    record = record_from_run(run, "acc", rig, OP, model_signal="accel_1b1_y")
+    c = compare(record, machine=m, causes=[CAUSES["noise"]()], seed=3)
+    assert c.finding == "noise", c.causes[:3]
+    ratio = c.parameters["noise_ratio"] / (30.0 * NOMINAL_NOISE_RATIO)
+    assert 0.5 <= ratio <= 2.0, c.parameters
