@@ -51,8 +51,9 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    lines less what the model's own lines put there through the path (powers subtracted, the
    lines matched within :data:`LINE_TOLERANCE` as the pins are), each filed as an order of
    the input or output shaft when it sits on one (so it follows the speed), else at its
-   frequency (the mains, other machines). The **rotating forces** of an unbalance or a misalignment reach
-   the sensor at the sensor bearing's shaft orders 1-3 through gains of their own: the
+   frequency (the mains, other machines). The **rotating forces** of an unbalance or a
+   misalignment reach the sensor at the sensor bearing's shaft orders 1-3 through gains of
+   their own: the
    baseline's line at each order over the force of a residual unbalance of grade
    :data:`BALANCE_GRADE_MM_S` (:func:`_shaft_gains`), so that they are sized as a trend
    against the baseline's own lines.

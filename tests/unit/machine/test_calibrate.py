@@ -467,11 +467,10 @@ def test_a_background_thirty_times_the_baseline_s_is_named_noise_and_sized(case)
     from cmsim.discrepancy.causes import CAUSES, NOMINAL_NOISE_RATIO
 
     rig, path, background, m = case
-    force, edge, n = model_force(rig, OP, "accel_1b1_y", FS, 3.0, 29)
-    y = path.apply(force, FS)[edge:edge + n] + background.synthesize(
-        n, FS, (OP.shaft_hz, OP.shaft_hz), np.random.default_rng(30), 30.0, 30.0)
-    run = Run(np.arange(n) / FS, {"acc": y}, {"fs_hz": FS}, source="measured")
-    record = record_from_run(run, "acc", rig, OP, model_signal="accel_1b1_y")
+    louder = replace(background, psd=tuple(900.0 * p for p in background.psd),
+                     lines=tuple(replace(ln, amplitude=30.0 * ln.amplitude)
+                                 for ln in background.lines))
+    record = _unbalanced(rig, OP, path, louder, FS, 29, 1.0)     # its own 1× line, ×30
     c = compare(record, machine=m, causes=[CAUSES["noise"]()], seed=3)
     assert c.finding == "noise", c.causes[:3]
     ratio = c.parameters["noise_ratio"] / (30.0 * NOMINAL_NOISE_RATIO)
