@@ -53,10 +53,9 @@ segment of :data:`SEGMENT_S` alternately goes to the **fit** set (even) and the
    the input or output shaft when it sits on one (so it follows the speed), else at its
    frequency (the mains, other machines). The **rotating forces** of an unbalance or a
    misalignment reach the sensor at the sensor bearing's shaft orders 1-3 through gains of
-   their own: the
-   baseline's line at each order over the force of a residual unbalance of grade
-   :data:`BALANCE_GRADE_MM_S` (:func:`_shaft_gains`), so that they are sized as a trend
-   against the baseline's own lines.
+   their own: the baseline's line at each order over the force of a residual unbalance of
+   grade :data:`BALANCE_GRADE_MM_S` (:func:`_shaft_gains`), so that they are sized as a
+   trend against the baseline's own lines.
 5. **Bearing clearance.** A healthy ball bearing under load makes a comb of ball-pass lines
    (varying compliance) whose level its clearance sets: strong with a clearance (fewer
    balls loaded), weak in line contact or under a preload. A machine's clearance is rarely
