@@ -43,6 +43,12 @@ __all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
 #: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
 NOMINAL_NOISE_RATIO = 0.1
 
+#: A calibrated machine's background level may differ from its baseline's by this factor
+#: either way (:data:`MACHINE_NUISANCES`); the ``noise`` cause through a machine scales it
+#: up to this and adds white noise beyond (a scaled baseline background cannot change the
+#: spectrum's shape, which a sensor's or a cable's noise does).
+MACHINE_BACKGROUND_SPREAD = 1.25
+
 #: Statistics of the whole signal that every impulsive fault moves (a bearing defect's and a
 #: tooth fault's signature share them): they add to a fault's evidence but never tell one
 #: fault from another, so a fault is told from the others by the rest of its signature, its
@@ -74,6 +80,9 @@ class ModelSetup:
         Scale of the machine path's frequencies (1: as calibrated).
     background_gain : float
         Factor on the machine's background (1: as calibrated).
+    white_noise : float
+        White noise at the machine's sensor, RMS relative to its background noise's
+        (:meth:`Machine.sensor_signal <cmsim.machine.Machine.sensor_signal>`).
     shaft_forces : tuple of (float, float)
         (shaft order, relative amplitude): a rotating force laid on the bearing force after
         the dynamics, ``F̄ + (F − F̄)·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
@@ -89,6 +98,7 @@ class ModelSetup:
     machine: object = None
     frequency_factor: float = 1.0
     background_gain: float = 1.0
+    white_noise: float = 0.0
     shaft_forces: tuple = ()
 
     def with_faults(self, *faults):
@@ -99,12 +109,13 @@ class ModelSetup:
         """What the simulated forces depend on (not the measurement chain nor the shaft
         forces laid on the force after the dynamics)."""
         return repr(replace(self, housing=None, noise_ratio=0.0, machine=None,
-                            frequency_factor=1.0, background_gain=1.0, shaft_forces=()))
+                            frequency_factor=1.0, background_gain=1.0, white_noise=0.0,
+                            shaft_forces=()))
 
     def chain_key(self):
         """What the sensor signal depends on besides the dynamics."""
         return (self.housing, self.noise_ratio, self.frequency_factor, self.background_gain,
-                self.shaft_forces)
+                self.white_noise, self.shaft_forces)
 
 
 @dataclass(frozen=True)
@@ -547,8 +558,13 @@ class NoiseCause(Cause):
     post_dynamics = True
 
     def apply(self, setup, value, component):
-        if setup.machine is not None:                # the calibrated background, scaled
-            return replace(setup, background_gain=value / NOMINAL_NOISE_RATIO)
+        if setup.machine is not None:
+            # the calibrated background, scaled within its own spread; a noise beyond it is
+            # one the baseline did not have, of a colour it cannot tell: white
+            gain = value / NOMINAL_NOISE_RATIO
+            return replace(setup, background_gain=min(gain, MACHINE_BACKGROUND_SPREAD),
+                           white_noise=math.sqrt(max(gain ** 2
+                                                     - MACHINE_BACKGROUND_SPREAD ** 2, 0.0)))
         return replace(setup, noise_ratio=value)
 
 
@@ -580,7 +596,8 @@ MACHINE_NUISANCES = (
     Nuisance("transfer_path", 1.0, (0.97, 1.03),
              tuple(float(v) for v in (0.5, 0.65, 0.8, 0.9, 0.97, 1.0, 1.03, 1.1, 1.25, 1.5,
                                       2.0))),
-    Nuisance("noise", NOMINAL_NOISE_RATIO, (0.08, 0.125),
+    Nuisance("noise", NOMINAL_NOISE_RATIO, (NOMINAL_NOISE_RATIO / MACHINE_BACKGROUND_SPREAD,
+                                            NOMINAL_NOISE_RATIO * MACHINE_BACKGROUND_SPREAD),
              tuple(float(v) for v in (0.02, 0.05, 0.08, 0.1, 0.125, 0.2, 0.35, 0.6, 1.0,
                                       1.8, 3.2, 6.0))),
 )

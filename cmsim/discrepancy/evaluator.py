@@ -27,11 +27,15 @@ from cmsim.sensors import housing_acceleration
 from cmsim.spectra.floor import running_median_floor, segment_psd
 
 __all__ = ["simulate_setup", "sensor_signal", "record_floor", "feature_floor", "path_free",
-           "chi2", "Evaluator", "Budget", "Z_CAP", "DB_FLOOR", "LOG_FLOOR", "LEVEL_REF",
-           "FLOOR_MEDIAN_HZ"]
+           "chi2", "huber", "Evaluator", "Budget", "Z_CAP", "DB_FLOOR", "LOG_FLOOR",
+           "LEVEL_REF", "FLOOR_MEDIAN_HZ"]
 
-#: A feature adds at most Z_CAP² to the χ² (robust: a misfit the catalogue cannot mend, such
-#: as an unknown transfer path next to a fault, does not hide what another cause explains).
+#: Beyond Z_CAP σ a feature's χ² grows linearly, not quadratically (Huber's loss,
+#: continuous in value and slope): a misfit the catalogue cannot mend, such as an unknown
+#: transfer path next to a fault, does not swamp what another cause explains, yet a cause
+#: that takes a far-off feature farther still pays for it. (A cap at Z_CAP², 2026-11-27 and
+#: before, could not tell a preload that brings a record 20 dB quieter than its twin 11 dB
+#: nearer from white noise that takes it 15 dB farther: both read Z_CAP² on the level.)
 Z_CAP = 4.0
 
 #: Least model uncertainty of a dB column (a line's level, a band's share), dB.
@@ -180,6 +184,7 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="
                                            frequency_factor=setup.frequency_factor,
                                            noise_gain=setup.background_gain,
                                            line_gain=setup.background_gain,
+                                           white_noise=setup.white_noise,
                                            rotating=(fr, rotating) if rotating else None)
     if rotating:
         force = force + rotating_force(force.size, fs, fr, rotating)
@@ -243,8 +248,13 @@ def chi2(meas, sim, sigma, names):
         s = sim.get(k, math.nan)
         if not math.isfinite(s):
             s = meas[k] - 3.0 * sigma[k]
-        total += weight(k) * min(((meas[k] - s) / sigma[k]) ** 2, Z_CAP ** 2)
+        total += weight(k) * huber(abs(meas[k] - s) / sigma[k])
     return total
+
+
+def huber(z):
+    """Huber's loss of a misfit ``z`` (in σ, ≥ 0): z² up to :data:`Z_CAP`, linear beyond."""
+    return z * z if z <= Z_CAP else Z_CAP * (2.0 * z - Z_CAP)
 
 
 class Budget(Exception):

@@ -144,7 +144,8 @@ def nuisance_params(setup, nominal):
     """The fitted chain of ``setup`` against the ``nominal`` one: ``noise_ratio`` and
     ``frequency_factor`` (the parameters of the ``noise`` and ``transfer_path`` causes)."""
     if setup.machine is not None:
-        return {"noise_ratio": setup.background_gain * nominal.noise_ratio,
+        return {"noise_ratio": math.hypot(setup.background_gain, setup.white_noise)
+                * nominal.noise_ratio,
                 "frequency_factor": setup.frequency_factor}
     return {"noise_ratio": setup.noise_ratio,
             "frequency_factor": setup.housing.natural_frequencies_hz[0]

@@ -93,6 +93,13 @@ class Background:
         object.__setattr__(self, "psd", tuple(float(x) for x in p))
         object.__setattr__(self, "lines", tuple(self.lines))
 
+    def noise_rms(self, fs_hz):
+        """RMS of the coloured noise up to the Nyquist frequency of ``fs_hz``: √∫ psd df."""
+        f = np.asarray(self.freq_hz)
+        keep = f <= 0.5 * fs_hz
+        f, p = f[keep], np.asarray(self.psd)[keep]
+        return float(np.sqrt(np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(f))))
+
     def noise(self, n, fs_hz, rng, gain=1.0):
         """``n`` samples of the coloured noise at ``fs_hz`` (``gain`` scales its RMS).
 

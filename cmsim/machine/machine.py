@@ -192,7 +192,7 @@ class Machine:
         return (fr1, fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1)
 
     def sensor_signal(self, force, edge, n, seed, *, speed_rpm=None, frequency_factor=1.0,
-                      noise_gain=1.0, line_gain=1.0, rotating=None):
+                      noise_gain=1.0, line_gain=1.0, rotating=None, white_noise=0.0):
         """The machine's sensor signal of a model force (:func:`model_force`'s output).
 
         Parameters
@@ -213,6 +213,10 @@ class Machine:
             Rotating forces at shaft orders, not in ``force``: the shaft's rate (Hz) and
             (order, amplitude N, phase rad) of each, ``A·cos(2π·k·fr·t + φ)`` with t = 0 at
             the force's first sample; each reaches the sensor through :attr:`shaft_gain`.
+        white_noise : float
+            White noise added at the sensor, RMS relative to the calibrated background
+            noise's (a noise the machine's baseline did not have: a sensor, a cable, a
+            loose mount).
 
         Returns
         -------
@@ -229,6 +233,9 @@ class Machine:
         rng = np.random.default_rng([int(seed), 104729])
         y = y + self.background.synthesize(n, self.fs_hz, (fr1, fr2), rng, noise_gain,
                                            line_gain)
+        if white_noise > 0.0:
+            y = y + white_noise * self.background.noise_rms(self.fs_hz) \
+                * rng.standard_normal(n)
         return y - y.mean()
 
     def rotating_gain(self, order, shaft_hz):

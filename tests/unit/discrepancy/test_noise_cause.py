@@ -1,0 +1,48 @@
+"""The ``noise`` cause through a calibrated machine (issue 25).
+
+Tier: closed form — the machine's background is a coloured noise of known RMS confined
+under 1 kHz; the cause scales it within its spread (:data:`MACHINE_BACKGROUND_SPREAD`) and
+adds white noise beyond, so the total RMS is the cause's ratio over the nominal one times
+the background's, and the noise beyond the spread reaches the bands the baseline's
+background leaves empty (a scaled background cannot change the spectrum's shape).
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from cmsim.discrepancy.causes import (CAUSES, MACHINE_BACKGROUND_SPREAD, NOMINAL_NOISE_RATIO,
+                                      ModelSetup)
+from cmsim.discrepancy.evaluator import _chain
+from cmsim.machine import Background, Machine, TransferPath
+from cmsim.rig import OperatingPoint, Rig
+
+FS = 10_000.0
+
+
+def _setup(value):
+    rig = Rig.paper_2016()
+    f = np.linspace(0.0, FS / 2, 501)
+    psd = np.where(f <= 1000.0, 2e-4, 0.0)                     # 0.2 g² in all: RMS 0.447
+    m = Machine("m", rig, "acc", "accel_1b1_y", FS, OperatingPoint(1500.0, 50.0),
+                TransferPath("F_1b1_y", (0.0, FS / 2), (1e-12, 1e-12), "g"),
+                Background(tuple(f), tuple(psd)))
+    nominal = ModelSetup(rig=rig, op=m.op, machine=m)
+    return m, CAUSES["noise"]().apply(nominal, value, None)
+
+
+@pytest.mark.parametrize("factor", [0.5, 1.0, MACHINE_BACKGROUND_SPREAD, 2.5, 6.0])
+def test_the_noise_cause_sets_the_total_rms_and_whitens_beyond_the_spread(factor):
+    m, setup = _setup(NOMINAL_NOISE_RATIO * factor)
+    n = 200_000
+    y = _chain(setup, np.zeros(n), 0, n, FS, 3, None)
+    bg = m.background.noise_rms(FS)
+    assert bg == pytest.approx(math.sqrt(0.2), rel=0.01)
+    assert float(np.std(y)) == pytest.approx(factor * bg, rel=0.02)
+    spec = np.abs(np.fft.rfft(y)) ** 2
+    f = np.fft.rfftfreq(n, 1.0 / FS)
+    high = float(np.sum(spec[f > 1100.0]) / np.sum(spec))
+    white = max(factor ** 2 - MACHINE_BACKGROUND_SPREAD ** 2, 0.0)
+    # the white part spreads evenly to the Nyquist frequency: 0.78 of it above 1.1 kHz
+    assert high == pytest.approx(white / factor ** 2 * (1.0 - 1100.0 / (FS / 2)), abs=0.01)
