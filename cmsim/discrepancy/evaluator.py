@@ -355,6 +355,8 @@ class Evaluator:
         rows = [self.row(setup, s) for s in seeds]
         if any(r is None for r in rows):
             return None
+        names = list(rows[0])
         with warnings.catch_warnings():          # a column NaN in every run stays NaN
             warnings.simplefilter("ignore", RuntimeWarning)
-            return {k: float(np.nanmean([r[k] for r in rows])) for k in rows[0]}
+            mean = np.nanmean([[r[k] for k in names] for r in rows], axis=0)
+        return dict(zip(names, mean.tolist()))

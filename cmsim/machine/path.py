@@ -122,9 +122,16 @@ class TransferPath:
 
     def fir(self, fs_hz, frequency_factor=1.0):
         """The minimum-phase FIR of the path at ``fs_hz`` (:func:`minimum_phase_fir`), its
-        frequencies scaled by ``frequency_factor``."""
-        grid = tuple(float(f) * frequency_factor for f in self.freq_hz)
-        return minimum_phase_fir(grid, self.gain, fs_hz)
+        frequencies scaled by ``frequency_factor`` (kept on the path: a comparison applies
+        one path hundreds of times, and converting and hashing its grid cost as much as the
+        convolution)."""
+        key = (float(fs_hz), float(frequency_factor))
+        kept = self.__dict__.setdefault("_firs", {})
+        if key not in kept:
+            grid = tuple(float(f) * frequency_factor for f in self.freq_hz)
+            kept[key] = minimum_phase_fir(grid, self.gain, fs_hz)
+            kept[key].setflags(write=False)
+        return kept[key]
 
     def apply(self, force, fs_hz, frequency_factor=1.0):
         """The sensor signal of a force, causal, same length and instants; the filter starts

@@ -34,6 +34,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.linalg
@@ -138,11 +139,18 @@ def residual_kurtogram(x, fs, **kwargs):
     return kurtogram(prediction_residual(x), fs, **kwargs)
 
 
+@lru_cache(maxsize=64)
+def _hann_stft(nperseg, hop, fs):
+    """The Hann STFT of a window length, hop and rate, kept (its set-up cost as much as the
+    transform of a short record, and a band rule reads thousands of them)."""
+    return scipy.signal.ShortTimeFFT(scipy.signal.get_window("hann", nperseg), hop, fs,
+                                     fft_mode="onesided")
+
+
 def _stft_moments(x, fs, nperseg, overlap):
     """|X|² and |X|⁴ averaged over the fully contained STFT segments."""
     hop = max(1, int(round(nperseg * (1.0 - overlap))))
-    sft = scipy.signal.ShortTimeFFT(scipy.signal.get_window("hann", nperseg), hop, fs,
-                                    fft_mode="onesided")
+    sft = _hann_stft(nperseg, hop, fs)
     p0 = sft.lower_border_end[1]
     p1 = sft.upper_border_begin(x.size)[1]
     if p1 - p0 < MIN_SEGMENTS:

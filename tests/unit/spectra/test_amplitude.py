@@ -101,3 +101,22 @@ def test_record_too_short_message_gives_needed_length():
         amplitude_spectrum(np.ones(100), 100.0, resolution_hz=0.5)
     s = amplitude_spectrum(np.ones(200), 100.0, resolution_hz=0.5)
     assert s.resolution_hz <= 0.5
+
+
+@pytest.mark.parametrize("n", [1000, 1001, 4096])
+@pytest.mark.parametrize("window", ["flattop", "hann", "boxcar"])
+@pytest.mark.parametrize("detrend", ["constant", "linear", None])
+def test_the_single_fft_spectrum_is_scipy_s_periodogram_in_amplitude(n, window, detrend):
+    """The spectrum is computed without scipy's per-call set-up; it must stay the periodogram
+    (``scaling="spectrum"``) in amplitude: √(2P), at DC and Nyquist √P."""
+    import scipy.signal
+    x = np.random.default_rng(n).standard_normal(n) + 3.0 + np.linspace(0.0, 2.0, n)
+    f, p = scipy.signal.periodogram(x, FS, window=window, detrend=detrend or False,
+                                    scaling="spectrum")
+    want = np.sqrt(2.0 * p)
+    want[0] = np.sqrt(p[0])
+    if n % 2 == 0:
+        want[-1] = np.sqrt(p[-1])
+    got = amplitude_spectrum(x, FS, window=window, detrend=detrend)
+    np.testing.assert_allclose(got.freq_hz, f, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(got.amplitude, want, rtol=1e-10, atol=1e-12 * want.max())
