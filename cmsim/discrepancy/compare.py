@@ -28,7 +28,8 @@
    averaged; every setup uses the same seeds (common random numbers). The model's own
    spread is measured on :data:`VAR_SEEDS` runs of the nominal model; with the record's
    spread, a floor (and the scatter of a machine's calibrated bias) it is each feature's σ,
-   and χ² = Σ w·ρ(|measured − simulated|/σ), ρ Huber's loss (z² up to Z_CAP, linear beyond).
+   and χ² = Σ w·min(((measured − simulated)/σ)², Z_CAP²) (the level rising linearly beyond
+   Z_CAP instead: :data:`~cmsim.discrepancy.evaluator.RISING`).
 4. Causes are ranked and decided on the evidence their own signature moves
    (:mod:`cmsim.discrepancy.ranking`); the finding is a named cause, ``none`` (nothing
    departs from the model beyond its uncertainty), or ``unexplained`` (the record departs
@@ -84,7 +85,7 @@ UNEXPLAINED_CHI2_PER_FEATURE = 2.5
 
 #: Against a machine, a record with one feature this many σ from its twin departs from the
 #: baseline whatever the others read: σ holds the baseline's own segment-to-segment spread,
-#: the twin's scatter and that of its calibrated bias, and χ² capped a feature at Z_CAP, so
+#: the twin's scatter and that of its calibrated bias, and χ² caps a feature at Z_CAP, so
 #: a shaft line 12 dB over the baseline's (z 14; 4 times the force, the classic alarm of a
 #: trend) moved χ²/feature by 0.4 and read ``none`` when no cause could make that line.
 #: Records with no hidden effect reach |z| 5.2 (benchmarks/bench_compare.py, both
