@@ -75,23 +75,11 @@ def line_window(freq, f_hz, tolerance=EXACT_TOLERANCE, half_width_bins=LINE_HALF
         None when the line is not in the spectrum (f <= 0, not finite, or its window holds
         no bin).
     """
-    bins = _line_bins(freq, f_hz, tolerance, half_width_bins)
-    if bins is None:
-        return None
-    sel = np.zeros(np.shape(freq), dtype=bool)
-    sel[bins] = True
-    return sel
-
-
-def _line_bins(freq, f_hz, tolerance, half_width_bins=LINE_HALF_WIDTH_BINS):
-    """The bins of :func:`line_window` as a slice (found by bisection: the features of a
-    comparison read a hundred thousand lines), or None."""
     if not (math.isfinite(f_hz) and f_hz > 0.0):
         return None
     half = tolerance * f_hz + half_width_bins * float(freq[1] - freq[0])
-    lo = int(np.searchsorted(freq, f_hz - half, side="left"))      # first freq >= f - half
-    hi = int(np.searchsorted(freq, f_hz + half, side="right"))     # past the last <= f + half
-    return slice(lo, hi) if hi > lo else None
+    sel = (freq >= f_hz - half) & (freq <= f_hz + half)
+    return sel if np.any(sel) else None
 
 
 def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE):
@@ -125,7 +113,7 @@ def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE):
     2.0
     """
     amp = np.asarray(amp)
-    sel = _line_bins(freq, f_hz, tolerance)
+    sel = line_window(freq, f_hz, tolerance)
     if sel is None:
         return math.nan if amp.ndim == 1 else np.full(amp.shape[:-1], math.nan)
     peak = amp[..., sel].max(axis=-1)

@@ -1,4 +1,4 @@
-"""THE line rule's window (issue 25's speed-up reads it by bisection).
+"""THE line rule's window: every bin within the tolerance and half-width of the line.
 
 Test tier: closed form — the window of a line at f with relative tolerance t holds exactly
 the bins within t·f + 1.5 bins of f (its definition as a mask over every bin); a line's
