@@ -587,11 +587,12 @@ NUISANCES = (
 )
 
 #: Against a calibrated machine: its path within ±3 % (temperature, mounting) and its
-#: background within ±25 % (the noise as the fraction :data:`NOMINAL_NOISE_RATIO` of 1);
-#: released (the ``noise`` cause) up to 60 times the baseline's background (+36 dB: a
-#: loose sensor or a neighbour as loud as the machine over a background 20-30 dB under it;
-#: the grid stopped at 10 times, under the noise the benchmark hides, 0.8-3 times the
-#: healthy signal's RMS, which was then sized at that bound).
+#: background within ±25 % (:data:`MACHINE_BACKGROUND_SPREAD`; the noise as the fraction
+#: :data:`NOMINAL_NOISE_RATIO` of 1); released (the ``noise`` cause, white beyond the
+#: spread) up to 60 times the baseline's background noise in RMS (+36 dB: a loose sensor or
+#: a neighbour as loud as the machine over a background 20-30 dB under it; the grid stopped
+#: at 10 times, under the noise the benchmark hides, 0.8-3 times the healthy signal's RMS,
+#: which was then sized at that bound).
 MACHINE_NUISANCES = (
     Nuisance("transfer_path", 1.0, (0.97, 1.03),
              tuple(float(v) for v in (0.5, 0.65, 0.8, 0.9, 0.97, 1.0, 1.03, 1.1, 1.25, 1.5,
