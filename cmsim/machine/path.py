@@ -18,7 +18,6 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 from scipy.signal import oaconvolve
@@ -57,24 +56,19 @@ def minimum_phase_fir(freq_hz, gain, fs_hz, n_taps=FIR_TAPS):
     >>> round(float(h[0]), 6), round(float(np.abs(h[1:]).max()), 6)
     (2.0, 0.0)
     """
-    return _fir(tuple(float(f) for f in freq_hz), tuple(float(g) for g in gain),
-                float(fs_hz), int(n_taps)).copy()
-
-
-@lru_cache(maxsize=32)
-def _fir(freq_hz, gain, fs_hz, n_taps):
-    n_fft = 4 * n_taps
-    f = np.fft.rfftfreq(n_fft, 1.0 / fs_hz)
-    log_mag = np.interp(f, freq_hz, np.log(np.maximum(gain, 1e-30)))
+    n_fft = 4 * int(n_taps)
+    f = np.fft.rfftfreq(n_fft, 1.0 / float(fs_hz))
+    log_mag = np.interp(f, np.asarray(freq_hz, dtype=float),
+                        np.log(np.maximum(np.asarray(gain, dtype=float), 1e-30)))
     full = np.concatenate([log_mag, log_mag[-2:0:-1]])           # even, real: log|H|
     cep = np.fft.ifft(full).real
     fold = np.zeros(n_fft)
     fold[0] = 1.0
     fold[1:n_fft // 2] = 2.0
     fold[n_fft // 2] = 1.0
-    h = np.fft.ifft(np.exp(np.fft.fft(cep * fold))).real[:n_taps]
-    taper = np.ones(n_taps)                                      # no truncation click
-    k = n_taps // 8
+    h = np.fft.ifft(np.exp(np.fft.fft(cep * fold))).real[:int(n_taps)]
+    taper = np.ones(int(n_taps))                                 # no truncation click
+    k = int(n_taps) // 8
     taper[-k:] = 0.5 * (1.0 + np.cos(np.pi * np.arange(1, k + 1) / k))
     return h * taper
 
@@ -122,13 +116,12 @@ class TransferPath:
 
     def fir(self, fs_hz, frequency_factor=1.0):
         """The minimum-phase FIR of the path at ``fs_hz`` (:func:`minimum_phase_fir`), its
-        frequencies scaled by ``frequency_factor`` (kept on the path: a comparison applies
-        one path hundreds of times, and converting and hashing its grid cost as much as the
-        convolution)."""
+        frequencies scaled by ``frequency_factor`` (kept on the path, per rate and factor: a
+        comparison applies one path hundreds of times)."""
         key = (float(fs_hz), float(frequency_factor))
         kept = self.__dict__.setdefault("_firs", {})
         if key not in kept:
-            grid = tuple(float(f) * frequency_factor for f in self.freq_hz)
+            grid = np.asarray(self.freq_hz) * frequency_factor
             kept[key] = minimum_phase_fir(grid, self.gain, fs_hz)
             kept[key].setflags(write=False)
         return kept[key]
