@@ -182,7 +182,7 @@ def amplitude_spectrum(x, fs, window="flattop", detrend="constant", *, resolutio
                 f"record too short for resolution_hz={res:g} Hz: it needs at least {need} "
                 f"samples ({need / fs:g} s) at fs={fs:g} Hz, got {n} samples ({n / fs:g} s)")
     # scipy.signal.periodogram(scaling="spectrum") converted to amplitude, without its
-    # per-call window and STFT set-up (a third of a comparison's feature time)
+    # per-call window and STFT set-up (a quarter of a comparison's feature time)
     if det == "constant":
         x = x - x.mean()
     elif det:
