@@ -3,6 +3,7 @@ cause, its fit and the gain on held-out segments."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, load_file, ranged
@@ -39,6 +40,9 @@ def register(sub):
                    help="the record's machine (cmsim calibrate on a healthy baseline): the "
                         "nominal model; without it, only path-free evidence is judged "
                         "unless --rig documents the housing path")
+    p.add_argument("--workers", type=ranged(Range(1, 256, integer=True)), default=None,
+                   help="processes that make the model's runs (default: 2 where there are "
+                        "2 CPUs or more; the same result with any number)")
     p.add_argument("--span", type=ranged(Range(0.0, 1.0e5, unit="s")), nargs=2,
                    metavar=("START", "STOP"), help="compare only this part of the record, s")
     p.set_defaults(func=run, text=text)
@@ -62,6 +66,7 @@ def run(args):
     if args.span is not None:
         record = record.span(*args.span)
     kw = {} if args.budget is None else {"budget": args.budget}
+    kw["workers"] = args.workers or min(2, os.cpu_count() or 1)
     args.notice_compile()
     try:
         res = compare(record, machine=machine, seed=args.seed, **kw)

@@ -35,8 +35,9 @@ from concurrent.futures.process import BrokenProcessPool
 
 from cmsim.errors import ParameterError, WorkersDied
 
-__all__ = ["run_tasks", "Interrupted", "POOL_RESTARTS", "START_METHODS", "default_start_method",
-           "check_workers", "check_start_method", "scheduler_client", "keep_freed_memory"]
+__all__ = ["run_tasks", "process_pool", "Interrupted", "POOL_RESTARTS", "START_METHODS",
+           "default_start_method", "check_workers", "check_start_method", "scheduler_client",
+           "keep_freed_memory"]
 
 #: Process start methods accepted by :func:`run_tasks`.
 START_METHODS = ("fork", "spawn", "forkserver")
@@ -128,19 +129,36 @@ def _die_with_parent():
         return False
 
 
-def _worker_init(parent_pid):
+def _worker_init(parent_pid, initializer=None, initargs=()):
     """Pool initializer: only the parent reacts to Ctrl-C/SIGTERM; the worker dies with the
     parent (SIGKILL from the kernel on Linux, else a thread that watches it) and keeps the
-    memory its tasks free (:func:`keep_freed_memory`)."""
+    memory its tasks free (:func:`keep_freed_memory`); then ``initializer(*initargs)``."""
     keep_freed_memory()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if _die_with_parent():
         if os.getppid() != parent_pid:             # the parent died before the request
             os._exit(1)
-        return
-    threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True,
-                     name="cmsim-parent-watch").start()
+    else:
+        threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True,
+                         name="cmsim-parent-watch").start()
+    if initializer is not None:
+        initializer(*initargs)
+
+
+def process_pool(workers, start_method=None, initializer=None, initargs=()):
+    """A local :class:`~concurrent.futures.ProcessPoolExecutor` of ``workers`` processes set
+    up as a run's workers (they ignore Ctrl-C, die with this process, keep the memory their
+    tasks free), each then calling ``initializer(*initargs)``.
+
+    With ``start_method="fork"`` (Linux's default) the initializer's arguments reach the
+    workers without being pickled: a worker starts from a copy of this process's objects,
+    caches included.
+    """
+    ctx = multiprocessing.get_context(check_start_method(start_method))
+    return ProcessPoolExecutor(max_workers=check_workers(workers), mp_context=ctx,
+                               initializer=_worker_init,
+                               initargs=(os.getpid(), initializer, initargs))
 
 
 class _SignalHandlers:
@@ -259,9 +277,7 @@ def _run_local(fn, tasks, done, n_workers, method):
 
 def _run_pool(fn, tasks, done, n_workers, method):
     """One pool over ``tasks``; returns the tasks not finished if a worker died, else []."""
-    ctx = multiprocessing.get_context(method)
-    pool = ProcessPoolExecutor(max_workers=n_workers, mp_context=ctx,
-                               initializer=_worker_init, initargs=(os.getpid(),))
+    pool = process_pool(n_workers, method)
     futures, delivered = {}, set()
     try:
         for key, args in tasks:

@@ -261,7 +261,7 @@ def _check_machine(record, machine):
 
 
 def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
-            max_segments=8, causes=None):
+            max_segments=8, causes=None, workers=1):
     """Compare a measured record with the model, name a cause, fit it, measure the gain.
 
     Parameters
@@ -281,6 +281,9 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         Segments read from the record (spread over it), >= 4.
     causes : sequence of Cause, optional
         Default: every registered cause that applies to the rig.
+    workers : int
+        Processes that make the model's runs (the seeds of a setup dealt out among them,
+        :class:`~cmsim.discrepancy.evaluator.Evaluator`); the result is the same with one.
 
     Returns
     -------
@@ -305,133 +308,134 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
     if RECORD_FLOOR and mode == "path-free" and record.unit_scale is not None:
         spans = segments(record.signal.size, record.fs_hz, seg_s, max_segments)[0::2]
         floor = np.concatenate([record.signal[a:b] for a, b in spans])
-    ev = Evaluator(record, seg_s, seed, budget - 2 * SIM_SEEDS, floor=floor)
-    fit_rows, held_rows = F[0::2], F[1::2]
-    meas_fit = dict(zip(names, np.nanmean(fit_rows, axis=0)))
-    meas_held = dict(zip(names, np.nanmean(held_rows, axis=0)))
-    spread = dict(zip(names, np.nanstd(F, axis=0, ddof=1)))
-    rig = machine.rig if machine is not None else record.rig
-    nominal = ModelSetup(rig=rig, op=record.op, housing=rig.housing, machine=machine)
-    seeds = ev.seeds(SIM_SEEDS)
-    var_rows = [ev.row(nominal, s) for s in ev.seeds(VAR_SEEDS)]
-    if any(r is None for r in var_rows):
-        raise ParameterError("the nominal model of this record diverged", param="record")
-    f_nom = ev.features(nominal, seeds)
-    cols = [k for k in names if math.isfinite(meas_fit[k]) and math.isfinite(meas_held[k])
-            and math.isfinite(f_nom.get(k, math.nan))]
-    not_judged = []
-    if mode == "path-free":
-        not_judged = sorted({k.split("_")[0] + "_*" if k.startswith("shape_") else k
-                             for k in cols if not path_free(k)})
-        cols = [k for k in cols if path_free(k)]
-    sigma, bias = {}, {}
-    for k in cols:
-        v_seed = float(np.nanvar([r[k] for r in var_rows], ddof=1))
-        if mode == "machine":
-            bias[k], bias_sigma = _calibration_bias(machine, k)
-            floor = 0.5 * feature_floor(k)
-        else:
-            bias[k], bias_sigma = 0.0, 0.0
-            floor = LEVEL_SIGMA_DB if k == "level_db" else feature_floor(k)
-        sigma[k] = math.sqrt(v_seed * (1.0 + 1.0 / SIM_SEEDS)
-                             + spread[k] ** 2 * 2.0 / F.shape[0] + bias_sigma ** 2
-                             + floor ** 2)
-    # the record as the twin sees it: its features moved by the twin's calibrated bias
-    seen_fit = {k: meas_fit[k] + bias[k] for k in cols}
-    seen_held = {k: meas_held[k] + bias[k] for k in cols}
-    n_eff = sum(weight(k) for k in cols)
+    with Evaluator(record, seg_s, seed, budget - 2 * SIM_SEEDS, floor=floor,
+                   workers=workers) as ev:
+        fit_rows, held_rows = F[0::2], F[1::2]
+        meas_fit = dict(zip(names, np.nanmean(fit_rows, axis=0)))
+        meas_held = dict(zip(names, np.nanmean(held_rows, axis=0)))
+        spread = dict(zip(names, np.nanstd(F, axis=0, ddof=1)))
+        rig = machine.rig if machine is not None else record.rig
+        nominal = ModelSetup(rig=rig, op=record.op, housing=rig.housing, machine=machine)
+        seeds = ev.seeds(SIM_SEEDS)
+        var_rows = ev.rows(nominal, ev.seeds(VAR_SEEDS))
+        if any(r is None for r in var_rows):
+            raise ParameterError("the nominal model of this record diverged", param="record")
+        f_nom = ev.features(nominal, seeds)
+        cols = [k for k in names if math.isfinite(meas_fit[k]) and math.isfinite(meas_held[k])
+                and math.isfinite(f_nom.get(k, math.nan))]
+        not_judged = []
+        if mode == "path-free":
+            not_judged = sorted({k.split("_")[0] + "_*" if k.startswith("shape_") else k
+                                 for k in cols if not path_free(k)})
+            cols = [k for k in cols if path_free(k)]
+        sigma, bias = {}, {}
+        for k in cols:
+            v_seed = float(np.nanvar([r[k] for r in var_rows], ddof=1))
+            if mode == "machine":
+                bias[k], bias_sigma = _calibration_bias(machine, k)
+                floor = 0.5 * feature_floor(k)
+            else:
+                bias[k], bias_sigma = 0.0, 0.0
+                floor = LEVEL_SIGMA_DB if k == "level_db" else feature_floor(k)
+            sigma[k] = math.sqrt(v_seed * (1.0 + 1.0 / SIM_SEEDS)
+                                 + spread[k] ** 2 * 2.0 / F.shape[0] + bias_sigma ** 2
+                                 + floor ** 2)
+        # the record as the twin sees it: its features moved by the twin's calibrated bias
+        seen_fit = {k: meas_fit[k] + bias[k] for k in cols}
+        seen_held = {k: meas_held[k] + bias[k] for k in cols}
+        n_eff = sum(weight(k) for k in cols)
 
-    def chi_of(features, which):
-        return chi2(seen_fit, features, sigma, which)
+        def chi_of(features, which):
+            return chi2(seen_fit, features, sigma, which)
 
-    nuis = Nuisances(ev, lambda f: chi_of(f, cols), seeds,
-                     MACHINE_NUISANCES if mode == "machine" else NUISANCES)
-    chi_nom, setup_nom = nuis.fit(nominal)
-    f_nom_fit = ev.features(setup_nom, seeds)
-    cands = list(causes) if causes is not None else applicable_causes(rig)
-    ranked = []
-    for cause in cands:
+        nuis = Nuisances(ev, lambda f: chi_of(f, cols), seeds,
+                         MACHINE_NUISANCES if mode == "machine" else NUISANCES)
+        chi_nom, setup_nom = nuis.fit(nominal)
+        f_nom_fit = ev.features(setup_nom, seeds)
+        cands = list(causes) if causes is not None else applicable_causes(rig)
+        ranked = []
+        for cause in cands:
+            try:
+                ranked += rank(cause, nominal, nuis, ev)
+            except Budget:
+                break
+        ranked.sort(key=lambda r: r["chi2"])
+        leaders = [r for r in ranked if not r["cause"].post_dynamics][:REFINE_TOP]
         try:
-            ranked += rank(cause, nominal, nuis, ev)
+            for r in leaders:
+                refine(r, nominal, nuis)
+            if leaders:                     # the best of them also between the grid's points
+                refine(min(leaders, key=lambda r: r["chi2"]), nominal, nuis, dense=True)
         except Budget:
-            break
-    ranked.sort(key=lambda r: r["chi2"])
-    leaders = [r for r in ranked if not r["cause"].post_dynamics][:REFINE_TOP]
-    try:
-        for r in leaders:
-            refine(r, nominal, nuis)
-        if leaders:                     # the best of them also between the grid's points
-            refine(min(leaders, key=lambda r: r["chi2"]), nominal, nuis, dense=True)
-    except Budget:
-        pass
-    for r in ranked:
-        r["features"] = ev.features(r["setup"], seeds)
-        evidence(r, chi_of, f_nom_fit, cols)
-        r["score"] = max(0.0, r["total"] / chi_nom) if chi_nom > 0 else 0.0
-    ranked.sort(key=lambda r: -r["delta_chi2"])
+            pass
+        for r in ranked:
+            r["features"] = ev.features(r["setup"], seeds)
+            evidence(r, chi_of, f_nom_fit, cols)
+            r["score"] = max(0.0, r["total"] / chi_nom) if chi_nom > 0 else 0.0
+        ranked.sort(key=lambda r: -r["delta_chi2"])
 
-    edges = shape_band_edges(record.fs_hz, 1.0 / seg_s)
-    discrepancies = sorted(
-        ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k] - bias[k],
-          "sigma": sigma[k], "z": (seen_fit[k] - f_nom_fit[k]) / sigma[k],
-          **_band_of(k, edges)} for k in cols),
-        key=lambda d: -abs(d["z"]))
-    top, ties = decide(ranked, ev.sensor_bearing, chi_nom)
-    finding, component, params, ranges, fitted = "none", None, {}, {}, setup_nom
-    if top is not None:
-        finding = top["name"]
-        component = _component_name(record, top["component"])
-        params, ranges, fitted = fit(top, nominal, nuis, ev)
-        top["fitted"] = params
-    elif chi_nom / max(n_eff, 1e-9) > UNEXPLAINED_CHI2_PER_FEATURE or (
-            mode == "machine" and discrepancies and abs(discrepancies[0]["z"]) >= ALARM_Z):
-        finding = "unexplained"
-    # held-out: re-simulate nominal and fitted with new seeds
-    ev.budget = budget
-    held_seeds = ev.seeds(SIM_SEEDS, seed + 1)
+        edges = shape_band_edges(record.fs_hz, 1.0 / seg_s)
+        discrepancies = sorted(
+            ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k] - bias[k],
+              "sigma": sigma[k], "z": (seen_fit[k] - f_nom_fit[k]) / sigma[k],
+              **_band_of(k, edges)} for k in cols),
+            key=lambda d: -abs(d["z"]))
+        top, ties = decide(ranked, ev.sensor_bearing, chi_nom)
+        finding, component, params, ranges, fitted = "none", None, {}, {}, setup_nom
+        if top is not None:
+            finding = top["name"]
+            component = _component_name(record, top["component"])
+            params, ranges, fitted = fit(top, nominal, nuis, ev)
+            top["fitted"] = params
+        elif chi_nom / max(n_eff, 1e-9) > UNEXPLAINED_CHI2_PER_FEATURE or (
+                mode == "machine" and discrepancies and abs(discrepancies[0]["z"]) >= ALARM_Z):
+            finding = "unexplained"
+        # held-out: re-simulate nominal and fitted with new seeds
+        ev.budget = budget
+        held_seeds = ev.seeds(SIM_SEEDS, seed + 1)
 
-    def held(setup):
-        return chi2(seen_held, ev.features(setup, held_seeds), sigma, cols) / n_eff
+        def held(setup):
+            return chi2(seen_held, ev.features(setup, held_seeds), sigma, cols) / n_eff
 
-    before = held(setup_nom)
-    after = before if fitted is setup_nom else held(fitted)
-    gain = {"before": float(before), "after": float(after),
-            "relative": 0.0 if before <= 0 else float(1.0 - after / before),
-            "baseline_level": 1.0,
-            "on": "held-out segments (odd), re-simulated with new seeds; chi2 per feature, "
-                  "where a record like the model's own sits near 1"}
-    causes_out = [{"name": r["name"], "component": _component_name(record, r["component"]),
-                   "score": r["score"], "delta_chi2": r["delta_chi2"],
-                   "delta_chi2_all": r["total"], "judged_on": len(r["judged_on"]),
-                   "parameters": r.get("fitted", r["probe"])} for r in ranked]
-    near_ties = [{"name": r["name"], "component": _component_name(record, r["component"]),
-                  "delta_chi2": r["delta_chi2"]} for r in ties]
-    departures = [d["feature"] + (f" ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)"
-                                  if "band_hz" in d else "")
-                  for d in discrepancies if abs(d["z"]) > 2.0][:8]
-    spectra = {"measured": record.signal, "fs_hz": record.fs_hz,
-               "bearing": ev.freqs.bearings.get(ev.sensor_bearing),
-               "bearing_name": _component_name(record, ev.sensor_bearing),
-               "nominal": _concat([ev.signal(setup_nom, s) for s in held_seeds]),
-               "fitted": None if fitted is setup_nom else _concat(
-                   [ev.signal(fitted, s) for s in held_seeds])}
-    return Comparison(
-        discrepancies=[{k: (v if k in ("feature", "band_hz") else float(v))
-                        for k, v in d.items()} for d in discrepancies[:12]],
-        causes=causes_out, finding=finding, component=component, parameters=params,
-        gain=gain, simulations=ev.count, wall_s=time.perf_counter() - start,
-        chi2_per_feature=chi_nom / max(n_eff, 1e-9), n_features=len(cols),
-        inferred=dict(record.inferred),
-        record={"channel": record.channel, "model_signal": record.model_signal,
-                "fs_hz": record.fs_hz, "duration_s": duration,
-                "speed_rpm": record.op.speed_rpm, "torque_nm": record.op.torque_nm,
-                "radial_load_n": record.op.radial_load_n, "segment_s": seg_s,
-                "segments": int(F.shape[0]), "unit_scale_to_m_s2": record.unit_scale,
-                "machine": None if machine is None else machine.name},
-        mode=mode, ranges={k: [float(a), float(b)] for k, (a, b) in ranges.items()},
-        near_ties=near_ties, departures=departures if finding == "unexplained" else [],
-        not_judged=not_judged, words=describe(finding, component, params, ranges),
-        spectra=spectra)
+        before = held(setup_nom)
+        after = before if fitted is setup_nom else held(fitted)
+        gain = {"before": float(before), "after": float(after),
+                "relative": 0.0 if before <= 0 else float(1.0 - after / before),
+                "baseline_level": 1.0,
+                "on": "held-out segments (odd), re-simulated with new seeds; chi2 per feature, "
+                      "where a record like the model's own sits near 1"}
+        causes_out = [{"name": r["name"], "component": _component_name(record, r["component"]),
+                       "score": r["score"], "delta_chi2": r["delta_chi2"],
+                       "delta_chi2_all": r["total"], "judged_on": len(r["judged_on"]),
+                       "parameters": r.get("fitted", r["probe"])} for r in ranked]
+        near_ties = [{"name": r["name"], "component": _component_name(record, r["component"]),
+                      "delta_chi2": r["delta_chi2"]} for r in ties]
+        departures = [d["feature"] + (f" ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)"
+                                      if "band_hz" in d else "")
+                      for d in discrepancies if abs(d["z"]) > 2.0][:8]
+        spectra = {"measured": record.signal, "fs_hz": record.fs_hz,
+                   "bearing": ev.freqs.bearings.get(ev.sensor_bearing),
+                   "bearing_name": _component_name(record, ev.sensor_bearing),
+                   "nominal": _concat([ev.signal(setup_nom, s) for s in held_seeds]),
+                   "fitted": None if fitted is setup_nom else _concat(
+                       [ev.signal(fitted, s) for s in held_seeds])}
+        return Comparison(
+            discrepancies=[{k: (v if k in ("feature", "band_hz") else float(v))
+                            for k, v in d.items()} for d in discrepancies[:12]],
+            causes=causes_out, finding=finding, component=component, parameters=params,
+            gain=gain, simulations=ev.count, wall_s=time.perf_counter() - start,
+            chi2_per_feature=chi_nom / max(n_eff, 1e-9), n_features=len(cols),
+            inferred=dict(record.inferred),
+            record={"channel": record.channel, "model_signal": record.model_signal,
+                    "fs_hz": record.fs_hz, "duration_s": duration,
+                    "speed_rpm": record.op.speed_rpm, "torque_nm": record.op.torque_nm,
+                    "radial_load_n": record.op.radial_load_n, "segment_s": seg_s,
+                    "segments": int(F.shape[0]), "unit_scale_to_m_s2": record.unit_scale,
+                    "machine": None if machine is None else machine.name},
+            mode=mode, ranges={k: [float(a), float(b)] for k, (a, b) in ranges.items()},
+            near_ties=near_ties, departures=departures if finding == "unexplained" else [],
+            not_judged=not_judged, words=describe(finding, component, params, ranges),
+            spectra=spectra)
 
 
 def _band_of(name, edges):

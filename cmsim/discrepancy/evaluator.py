@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
 from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
+from cmsim.datasets.pool import check_workers, process_pool
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.features import N_SHAPE_BANDS, relative_features
 from cmsim.frequencies import rig_frequencies
@@ -290,14 +292,24 @@ class Evaluator:
         Samples the sensor noise's floor is read from (:func:`record_floor`, scaled to m/s²:
         the fit segments laid end to end) instead of a share of the healthy model's RMS;
         needs the record's unit.
+    workers : int
+        Processes that make a setup's runs: the runs of its seeds are dealt out by their
+        place in the seed list, every ``workers``-th to the same process (so each process
+        finds the forces of its seeds in its own cache), this one making the first share.
+        Each helper process is a fork of this one, started at the first call that needs it;
+        :meth:`close` (or ``with``) stops them. The features are the same as with one.
     """
 
-    def __init__(self, record, seg_s, seed, budget, floor=None):
+    def __init__(self, record, seg_s, seed, budget, floor=None, workers=1):
         self.record = record
         self.seg_s = seg_s
         self.seed = seed
         self.budget = budget
         self.count = 0
+        self.simulated = set()
+        self.workers = check_workers(workers)
+        self._helpers = None
+        self._machine = None
         self.freqs = record.model_frequencies()
         self.sensor_bearing = signal_info(record.model_signal).component
         self.bearings = list(record.rig.bearing_names)
@@ -316,9 +328,11 @@ class Evaluator:
     def _forces(self, setup, seed):
         key = (setup.dynamics_key(), seed)
         if key not in self.forces:
-            if self.count >= self.budget:
-                raise Budget()
-            self.count += 1
+            if key not in self.simulated:          # a helper's run is not counted twice
+                if self.count >= self.budget:
+                    raise Budget()
+                self.count += 1
+                self.simulated.add(key)
             try:
                 self.forces[key] = model_force(setup.rig, setup.op, self.record.model_signal,
                                                self.fs, self.seg_s, seed, faults=setup.faults,
@@ -361,9 +375,67 @@ class Evaluator:
                 self.cache[key] = f
         return self.cache[key]
 
+    def rows(self, setup, seeds):
+        """Features of one run of ``setup`` per seed of ``seeds`` (None where it diverged),
+        every ``workers``-th seed's run made by the same helper process alongside."""
+        keys = [(setup.dynamics_key(), setup.chain_key(), s) for s in seeds]
+        if self.ref_rms is None and setup.machine is None and keys[0] not in self.cache:
+            self.row(setup, seeds[0])              # the healthy level first, for every process
+        todo = [i for i, k in enumerate(keys) if k not in self.cache]
+        away = [i for i in todo if i % self.workers]
+        new = {(keys[i][0], seeds[i]) for i in todo} - self.simulated
+        if away and self._helper_can(setup) and self.count + len(new) <= self.budget:
+            self.count += len(new)
+            self.simulated |= new
+            sent = {}
+            for i in away:
+                sent.setdefault(i % self.workers, []).append(i)
+            pending = [(self._helper(w).submit(_helper_rows, replace(setup, machine=None),
+                                               [seeds[i] for i in idx], self.ref_rms), idx)
+                       for w, idx in sent.items()]
+            for i in todo:
+                if not i % self.workers:
+                    self.row(setup, seeds[i])
+            for fut, idx in pending:
+                for i, r in zip(idx, fut.result()):
+                    self.cache[keys[i]] = r
+        return [self.row(setup, s) for s in seeds]
+
+    def _helper_can(self, setup):
+        """Whether helper processes can make runs of ``setup`` (the one machine they hold)."""
+        if self.workers == 1:
+            return False
+        if self._helpers is None:
+            self._machine = setup.machine
+        return setup.machine is self._machine
+
+    def _helper(self, w):
+        """Helper process ``w`` (1 ... workers − 1), started on first use."""
+        if self._helpers is None:
+            self._helpers = {}
+        if w not in self._helpers:
+            self._helpers[w] = process_pool(1, initializer=_adopt, initargs=(self,))
+        return self._helpers[w]
+
+    def close(self):
+        """Stop the helper processes (a later call that needs them starts them again)."""
+        for pool in (self._helpers or {}).values():
+            pool.shutdown(wait=True, cancel_futures=True)
+        self._helpers = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __getstate__(self):                        # a helper gets no helpers of its own
+        return {**self.__dict__, "_helpers": None}
+
     def features(self, setup, seeds):
         """Features of ``setup`` averaged over ``seeds`` (None if a run diverged)."""
-        rows = [self.row(setup, s) for s in seeds]
+        rows = self.rows(setup, seeds)
         if any(r is None for r in rows):
             return None
         names = list(rows[0])
@@ -371,3 +443,22 @@ class Evaluator:
             warnings.simplefilter("ignore", RuntimeWarning)
             mean = np.nanmean([[r[k] for k in names] for r in rows], axis=0)
         return dict(zip(names, mean.tolist()))
+
+
+#: A helper process's evaluator (:meth:`Evaluator.rows`).
+_HELPER = None
+
+
+def _adopt(ev):
+    """Helper process initializer: make runs for ``ev`` (this process's copy), uncounted."""
+    global _HELPER
+    _HELPER = ev
+    ev._helpers, ev.workers, ev.budget = None, 1, math.inf
+
+
+def _helper_rows(setup, seeds, ref_rms):
+    """Features of one run of ``setup`` (its machine the helper's) per seed, in a helper."""
+    _HELPER.ref_rms = ref_rms
+    if _HELPER._machine is not None:
+        setup = replace(setup, machine=_HELPER._machine)
+    return [_HELPER.row(setup, s) for s in seeds]

@@ -1,0 +1,67 @@
+"""A comparison made by several processes (issue 25's speed): the model's runs of a setup are
+dealt out by seed to helper processes; the comparison must not change with their number.
+
+Tier: equality against the one-process comparison (every number of the result), on a record
+whose nominal model is the documented path (the healthy level the sensor noise refers to is
+read first, then shared) and on one against a calibrated machine (the helpers hold its path);
+both with a budget that runs out during the ranking, so that the budget's accounting is
+checked too (a run made by a helper is counted once, where one process counts it).
+"""
+
+import json
+
+import pytest
+
+from cmsim.discrepancy import compare
+from cmsim.discrepancy.causes import ModelSetup
+from cmsim.discrepancy.evaluator import Evaluator
+from cmsim.discrepancy.synthetic import hidden_effect_record
+from cmsim.machine import calibrate
+
+
+def _same(a, b):
+    da, db = a.to_dict(), b.to_dict()
+    for d in (da, db):
+        d.pop("wall_s")
+    assert json.dumps(da, default=float) == json.dumps(db, default=float)
+    assert a.simulations == b.simulations
+
+
+@pytest.mark.slow
+def test_documented_path_comparison_is_the_same_on_two_processes():
+    record = hidden_effect_record("bearing_inner_race", 1003, duration_s=2.0).record
+    one = compare(record, budget=24, workers=1)
+    two = compare(record, budget=24, workers=2)
+    _same(one, two)
+    # the ranking spent its whole share (24 − 4), the held-out runs of the nominal model 2
+    assert one.simulations == 24 - 4 + 2
+
+
+@pytest.mark.slow
+def test_machine_comparison_is_the_same_on_two_and_three_processes():
+    baseline = hidden_effect_record(None, 4, sim_seed=9, duration_s=2.0).record
+    machine = calibrate([baseline], seed=4)
+    record = hidden_effect_record("bearing_outer_race", 4, duration_s=2.0).record
+    one = compare(record, machine=machine, budget=24, workers=1)
+    _same(one, compare(record, machine=machine, budget=24, workers=2))
+    _same(one, compare(record, machine=machine, budget=24, workers=3))
+
+
+def test_helpers_stop_with_the_evaluator_and_runs_are_counted_once():
+    """The seeds of a setup are dealt out (odd places to the helper), its runs counted once;
+    the helper is stopped on leaving the ``with`` block, and one process gives the same
+    features."""
+    record = hidden_effect_record(None, 5, duration_s=1.0).record
+    setup = ModelSetup(rig=record.rig, op=record.op, housing=record.rig.housing)
+    with Evaluator(record, 0.25, 0, 10, workers=2) as ev:
+        rows = ev.rows(setup, ev.seeds(3))
+        assert ev.count == 3 and len(ev._helpers) == 1
+        pool = ev._helpers[1]
+        again = ev.features(setup, ev.seeds(2))       # cached: no new run
+        assert ev.count == 3
+    assert ev._helpers is None
+    with pytest.raises(RuntimeError):                 # the helper's pool was shut down
+        pool.submit(int)
+    alone = Evaluator(record, 0.25, 0, 10)
+    assert alone.rows(setup, alone.seeds(3)) == rows
+    assert alone.features(setup, alone.seeds(2)) == again
