@@ -14,12 +14,13 @@ from __future__ import annotations
 
 import math
 import warnings
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
 
 import numpy as np
 
-from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.datasets.pool import check_workers, process_pool
+from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO
 from cmsim.errors import IntegrationDiverged, ParameterError
 from cmsim.features import N_SHAPE_BANDS, relative_features
 from cmsim.frequencies import rig_frequencies
@@ -297,7 +298,8 @@ class Evaluator:
         place in the seed list, every ``workers``-th to the same process (so each process
         finds the forces of its seeds in its own cache), this one making the first share.
         Each helper process is a fork of this one, started at the first call that needs it;
-        :meth:`close` (or ``with``) stops them. The features are the same as with one.
+        :meth:`close` (or ``with``) stops them. The features are the same as with one; if a
+        helper dies, this process makes its runs and the rest alone.
     """
 
     def __init__(self, record, seg_s, seed, budget, floor=None, workers=1):
@@ -397,8 +399,12 @@ class Evaluator:
                 if not i % self.workers:
                     self.row(setup, seeds[i])
             for fut, idx in pending:
-                for i, r in zip(idx, fut.result()):
-                    self.cache[keys[i]] = r
+                try:
+                    for i, r in zip(idx, fut.result()):
+                        self.cache[keys[i]] = r
+                except BrokenProcessPool:          # a helper died (killed, out of memory):
+                    self.close()                   # this process makes the rest alone
+                    self.workers = 1
         return [self.row(setup, s) for s in seeds]
 
     def _helper_can(self, setup):

@@ -379,6 +379,7 @@ CATALOGUE = [
     R("compare-channel", "compare {record} --channel nosuch", "--channel", "DE"),
     R("compare-budget-low", "compare {record} --budget 2", "--budget", numeric=True),
     R("compare-seed-negative", "compare {record} --seed -1", "--seed", numeric=True),
+    R("compare-workers-zero", "compare {record} --workers 0", "--workers", numeric=True),
     R("compare-rig-missing", "compare {record} --rig {work}/none.toml", "--rig"),
     R("compare-rig-text", "compare {record} --rig {text}", "--rig"),
     R("compare-report-file", "compare {record} --report {text}", "--report"),

@@ -9,11 +9,13 @@ checked too (a run made by a helper is counted once, where one process counts it
 """
 
 import json
+import os
 
 import pytest
 
 from cmsim.discrepancy import compare
 from cmsim.discrepancy.causes import ModelSetup
+from cmsim.discrepancy import evaluator
 from cmsim.discrepancy.evaluator import Evaluator
 from cmsim.discrepancy.synthetic import hidden_effect_record
 from cmsim.machine import calibrate
@@ -65,3 +67,18 @@ def test_helpers_stop_with_the_evaluator_and_runs_are_counted_once():
     alone = Evaluator(record, 0.25, 0, 10)
     assert alone.rows(setup, alone.seeds(3)) == rows
     assert alone.features(setup, alone.seeds(2)) == again
+
+
+def _die(*args):
+    os._exit(1)                                       # a helper killed mid-run
+
+
+def test_a_dead_helper_leaves_its_runs_to_this_process(monkeypatch):
+    record = hidden_effect_record(None, 5, duration_s=1.0).record
+    setup = ModelSetup(rig=record.rig, op=record.op, housing=record.rig.housing)
+    alone = Evaluator(record, 0.25, 0, 10)
+    expected = alone.rows(setup, alone.seeds(2))
+    monkeypatch.setattr(evaluator, "_helper_rows", _die)
+    with Evaluator(record, 0.25, 0, 10, workers=2) as ev:
+        assert ev.rows(setup, ev.seeds(2)) == expected
+        assert ev.workers == 1 and ev._helpers is None and ev.count == 2
