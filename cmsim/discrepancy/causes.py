@@ -194,6 +194,9 @@ class Cause:
     #: Acts on the simulated force after the dynamics (a shaft force): no new simulation,
     #: but ranked and fitted like a model cause.
     force_level: typing.ClassVar[bool] = False
+    #: Only adds a broadband signal (sensor noise): named only if no band of the spectral
+    #: shape moves away from the record (:data:`~cmsim.discrepancy.ranking.NOISE_SHAPE_DELTA_CHI2`).
+    adds_broadband: typing.ClassVar[bool] = False
     #: Prefixes of the features the cause is judged on (its families, sidebands, bands;
     #: ``{b}`` stands for its bearing); None: it reshapes the spectrum and is judged on all.
     signature: typing.ClassVar[tuple | None] = None
@@ -556,6 +559,7 @@ class NoiseCause(Cause):
     bounds = (0.005, 10.0)
     probes = ()
     post_dynamics = True
+    adds_broadband = True
 
     def apply(self, setup, value, component):
         if setup.machine is not None:

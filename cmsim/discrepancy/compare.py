@@ -28,8 +28,9 @@
    averaged; every setup uses the same seeds (common random numbers). The model's own
    spread is measured on :data:`VAR_SEEDS` runs of the nominal model; with the record's
    spread, a floor (and the scatter of a machine's calibrated bias) it is each feature's σ,
-   and χ² = Σ w·min(((measured − simulated)/σ)², Z_CAP²) (the level rising linearly beyond
-   Z_CAP instead: :data:`~cmsim.discrepancy.evaluator.RISING`).
+   and χ² = Σ w·min(((measured − simulated)/σ)², Z_CAP²) (rising linearly beyond Z_CAP
+   instead: the level, and against a machine every feature but the kurtosis and crest
+   factor, :func:`~cmsim.discrepancy.evaluator.rises`).
 4. Causes are ranked and decided on the evidence their own signature moves
    (:mod:`cmsim.discrepancy.ranking`); the finding is a named cause, ``none`` (nothing
    departs from the model beyond its uncertainty), or ``unexplained`` (the record departs
@@ -344,9 +345,10 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         seen_fit = {k: meas_fit[k] + bias[k] for k in cols}
         seen_held = {k: meas_held[k] + bias[k] for k in cols}
         n_eff = sum(weight(k) for k in cols)
+        calibrated = mode == "machine"             # far departures rise (evaluator.rises)
 
         def chi_of(features, which):
-            return chi2(seen_fit, features, sigma, which)
+            return chi2(seen_fit, features, sigma, which, calibrated)
 
         nuis = Nuisances(ev, lambda f: chi_of(f, cols), seeds,
                          MACHINE_NUISANCES if mode == "machine" else NUISANCES)
@@ -395,7 +397,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         held_seeds = ev.seeds(SIM_SEEDS, seed + 1)
 
         def held(setup):
-            return chi2(seen_held, ev.features(setup, held_seeds), sigma, cols) / n_eff
+            return chi2(seen_held, ev.features(setup, held_seeds), sigma, cols,
+                        calibrated) / n_eff
 
         before = held(setup_nom)
         after = before if fitted is setup_nom else held(fitted)

@@ -1,16 +1,18 @@
 """The robust χ² of a comparison (issue 25).
 
 Tier: closed form — a feature adds z² up to Z_CAP σ and Z_CAP² beyond, except the overall
-level (:data:`RISING`), whose loss keeps rising beyond Z_CAP linearly with the value and
-slope of z² there (Huber's); a feature's weight multiplies it; a feature the model lost
-counts as 3σ off.
+level (:data:`RISING`) and, against a calibrated machine, every feature but the kurtosis
+and crest factor, whose loss keeps rising beyond Z_CAP linearly with the value and slope of
+z² there (Huber's); a feature's weight multiplies it; a feature the model lost counts as 3σ
+off.
 """
 
 import math
 
 import pytest
 
-from cmsim.discrepancy.evaluator import RISING, Z_CAP, chi2, loss, weight
+from cmsim.discrepancy.causes import STATISTICS
+from cmsim.discrepancy.evaluator import RISING, Z_CAP, chi2, loss, rises, weight
 
 
 @pytest.mark.parametrize("name", ["shape_b3_db", "kurtosis_log", "level_db"])
@@ -57,3 +59,24 @@ def test_weights_and_a_lost_feature():
     got = chi2(meas, sim, sigma, ["shape_b1_db", "kurtosis_log"])
     assert got == pytest.approx(weight("shape_b1_db") * 4.0 + weight("kurtosis_log") * 9.0)
     assert chi2(meas, None, sigma, ["shape_b1_db"]) == math.inf
+
+
+def test_against_a_calibrated_machine_every_feature_but_the_statistics_rises():
+    """A far-off band against the machine's own twin rises (a cause that brings it nearer
+    explains more); against an uncalibrated model it stays capped; the kurtosis and crest
+    factor stay capped everywhere (every impulsive fault moves them)."""
+    assert set(STATISTICS) == {"kurtosis_log", "crest_log"}
+    for name in ("shape_b5_db", "env_bpfo_1b1_h1_db", "raw_fr_h1_db", "level_db"):
+        assert rises(name, calibrated=True)
+        assert rises(name) is (name in RISING)
+        assert loss(name, 30.0, calibrated=True) == pytest.approx(Z_CAP * (60.0 - Z_CAP))
+    for name in STATISTICS:
+        assert not rises(name, calibrated=True)
+        assert loss(name, 30.0, calibrated=True) == Z_CAP ** 2
+    meas, sigma = {"shape_b5_db": -49.6}, {"shape_b5_db": 0.8}
+    nominal, nearer = ({"shape_b5_db": v} for v in (-29.6, -40.6))
+    names = ["shape_b5_db"]
+    assert chi2(meas, nearer, sigma, names) == chi2(meas, nominal, sigma, names)
+    # 11 dB nearer at σ 0.8: 13.75σ less, at the linear slope 2·Z_CAP, weighted
+    gain = chi2(meas, nominal, sigma, names, True) - chi2(meas, nearer, sigma, names, True)
+    assert gain == pytest.approx(weight("shape_b5_db") * 2.0 * Z_CAP * 11.0 / 0.8)

@@ -11,7 +11,8 @@ import pytest
 
 from cmsim.discrepancy.causes import STATISTICS
 from cmsim.discrepancy.ranking import (FAR_MARGIN, MIN_DELTA_CHI2, MIN_FAMILY_DELTA_CHI2,
-                                       MIN_SIGNATURE_DELTA_CHI2, NEAR_TIE, decide)
+                                       MIN_SIGNATURE_DELTA_CHI2, NEAR_TIE,
+                                       NOISE_SHAPE_DELTA_CHI2, decide)
 
 FEATURES = ["env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "env_bpfi_1b1_h1_db", "shape_b3_db",
             "shape_b4_db", "kurtosis_log"]
@@ -25,7 +26,7 @@ def _row(name, per_feature, signature=None, component=None):
     return {"name": name, "component": component, "judged_on": judged, "family": family,
             "per_feature": pf, "delta_chi2": sum(pf[k] for k in judged),
             "cause": SimpleNamespace(signature=None if signature is None else (signature,),
-                                     kind=name)}
+                                     kind=name, adds_broadband=name == "noise")}
 
 
 def _outer(level, component="1b1"):
@@ -59,6 +60,22 @@ def test_a_fault_the_reshaping_cause_explains_as_well_does_not_stand_out():
 def test_a_reshaping_cause_needs_its_share_of_the_discrepancy():
     assert decide([_load(MIN_DELTA_CHI2 + 1)], "1b1", 10 * MIN_DELTA_CHI2)[0] is None
     assert decide([_load(MIN_DELTA_CHI2 + 1)], "1b1", 2 * MIN_DELTA_CHI2)[0] is not None
+
+
+def test_noise_that_moves_a_band_away_from_the_record_is_not_named():
+    """Noise only adds a floor: the same evidence names it when every band came nearer, and
+    not when it overfilled one band to fill another (the load, which may reshape, still
+    can be named on the same evidence)."""
+    level = 3 * MIN_DELTA_CHI2
+    filled = _row("noise", {"shape_b3_db": level, "env_bpfo_1b1_h1_db": 1.0})
+    assert decide([filled], "1b1", 2 * level)[0]["name"] == "noise"
+    eps = 0.1
+    for away, named in ((NOISE_SHAPE_DELTA_CHI2 - eps, True),
+                        (NOISE_SHAPE_DELTA_CHI2 + eps, False)):
+        over = _row("noise", {"shape_b3_db": level + away, "shape_b4_db": -away})
+        assert (decide([over], "1b1", 2 * level)[0] is not None) is named
+    load = _row("torque_mismatch", {"shape_b3_db": level + 10, "shape_b4_db": -10})
+    assert decide([load, over], "1b1", 2 * level)[0]["name"] == "torque_mismatch"
 
 
 def test_the_sensors_bearing_is_preferred_unless_the_far_one_is_clearly_stronger():
