@@ -266,7 +266,21 @@ def chi2(meas, sim, sigma, names, calibrated=False):
 
 def loss(name, z, calibrated=False):
     """χ² of feature ``name`` off by ``z`` σ (≥ 0): z² up to :data:`Z_CAP`; beyond, Z_CAP²
-    (capped), or where the feature :func:`rises`, Huber's loss, rising linearly."""
+    (capped), or where the feature :func:`rises`, Huber's loss, rising linearly.
+
+    Parameters
+    ----------
+    name : str
+        Feature name.
+    z : float
+        Its departure, σ (≥ 0).
+    calibrated : bool
+        Against a machine calibrated on this machine's baseline (:func:`rises`).
+
+    Returns
+    -------
+    float
+    """
     if z <= Z_CAP:
         return z * z
     return Z_CAP * (2.0 * z - Z_CAP) if rises(name, calibrated) else Z_CAP * Z_CAP
