@@ -195,7 +195,8 @@ class Cause:
     #: but ranked and fitted like a model cause.
     force_level: typing.ClassVar[bool] = False
     #: Only adds a broadband signal (sensor noise): named only if no band of the spectral
-    #: shape moves away from the record (:data:`~cmsim.discrepancy.ranking.NOISE_SHAPE_DELTA_CHI2`).
+    #: shape moves away from the record
+    #: (:data:`~cmsim.discrepancy.ranking.NOISE_SHAPE_DELTA_CHI2`).
     adds_broadband: typing.ClassVar[bool] = False
     #: Prefixes of the features the cause is judged on (its families, sidebands, bands;
     #: ``{b}`` stands for its bearing); None: it reshapes the spectrum and is judged on all.

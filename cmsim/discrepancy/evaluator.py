@@ -418,7 +418,9 @@ class Evaluator:
         todo = [i for i, k in enumerate(keys) if k not in self.cache]
         away = [i for i in todo if i % self.workers]
         new = {(keys[i][0], seeds[i]) for i in todo} - self.simulated
-        if away and self._helper_can(setup) and self.count + len(new) <= self.budget:
+        if not self._helpers:
+            self._machine = setup.machine          # the one machine the helpers will hold
+        if away and setup.machine is self._machine and self.count + len(new) <= self.budget:
             self.count += len(new)
             self.simulated |= new
             sent = {}
@@ -438,14 +440,6 @@ class Evaluator:
                     self.close()                   # this process makes the rest alone
                     self.workers = 1
         return [self.row(setup, s) for s in seeds]
-
-    def _helper_can(self, setup):
-        """Whether helper processes can make runs of ``setup`` (the one machine they hold)."""
-        if self.workers == 1:
-            return False
-        if self._helpers is None:
-            self._machine = setup.machine
-        return setup.machine is self._machine
 
     def _helper(self, w):
         """Helper process ``w`` (1 ... workers − 1), started on first use."""
