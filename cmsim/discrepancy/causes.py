@@ -32,6 +32,7 @@ import math
 import typing
 from dataclasses import dataclass, replace
 
+from cmsim.errors import ParameterError
 from cmsim.faults import (BallDefect, Eccentricity, InnerRaceDefect, OuterRaceDefect,
                           RollingSlip, SpeedFluctuation, ToothBreakage)
 from cmsim.rig import HousingPath, OperatingPoint, Rig
@@ -83,6 +84,9 @@ class ModelSetup:
     white_noise : float
         White noise at the machine's sensor, RMS relative to its background noise's
         (:meth:`Machine.sensor_signal <cmsim.machine.Machine.sensor_signal>`).
+    background_level : float
+        Factor on the machine's whole background (coloured noise and lines) beyond what
+        ``background_gain`` refits within its spread: the ``background`` cause (1: none).
     shaft_forces : tuple of (float, float)
         (shaft order, relative amplitude): a rotating force laid on the bearing force after
         the dynamics, ``F̄ + (F − F̄)·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
@@ -100,6 +104,7 @@ class ModelSetup:
     background_gain: float = 1.0
     white_noise: float = 0.0
     shaft_forces: tuple = ()
+    background_level: float = 1.0
 
     def with_faults(self, *faults):
         """Same setup with ``faults`` added."""
@@ -110,12 +115,12 @@ class ModelSetup:
         forces laid on the force after the dynamics)."""
         return repr(replace(self, housing=None, noise_ratio=0.0, machine=None,
                             frequency_factor=1.0, background_gain=1.0, white_noise=0.0,
-                            shaft_forces=()))
+                            shaft_forces=(), background_level=1.0))
 
     def chain_key(self):
         """What the sensor signal depends on besides the dynamics."""
         return (self.housing, self.noise_ratio, self.frequency_factor, self.background_gain,
-                self.white_noise, self.shaft_forces)
+                self.white_noise, self.shaft_forces, self.background_level)
 
 
 @dataclass(frozen=True)
@@ -198,6 +203,9 @@ class Cause:
     #: shape moves away from the record
     #: (:data:`~cmsim.discrepancy.ranking.NOISE_SHAPE_DELTA_CHI2`).
     adds_broadband: typing.ClassVar[bool] = False
+    #: Re-ranked at its best over a grid of its bounds when among the leaders (compare);
+    #: False: judged at its probes, fitted only if named.
+    refined: typing.ClassVar[bool] = True
     #: Prefixes of the features the cause is judged on (its families, sidebands, bands;
     #: ``{b}`` stands for its bearing); None: it reshapes the spectrum and is judged on all.
     signature: typing.ClassVar[tuple | None] = None
@@ -571,6 +579,27 @@ class NoiseCause(Cause):
                            white_noise=math.sqrt(max(gain ** 2
                                                      - MACHINE_BACKGROUND_SPREAD ** 2, 0.0)))
         return replace(setup, noise_ratio=value)
+
+
+@register_cause
+class BackgroundCause(Cause):
+    """The machine's own background louder than at its baseline — its coloured noise and
+    its lines together (a loud neighbour, a worn coupling, a pump started), where the
+    ``noise`` cause adds white noise (a noisier sensor). It keeps the baseline's spectral
+    shape, so the noise cause's band rule does not bind it. Against a calibrated machine
+    only: without one there is no background of the machine's to scale."""
+    name = "background"
+    parameter = "level_factor"
+    bounds = (MACHINE_BACKGROUND_SPREAD, 100.0)
+    probes = (3.0, 10.0, 30.0)
+    force_level = True                 # no new simulation: fitted whatever the budget left
+    refined = False
+
+    def apply(self, setup, value, component):
+        if setup.machine is None:
+            raise ParameterError("the background cause needs a calibrated machine",
+                                 param="machine")
+        return replace(setup, background_level=value)
 
 
 def _scaled_path(path, factor):

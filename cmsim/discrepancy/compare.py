@@ -109,7 +109,8 @@ _WORDS = {"bearing_outer_race": "outer-race defect", "bearing_inner_race": "inne
           "torque_mismatch": "load other than documented", "clearance": "bearing clearance",
           "preload": "bearing preload", "rolling_slip": "rolling slip",
           "friction": "tooth friction", "transfer_path": "transfer path other than the model's",
-          "noise": "background noise other than the model's"}
+          "noise": "background noise other than the model's",
+          "background": "the machine's background louder than at its baseline"}
 
 
 @dataclass
@@ -362,7 +363,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             except Budget:
                 break
         ranked.sort(key=lambda r: r["chi2"])
-        leaders = [r for r in ranked if not r["cause"].post_dynamics][:REFINE_TOP]
+        leaders = [r for r in ranked if r["cause"].refined
+                   and not r["cause"].post_dynamics][:REFINE_TOP]
         try:
             for r in leaders:
                 refine(r, nominal, nuis)

@@ -192,8 +192,10 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="
     if setup.machine is not None:   # a machine's rotating forces have gains of their own
         return setup.machine.sensor_signal(force, edge, n, seed, speed_rpm=setup.op.speed_rpm,
                                            frequency_factor=setup.frequency_factor,
-                                           noise_gain=setup.background_gain,
-                                           line_gain=setup.background_gain,
+                                           noise_gain=setup.background_gain
+                                           * setup.background_level,
+                                           line_gain=setup.background_gain
+                                           * setup.background_level,
                                            white_noise=setup.white_noise,
                                            rotating=(fr, rotating) if rotating else None)
     if rotating:
