@@ -1,10 +1,11 @@
-"""The ``noise`` cause through a calibrated machine (issue 25).
+"""The ``noise`` and ``background`` causes through a calibrated machine (issue 25).
 
 Tier: closed form — the machine's background is a coloured noise of known RMS confined
 under 1 kHz; the cause scales it within its spread (:data:`MACHINE_BACKGROUND_SPREAD`) and
 adds white noise beyond, so the total RMS is the cause's ratio over the nominal one times
 the background's, and the noise beyond the spread reaches the bands the baseline's
-background leaves empty (a scaled background cannot change the spectrum's shape).
+background leaves empty (a scaled background cannot change the spectrum's shape). The
+``background`` cause scales the machine's whole background and keeps its shape.
 """
 
 import math
@@ -15,6 +16,7 @@ import pytest
 from cmsim.discrepancy.causes import (CAUSES, MACHINE_BACKGROUND_SPREAD, NOMINAL_NOISE_RATIO,
                                       ModelSetup)
 from cmsim.discrepancy.evaluator import _chain
+from cmsim.errors import ParameterError
 from cmsim.machine import Background, Machine, TransferPath
 from cmsim.rig import OperatingPoint, Rig
 
@@ -46,3 +48,20 @@ def test_the_noise_cause_sets_the_total_rms_and_whitens_beyond_the_spread(factor
     white = max(factor ** 2 - MACHINE_BACKGROUND_SPREAD ** 2, 0.0)
     # the white part spreads evenly to the Nyquist frequency: 0.78 of it above 1.1 kHz
     assert high == pytest.approx(white / factor ** 2 * (1.0 - 1100.0 / (FS / 2)), abs=0.01)
+
+
+@pytest.mark.parametrize("factor", [3.0, 30.0])
+def test_the_background_cause_scales_the_machine_s_background_and_keeps_its_shape(factor):
+    m, nominal = _setup(NOMINAL_NOISE_RATIO)
+    setup = CAUSES["background"]().apply(nominal, factor, None)
+    assert setup.dynamics_key() == nominal.dynamics_key()      # no new simulation
+    assert setup.chain_key() != nominal.chain_key()
+    n = 200_000
+    y = _chain(setup, np.zeros(n), 0, n, FS, 3, None)
+    assert float(np.std(y)) == pytest.approx(factor * m.background.noise_rms(FS), rel=0.02)
+    spec = np.abs(np.fft.rfft(y)) ** 2
+    f = np.fft.rfftfreq(n, 1.0 / FS)
+    assert float(np.sum(spec[f > 1100.0]) / np.sum(spec)) < 1e-3   # nothing beyond its band
+    rig = m.rig
+    with pytest.raises(ParameterError):                  # no machine: nothing to scale
+        CAUSES["background"]().apply(ModelSetup(rig=rig, op=m.op), factor, None)
