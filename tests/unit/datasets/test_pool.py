@@ -19,6 +19,14 @@ from cmsim.datasets.pool import run_tasks
 ARRAY_BYTES = 3 << 20
 
 
+def _faults_of_four_tasks(method):
+    """Page faults of four tasks in turn on one worker."""
+    faults = []
+    run_tasks(_page_faults_of_a_task, [(i, ()) for i in range(4)],
+              lambda key, n: faults.append(n), workers=1, start_method=method)
+    return faults
+
+
 def _page_faults_of_a_task():
     """Minor page faults of filling three arrays at once (freed on return)."""
     before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
@@ -30,9 +38,12 @@ def _page_faults_of_a_task():
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc mallopt")
 @pytest.mark.parametrize("method", ["fork", "spawn"])
 def test_a_worker_reuses_the_memory_its_tasks_free(method):
-    faults = []
-    run_tasks(_page_faults_of_a_task, [(i, ()) for i in range(4)],
-              lambda key, n: faults.append(n), workers=1, start_method=method)
+    faults = _faults_of_four_tasks(method)
+    if not (faults[0] > 2000 or method == "fork") or max(faults[1:]) >= 100:
+        # once more in a fresh worker: what a worker's heap holds after importing the task's
+        # module varies from run to run (2 runs in 8 alone, 2026-11-27, before and after the
+        # pool's last change); a worker that does not keep freed memory fails both
+        faults = _faults_of_four_tasks(method)
     # the first task takes the arrays' 2304 pages; the next ones reuse them (glibc's defaults
     # hand them back to the kernel: 1500-2300 faults for every task). A forked worker starts
     # with its parent's heap: when the parent already holds that much freed memory the first
