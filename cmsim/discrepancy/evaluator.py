@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from concurrent.futures import CancelledError
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
 
@@ -190,12 +191,10 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="
     fr = rig_frequencies(setup.rig, setup.op).bearing(bearing).shaft_hz
     force, rotating = _shaft_forces(force, fs, fr, setup.shaft_forces, seed)
     if setup.machine is not None:   # a machine's rotating forces have gains of their own
+        gain = setup.background_gain * setup.background_level
         return setup.machine.sensor_signal(force, edge, n, seed, speed_rpm=setup.op.speed_rpm,
                                            frequency_factor=setup.frequency_factor,
-                                           noise_gain=setup.background_gain
-                                           * setup.background_level,
-                                           line_gain=setup.background_gain
-                                           * setup.background_level,
+                                           noise_gain=gain, line_gain=gain,
                                            white_noise=setup.white_noise,
                                            rotating=(fr, rotating) if rotating else None)
     if rotating:
@@ -438,9 +437,9 @@ class Evaluator:
                 try:
                     for i, r in zip(idx, fut.result()):
                         self.cache[keys[i]] = r
-                except BrokenProcessPool:          # a helper died (killed, out of memory):
-                    self.close()                   # this process makes the rest alone
-                    self.workers = 1
+                except (BrokenProcessPool, CancelledError):  # a helper died (killed, out of
+                    self.close()                   # memory; close cancels the others' queue):
+                    self.workers = 1               # this process makes the rest alone
         return [self.row(setup, s) for s in seeds]
 
     def _helper(self, w):
