@@ -57,6 +57,7 @@ from cmsim.spectra.run_spectrum import run_families, signal_bearing
 from cmsim.spectra.tsa import time_synchronous_average
 
 __all__ = ["FeatureRow", "LabelledLine", "extract_features", "run_features", "gmf_levels",
+           "tsa_residual_kurtosis",
            "statistics", "N_GMF_HARMONICS", "SIDEBAND_ORDERS", "N_ENVELOPE_HARMONICS",
            "ENVELOPE_FAMILIES", "MIN_SIDEBAND_BINS"]
 
@@ -244,7 +245,11 @@ def statistics(x):
     return rms, float(np.mean(d ** 4)) / m2 ** 2, float(np.max(np.abs(d))) / rms
 
 
-def _tsa_residual_kurtosis(x, fs, shaft_hz):
+def tsa_residual_kurtosis(x, fs, shaft_hz):
+    """Kurtosis of the residual of the time-synchronous average of ``x`` on a shaft of rate
+    ``shaft_hz`` (NaN when the record is too short for an average): what is not periodic
+    with the shaft, a local tooth fault's impulse among it (Randall, *Vibration-based
+    condition monitoring*, 2011, §5.4)."""
     try:
         avg = time_synchronous_average(x, fs, speed_rpm=60.0 * shaft_hz)
     except ParameterError:
@@ -341,7 +346,7 @@ def extract_features(signal, fs_hz, freqs, *, bearing=None, band_hz=None,
                 sidebands[f"{key}_{'m' if n < 0 else 'p'}{abs(n)}"] = tuple(
                     line_amplitude(freq, amp, k * gmf + off, tolerance) if ok else math.nan
                     for k in range(1, n_gmf + 1))
-        tsa_k = _tsa_residual_kurtosis(x, fs, freqs.fr1_hz)
+        tsa_k = tsa_residual_kurtosis(x, fs, freqs.fr1_hz)
     else:
         gmf_amp, tsa_k = nan_h, math.nan
         sidebands = {f"{key}_{'m' if n < 0 else 'p'}{abs(n)}": nan_h

@@ -16,10 +16,10 @@ import math
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.features.absolute import extract_features, statistics
+from cmsim.features.absolute import gmf_levels, statistics, tsa_residual_kurtosis
 from cmsim.features.envelope import (band_excess, demodulated_spectrum, envelope_lines,
                                      line_amplitudes)
-from cmsim.features.lines import SLIP_TOLERANCE, line_amplitude
+from cmsim.features.lines import EXACT_TOLERANCE, SLIP_TOLERANCE, line_amplitude
 from cmsim.features.sidebands import sideband_energies
 from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
@@ -93,7 +93,8 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
       2·BPFO ± the shaft rate: a once-per-rev speed or load modulation) and
       ``env_bpfo_{b}_band_db`` (the power in the BPFO line's bins over the median's);
     * gear rigs: ``gmf{k}_rel_db`` (k = 1..4, relative to the largest) and
-      ``tsa_residual_kurtosis_log`` from :func:`~cmsim.features.absolute.extract_features`,
+      ``tsa_residual_kurtosis_log`` (:func:`~cmsim.features.absolute.gmf_levels`,
+      :func:`~cmsim.features.absolute.tsa_residual_kurtosis`),
       and the sideband energies of :func:`~cmsim.features.sidebands.sideband_energies`.
 
     Parameters
@@ -155,14 +156,12 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
                                                                  tol))
     if freqs.gmf_hz is not None:
         n_gmf = N_RELATIVE_GMF_HARMONICS
-        row = extract_features(x, fs, freqs, bearing=names[0] if names else None,
-                               envelope=False, n_gmf_harmonics=n_gmf)
-        g = np.asarray(row.gmf_amp, dtype=float)
+        g = gmf_levels(amplitude_spectrum(x, fs), freqs.gmf_hz, n_gmf, EXACT_TOLERANCE)
         gmax = np.nanmax(g) if np.any(np.isfinite(g)) else math.nan
         for k in range(1, n_gmf + 1):
             out[f"gmf{k}_rel_db"] = _db(g[k - 1], gmax)
         out.update(sideband_energies(x, fs, freqs))
-        tk = row.tsa_residual_kurtosis
+        tk = tsa_residual_kurtosis(x, fs, freqs.fr1_hz)
         out["tsa_residual_kurtosis_log"] = math.log(tk) if math.isfinite(tk) and tk > 0 \
             else math.nan
     return out

@@ -87,8 +87,10 @@ def sideband_energies(x, fs, freqs):
             if fk / fr > MAX_SIDEBAND_ORDER + 0.5 or fk + 3.5 * fr > 0.45 * fs:
                 out[f"sb1_{name}_k{k}_db"] = out[f"sb23_{name}_k{k}_db"] = math.nan
                 continue
-            e = {n: float(np.sum(power[(freq >= fk + n * fr - w) & (freq < fk + n * fr + w)]))
-                 for n in (-3, -2, -1, 0, 1, 2, 3)}
+            edges = np.searchsorted(freq, [fk + n * fr + d for n in range(-3, 4)
+                                           for d in (-w, w)], side="left")
+            e = {n: float(np.sum(power[edges[2 * i]:edges[2 * i + 1]]))   # bins in [lo, hi)
+                 for i, n in enumerate(range(-3, 4))}
             c = e[0]
             out[f"sb1_{name}_k{k}_db"] = _db_power(e[-1] + e[1], c)
             out[f"sb23_{name}_k{k}_db"] = _db_power(e[-3] + e[-2] + e[2] + e[3], c)
@@ -130,12 +132,17 @@ def mesh_tracked(x, fs, freqs):
     while k * freqs.gmf_hz / freqs.fr1_hz <= TRACK_MAX_ORDER + 0.5 \
             and k * freqs.gmf_hz + 3 * fr < 0.45 * fs:
         fc = k * freqs.gmf_hz
-        band = np.abs(f - fc) < 0.5 * fr
-        near = (np.abs(f - fc) < 3.0 * fr) & ~band
+        fk, sk = f, spec
+        if fc - 3.0 * fr > f[1]:                  # the neighbourhood: positive bins only,
+            i0, i1 = np.searchsorted(f[:(n + 1) // 2], [fc - 3.0 * fr - f[1],  # sorted
+                                                        fc + 3.0 * fr + f[1]])
+            fk, sk = f[i0:i1], spec[i0:i1]
+        band = np.abs(fk - fc) < 0.5 * fr
+        near = (np.abs(fk - fc) < 3.0 * fr) & ~band
         if np.any(band) and np.any(near):
-            p = np.abs(spec[band]) ** 2
+            p = np.abs(sk[band]) ** 2
             snr = 10 * math.log10(max(float(p.max()), 1e-300)
-                                  / max(float(np.median(np.abs(spec[near]) ** 2)), 1e-300))
+                                  / max(float(np.median(np.abs(sk[near]) ** 2)), 1e-300))
             if best is None or float(p.sum()) > best[0]:
                 best = (float(p.sum()), snr, k)
         k += 1
