@@ -40,7 +40,7 @@ def register(sub):
                    help="the record's machine (cmsim calibrate on a healthy baseline): the "
                         "nominal model; without it, only path-free evidence is judged "
                         "unless --rig documents the housing path")
-    p.add_argument("--workers", type=ranged(Range(1, 256, integer=True)), default=None,
+    p.add_argument("--workers", type=ranged(RANGES["workers"]), default=None,
                    help="processes that make the model's runs (default: 2 where there are "
                         "2 CPUs or more; the same result with any number)")
     p.add_argument("--span", type=ranged(Range(0.0, 1.0e5, unit="s")), nargs=2,

@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, load_file, ranged
-from cmsim.rig import Range
+from cmsim.rig import RANGES
 
 
 def register(sub):
@@ -19,7 +19,7 @@ def register(sub):
                                    "resumes: finished records are not recomputed.")
     p.add_argument("spec", metavar="SPEC", help="dataset spec (TOML)")
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="dataset directory")
-    p.add_argument("--workers", type=ranged(Range(1, 1024, integer=True)), default=None,
+    p.add_argument("--workers", type=ranged(RANGES["workers"]), default=None,
                    help="local worker processes (default: number of CPUs)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="dask.distributed scheduler address (tcp://host:8786); its workers "

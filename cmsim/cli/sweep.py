@@ -11,7 +11,7 @@ from cmsim.cli.options import (add_fault_options, add_losses_option, add_mesh_op
                                add_rig_options, add_sampling_options, check_losses_options,
                                faults_of, load_rig, mesh_argument, number, operating_warnings,
                                prepare_tables)
-from cmsim.rig import OperatingPoint, Range
+from cmsim.rig import RANGES, OperatingPoint
 
 
 def register(sub):
@@ -35,7 +35,7 @@ def register(sub):
                                        "SeedSequence([seed, i])")
     p.add_argument("--seed-policy", default="per_run", choices=("per_run", "shared"),
                    help="per_run: independent seed per run; shared: every run uses --seed")
-    p.add_argument("--workers", type=ranged(Range(1, 1024, integer=True)), default=None,
+    p.add_argument("--workers", type=ranged(RANGES["workers"]), default=None,
                    help="worker processes (default: number of CPUs)")
     p.add_argument("--force", action="store_true",
                    help="replace a manifest written for a different spec")

@@ -24,6 +24,8 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import multiprocessing
+import numbers
+import operator
 import os
 import signal
 import socket
@@ -34,6 +36,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
 from cmsim.errors import ParameterError, WorkersDied
+from cmsim.rig.ranges import RANGES
 
 __all__ = ["run_tasks", "process_pool", "Interrupted", "POOL_RESTARTS", "START_METHODS",
            "default_start_method", "check_workers", "check_start_method", "scheduler_client",
@@ -57,13 +60,11 @@ def default_start_method():
 
 
 def check_workers(workers):
-    """``workers`` (default ``os.cpu_count()``) checked to be an integer in [1, 256]."""
+    """``workers`` (default ``os.cpu_count()``) checked against ``RANGES["workers"]``."""
     workers = (os.cpu_count() or 1) if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, int) \
-            and not hasattr(workers, "__index__") or not 1 <= workers <= 256:
-        raise ParameterError(f"workers must be an integer in [1, 256], got {workers!r}",
-                             param="workers")
-    return int(workers)
+    if not isinstance(workers, numbers.Integral) and hasattr(workers, "__index__"):
+        workers = operator.index(workers)
+    return RANGES["workers"].check("workers", workers)
 
 
 def check_start_method(start_method):

@@ -145,4 +145,6 @@ RANGES = {
     "n_samples": Range(1, 1.0e12, integer=True),
     # physical units per stored sample value of a recording (a WAV in counts or volts)
     "calibration": Range(0.0, 1.0e12, lo_open=True),
+    # processes of a job (a sweep, a dataset, a comparison's runs)
+    "workers": Range(1, 256, integer=True),
 }

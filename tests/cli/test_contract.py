@@ -239,6 +239,9 @@ CATALOGUE = [
       "--torque-nm", numeric=True),
     R("sweep-workers-zero", "sweep --speed-rpm 1000 --workers 0 --out {work}/s", "--workers",
       numeric=True),
+    # the one bound of RANGES["workers"] (the command once took 1024, the API 256)
+    R("sweep-workers-over", "sweep --speed-rpm 1000 --workers 257 --out {work}/s", "--workers",
+      "256", numeric=True),
     R("sweep-seed-policy", "sweep --speed-rpm 1000 --seed-policy each --out {work}/s",
       "--seed-policy"),
     R("sweep-torque-bearing-rig", "sweep --speed-rpm 1000 --torque-nm 10 --rig {bearing_rig} "
@@ -345,6 +348,8 @@ CATALOGUE = [
     R("dataset-out-missing", "dataset {ds_spec}", "--out"),
     R("dataset-workers-zero", "dataset {ds_spec} --out {work}/d --workers 0", "--workers",
       numeric=True),
+    R("dataset-workers-over", "dataset {ds_spec} --out {work}/d --workers 257", "--workers",
+      "256", numeric=True),
     # ---- losses
     R("losses-speed-zero", "losses --speed-rpm 0 --torque-nm 10", "--speed-rpm", numeric=True),
     R("losses-torque-missing", "losses --speed-rpm 1000", "--torque-nm"),
