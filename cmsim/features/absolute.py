@@ -246,10 +246,24 @@ def statistics(x):
 
 
 def tsa_residual_kurtosis(x, fs, shaft_hz):
-    """Kurtosis of the residual of the time-synchronous average of ``x`` on a shaft of rate
-    ``shaft_hz`` (NaN when the record is too short for an average): what is not periodic
-    with the shaft, a local tooth fault's impulse among it (Randall, *Vibration-based
-    condition monitoring*, 2011, §5.4)."""
+    """Kurtosis of the residual of the time-synchronous average of a signal on one shaft:
+    what is not periodic with the shaft, a local tooth fault's impulse among it (Randall,
+    *Vibration-based condition monitoring*, 2011, §5.4).
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Signal, any unit.
+    fs : float
+        Sample rate, Hz.
+    shaft_hz : float
+        Rate of the shaft, Hz.
+
+    Returns
+    -------
+    float
+        NaN when the signal is too short for an average.
+    """
     try:
         avg = time_synchronous_average(x, fs, speed_rpm=60.0 * shaft_hz)
     except ParameterError:
