@@ -133,9 +133,11 @@ def mesh_tracked(x, fs, freqs):
             and k * freqs.gmf_hz + 3 * fr < 0.45 * fs:
         fc = k * freqs.gmf_hz
         fk, sk = f, spec
-        if fc - 3.0 * fr > f[1]:                  # the neighbourhood: positive bins only,
-            i0, i1 = np.searchsorted(f[:(n + 1) // 2], [fc - 3.0 * fr - f[1],  # sorted
-                                                        fc + 3.0 * fr + f[1]])
+        if fc - 3.0 * fr > f[1]:
+            # only the bins around fc take part: cut them (a bin's margin) from the sorted
+            # positive half, then the same tests as on the whole spectrum
+            lo_hi = [fc - 3.0 * fr - f[1], fc + 3.0 * fr + f[1]]
+            i0, i1 = np.searchsorted(f[:(n + 1) // 2], lo_hi)
             fk, sk = f[i0:i1], spec[i0:i1]
         band = np.abs(fk - fc) < 0.5 * fr
         near = (np.abs(fk - fc) < 3.0 * fr) & ~band
