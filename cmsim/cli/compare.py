@@ -75,6 +75,7 @@ def run(args):
             raise CLIError(f"--machine {args.machine}: {exc}", option="--machine") from None
         raise
     out = res.to_dict()
+    out["workers"] = kw["workers"]            # what wall_s was measured on (not the result)
     out["report"] = str(write_report(res, args.report)) if args.report else None
     return out
 
@@ -108,7 +109,8 @@ def text(res):
         lines.append(f"  {d['feature'] + band:24s} measured {d['measured']:.3g} simulated "
                      f"{d['simulated']:.3g} (z {d['z']:.1f})")
     lines += inferred_lines(res["inferred"])
-    lines.append(f"{res['simulations']} simulations, {res['wall_s']:.1f} s")
+    lines.append(f"{res['simulations']} simulations, {res['wall_s']:.1f} s"
+                 + (f" on {res['workers']} processes" if res.get("workers", 1) > 1 else ""))
     if res["report"]:
         lines.append(f"wrote {res['report']}")
     return "\n".join(lines)

@@ -8,6 +8,7 @@ the ones that run several comparisons are marked slow.
 
 import json
 import math
+import os
 import shutil
 import wave
 from types import SimpleNamespace
@@ -316,6 +317,7 @@ def test_cli_compare_json(tmp_path, capsys):
     for key in ("discrepancies", "causes", "finding", "gain", "simulations", "wall_s"):
         assert key in out
     assert out["simulations"] <= 12
+    assert out["workers"] == min(2, os.cpu_count() or 1)    # the command's default
     html = (tmp_path / "rep" / "compare.html").read_text()
     assert "data:image/png;base64" in html and out["finding"] in html
 
