@@ -50,7 +50,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.features.lines import (FALLBACK_BAND, SLIP_TOLERANCE, demodulation_band,
-                                  highest_fault_hz, line_amplitude, line_window)
+                                  highest_fault_hz, line_amplitude, line_bins)
 from cmsim.frequencies import BearingFrequencies
 from cmsim.spectra.envelope import envelope_spectrum
 
@@ -283,10 +283,10 @@ def band_excess(freq, amp, f_hz, floor, tolerance=SLIP_TOLERANCE):
     float
         Σ amp² over the line's bins / (bins × floor²); NaN outside the spectrum.
     """
-    sel = line_window(freq, f_hz, tolerance)
+    sel = line_bins(freq, f_hz, tolerance)
     if sel is None or not floor > 0:
         return math.nan
-    return float(np.sum(amp[sel] ** 2) / (np.count_nonzero(sel) * floor ** 2))
+    return float(np.sum(amp[sel] ** 2) / ((sel.stop - sel.start) * floor ** 2))
 
 
 # ---------------------------------------------------------------------- band bank

@@ -1,6 +1,6 @@
 """THE line rule and THE demodulation-band rule: every feature extractor reads lines with these.
 
-Line rule (:func:`line_window`, :func:`line_amplitude`)
+Line rule (:func:`line_window`, :func:`line_bins`, :func:`line_amplitude`)
     Defined in :mod:`cmsim.spectra.lines` (below :mod:`cmsim.measured`, whose metadata
     checks read lines by it too) and re-exported here: a line of nominal frequency f is the
     largest bin within f·(1 ± tolerance) ± 1.5 bins, the tolerance
@@ -42,9 +42,9 @@ import numpy as np
 from cmsim.errors import ParameterError
 from cmsim.spectra.kurtogram import FAULT_BANDWIDTH_FACTOR, residual_kurtogram
 from cmsim.spectra.lines import (EXACT_TOLERANCE, LINE_HALF_WIDTH_BINS, SLIP_TOLERANCE,
-                                 line_amplitude, line_window)
+                                 line_amplitude, line_bins, line_window)
 
-__all__ = ["line_window", "line_amplitude", "demodulation_band", "highest_fault_hz",
+__all__ = ["line_window", "line_bins", "line_amplitude", "demodulation_band", "highest_fault_hz",
            "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE", "SLIP_TOLERANCE",
            "FAULT_BANDWIDTH_FACTOR", "MAX_FAULT_FRACTION", "NARROW_BAND_FRACTION",
            "FALLBACK_BAND"]

@@ -1,6 +1,6 @@
 """THE line rule: every reader of a spectral line at a nominal frequency uses it.
 
-Line rule (:func:`line_window`, :func:`line_amplitude`)
+Line rule (:func:`line_window`, :func:`line_bins`, :func:`line_amplitude`)
     A spectral line of nominal frequency f is the largest bin within
 
         f·(1 − tolerance) − 1.5·Δf  ≤  f_bin  ≤  f·(1 + tolerance) + 1.5·Δf   (Δf: bin spacing).
@@ -41,7 +41,7 @@ import math
 
 import numpy as np
 
-__all__ = ["line_window", "line_amplitude", "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE",
+__all__ = ["line_window", "line_bins", "line_amplitude", "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE",
            "SLIP_TOLERANCE"]
 
 #: Half-width of a line's window beyond its relative tolerance, bins.
@@ -75,7 +75,7 @@ def line_window(freq, f_hz, tolerance=EXACT_TOLERANCE, half_width_bins=LINE_HALF
         None when the line is not in the spectrum (f <= 0, not finite, or its window holds
         no bin).
     """
-    span = _line_span(freq, f_hz, tolerance, half_width_bins)
+    span = line_bins(freq, f_hz, tolerance, half_width_bins)
     if span is None:
         return None
     sel = np.zeros(len(freq), dtype=bool)
@@ -83,10 +83,26 @@ def line_window(freq, f_hz, tolerance=EXACT_TOLERANCE, half_width_bins=LINE_HALF
     return sel
 
 
-def _line_span(freq, f_hz, tolerance, half_width_bins=LINE_HALF_WIDTH_BINS):
-    """The bins of :func:`line_window` as a slice (bisection on the sorted bins: a reader of
-    hundreds of lines per spectrum would spend most of its time on full-length masks), or
-    None."""
+def line_bins(freq, f_hz, tolerance=EXACT_TOLERANCE, half_width_bins=LINE_HALF_WIDTH_BINS):
+    """The bins of :func:`line_window` as a slice, found by bisection on the sorted bins (a
+    reader of hundreds of lines per spectrum spent most of its time on full-length masks).
+
+    Parameters
+    ----------
+    freq : numpy.ndarray, shape (n_bins,)
+        Bin frequencies, Hz, uniformly spaced from 0.
+    f_hz : float
+        Nominal frequency of the line, Hz.
+    tolerance : float
+        Relative tolerance, >= 0.
+    half_width_bins : float
+        Bins beyond the tolerance on each side.
+
+    Returns
+    -------
+    slice or None
+        None when the line is not in the spectrum.
+    """
     if not (math.isfinite(f_hz) and f_hz > 0.0):
         return None
     half = tolerance * f_hz + half_width_bins * float(freq[1] - freq[0])
@@ -126,7 +142,7 @@ def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE):
     2.0
     """
     amp = np.asarray(amp)
-    sel = _line_span(freq, f_hz, tolerance)
+    sel = line_bins(freq, f_hz, tolerance)
     if sel is None:
         return math.nan if amp.ndim == 1 else np.full(amp.shape[:-1], math.nan)
     peak = amp[..., sel].max(axis=-1)
