@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -20,12 +21,13 @@ def register(sub):
     """Add the ``simulate`` parser."""
     p = sub.add_parser("simulate", help="simulate the rig at one operating point",
                        description="Integrate the model and write a run (.npz).")
-    p.add_argument("--speed-rpm", type=number("speed_rpm"), required=True,
-                   help="input shaft speed, rpm")
-    p.add_argument("--torque-nm", type=number("torque_nm"), default=0.0,
-                   help="output torque, N m")
-    p.add_argument("--radial-load-n", type=number("radial_load_n"), default=0.0,
-                   help="static radial load on shaft 1's centre node, N (bearing rigs)")
+    p.add_argument("--speed-rpm", type=number("speed_rpm"),
+                   help="input shaft speed, rpm (required, unless --machine: its speed)")
+    p.add_argument("--torque-nm", type=number("torque_nm"),
+                   help="output torque, N m (default 0, or --machine's)")
+    p.add_argument("--radial-load-n", type=number("radial_load_n"),
+                   help="static radial load on shaft 1's centre node, N (bearing rigs; "
+                        "default 0, or --machine's)")
     add_sampling_options(p)
     add_mesh_options(p)
     p.add_argument("--cage-slip", type=number("cage_slip"), default=0.0, metavar="FRACTION",
@@ -97,6 +99,10 @@ def run(args):
                                f"sample rate; leave out {option}", option=option)
         args.fs_hz = machine.fs_hz
         rig = machine.rig
+        # the machine's operating point, as calibrated, where the options leave it out
+        for name in ("speed_rpm", "torque_nm", "radial_load_n"):
+            if getattr(args, name) is None:
+                setattr(args, name, getattr(machine.op, name))
         if args.clearance_m is not None:
             rig = rig.with_clearance(args.clearance_m)
         if args.friction is not None:
@@ -104,8 +110,15 @@ def run(args):
                 raise CLIError("--friction needs a rig with gears", option="--friction")
             rig = rig.with_friction(args.friction)
     else:
+        if args.speed_rpm is None:
+            raise CLIError("--speed-rpm: required (the input shaft speed, rpm), unless "
+                           "--machine gives it", option="--speed-rpm")
         rig = load_rig(args)
+        args.torque_nm = 0.0 if args.torque_nm is None else args.torque_nm
+        args.radial_load_n = 0.0 if args.radial_load_n is None else args.radial_load_n
     op = operating_point(args, rig)
+    if machine is not None:
+        op = dataclasses.replace(op, radial_load_angle_rad=machine.op.radial_load_angle_rad)
     faults = faults_of(args, rig)
     profile = _speed_profile(args)
     mesh = mesh_argument(args, rig, [op.torque_nm])

@@ -48,8 +48,8 @@ import numpy as np
 
 from cmsim.datasets.distribution import Distribution
 from cmsim.datasets.plan import NUISANCES, PER_MODE, FaultChoice, RecordPlan, nuisance_faults
-from cmsim.datasets.spec_toml import (check_channels, read_toml, setting_range, toml_key,
-                                      toml_keywords)
+from cmsim.datasets.spec_toml import (check_channels, machine_operating, read_toml,
+                                      setting_range, toml_key, toml_keywords)
 from cmsim.datasets.variation import (OPERATING_POINT_FIELDS, Variation, _check_value,
                                       apply_rig_setting, setting_kind, value_token)
 from cmsim.dynamics.step import fastest_excitation, integration_substeps
@@ -163,7 +163,8 @@ class DatasetSpec:
     machine : cmsim.machine.Machine, optional
         A calibrated machine (:func:`cmsim.machine.calibrate`): the records are made on its
         rig at its sample rate, and the channel named as the machine's is the model force
-        through its calibrated path plus its background.
+        through its calibrated path plus its background; its speed and load (as calibrated)
+        are fixed where the settings leave them out.
     """
 
     name: str
@@ -219,7 +220,8 @@ class DatasetSpec:
             raise ParameterError(f"sampling must be 'random' or 'grid', got {sampling!r}",
                                  param="sampling")
         set_(self, "sampling", sampling)
-        set_(self, "settings", _settings(variations, fixed, rig, sampling))
+        set_(self, "settings", _settings(variations, fixed, rig, sampling, None if machine is None
+                                         else machine_operating(machine)))
         set_(self, "seed", RANGES["seed"].check("seed", seed))
         check_choice("seed_policy", seed_policy, SEED_POLICIES)
         set_(self, "seed_policy", seed_policy)
@@ -553,8 +555,9 @@ def _share(name, v):
     return check_range(name, v, 0.0, 1.0)
 
 
-def _settings(variations, fixed, rig, sampling):
-    """``fixed`` then ``variations`` as ``(name, Distribution)`` pairs, checked."""
+def _settings(variations, fixed, rig, sampling, defaults=None):
+    """``fixed`` then ``variations`` as ``(name, Distribution)`` pairs, checked; a name of
+    ``defaults`` that neither names is fixed at its default."""
     if isinstance(variations, dict):
         variations = list(variations.items())
     if isinstance(variations, (str, bytes)) or not hasattr(variations, "__iter__"):
@@ -572,8 +575,12 @@ def _settings(variations, fixed, rig, sampling):
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         raise ParameterError(f"variations name {dup} more than once", param="variations")
+    fixed = dict(fixed or {})
+    for name, value in (defaults or {}).items():
+        if name not in names and name not in fixed:
+            fixed[name] = value
     out = []
-    for name, value in dict(fixed or {}).items():
+    for name, value in fixed.items():
         if name in names:
             raise ParameterError(f"{name} is both varied and fixed", param=name)
         setting_kind(name, rig)

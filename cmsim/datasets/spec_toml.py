@@ -34,8 +34,9 @@ checked, and a bad spec is refused before any work with a message naming the key
     [machine]      file = "MACHINE.toml" (``cmsim calibrate --out``; relative to the spec
                    file): the records are made on the machine's rig at its sample rate, and
                    its channel (e.g. ``DE``; the default channels are it and ``tacho``) is the
-                   model force through the machine's calibrated path plus its background;
-                   leave ``[rig]`` out
+                   model force through the machine's calibrated path plus its background,
+                   at the machine's speed and load where ``[operating]`` leaves them out
+                   (:func:`machine_operating`); leave ``[rig]`` out
 
 Values are :class:`~cmsim.datasets.distribution.Distribution` s: a number (constant), a list
 (grid values; drawn uniformly under random sampling) or a distribution table.
@@ -54,7 +55,17 @@ from cmsim.machine import Machine
 from cmsim.rig import PRESETS, RANGES, SAMPLING, Rig
 
 __all__ = ["read_toml", "toml_keywords", "load_rig", "load_machine", "check_channels", "setting_range",
-           "OPERATING_DEFAULTS"]
+           "OPERATING_DEFAULTS", "machine_operating"]
+
+
+def machine_operating(machine):
+    """The operating settings a machine brings, as calibrated (its speed, its load: a
+    bearing rig's radial load, a gear rig's torque): what its records default to."""
+    out = {"speed_rpm": machine.op.speed_rpm, "radial_load_n": machine.op.radial_load_n}
+    if machine.rig.gears is not None:
+        out["torque_nm"] = machine.op.torque_nm
+    return out
+
 
 #: Operating settings a TOML spec always has (with these values when it leaves them out),
 #: and the order in which a record draws the named operating settings.
@@ -167,7 +178,10 @@ def toml_keywords(data, base_dir=None):
                    else load_rig(data.get("rig", {}), base_dir))
     op = data.get("operating", {})
     sampling = op.get("sampling", "random")
-    named = [n for n in OPERATING_DEFAULTS if n in op or OPERATING_DEFAULTS[n] is not None]
+    # a machine's records default to its own speed and load (DatasetSpec fixes them)
+    brought = machine_operating(machine) if machine is not None else {}
+    named = [n for n in OPERATING_DEFAULTS if n in op or (OPERATING_DEFAULTS[n] is not None
+                                                          and n not in brought)]
     others = [n for n in op if n not in OPERATING_DEFAULTS and n not in _TABLES["operating"]]
     settings = []
     for name in named + others:

@@ -6,6 +6,8 @@ the path (the same as ``simulate --machine`` makes of the same run), and the spe
 what contradicts the machine (another rig, another sample rate, a missing file).
 """
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -14,7 +16,7 @@ from cmsim.diagnostics.syn2real import synthetic_windows
 from cmsim.dynamics import simulate
 from cmsim.errors import ParameterError
 from cmsim.machine import Background, BackgroundLine, Machine, TransferPath
-from cmsim.rig import OperatingPoint, Rig
+from cmsim.rig import OperatingPoint, Rig, Rotor
 
 FS = 12_800.0
 GAIN = 0.01                     # sensor unit per N, flat
@@ -88,3 +90,27 @@ def test_a_spec_refuses_what_contradicts_its_machine(tmp_path):
                               base_dir=tmp_path)
     with pytest.raises(ParameterError, match="machine.file"):
         DatasetSpec.from_dict({**_spec_dict(tmp_path), "machine": {}}, base_dir=tmp_path)
+
+
+def test_records_default_to_the_machines_operating_point(tmp_path):
+    """A spec through a machine that leaves [operating] out runs at the machine's speed and
+    load (a bearing rig's radial load, a gear rig's torque), not at 1000 rpm unloaded: an
+    unloaded bearing carries no force, and a labelled fault would make no signal."""
+    data = _spec_dict(tmp_path)
+    del data["operating"]
+    spec = DatasetSpec.from_dict(data, base_dir=tmp_path)
+    op = spec.record_operating_point(spec.record(0))
+    assert (op.speed_rpm, op.torque_nm) == (1000.0, 40.0)
+    # the Python API the same, and what a spec states still wins
+    api = DatasetSpec(fixed={"torque_nm": 10.0}, records=2, sampling="random", fs_hz=FS,
+                      machine=_machine(), channels=["DE"])
+    op = api.record_operating_point(api.record(0))
+    assert (op.speed_rpm, op.torque_nm) == (1000.0, 10.0)
+    bearing = Machine.load(tmp_path / "m.toml")
+    bearing_rig = Rig.rotor_on_bearings(bearing.rig.bearings[0], Rotor(3.0, 0.01))
+    loaded = dataclasses.replace(bearing, rig=bearing_rig,
+                                 op=OperatingPoint(1797.0, 0.0, radial_load_n=98.0))
+    spec = DatasetSpec(records=1, sampling="random", fs_hz=FS, machine=loaded,
+                       channels=["DE"])
+    op = spec.record_operating_point(spec.record(0))
+    assert (op.speed_rpm, op.radial_load_n, op.torque_nm) == (1797.0, 98.0, 0.0)
