@@ -62,7 +62,16 @@ def run(args):
                         "a machine file (cmsim calibrate --out)") if args.machine else None
     rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None
     channel = args.channel or (machine.channel if machine is not None else None)
-    record = read_record(args.record, channel=channel, rig=rig, **recording_values(args))
+    try:
+        record = read_record(args.record, channel=channel, rig=rig, **recording_values(args))
+    except ParameterError as exc:
+        if exc.param != "--channel" or args.channel is not None or machine is None:
+            raise
+        # the channel was the machine's, not the user's: the machine is what does not fit
+        raise CLIError(f"--machine {args.machine}: calibrated on channel {machine.channel!r}, "
+                       f"which the record does not have ({exc}); a machine file belongs to "
+                       "the recordings of the machine it was calibrated on",
+                       option="--machine") from None
     if args.span is not None:
         record = record.span(*args.span)
     kw = {} if args.budget is None else {"budget": args.budget}

@@ -642,7 +642,8 @@ def _reading(forced, spectra, fs, freqs, bearing, shaft_hz, ref, longest):
         corr = correction(points + capped)
         notes.append(f"path gain capped at {len(capped)} frequencies where the record does "
                      f"not show the model's lines or modulation "
-                     f"({', '.join(f'{f:.1f}' for f, _ in sorted(capped)[:6])} Hz)")
+                     f"({', '.join(f'{f:.1f}' for f, _ in sorted(capped)[:6])}"
+                     f"{', …' if len(capped) > 6 else ''} Hz)")
     gain = shape * corr
     if not (pins or mod_pins):   # a prior gain must keep the model's broadband under the floor
         gain = np.minimum(gain, np.sqrt(BROADBAND_SHARE * floor / pf_floor))

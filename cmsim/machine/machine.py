@@ -316,6 +316,9 @@ class Machine:
             The parsed machine file.
         """
         version = data.get("format_version")
+        if version is None and "machine" not in data:
+            raise ParameterError("not a machine file (no format_version nor [machine] table; "
+                                 "cmsim calibrate --out writes one)", param="machine")
         if version != MACHINE_FORMAT_VERSION:
             raise ParameterError(f"machine format_version {version!r} is not supported (this "
                                  f"cmsim reads version {MACHINE_FORMAT_VERSION})",
@@ -341,8 +344,11 @@ class Machine:
                 spread={k: (float(v[0]), float(v[1])) for k, v in data.get("spread", {}).items()},
                 fit_quality=dict(data.get("fit_quality", {})),
                 calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())))
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise ParameterError(f"not a machine file ({type(exc).__name__}: {exc})",
+        except KeyError as exc:
+            raise ParameterError(f"not a machine file (it lacks {exc.args[0]!r})",
+                                 param="machine") from None
+        except (TypeError, ValueError, IndexError) as exc:
+            raise ParameterError(f"not a machine file (a malformed value: {exc})",
                                  param="machine") from None
 
     def save(self, path):
