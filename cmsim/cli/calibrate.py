@@ -98,11 +98,20 @@ def run(args):
 
 def _check_out(args):
     """--out is a new file (or --force), and never an input: refused before any work."""
+    from cmsim.measured.readers import resolve_path
+
     out = Path(args.out).resolve()
     for option, path in [("--rig", args.rig)] + [("BASELINE", b) for b in args.baseline]:
-        if path is not None and Path(path).resolve() == out:
-            raise CLIError(f"--out {args.out}: is the {option} input; write the machine to "
-                           f"another file", option="--out")
+        if path is None:
+            continue
+        try:                    # the input as it will be read: also under CMSIM_DATA
+            found = resolve_path(path).resolve()
+        except ParameterError:
+            found = None        # no such input: reading it says so, after this check
+        if out in (Path(path).resolve(), found):
+            raise CLIError(f"--out {args.out}: is the {option} input"
+                           f"{'' if found in (None, Path(path).resolve()) else f' ({found})'}"
+                           "; write the machine to another file", option="--out")
     if out.exists() and not args.force:
         raise CLIError(f"--out {args.out}: exists; give --force to overwrite it (or a new "
                        f"file)", option="--out")

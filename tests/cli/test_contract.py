@@ -29,6 +29,7 @@ import pytest
 import cmsim
 from cmsim.cli import app, build_parser, contract, main
 from cmsim.datasets.manifest import write_row
+from cmsim.machine import Background, Machine, TransferPath
 from cmsim.rig import Rig
 from cmsim.run import Run
 
@@ -364,6 +365,8 @@ CATALOGUE = [
     # ---- compare
     R("compare-machine-missing", "compare {record} --machine {work}/none.toml", "--machine"),
     R("compare-machine-text", "compare {record} --machine {text}", "--machine"),
+    R("compare-machine-other-channel", "compare {record} --machine {machine_other}",
+      "--machine", "'a1'"),
     R("compare-span-reversed", "compare {record} --span 1 0.5", "--span"),
     R("calibrate-missing-out", "calibrate {record}", "--out"),
     R("calibrate-record-missing", "calibrate {work}/none.npz --out {work}/m.toml", "BASELINE",
@@ -731,6 +734,12 @@ def files(tmp_path_factory):
         "recordings": [{"file": "rec.npz", "shaft_speed_rpm": 1797.0}]}))
     f["record"] = meas / "rec.npz"
     f["measured_dir"] = meas
+    grid = tuple(np.linspace(0.0, 6000.0, 9))          # a machine of another rig's channel
+    Machine(name="other", rig=paper, channel="a1", model_signal="accel_1b1_y", fs_hz=12000.0,
+            op=cmsim.OperatingPoint(1797.0, 10.0),
+            path=TransferPath("F_1b1_y", grid, (0.01,) * len(grid), "g"),
+            background=Background(grid, (1e-12,) * len(grid)), unit="g").save(d / "other.toml")
+    f["machine_other"] = d / "other.toml"
     mat = d / "mat"                                # a CWRU-layout .mat, no metadata.json
     mat.mkdir()
     from scipy.io import savemat
@@ -909,6 +918,42 @@ def test_bad_input(row, as_json, files, capsys, cold_numba_cache):
     else:
         assert cap.out == ""
     assert _tree(files["root"]) == before
+
+
+def test_calibrate_never_writes_over_a_baseline_found_under_cmsim_data(files, tmp_path,
+                                                                       monkeypatch, capsys):
+    """--out is refused when it is a BASELINE however the BASELINE was found: as typed, or
+    (a relative path) under $CMSIM_DATA — with --force too (a user's data overwritten by
+    the machine file before the fix)."""
+    root = tmp_path / "data"
+    (root / "rig").mkdir(parents=True)
+    for name in ("rec.npz", "metadata.json"):
+        (root / "rig" / name).write_bytes((files["measured_dir"] / name).read_bytes())
+    before = (root / "rig" / "rec.npz").read_bytes()
+    monkeypatch.setenv("CMSIM_DATA", str(root))
+    monkeypatch.chdir(tmp_path)
+    status = main(["calibrate", "rig/rec.npz", "--out", str(root / "rig" / "rec.npz"),
+                   "--force", "--json"])
+    cap = capsys.readouterr()
+    assert status == 2 and json.loads(cap.out)["option"] == "--out", cap.err
+    assert "BASELINE" in cap.err and (root / "rig" / "rec.npz").read_bytes() == before
+
+
+def test_simulate_through_a_machine_runs_at_its_operating_point(files, tmp_path, capsys):
+    """simulate --machine without --speed-rpm / --torque-nm / --radial-load-n runs at the
+    machine's speed and load; an option given still wins; without a machine the speed is
+    required."""
+    out = tmp_path / "run.npz"
+    assert main(["simulate", "--machine", str(files["machine_other"]), "--duration-s", "0.02",
+                 "--out", str(out), "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["shaft_hz"] == pytest.approx(1797.0 / 60.0)
+    meta = Run.load(out).meta["operating_point"]
+    assert (meta["speed_rpm"], meta["torque_nm"]) == (1797.0, 10.0)
+    assert main(["simulate", "--machine", str(files["machine_other"]), "--duration-s", "0.02",
+                 "--torque-nm", "20", "--out", str(out), "--json"]) == 0
+    capsys.readouterr()
+    assert Run.load(out).meta["operating_point"]["torque_nm"] == 20.0
 
 
 def test_catalogue_size_and_commands():
