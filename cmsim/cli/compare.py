@@ -91,6 +91,8 @@ def run(args):
 
 def text(res):
     """The finding in words, the gain, the leading causes and discrepancies."""
+    from cmsim.discrepancy.compare import feature_label
+
     lines = [f"finding: {res['words']} [{res['finding']}"
              + (f" on {res['component']}" if res["component"] else "") + "]",
              f"nominal model: {res['mode']}"
@@ -108,14 +110,16 @@ def text(res):
     lines.append(f"held-out discrepancy (chi2 per feature, ~1 for a record like the model's "
                  f"own): {g['before']:.3g} -> {g['after']:.3g} (relative gain "
                  f"{g['relative']:.2f})")
+    lines.append("leading causes, by their evidence (Δχ²) on the features each moves (a fault "
+                 "is named when its own family stands out, before any cause that reshapes "
+                 "the whole spectrum):")
     for c in res["causes"][:5]:
-        lines.append(f"  {c['name']:20s} {str(c['component']):10s} evidence "
+        lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
                      f"{c['delta_chi2']:7.1f} on {c['judged_on']} features (all: "
                      f"{c['delta_chi2_all']:.1f})")
+    lines.append("largest departures of the record from the model:")
     for d in res["discrepancies"][:5]:
-        band = (f" ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)" if "band_hz" in d
-                else "")
-        lines.append(f"  {d['feature'] + band:24s} measured {d['measured']:.3g} simulated "
+        lines.append(f"  {feature_label(d)}: measured {d['measured']:.3g} simulated "
                      f"{d['simulated']:.3g} (z {d['z']:.1f})")
     lines += inferred_lines(res["inferred"])
     lines.append(f"{res['simulations']} simulations, {res['wall_s']:.1f} s"

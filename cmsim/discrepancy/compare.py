@@ -61,7 +61,7 @@ from cmsim.errors import ParameterError
 from cmsim.features import segment_features, segments
 from cmsim.features.relative import shape_band_edges
 
-__all__ = ["Comparison", "compare", "describe", "DEFAULT_BUDGET", "SIM_SEEDS", "VAR_SEEDS",
+__all__ = ["Comparison", "compare", "describe", "feature_label", "DEFAULT_BUDGET", "SIM_SEEDS", "VAR_SEEDS",
            "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "ALARM_Z", "MODES"]
 
 #: Default budget of simulations (model runs: ranking, fit and the held-out re-simulations).
@@ -382,7 +382,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         discrepancies = sorted(
             ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k] - bias[k],
               "sigma": sigma[k], "z": (seen_fit[k] - f_nom_fit[k]) / sigma[k],
-              **_band_of(k, edges)} for k in cols),
+              **_band_of(k, edges, ev.freqs, record.components)} for k in cols),
             key=lambda d: -abs(d["z"]))
         top, ties = decide(ranked, ev.sensor_bearing, chi_nom)
         finding, component, params, ranges, fitted = "none", None, {}, {}, setup_nom
@@ -415,9 +415,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
                        "parameters": r.get("fitted", r["probe"])} for r in ranked]
         near_ties = [{"name": r["name"], "component": _component_name(record, r["component"]),
                       "delta_chi2": r["delta_chi2"]} for r in ties]
-        departures = [d["feature"] + (f" ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)"
-                                      if "band_hz" in d else "")
-                      for d in discrepancies if abs(d["z"]) > 2.0][:8]
+        departures = [feature_label(d) for d in discrepancies if abs(d["z"]) > 2.0][:8]
         spectra = {"measured": record.signal, "fs_hz": record.fs_hz,
                    "bearing": ev.freqs.bearings.get(ev.sensor_bearing),
                    "bearing_name": _component_name(record, ev.sensor_bearing),
@@ -425,8 +423,9 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
                    "fitted": None if fitted is setup_nom else _concat(
                        [ev.signal(fitted, s) for s in held_seeds])}
         return Comparison(
-            discrepancies=[{k: (v if k in ("feature", "band_hz") else float(v))
-                            for k, v in d.items()} for d in discrepancies[:12]],
+            discrepancies=[{k: (v if k in ("feature", "band_hz", "reads", "line_hz")
+                                else float(v)) for k, v in d.items()}
+                           for d in discrepancies[:12]],
             causes=causes_out, finding=finding, component=component, parameters=params,
             gain=gain, simulations=ev.count, wall_s=time.perf_counter() - start,
             chi2_per_feature=chi_nom / max(n_eff, 1e-9), n_features=len(cols),
@@ -443,12 +442,68 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             spectra=spectra)
 
 
-def _band_of(name, edges):
-    """``{"band_hz": [lo, hi]}`` of a spectral-shape feature, else ``{}``."""
-    if not name.startswith("shape_b"):
+def _band_of(name, edges, freqs=None, components=None):
+    """Where a feature reads, in Hz: ``{"band_hz": [lo, hi]}`` of a spectral-shape band;
+    ``{"reads": words, "line_hz": [f, ...]}`` of a line feature (a shaft order, a mesh
+    harmonic and its sidebands, a bearing's defect family in the spectrum or the envelope
+    spectrum) at the record's rates ``freqs``, its bearing by the record's name
+    (``components``); else ``{}``."""
+    if name.startswith("shape_b"):
+        i = int(name[len("shape_b"):].split("_")[0])
+        return {"band_hz": [float(edges[i]), float(edges[i + 1])]}
+    if freqs is None:
         return {}
-    i = int(name[len("shape_b"):].split("_")[0])
-    return {"band_hz": [float(edges[i]), float(edges[i + 1])]}
+    parts = name.removesuffix("_db").split("_")
+    fr = freqs.fr1_hz
+    if parts[:2] in (["raw", "fr"], ["env", "fr"]):
+        h = int(parts[2][1:])
+        return _reads(f"{h}× input shaft" + (" (envelope)" if parts[0] == "env" else ""),
+                      [h * fr])
+    if name.startswith("gmf") and freqs.gmf_hz:
+        k = int(parts[0][3:])
+        return _reads(f"GMF harmonic {k} (level relative to the largest)", [k * freqs.gmf_hz])
+    if parts[0] in ("sb1", "sb23") and freqs.gmf_hz:
+        rate = fr if parts[1] == "fr1" else freqs.fr2_hz
+        k = int(parts[2][1:])
+        orders = (1,) if parts[0] == "sb1" else (2, 3)
+        return _reads(f"GMF harmonic {k} ± {'/'.join(map(str, orders))}× the "
+                      f"{'input' if parts[1] == 'fr1' else 'output'} shaft over the carrier",
+                      [k * freqs.gmf_hz + s * n * rate for n in orders for s in (-1, 1)])
+    if parts[0] not in ("raw", "env") or len(parts) < 3 \
+            or parts[2] not in freqs.bearing_names:
+        return {}
+    bf, fam, rest = freqs.bearing(parts[2]), parts[1], parts[3:]
+    where = f"{(components or {}).get(parts[2], parts[2]).replace('_', '-')} bearing"
+    base = {"bpfo": bf.bpfo_hz, "bpfi": bf.bpfi_hz, "bsf2": 2.0 * bf.bsf_hz,
+            "ftf": bf.ftf_hz}.get(fam)
+    if base is None:
+        return {}
+    label = {"bsf2": "2×BSF"}.get(fam, fam.upper())
+    space = " (envelope)" if parts[0] == "env" else ""
+    if rest and rest[0].startswith("h"):
+        h = int(rest[0][1:])
+        return _reads(f"{'' if h == 1 else f'{h}×'}{label} of the {where}{space}", [h * base])
+    if rest == ["sb"]:
+        harmonics = (1, 2) if fam == "bpfo" else (1,)
+        return _reads(f"{label} ± the shaft rate of the {where}{space}",
+                      [h * base + s * bf.shaft_hz for h in harmonics for s in (-1, 1)])
+    what = " (its bins' power over the floor)" if rest == ["band"] else ""
+    return _reads(f"{label} of the {where}{space}{what}", [base])
+
+
+def _reads(words, lines_hz):
+    return {"reads": words, "line_hz": [float(f) for f in lines_hz]}
+
+
+def feature_label(d):
+    """A discrepancy's feature with where it reads, in Hz: ``shape_b6_db (2400-3000 Hz)``,
+    ``env_bpfi_1b1_h1_db (BPFI of the drive-end bearing (envelope), 162.1 Hz)``."""
+    if "band_hz" in d:
+        return f"{d['feature']} ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)"
+    if "reads" in d:
+        return (f"{d['feature']} ({d['reads']}, "
+                f"{', '.join(f'{f:.1f}' for f in d['line_hz'])} Hz)")
+    return d["feature"]
 
 
 def _bounds_of(finding, name):

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_text
+from cmsim.discrepancy.compare import feature_label
 from cmsim.features.envelope import demodulated_spectrum
 from cmsim.spectra.plots import agg_figure
 
@@ -108,9 +109,7 @@ def write_report(comparison, out_dir):
     named = (f" on {html.escape(str(d['component']))}" if d["component"] else "") + (
         " " + html.escape(json.dumps(d["parameters"])) if d["parameters"] else "")
     png = _figure(comparison.spectra, after)
-    rows = "".join(f"<tr><td>{html.escape(x['feature'])}"
-                   + (f" ({x['band_hz'][0]:.0f}-{x['band_hz'][1]:.0f} Hz)" if "band_hz" in x
-                      else "") + f"</td><td>{x['measured']:.3g}</td>"
+    rows = "".join(f"<tr><td>{html.escape(feature_label(x))}</td><td>{x['measured']:.3g}</td>"
                    f"<td>{x['simulated']:.3g}</td><td>{x['z']:.2f}</td></tr>"
                    for x in d["discrepancies"])
     causes = "".join(f"<tr><td>{html.escape(c['name'])}</td><td>{c['component']}</td>"
