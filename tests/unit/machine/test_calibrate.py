@@ -361,7 +361,7 @@ def test_a_shaft_line_far_over_the_baseline_s_departs_though_no_cause_makes_it(c
     assert alarm.finding == "unexplained", alarm.discrepancies[:3]
     assert alarm.discrepancies[0]["feature"] == "raw_fr_h1_db"
     assert alarm.discrepancies[0]["z"] >= 8.0
-    assert "raw_fr_h1_db" in alarm.departures
+    assert alarm.departures[0].startswith("raw_fr_h1_db (1× input shaft, ")   # with its Hz
     # the line's χ² rises with its z against a machine (evaluator.rises): the χ² rule too
     # reads it (3.0 per feature; capped at Z_CAP², 1.6 — only the alarm on z said so then)
     assert alarm.chi2_per_feature > found[1.0].chi2_per_feature + 1.0
