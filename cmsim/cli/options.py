@@ -106,12 +106,12 @@ def add_mesh_options(p):
     """Add --mesh, --mesh-table and --table-torque-nm to the parser ``p`` (simulate, modes,
     sweep, losses)."""
     p.add_argument("--mesh", choices=("hybrid-tables", "potential-energy", "hybrid"),
-                   default="hybrid-tables",
                    help="tooth contact: hybrid FE + Weber-Banaschek tables at the run's torque "
                         "(default; paper model B, shipped for the paper's rig, built and "
                         "cached on first use for other rigs), the load-independent "
-                        "potential-energy table, or the contact solved on-line from the FE "
-                        "influence coefficients (hybrid: paper model A, ~4x slower)")
+                        "potential-energy table (the default through a --machine: its twin's), "
+                        "or the contact solved on-line from the FE influence coefficients "
+                        "(hybrid: paper model A, ~4x slower)")
     p.add_argument("--mesh-table", metavar="FILE.npz",
                    help="pair stiffness table(s) from cmsim mesh-table instead; the table at "
                         "the run's torque is used (linear in torque between tables)")
@@ -120,9 +120,9 @@ def add_mesh_options(p):
                         "tables at the wrong torque)")
 
 
-def mesh_argument(args, rig, torques_nm=()):
-    """The ``mesh`` value the options in ``args`` name: a string, or the MeshTableSet /
-    table of a file (a gear ``rig`` only).
+def mesh_argument(args, rig, torques_nm=(), default="hybrid-tables"):
+    """The ``mesh`` value the options in ``args`` name: a string (``default`` without
+    --mesh), or the MeshTableSet / table of a file (a gear ``rig`` only).
 
     A --mesh-table set of several torques is read between its tables only: a torque outside
     its range (--table-torque-nm, or each of ``torques_nm`` without it) is refused, not
@@ -134,8 +134,8 @@ def mesh_argument(args, rig, torques_nm=()):
         raise CLIError("--table-torque-nm selects a table of --mesh-table FILE; give "
                        "--mesh-table too", option="--table-torque-nm")
     if not args.mesh_table:
-        return args.mesh
-    if args.mesh != "hybrid-tables":
+        return args.mesh or default
+    if args.mesh not in (None, "hybrid-tables"):
         raise CLIError(f"--mesh {args.mesh} and --mesh-table exclude each other",
                        option="--mesh")
     if rig.gears is None:

@@ -89,7 +89,7 @@ def run(args):
 
     machine = None
     if args.machine:
-        from cmsim.machine import Machine
+        from cmsim.machine import Machine, twin_mesh
         machine = load_file("--machine", args.machine, Machine.load,
                             "a machine file (cmsim calibrate --out)")
         for option, given in (("--rig", args.rig), ("--fs-hz", args.fs_hz != SAMPLING.fs_hz),
@@ -121,7 +121,8 @@ def run(args):
         op = dataclasses.replace(op, radial_load_angle_rad=machine.op.radial_load_angle_rad)
     faults = faults_of(args, rig)
     profile = _speed_profile(args)
-    mesh = mesh_argument(args, rig, [op.torque_nm])
+    mesh = mesh_argument(args, rig, [op.torque_nm],
+                         **({"default": twin_mesh(rig)} if machine is not None else {}))
     check_losses_options(args)
     prepare_tables(args, rig, mesh, [op.torque_nm])
     if args.sensor_fs_hz is not None:

@@ -57,7 +57,7 @@ from cmsim.dynamics.tooth_contact import MESH_CHOICES
 from cmsim.errors import ParameterError, check_choice, check_range
 from cmsim.faults import FAULT_TYPES, check_faults
 from cmsim.losses import LossSettings
-from cmsim.machine import Machine
+from cmsim.machine import Machine, twin_mesh
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
@@ -206,6 +206,8 @@ class DatasetSpec:
                 raise ParameterError("a machine brings its rig: leave rig out",
                                      param="machine")
             rig = machine.rig
+            if mesh is None:             # its twin's tooth contact, as calibrated
+                mesh = twin_mesh(rig)
             if abs(float(fs_hz) / machine.fs_hz - 1.0) > 1e-9:
                 raise ParameterError(f"fs_hz must be the machine's sample rate "
                                      f"({machine.fs_hz:g} Hz), got {fs_hz!r}", param="fs_hz")

@@ -13,8 +13,9 @@ background, calibrated on a healthy baseline of that machine.
 
 from cmsim.machine.background import Background, BackgroundLine
 from cmsim.machine.calibration import calibrate
-from cmsim.machine.machine import Machine, model_force, rotating_force, static_load
+from cmsim.machine.machine import (Machine, model_force, rotating_force, static_load,
+                                   twin_mesh)
 from cmsim.machine.path import TransferPath
 
 __all__ = ["Background", "BackgroundLine", "Machine", "TransferPath", "calibrate",
-           "model_force", "rotating_force", "static_load"]
+           "model_force", "rotating_force", "static_load", "twin_mesh"]

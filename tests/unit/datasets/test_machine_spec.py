@@ -15,7 +15,7 @@ from cmsim.datasets import DatasetSpec, generate_dataset, load
 from cmsim.diagnostics.syn2real import synthetic_windows
 from cmsim.dynamics import simulate
 from cmsim.errors import ParameterError
-from cmsim.machine import Background, BackgroundLine, Machine, TransferPath
+from cmsim.machine import Background, BackgroundLine, Machine, TransferPath, twin_mesh
 from cmsim.rig import OperatingPoint, Rig, Rotor
 
 FS = 12_800.0
@@ -46,6 +46,7 @@ def test_records_go_through_the_machine(tmp_path):
     spec = DatasetSpec.from_dict(_spec_dict(tmp_path), base_dir=tmp_path)
     assert spec.fs_hz == FS and spec.channels == ("DE", "tacho")
     assert spec.rig == Rig.paper_2016() and spec.rig_source == "machine:bench"
+    assert spec.mesh == "potential-energy"       # the twin's tooth contact, as calibrated
     generate_dataset(spec, tmp_path / "ds", workers=1)
     ds = load(tmp_path / "ds")
     assert len(ds) == 4
@@ -64,7 +65,7 @@ def test_records_go_through_the_machine(tmp_path):
         # makes of the same run
         run = simulate(Rig.paper_2016(), OperatingPoint(1000.0, 40.0), 1.0, fs_hz=FS,
                        seed=r.meta["record"]["seed"], warmup_s=0.02,
-                       record=list(machine.force_signals))
+                       record=list(machine.force_signals), mesh=twin_mesh(machine.rig))
         want = machine.sensor_channel(run, r.meta["record"]["seed"])["DE"]
         np.testing.assert_allclose(x, want, atol=1e-5 * np.abs(want).max())
         force = np.asarray(run["F_1b1_y"])
