@@ -81,6 +81,7 @@ def run(args):
     machine = calibrate(records, seed=args.seed)
     machine.save(args.out)
     q = machine.fit_quality
+    _warn_fit(args, q)
     out = {"machine": str(args.out), "name": machine.name, "channel": machine.channel,
            "fs_hz": machine.fs_hz, "speed_rpm": machine.op.speed_rpm,
            "speed_wobble": machine.speed_wobble, "lines": len(machine.background.lines),
@@ -115,6 +116,26 @@ def _check_out(args):
     if out.exists() and not args.force:
         raise CLIError(f"--out {args.out}: exists; give --force to overwrite it (or a new "
                        f"file)", option="--out")
+
+
+def _warn_fit(args, q):
+    """Warn when the twin misses its own held-out baseline by more than ``compare`` lets a
+    record depart before it calls it unexplained: its comparisons then read healthy records
+    through offsets the twin does not make."""
+    from cmsim.discrepancy.compare import ALARM_Z, UNEXPLAINED_CHI2_PER_FEATURE
+
+    chi = q.get("chi2_per_feature") or 0.0
+    if chi <= UNEXPLAINED_CHI2_PER_FEATURE:
+        return
+    far = sorted((k for k, z in q.get("z", {}).items() if abs(z) >= 3.0),
+                 key=lambda k: -abs(q["z"][k]))
+    args.warn(f"the twin reproduces its baseline's held-out segments to chi2 per feature "
+              f"{chi:.2f}, above the {UNEXPLAINED_CHI2_PER_FEATURE:g} at which compare calls a "
+              f"record unexplained ({len(far)} features 3 spreads or more off, worst "
+              f"{q['worst_feature']} z {q['worst_z']:.1f}"
+              f"{'' if abs(q['worst_z']) < ALARM_Z else ', beyond the alarm z'}): compare "
+              "reads records against the twin moved by these offsets, but a cause acting "
+              "on those features is judged through a twin that does not make them")
 
 
 def _wobble(w):

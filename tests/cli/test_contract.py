@@ -950,6 +950,7 @@ def test_simulate_through_a_machine_runs_at_its_operating_point(files, tmp_path,
     assert res["shaft_hz"] == pytest.approx(1797.0 / 60.0)
     meta = Run.load(out).meta["operating_point"]
     assert (meta["speed_rpm"], meta["torque_nm"]) == (1797.0, 10.0)
+    assert res["mesh_table"]["method"] == "potential-energy"     # the twin's tooth contact
     assert main(["simulate", "--machine", str(files["machine_other"]), "--duration-s", "0.02",
                  "--torque-nm", "20", "--out", str(out), "--json"]) == 0
     capsys.readouterr()
@@ -1172,3 +1173,23 @@ def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
     from cmsim.errors import ParameterError
     with pytest.raises(ParameterError, match="OR_vload3_100lb"):
         measured_windows(folder)
+
+
+def test_calibrate_warns_when_the_twin_misses_its_own_baseline():
+    """A twin that misses its held-out baseline by more than compare lets a record depart
+    before calling it unexplained is said so (the SpectraQuest twins read chi2/feature 4-10
+    and were written without a word); a twin within it is not."""
+    from types import SimpleNamespace
+
+    from cmsim.cli.calibrate import _warn_fit
+    said = []
+    args = SimpleNamespace(warn=said.append)
+    z = {"kurtosis_log": -11.5, "tsa_residual_kurtosis_log": -12.1, "shape_b2_db": 3.2,
+         "gmf1_rel_db": 0.4}
+    _warn_fit(args, {"chi2_per_feature": 6.07, "z": z, "worst_feature":
+                     "tsa_residual_kurtosis_log", "worst_z": -12.1})
+    assert len(said) == 1 and "6.07" in said[0] and "3 features" in said[0]
+    assert "tsa_residual_kurtosis_log z -12.1" in said[0]
+    _warn_fit(args, {"chi2_per_feature": 1.16, "z": {"shape_b2_db": 4.4},
+                     "worst_feature": "shape_b2_db", "worst_z": 4.4})
+    assert len(said) == 1
