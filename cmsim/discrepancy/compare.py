@@ -497,7 +497,18 @@ def _reads(words, lines_hz):
 
 def feature_label(d):
     """A discrepancy's feature with where it reads, in Hz: ``shape_b6_db (2400-3000 Hz)``,
-    ``env_bpfi_1b1_h1_db (BPFI of the drive-end bearing (envelope), 162.1 Hz)``."""
+    ``env_bpfi_1b1_h1_db (BPFI of the drive-end bearing (envelope), 162.1 Hz)``.
+
+    Parameters
+    ----------
+    d : dict
+        A row of :attr:`Comparison.discrepancies` (``feature``, and ``band_hz`` or
+        ``reads`` with ``line_hz`` where the feature has them).
+
+    Returns
+    -------
+    str
+    """
     if "band_hz" in d:
         return f"{d['feature']} ({d['band_hz'][0]:.0f}-{d['band_hz'][1]:.0f} Hz)"
     if "reads" in d:
