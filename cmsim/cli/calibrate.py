@@ -127,11 +127,10 @@ def _warn_fit(args, q):
     chi = q.get("chi2_per_feature") or 0.0
     if chi <= UNEXPLAINED_CHI2_PER_FEATURE:
         return
-    far = sorted((k for k, z in q.get("z", {}).items() if abs(z) >= 3.0),
-                 key=lambda k: -abs(q["z"][k]))
+    far = sum(abs(z) >= 3.0 for z in q.get("z", {}).values())
     args.warn(f"the twin reproduces its baseline's held-out segments to chi2 per feature "
               f"{chi:.2f}, above the {UNEXPLAINED_CHI2_PER_FEATURE:g} at which compare calls a "
-              f"record unexplained ({len(far)} features 3 spreads or more off, worst "
+              f"record unexplained ({far} features 3 spreads or more off, worst "
               f"{q['worst_feature']} z {q['worst_z']:.1f}"
               f"{'' if abs(q['worst_z']) < ALARM_Z else ', beyond the alarm z'}): compare "
               "reads records against the twin moved by these offsets, but a cause acting "

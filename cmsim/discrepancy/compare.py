@@ -61,8 +61,8 @@ from cmsim.errors import ParameterError
 from cmsim.features import segment_features, segments
 from cmsim.features.relative import shape_band_edges
 
-__all__ = ["Comparison", "compare", "describe", "feature_label", "DEFAULT_BUDGET", "SIM_SEEDS", "VAR_SEEDS",
-           "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "ALARM_Z", "MODES"]
+__all__ = ["Comparison", "compare", "describe", "feature_label", "DEFAULT_BUDGET", "SIM_SEEDS",
+           "VAR_SEEDS", "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "ALARM_Z", "MODES"]
 
 #: Default budget of simulations (model runs: ranking, fit and the held-out re-simulations).
 DEFAULT_BUDGET = 140
