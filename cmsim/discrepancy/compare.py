@@ -382,7 +382,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         discrepancies = sorted(
             ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k] - bias[k],
               "sigma": sigma[k], "z": (seen_fit[k] - f_nom_fit[k]) / sigma[k],
-              **_band_of(k, edges, ev.freqs, record.components)} for k in cols),
+              **_where_it_reads(k, edges, ev.freqs, record.components)} for k in cols),
             key=lambda d: -abs(d["z"]))
         top, ties = decide(ranked, ev.sensor_bearing, chi_nom)
         finding, component, params, ranges, fitted = "none", None, {}, {}, setup_nom
@@ -442,7 +442,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             spectra=spectra)
 
 
-def _band_of(name, edges, freqs=None, components=None):
+def _where_it_reads(name, edges, freqs, components=None):
     """Where a feature reads, in Hz: ``{"band_hz": [lo, hi]}`` of a spectral-shape band;
     ``{"reads": words, "line_hz": [f, ...]}`` of a line feature (a shaft order, a mesh
     harmonic and its sidebands, a bearing's defect family in the spectrum or the envelope
@@ -451,8 +451,6 @@ def _band_of(name, edges, freqs=None, components=None):
     if name.startswith("shape_b"):
         i = int(name[len("shape_b"):].split("_")[0])
         return {"band_hz": [float(edges[i]), float(edges[i + 1])]}
-    if freqs is None:
-        return {}
     parts = name.removesuffix("_db").split("_")
     fr = freqs.fr1_hz
     if parts[:2] in (["raw", "fr"], ["env", "fr"]):

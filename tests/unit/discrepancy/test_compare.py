@@ -326,28 +326,28 @@ def test_every_line_feature_says_where_it_reads_in_hz():
     """The output an engineer acts on names each feature's band or line in Hz (issue 25): a
     bearing family at the record's rates, by the record's name of the bearing; a mesh
     harmonic and its shaft-rate sidebands; a shape band by its edges."""
-    from cmsim.discrepancy.compare import _band_of, feature_label
+    from cmsim.discrepancy.compare import _where_it_reads, feature_label
     from cmsim.features.relative import shape_band_edges
     from cmsim.rig import OperatingPoint, Rig
     rig = Rig.paper_2016()
     freqs = rig_frequencies(rig, OperatingPoint(1200.0, 50.0))
     bf, edges = freqs.bearing("1b1"), shape_band_edges(20_000.0, 2.0)
     names = {"1b1": "drive_end"}
-    x = _band_of("env_bpfi_1b1_h2_db", edges, freqs, names)
+    x = _where_it_reads("env_bpfi_1b1_h2_db", edges, freqs, names)
     assert x["line_hz"] == [pytest.approx(2 * bf.bpfi_hz)] and "drive-end" in x["reads"]
-    x = _band_of("env_bsf2_1b1_h1_db", edges, freqs, names)
+    x = _where_it_reads("env_bsf2_1b1_h1_db", edges, freqs, names)
     assert x["line_hz"] == [pytest.approx(2 * bf.bsf_hz)]
-    x = _band_of("env_bpfo_1b1_sb_db", edges, freqs, names)
+    x = _where_it_reads("env_bpfo_1b1_sb_db", edges, freqs, names)
     assert sorted(x["line_hz"]) == pytest.approx(sorted(
         h * bf.bpfo_hz + s * bf.shaft_hz for h in (1, 2) for s in (-1, 1)))
-    x = _band_of("sb23_fr1_k2_db", edges, freqs, names)
+    x = _where_it_reads("sb23_fr1_k2_db", edges, freqs, names)
     assert sorted(x["line_hz"]) == pytest.approx(sorted(
         2 * freqs.gmf_hz + s * n * freqs.fr1_hz for n in (2, 3) for s in (-1, 1)))
-    assert _band_of("gmf3_rel_db", edges, freqs)["line_hz"] == [pytest.approx(3 * freqs.gmf_hz)]
-    assert _band_of("raw_fr_h2_db", edges, freqs)["line_hz"] == [pytest.approx(2 * freqs.fr1_hz)]
-    assert _band_of("shape_b1_db", edges, freqs) == {"band_hz": [edges[1], edges[2]]}
-    assert _band_of("kurtosis_log", edges, freqs) == {}
-    d = {"feature": "raw_bpfo_1b2_db", **_band_of("raw_bpfo_1b2_db", edges, freqs, names)}
+    assert _where_it_reads("gmf3_rel_db", edges, freqs)["line_hz"] == [pytest.approx(3 * freqs.gmf_hz)]
+    assert _where_it_reads("raw_fr_h2_db", edges, freqs)["line_hz"] == [pytest.approx(2 * freqs.fr1_hz)]
+    assert _where_it_reads("shape_b1_db", edges, freqs) == {"band_hz": [edges[1], edges[2]]}
+    assert _where_it_reads("kurtosis_log", edges, freqs) == {}
+    d = {"feature": "raw_bpfo_1b2_db", **_where_it_reads("raw_bpfo_1b2_db", edges, freqs, names)}
     assert feature_label(d) == (f"raw_bpfo_1b2_db (BPFO of the 1b2 bearing, "
                                 f"{freqs.bearing('1b2').bpfo_hz:.1f} Hz)")
 
