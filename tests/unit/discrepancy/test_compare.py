@@ -343,8 +343,10 @@ def test_every_line_feature_says_where_it_reads_in_hz():
     x = _where_it_reads("sb23_fr1_k2_db", edges, freqs, names)
     assert sorted(x["line_hz"]) == pytest.approx(sorted(
         2 * freqs.gmf_hz + s * n * freqs.fr1_hz for n in (2, 3) for s in (-1, 1)))
-    assert _where_it_reads("gmf3_rel_db", edges, freqs)["line_hz"] == [pytest.approx(3 * freqs.gmf_hz)]
-    assert _where_it_reads("raw_fr_h2_db", edges, freqs)["line_hz"] == [pytest.approx(2 * freqs.fr1_hz)]
+    gmf3 = _where_it_reads("gmf3_rel_db", edges, freqs)
+    assert gmf3["line_hz"] == [pytest.approx(3 * freqs.gmf_hz)]
+    fr2 = _where_it_reads("raw_fr_h2_db", edges, freqs)
+    assert fr2["line_hz"] == [pytest.approx(2 * freqs.fr1_hz)]
     assert _where_it_reads("shape_b1_db", edges, freqs) == {"band_hz": [edges[1], edges[2]]}
     assert _where_it_reads("kurtosis_log", edges, freqs) == {}
     d = {"feature": "raw_bpfo_1b2_db", **_where_it_reads("raw_bpfo_1b2_db", edges, freqs, names)}
