@@ -104,7 +104,9 @@ from cmsim.machine.background import Background, BackgroundLine
 from cmsim.machine.machine import Machine, model_force, static_load
 from cmsim.machine.path import TransferPath, smooth_log
 from cmsim.run import signal_info
-from cmsim.spectra.floor import median_window_bins, running_median_floor, segment_psd
+from cmsim.spectra.floor import segment_psd
+from cmsim.spectra.line_detector import (FLOOR_HALF_WIDTH_HZ, LINE_MIN_DB, LINE_TOLERANCE,
+                                          MAX_LINES, detect_lines, line_free)
 
 __all__ = ["calibrate", "SEGMENT_S", "N_SEEDS", "LINE_MIN_DB", "FLOOR_HALF_WIDTH_HZ",
            "PATH_SMOOTHING_OCTAVE", "MAX_LINES", "feature_rows"]
@@ -115,15 +117,8 @@ SEGMENT_S = 0.5
 N_SEEDS = 3
 #: Seeds (one segment each) of the twin compared with the held-out baseline segments.
 N_TWIN_SEEDS = 6
-#: Least height of a narrow line over the running median, dB (the median of a PSD averaged
-#: over ~10 segments exceeds this by chance in about one bin in a thousand).
-LINE_MIN_DB = 6.0
-#: Half-width of the running median that gives the background spectrum, Hz.
-FLOOR_HALF_WIDTH_HZ = 25.0
 #: Smoothing of the path's shape, octave.
 PATH_SMOOTHING_OCTAVE = 1.0 / 12.0
-#: Most background lines kept (the strongest).
-MAX_LINES = 300
 #: Least height of a model line over the model force's own floor to pin the path, dB.
 MODEL_LINE_MIN_DB = 20.0
 #: Most a pinned gain may exceed the lowest bound set by model lines the record does not
@@ -154,10 +149,6 @@ MODULATION_MIN_SIGMA = 3.0
 #: frequency to tell the speed wobble (20 dB: the noise then adds under 0.5 % of the line's
 #: phase wander).
 WOBBLE_MIN_SNR = 100.0
-#: Relative tolerance of a line's frequency against a shaft order or a model line, and how
-#: far a line may wander from its mean (a speed wobble moves every line in proportion to
-#: its frequency: ±9 Hz at 2.3 kHz, within the Hann main lobe below 1 kHz at 2-Hz bins).
-LINE_TOLERANCE = 0.004
 #: Shaft-rate sidebands each side of a mesh harmonic whose lines are taken for the mesh's
 #: own (:func:`_classify`): those the features read (``sb23``: ±2, ±3).
 MESH_FAMILY_SIDEBANDS = 3
@@ -188,68 +179,11 @@ def _clearance_words(c):
     return f"{abs(c) * 1e6:g} µm {'clearance' if c > 0 else 'preload'}"
 
 
-def _window_bins(freq):
-    """Odd number of bins of the ± :data:`FLOOR_HALF_WIDTH_HZ` running windows."""
-    return median_window_bins(freq, FLOOR_HALF_WIDTH_HZ)
-
-
-def _floor(freq, psd):
-    """Running median of the PSD over ± :data:`FLOOR_HALF_WIDTH_HZ` (end bins repeated):
-    blind to lines, but biased low on a noisy estimate (what line detection needs, not the
-    level)."""
-    return running_median_floor(freq, psd, FLOOR_HALF_WIDTH_HZ, mode="nearest")
-
-
 def _lines_and_floor(freq, psd):
-    """(lines, floor): the narrow lines [(frequency, amplitude)] standing
-    :data:`LINE_MIN_DB` over the running median, strongest first, and the broadband floor —
-    the running mean of the PSD with the lines' bins replaced by the median (unbiased: the
-    power of a line too weak to be called stays in the broadband)."""
-    df = freq[1] - freq[0]
-    med = _floor(freq, psd)
-    ratio = psd / med
-    thr = 10.0 ** (LINE_MIN_DB / 10.0)
-    peaks = [i for i in range(2, psd.size - 2) if ratio[i] > thr and freq[i] >= 2.0
-             and psd[i] >= psd[i - 1] and psd[i] >= psd[i + 1]]
-    owner = np.full(psd.size, -1)        # the line each bin belongs to
-    spans = []
-    for i in sorted(peaks, key=lambda j: -psd[j]):
-        if owner[i] >= 0:                # a local maximum within a stronger line's bins
-            continue
-        bins = _line_bins(ratio, owner, i, thr,
-                          max(2, math.ceil(LINE_TOLERANCE * freq[i] / df)))
-        owner[bins] = len(spans)
-        spans.append((i, bins))
-    k = _window_bins(freq)
-    masked = np.where(owner >= 0, med, psd)
-    floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
-                                   mode="valid"), 1e-300)
-    kept = []
-    for i, bins in spans:
-        over = np.maximum(psd[bins] - floor[bins], 0.0)
-        excess = float(np.sum(over)) * df
-        if excess > 0:
-            # Hann: the line's power spreads over its main lobe; ∑ (P − floor)·df = A²/2
-            kept.append((float(freq[i]), math.sqrt(2.0 * excess)))
-    kept.sort(key=lambda fa: -fa[1])
-    return kept[:MAX_LINES], floor
-
-
-def _line_bins(ratio, owner, i, thr, most):
-    """Bins of the line peaking at bin ``i``: its Hann main lobe (± 2 bins) and the bins
-    beside it that still stand ``thr`` over the median — a line whose frequency wanders (a
-    speed wobble moves the k-th harmonic k times as far) or whose leakage stands over a low
-    floor spreads over more — at most ``most`` bins each side (as far as
-    :data:`LINE_TOLERANCE` reaches: a wobble moves a line in proportion to its frequency),
-    and none that a stronger line holds (``owner`` ≥ 0)."""
-    bins = [i]
-    for step in (-1, 1):
-        j = i + step
-        while (0 <= j < ratio.size and owner[j] < 0 and abs(j - i) <= most
-               and (abs(j - i) <= 2 or ratio[j] > thr)):
-            bins.append(j)
-            j += step
-    return bins
+    """(lines [(frequency, amplitude)] strongest first, floor) of a PSD: the one line
+    detector (:func:`cmsim.spectra.line_detector.detect_lines`)."""
+    lines, floor = detect_lines(freq, psd)
+    return [(ln.frequency_hz, ln.amplitude) for ln in lines], floor
 
 
 def _refined(lines, x, fs, df):
@@ -353,17 +287,6 @@ def _pins(shape, strong, lines, floor, pin_at, df, weak_family):
     family = [(fb, gb) for fb, gb in bounds if any(_near(fb, g, df) for g in pin_at)]
     dropped = [p for p in pins if any(p[1] > PIN_CONSISTENCY * gb for _, gb in family)]
     return [p for p in pins if p not in dropped], bounds, dropped
-
-
-def _line_free(freq, psd):
-    """Mask of the bins of a PSD outside its narrow lines (those standing
-    :data:`LINE_MIN_DB` over the running median, with their Hann main lobe, ± 2 bins)."""
-    peak = psd > 10.0 ** (LINE_MIN_DB / 10.0) * _floor(freq, psd)
-    line = peak.copy()
-    for k in (1, 2):
-        line[k:] |= peak[:-k]
-        line[:-k] |= peak[k:]
-    return ~line
 
 
 def _cyclic_power(segs, fs, band, keep):
@@ -809,7 +732,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     wobble = _speed_wobble(np.concatenate([r.signal for r in records]), fs, freqs.fr1_hz)
     longest = max(records, key=lambda r: r.signal.size).signal
     baseline = {"freq": freq, "floor": floor, "lines": lines, "fit": fit,
-                "keep": _line_free(freq, psd)}
+                "keep": line_free(freq, psd)}
     calibrated_on = tuple(f"{r.record_id or r.path or 'record'}"
                           + (f" [{r.meta['span_s'][0]:g}, {r.meta['span_s'][1]:g}] s"
                              if r.meta.get("span_s") else "")
@@ -835,7 +758,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
                   if pf[int(round(f / df))] >= 10.0 ** (MODEL_LINE_MIN_DB / 10.0)
                   * pf_floor[int(round(f / df))]]
         spectra = dict(baseline, pf_floor=pf_floor, force_lines=force_lines, strong=strong,
-                       forces=force_runs + twin_forces, force_keep=_line_free(freq, pf))
+                       forces=force_runs + twin_forces, force_keep=line_free(freq, pf))
         shaft = _shaft_gains(lines, model_rig, bearing, fr, df, force_runs)
         candidates = []
         for forced in (False, True):
