@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import os
+import sys
+import time
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, load_file, ranged
 from cmsim.cli.options import add_recording_options, recording_values
 from cmsim.errors import ParameterError
-from cmsim.rig import Range, Rig
+from cmsim.rig import RANGES, Range, Rig
 
 
 def register(sub):
@@ -20,7 +23,11 @@ def register(sub):
                                    "applied in the time domain), the background (coloured "
                                    "noise and the lines the model does not make), the "
                                    "operating point, and the baseline's own spread of every "
-                                   "feature; writes the machine file for --machine.")
+                                   "feature; then the signature library: what each cause of "
+                                   "the catalogue, over a grid of its sizes, changes on the "
+                                   "baseline as the model predicts it (compare --machine "
+                                   "matches a record against it). Writes the machine file "
+                                   "for --machine, the baseline's samples in it.")
     p.add_argument("baseline", nargs="+", metavar="BASELINE",
                    help="healthy record(s) of one machine (.npz/.csv/.wav/.mat/.uff/.tdms; "
                         "what a file does not state from metadata.json beside it, else from "
@@ -42,6 +49,9 @@ def register(sub):
                    help="seed of the model simulations")
     p.add_argument("--report", type=Path, metavar="DIR",
                    help="write DIR/calibration.html (spectra, path, fit quality)")
+    p.add_argument("--workers", type=ranged(RANGES["workers"]), default=None,
+                   help="processes that build the signature library (default: 2 where "
+                        "there are 2 CPUs or more; the same library with any number)")
     p.set_defaults(func=run, text=text)
 
 
@@ -67,7 +77,9 @@ def read_records(paths, channel, rig_file, span, values=None):
 
 
 def run(args):
-    """Calibrate and write the machine file."""
+    """Calibrate, build the signature library and write the machine file."""
+    from cmsim.discrepancy.judge import baseline_consistency, detectability
+    from cmsim.discrepancy.signatures import build_library
     from cmsim.machine import calibrate
     from cmsim.machine.report import write_calibration_report
 
@@ -79,9 +91,25 @@ def run(args):
                            recording_values(args))
     args.notice_compile()
     machine = calibrate(records, seed=args.seed)
+    workers = args.workers or min(2, os.cpu_count() or 1)
+    show = not args.json and sys.stderr.isatty()
+
+    def progress(done, total, elapsed_s):
+        if show:
+            print(f"\rcmsim calibrate: signature library {done}/{total} ({elapsed_s:.0f} s)",
+                  end="", file=sys.stderr, flush=True)
+
+    t0 = time.perf_counter()
+    machine = machine.with_library(build_library(machine, seed=args.seed, workers=workers,
+                                                 progress=progress))
+    library_s = time.perf_counter() - t0
+    if show:
+        print(file=sys.stderr)
     machine.save(args.out)
     q = machine.fit_quality
-    _warn_fit(args, q)
+    consistency = baseline_consistency(machine)
+    _warn_consistency(args, consistency)
+    detectable = detectability(machine)
     out = {"machine": str(args.out), "name": machine.name, "channel": machine.channel,
            "fs_hz": machine.fs_hz, "speed_rpm": machine.op.speed_rpm,
            "speed_wobble": machine.speed_wobble, "lines": len(machine.background.lines),
@@ -91,9 +119,17 @@ def run(args):
                            "worst_z": q.get("worst_z"),
                            "chi2_per_feature": q.get("chi2_per_feature"),
                            "n_features": q.get("n_features")},
+           "baseline_consistency": consistency,
+           "detectability": detectable, "components": dict(machine.components),
+           "library": {"entries": len(machine.library.entries),
+                       "causes": sorted({e.cause for e in machine.library.entries}),
+                       "segments": machine.library.segments, "wall_s": library_s,
+                       "workers": workers},
            "report": None}
     if args.report:
-        out["report"] = str(write_calibration_report(machine, records, args.report))
+        out["report"] = str(write_calibration_report(machine, records, args.report,
+                                                     detectable=detectable,
+                                                     consistency=consistency))
     return out
 
 
@@ -118,23 +154,20 @@ def _check_out(args):
                        f"file)", option="--out")
 
 
-def _warn_fit(args, q):
-    """Warn when the twin misses its own held-out baseline by more than ``compare`` lets a
-    record depart before it calls it unexplained: its comparisons then read healthy records
-    through offsets the twin does not make."""
-    from cmsim.discrepancy.compare import ALARM_Z, UNEXPLAINED_CHI2_PER_FEATURE
+def _warn_consistency(args, c):
+    """Warn when the baseline, judged against itself as compare judges a record (its odd
+    segments against its even ones, the same σ and χ²), departs: healthy records of this
+    machine may then read as departures."""
+    from cmsim.discrepancy.judge import ALARM_Z, NONE_CHI2_PER_FEATURE
 
-    chi = q.get("chi2_per_feature") or 0.0
-    if chi <= UNEXPLAINED_CHI2_PER_FEATURE:
+    if not c["departs"]:
         return
-    far = sum(abs(z) >= 3.0 for z in q.get("z", {}).values())
-    args.warn(f"the twin reproduces its baseline's held-out segments to chi2 per feature "
-              f"{chi:.2f}, above the {UNEXPLAINED_CHI2_PER_FEATURE:g} at which compare calls a "
-              f"record unexplained ({far} features 3 spreads or more off, worst "
-              f"{q['worst_feature']} z {q['worst_z']:.1f}"
-              f"{'' if abs(q['worst_z']) < ALARM_Z else ', beyond the alarm z'}): compare "
-              "reads records against the twin moved by these offsets, but a cause acting "
-              "on those features is judged through a twin that does not make them")
+    args.warn(f"the baseline's own halves differ by chi2 per feature "
+              f"{c['chi2_per_feature']:.2f} (worst {c['worst_feature']} z "
+              f"{c['worst_z']:+.1f}), beyond what compare lets a record of this machine depart "
+              f"before naming anything (chi2 per feature {NONE_CHI2_PER_FEATURE:g}, a "
+              f"feature {ALARM_Z:g} spreads off): the baseline is not stationary, and healthy "
+              "records may read as departures; calibrate on a longer or steadier baseline")
 
 
 def _wobble(w):
@@ -150,6 +183,19 @@ def text(res):
              f"fit on held-out baseline segments: worst z {q['worst_z']:.2f} "
              f"({q['worst_feature']}), chi2 per feature {q['chi2_per_feature']:.2f} over "
              f"{q['n_features']} features"]
+    from cmsim.machine.report import detectability_rows
+
+    lib = res["library"]
+    lines.append(f"signature library: {lib['entries']} entries of {len(lib['causes'])} causes "
+                 f"on {lib['segments']} baseline segments, {lib['wall_s']:.0f} s on "
+                 f"{lib['workers']} processes")
+    c = res["baseline_consistency"]
+    lines.append(f"baseline against itself (odd segments against even, as compare judges a "
+                 f"record): chi2 per feature {c['chi2_per_feature']:.2f}, worst "
+                 f"{c['worst_feature']} z {c['worst_z']:+.1f}")
+    lines.append("what this sensor can see (smallest size compare names, from the library):")
+    lines += [f"  {a:20s} {b:12s} {s}" for a, b, s in
+              detectability_rows(res["detectability"], res["components"])]
     lines += [f"calibrated on {c}" for c in res["calibrated_on"]]
     lines += [f"note: {n}" for n in res["notes"]]
     lines += [f"inferred {k} of {record}: {v['value']:.6g} ({v['how']})"

@@ -107,20 +107,44 @@ def text(res):
     if res["departures"]:
         lines.append("departs from the model in: " + ", ".join(res["departures"]))
     g = res["gain"]
-    lines.append(f"held-out discrepancy (chi2 per feature, ~1 for a record like the model's "
-                 f"own): {g['before']:.3g} -> {g['after']:.3g} (relative gain "
-                 f"{g['relative']:.2f})")
-    lines.append("leading causes, by their evidence (Δχ²) on the features each moves (a fault "
-                 "is named when its own family stands out, before any cause that reshapes "
-                 "the whole spectrum):")
-    for c in res["causes"][:5]:
-        lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
-                     f"{c['delta_chi2']:7.1f} on {c['judged_on']} features (all: "
-                     f"{c['delta_chi2_all']:.1f})")
-    lines.append("largest departures of the record from the model:")
+    machine = res["mode"] == "machine"
+    like = "the machine's baseline" if machine else "the model's own"
+    lines.append(f"held-out discrepancy (chi2 per feature, ~1 for a record like {like}): "
+                 f"{g['before']:.3g} -> {g['after']:.3g} (relative gain {g['relative']:.2f})")
+    if machine:
+        how = {"whole": "its prediction reads the whole record best",
+               "family": "its own family stands out over the baseline and no cause reads the "
+                         "whole record"}.get(res.get("decided_on", ""))
+        if how:
+            lines.append(f"named because {how}")
+        if res.get("decided_on") == "family":
+            lines.append("leading faults, by their evidence against the machine's baseline on "
+                         "the features their own signature moves (Δχ²):")
+            for c in res["causes"][:5]:
+                lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
+                             f"{c['delta_chi2']:7.1f} on {c['judged_on']} features")
+        else:
+            lines.append("leading causes, by their evidence against the machine's baseline "
+                         "(Δχ² over every feature: the baseline's χ² less the cause's):")
+            for c in res["causes"][:5]:
+                lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
+                             f"{c['delta_chi2']:7.1f}")
+    else:
+        lines.append("leading causes, by their evidence (Δχ²) on the features each moves (a "
+                     "fault is named when its own family stands out, before any cause that "
+                     "reshapes the whole spectrum):")
+        for c in res["causes"][:5]:
+            lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
+                         f"{c['delta_chi2']:7.1f} on {c['judged_on']} features (all: "
+                         f"{c['delta_chi2_all']:.1f})")
+    lines.append("largest departures of the record from "
+                 + ("the machine's baseline:" if machine else "the model:"))
+    ref = "baseline" if machine else "simulated"
     for d in res["discrepancies"][:5]:
-        lines.append(f"  {feature_label(d)}: measured {d['measured']:.3g} simulated "
+        lines.append(f"  {feature_label(d)}: measured {d['measured']:.3g} {ref} "
                      f"{d['simulated']:.3g} (z {d['z']:.1f})")
+    for n in res.get("notes", []):
+        lines.append(f"note: {n}")
     lines += inferred_lines(res["inferred"])
     lines.append(f"{res['simulations']} simulations, {res['wall_s']:.1f} s"
                  + (f" on {res['workers']} processes" if res.get("workers", 1) > 1 else ""))

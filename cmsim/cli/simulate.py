@@ -156,7 +156,12 @@ def run(args):
         if bar is not None:
             bar.close()
     if machine is not None:
-        run_ = machine.sensor_channel(run_, args.seed)
+        healthy = None      # the same run, healthy, on the machine's rig at its op
+        if machine.needs_reference(op, faults, profile, rig):
+            healthy = simulate(machine.rig, machine.op, args.duration_s, fs_hz=args.fs_hz,
+                               substeps=args.substeps, mesh=mesh, slip=slip, seed=args.seed,
+                               warmup_s=args.warmup_s, losses=args.losses or None)
+        run_ = machine.sensor_channel(run_, args.seed, healthy=healthy)
     elif args.sensors or args.sensor_noise or args.sensor_fs_hz is not None:
         from cmsim.sensors import add_sensors
         run_ = add_sensors(run_, noise_rms=args.sensor_noise, fs_hz=args.sensor_fs_hz)

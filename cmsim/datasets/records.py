@@ -158,7 +158,8 @@ def simulate_record(spec, index):
                                                                             spec.machine))
     t1 = time.perf_counter()
     if spec.machine is not None and (channels is None or spec.machine.channel in channels):
-        run = spec.machine.sensor_channel(run, plan.sim_seed)
+        run = spec.machine.sensor_channel(run, plan.sim_seed, healthy=_machine_reference(
+            spec, rig, op, plan, profile, channels))
     if sensed:
         bearings, directions = _accelerometers(sensed)
         run = add_sensors(run, path=rig.housing, noise_rms=plan.params["sensor_noise_m_s2"],
@@ -188,6 +189,22 @@ def simulate_record(spec, index):
             "faults": [f.to_dict() for f in plan.faults], "substeps": run.meta.get("substeps"),
             "scheme": run.meta.get("scheme"), "sim_wall_s": integration, **record}
     return {c: np.asarray(run[c], dtype=np.float32) for c in channels}, meta
+
+
+def _machine_reference(spec, rig, op, plan, profile, channels):
+    """The healthy run a record's change through a machine is read against
+    (:meth:`cmsim.machine.Machine.sensor_channel`): the same model run — seed, duration,
+    warm-up, tooth contact — on the machine's rig at its operating point without the
+    record's faults; None when the record is that run (no fault, the machine's rig and
+    operating point, no run-up), or the machine has no baseline to lay a change on (a
+    version-1 machine file)."""
+    machine = spec.machine
+    if not machine.needs_reference(op, plan.faults, profile, rig):
+        return None
+    return simulate(machine.rig, machine.op, spec.duration_s, mesh=spec.mesh, fs_hz=spec.fs_hz,
+                    substeps=spec.substeps, seed=plan.sim_seed, warmup_s=spec.warmup_s,
+                    losses=spec.losses,
+                    record=None if channels is None else list(machine.force_signals))
 
 
 def manifest_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS, top_n=5):

@@ -6,12 +6,10 @@
    record's unit is known.
 2. **The nominal model** is one of three, and the result says which:
 
-   * ``machine`` — a calibrated machine (:mod:`cmsim.machine`): the model's forces through
-     the machine's path plus its background; every feature is judged, the record read
-     against the twin moved by the bias its calibration measured on held-out baseline
-     segments (a trend against the baseline), each with the baseline's own
-     segment-to-segment spread and the scatter of that bias in its uncertainty, and the
-     chain is refitted only within ±3 % / ±25 %;
+   * ``machine`` — a calibrated machine (:mod:`cmsim.machine`): the machine's own baseline
+     is the healthy prediction and the model supplies only what each cause changes; the
+     comparison is feature extraction and matching against the machine's signature library
+     (:mod:`cmsim.discrepancy.judge`; the rest of this list describes the other two);
    * ``documented`` — the rig's own housing path (a rig the user gave, or a record made
      through it): every feature, the chain refitted within an uncalibrated prior;
    * ``path-free`` — a rig built from metadata, whose housing path is a generic guess: only
@@ -27,16 +25,14 @@
 3. The model of a setup is simulated with :data:`SIM_SEEDS` seeds and its features
    averaged; every setup uses the same seeds (common random numbers). The model's own
    spread is measured on :data:`VAR_SEEDS` runs of the nominal model; with the record's
-   spread, a floor (and the scatter of a machine's calibrated bias) it is each feature's σ,
-   and χ² = Σ w·min(((measured − simulated)/σ)², Z_CAP²) (rising linearly beyond Z_CAP
-   instead: the level, and against a machine every feature but the kurtosis and crest
-   factor, :func:`~cmsim.discrepancy.evaluator.rises`).
+   spread and a floor it is each feature's σ, and χ² = Σ w·min(((measured − simulated)/σ)²,
+   Z_CAP²) (rising linearly beyond Z_CAP instead for the level,
+   :func:`~cmsim.discrepancy.evaluator.rises`).
 4. Causes are ranked and decided on the evidence their own signature moves
    (:mod:`cmsim.discrepancy.ranking`); the finding is a named cause, ``none`` (nothing
    departs from the model beyond its uncertainty), or ``unexplained`` (the record departs
-   from the model — χ² per feature above :data:`UNEXPLAINED_CHI2_PER_FEATURE`, or against
-   a machine one feature :data:`ALARM_Z` σ from its twin — in ways no cause explains; the
-   features where it departs are listed).
+   from the model — χ² per feature above :data:`UNEXPLAINED_CHI2_PER_FEATURE` — in ways no
+   cause explains; the features where it departs are listed).
 5. The finding's parameters are fitted within the budget; the nominal and the fitted model
    are re-simulated with new seeds and compared on the held-out segments: ``gain.before``
    and ``gain.after`` are χ² per feature there, beside the baseline's own level (1 by
@@ -51,10 +47,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cmsim.discrepancy.causes import (CAUSES, MACHINE_NUISANCES, NUISANCES, ModelSetup,
+from cmsim.discrepancy.causes import (CAUSES, NUISANCES, ModelSetup,
                                       applicable_causes)
 from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, feature_floor,
                                          path_free, weight)
+from cmsim.discrepancy.judge import judge
 from cmsim.discrepancy.ranking import (REFINE_TOP, Nuisances, decide, evidence, fit, rank,
                                        refine)
 from cmsim.errors import ParameterError
@@ -62,7 +59,7 @@ from cmsim.features import segment_features, segments
 from cmsim.features.relative import shape_band_edges
 
 __all__ = ["Comparison", "compare", "describe", "feature_label", "DEFAULT_BUDGET", "SIM_SEEDS",
-           "VAR_SEEDS", "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "ALARM_Z", "MODES"]
+           "VAR_SEEDS", "LEVEL_SIGMA_DB", "UNEXPLAINED_CHI2_PER_FEATURE", "MODES"]
 
 #: Default budget of simulations (model runs: ranking, fit and the held-out re-simulations).
 DEFAULT_BUDGET = 140
@@ -83,15 +80,6 @@ LEVEL_SIGMA_DB = 6.0
 #: correlated, so the χ² of independent features would understate the spread), records
 #: with an effect the catalogue misses sit at 2.9-4.8.
 UNEXPLAINED_CHI2_PER_FEATURE = 2.5
-
-#: Against a machine, a record with one feature this many σ from its twin departs from the
-#: baseline whatever the others read: σ holds the baseline's own segment-to-segment spread,
-#: the twin's scatter and that of its calibrated bias, and χ² caps a feature at Z_CAP, so
-#: a shaft line 12 dB over the baseline's (z 14; 4 times the force, the classic alarm of a
-#: trend) moved χ²/feature by 0.4 and read ``none`` when no cause could make that line.
-#: Records with no hidden effect reach |z| 5.2 (benchmarks/bench_compare.py, both
-#: generators, 7 records through a machine; real healthy halves 1.2-2.0).
-ALARM_Z = 8.0
 
 #: Path-free with the record's unit known, the model's sensor noise is the record's own
 #: broadband floor (:func:`~cmsim.discrepancy.evaluator.record_floor`) rather than
@@ -135,6 +123,9 @@ class Comparison:
     departures: list = field(default_factory=list)
     not_judged: list = field(default_factory=list)
     words: str = ""
+    nuisances: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+    decided_on: str = ""
     spectra: dict = field(default_factory=dict, repr=False)
 
     def to_dict(self):
@@ -146,10 +137,12 @@ class Comparison:
                 "discrepancies": self.discrepancies, "causes": self.causes,
                 "simulations": self.simulations, "wall_s": self.wall_s,
                 "chi2_per_feature": self.chi2_per_feature, "n_features": self.n_features,
-                "inferred": self.inferred, "record": self.record}
+                "inferred": self.inferred, "record": self.record,
+                "nuisances": self.nuisances, "notes": self.notes,
+                "decided_on": self.decided_on}
 
 
-def describe(finding, component, parameters, ranges):
+def describe(finding, component, parameters, ranges, against="model"):
     """The finding in words: ``"inner-race defect, drive-end bearing, size about 0.4 mm
     (0.2-0.8 mm)"``; a value the fit left at a bound of the cause's range says so.
 
@@ -163,11 +156,15 @@ def describe(finding, component, parameters, ranges):
         Fitted parameters.
     ranges : dict
         Parameter → (lo, hi) within the fit's uncertainty.
+    against : str
+        What the record was judged against: ``"model"`` or ``"baseline"`` (a machine's).
     """
+    ref = "the machine's baseline" if against == "baseline" else "the model"
     if finding == "none":
-        return "no departure from the model beyond its uncertainty"
+        return (f"no departure from {ref} beyond its "
+                f"{'spread' if against == 'baseline' else 'uncertainty'}")
     if finding == "unexplained":
-        return "the record departs from the model in ways no cause of the catalogue explains"
+        return f"the record departs from {ref} in ways no cause of the catalogue explains"
     text = _WORDS.get(finding, finding.replace("_", " "))
     if component:
         text += f", {component.replace('_', '-')}" + (
@@ -219,35 +216,6 @@ def _prepare(record, seg_s, max_segments):
     return seg_s, duration, names, F
 
 
-def _calibration_bias(machine, name):
-    """(bias, σ of the bias) of the twin on feature ``name`` as its calibration measured it
-    (sensor unit of the feature): the twin's mean minus the held-out baseline segments'.
-
-    A twin that misses a feature of its own baseline by a fixed amount (a waveform statistic
-    it cannot reproduce, an envelope line its background hides) misses it on every record
-    of the machine: the record is read against the twin's prediction moved by that bias, a
-    trend against the baseline as practice reads it. Widening σ by the bias instead muted
-    every feature the twin misses, and those are the features a fault moves (a gear twin's
-    kurtosis off by a hundred of its baseline's spreads judged nothing). The bias is known
-    to the scatter of the two means it was read from, of variance spread²/n_held + twin
-    spread²/n_twin (the twin's spread read back from z over the combined spread,
-    ``z_with_model_spread``): that is its σ. Where the calibration could not read it, no
-    bias and the baseline's spread (or the whole difference, when the twin's spread is
-    unknown).
-    """
-    q = machine.fit_quality
-    base = machine.spread.get(name, (0.0, 0.0))[1]
-    z = (q.get("z") or {}).get(name)
-    if z is None or not math.isfinite(z):
-        return 0.0, base
-    z_m = (q.get("z_with_model_spread") or {}).get(name)
-    n_held, n_twin = q.get("held_out_segments"), q.get("twin_segments")
-    if not (z_m and math.isfinite(z_m) and n_held and n_twin):
-        return 0.0, abs(z) * base
-    twin_over_base = max((z / z_m) ** 2 - 1.0, 0.0)     # twin spread² / spread²
-    return z * base, base * math.sqrt(1.0 / n_held + twin_over_base / n_twin)
-
-
 def _check_machine(record, machine):
     """The machine must be the record's: same channel, sample rate and bearings."""
     if machine.channel != record.channel:
@@ -271,16 +239,21 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
     record : MeasuredRecord
         From :func:`~cmsim.measured.read_record` (or a test generator).
     machine : cmsim.machine.Machine, optional
-        The record's machine, calibrated on a healthy baseline: the nominal model.
+        The record's machine, calibrated on a healthy baseline: its baseline is the healthy
+        prediction and its signature library what each cause changes
+        (:mod:`cmsim.discrepancy.judge`; a library the machine lacks is built first).
     budget : int
         Most simulations used: ranking, fit and the held-out re-simulations
-        (>= VAR_SEEDS + 2·SIM_SEEDS).
+        (>= VAR_SEEDS + 2·SIM_SEEDS); against a machine only those that refine the named
+        cause's size (one), never which cause is named.
     seed : int
         Seed of the model simulations.
     seg_s : float, optional
-        Segment length, s; default the machine's, else 0.5 s (a quarter of shorter records).
+        Segment length, s; default 0.5 s (a quarter of shorter records); against a machine
+        always the machine's.
     max_segments : int
-        Segments read from the record (spread over it), >= 4.
+        Segments read from the record (spread over it), >= 4 (against a machine, twice as
+        many: its comparison costs no simulation).
     causes : sequence of Cause, optional
         Default: every registered cause that applies to the rig.
     workers : int
@@ -298,10 +271,10 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
                              param="budget", allowed=f">= {least}")
     if machine is not None:
         _check_machine(record, machine)
-        seg_s = machine.segment_s if seg_s is None else seg_s
-        mode = "machine"
-    else:
-        mode = "documented" if record.path_documented else "path-free"
+        return _against_machine(record, machine, budget=budget, seed=seed,
+                                max_segments=2 * max_segments, causes=causes,
+                                workers=workers, start=start)
+    mode = "documented" if record.path_documented else "path-free"
     seg_s, duration, names, F = _prepare(record, seg_s, max_segments)
     # path-free with a known unit: the model's noise is the record's own floor (its SNR is
     # the record's, not an assumed one), read on the fit segments only; the held-out runs
@@ -316,8 +289,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         meas_fit = dict(zip(names, np.nanmean(fit_rows, axis=0)))
         meas_held = dict(zip(names, np.nanmean(held_rows, axis=0)))
         spread = dict(zip(names, np.nanstd(F, axis=0, ddof=1)))
-        rig = machine.rig if machine is not None else record.rig
-        nominal = ModelSetup(rig=rig, op=record.op, housing=rig.housing, machine=machine)
+        rig = record.rig
+        nominal = ModelSetup(rig=rig, op=record.op, housing=rig.housing)
         seeds = ev.seeds(SIM_SEEDS)
         var_rows = ev.rows(nominal, ev.seeds(VAR_SEEDS))
         if any(r is None for r in var_rows):
@@ -330,29 +303,19 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             not_judged = sorted({k.split("_")[0] + "_*" if k.startswith("shape_") else k
                                  for k in cols if not path_free(k)})
             cols = [k for k in cols if path_free(k)]
-        sigma, bias = {}, {}
+        sigma = {}
         for k in cols:
             v_seed = float(np.nanvar([r[k] for r in var_rows], ddof=1))
-            if mode == "machine":
-                bias[k], bias_sigma = _calibration_bias(machine, k)
-                floor = 0.5 * feature_floor(k)
-            else:
-                bias[k], bias_sigma = 0.0, 0.0
-                floor = LEVEL_SIGMA_DB if k == "level_db" else feature_floor(k)
+            floor = LEVEL_SIGMA_DB if k == "level_db" else feature_floor(k)
             sigma[k] = math.sqrt(v_seed * (1.0 + 1.0 / SIM_SEEDS)
-                                 + spread[k] ** 2 * 2.0 / F.shape[0] + bias_sigma ** 2
-                                 + floor ** 2)
-        # the record as the twin sees it: its features moved by the twin's calibrated bias
-        seen_fit = {k: meas_fit[k] + bias[k] for k in cols}
-        seen_held = {k: meas_held[k] + bias[k] for k in cols}
+                                 + spread[k] ** 2 * 2.0 / F.shape[0] + floor ** 2)
+        seen_fit, seen_held = ({k: m[k] for k in cols} for m in (meas_fit, meas_held))
         n_eff = sum(weight(k) for k in cols)
-        calibrated = mode == "machine"             # far departures rise (evaluator.rises)
 
         def chi_of(features, which):
-            return chi2(seen_fit, features, sigma, which, calibrated)
+            return chi2(seen_fit, features, sigma, which)
 
-        nuis = Nuisances(ev, lambda f: chi_of(f, cols), seeds,
-                         MACHINE_NUISANCES if mode == "machine" else NUISANCES)
+        nuis = Nuisances(ev, lambda f: chi_of(f, cols), seeds, NUISANCES)
         chi_nom, setup_nom = nuis.fit(nominal)
         f_nom_fit = ev.features(setup_nom, seeds)
         cands = list(causes) if causes is not None else applicable_causes(rig)
@@ -380,7 +343,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
 
         edges = shape_band_edges(record.fs_hz, 1.0 / seg_s)
         discrepancies = sorted(
-            ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k] - bias[k],
+            ({"feature": k, "measured": meas_fit[k], "simulated": f_nom_fit[k],
               "sigma": sigma[k], "z": (seen_fit[k] - f_nom_fit[k]) / sigma[k],
               **_where_it_reads(k, edges, ev.freqs, record.components)} for k in cols),
             key=lambda d: -abs(d["z"]))
@@ -391,16 +354,14 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             component = _component_name(record, top["component"])
             params, ranges, fitted = fit(top, nominal, nuis, ev)
             top["fitted"] = params
-        elif chi_nom / max(n_eff, 1e-9) > UNEXPLAINED_CHI2_PER_FEATURE or (
-                mode == "machine" and discrepancies and abs(discrepancies[0]["z"]) >= ALARM_Z):
+        elif chi_nom / max(n_eff, 1e-9) > UNEXPLAINED_CHI2_PER_FEATURE:
             finding = "unexplained"
         # held-out: re-simulate nominal and fitted with new seeds
         ev.budget = budget
         held_seeds = ev.seeds(SIM_SEEDS, seed + 1)
 
         def held(setup):
-            return chi2(seen_held, ev.features(setup, held_seeds), sigma, cols,
-                        calibrated) / n_eff
+            return chi2(seen_held, ev.features(setup, held_seeds), sigma, cols) / n_eff
 
         before = held(setup_nom)
         after = before if fitted is setup_nom else held(fitted)
@@ -440,6 +401,81 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             near_ties=near_ties, departures=departures if finding == "unexplained" else [],
             not_judged=not_judged, words=describe(finding, component, params, ranges),
             spectra=spectra)
+
+
+def _against_machine(record, machine, *, budget, seed, max_segments, causes, workers, start):
+    """:func:`compare` against a calibrated machine: the record judged against the machine's
+    own baseline, the causes matched against its signature library
+    (:func:`cmsim.discrepancy.judge.judge`); ``budget`` bounds only the simulations that
+    refine the named cause's size (one here), never which cause is named."""
+    del seed                     # the library's runs carry their own seed
+    res = judge(record, machine, max_segments=max_segments, workers=workers,
+                causes=None if causes is None else [c.name for c in causes],
+                refine=1 if budget >= 1 else 0)
+    top = res["cause"]
+    finding = res["finding"]
+    component = _component_name(record, top["component"]) if top else None
+    params = {top["parameter"]: top["value"]} if top else {}
+    ranges = {top["parameter"]: top["range"]} if top else {}
+    edges = shape_band_edges(record.fs_hz, 1.0 / res["segment_s"])
+    freqs = record.model_frequencies()
+    discrepancies = [{**d, **_where_it_reads(d["feature"], edges, freqs, record.components)}
+                     for d in res["discrepancies"]]
+    chi0 = max(res["chi2"], 1e-9)
+    family = res["decided_on"] == "family"      # named on its family: faults by the
+    causes_out = [{"name": r["name"],             # evidence on their own signature
+                   "component": _component_name(record, r["component"]),
+                   "score": max(0.0, r["total"]) / chi0,
+                   "delta_chi2": r["delta_chi2"] if family else r["evidence"],
+                   "delta_chi2_all": r["total"], "judged_on": len(r["judged_on"]) if family
+                   else res["n_features"],
+                   "parameters": {r["parameter"]: r["value"]}, "variant": r["variant"]}
+                  for r in (res["by_signature"] if family else res["ranked"])]
+    near_ties = [{"name": r["name"], "component": _component_name(record, r["component"]),
+                  "delta_chi2": r["evidence"]} for r in res["near_ties"]]
+    departures = [feature_label(d) for d in discrepancies if abs(d["z"]) > 2.0][:8]
+    segs = machine.baseline.segments(res["segment_s"], res["library"].segments)
+    spectra = {"measured": record.signal, "fs_hz": record.fs_hz,
+               "bearing": freqs.bearings.get(res["sensor_bearing"]),
+               "bearing_name": _component_name(record, res["sensor_bearing"]),
+               "nominal": np.concatenate(list(segs)),
+               "fitted": None if res["fitted_segments"] is None or top is None
+               else np.concatenate(list(res["fitted_segments"]))}
+    duration = record.signal.size / record.fs_hz
+    return Comparison(
+        discrepancies=[{k: (v if k in ("feature", "band_hz", "reads", "line_hz")
+                            else float(v)) for k, v in d.items()} for d in discrepancies[:12]],
+        causes=causes_out, finding=finding, component=component, parameters=params,
+        gain=res["gain"], simulations=res["simulations"],
+        wall_s=time.perf_counter() - start, chi2_per_feature=res["chi2_per_feature"],
+        n_features=res["n_features"], inferred=dict(record.inferred),
+        record={"channel": record.channel, "model_signal": record.model_signal,
+                "fs_hz": record.fs_hz, "duration_s": duration,
+                "speed_rpm": record.op.speed_rpm, "torque_nm": record.op.torque_nm,
+                "radial_load_n": record.op.radial_load_n, "segment_s": res["segment_s"],
+                "segments": res["segments"], "unit_scale_to_m_s2": record.unit_scale,
+                "machine": machine.name},
+        mode="machine", ranges={k: [float(a), float(b)] for k, (a, b) in ranges.items()},
+        near_ties=near_ties, departures=departures if finding == "unexplained" else [],
+        not_judged=[], words=describe(finding, component, params, ranges, against="baseline")
+        + (_variant_words(top["variant"]) if top else ""),
+        nuisances={"variant": top["variant"]} if top else {}, notes=res["notes"],
+        decided_on=res["decided_on"], spectra=spectra)
+
+
+def _variant_words(variant):
+    """A library variant in words: ``"line contact; path x3"`` → ``" (its model in line
+    contact, its change 3 times the calibrated path's gain: the size is a trend)"``."""
+    if variant == "documented":
+        return ""
+    base, _, gain = variant.partition("; path x")
+    parts = [] if base == "documented" else [f"its model in {base.replace('um', 'µm')}"
+                                              if base == "line contact"
+                                              else f"its model with a {base.replace('um', 'µm')}"]
+    if gain:
+        parts.append(f"its change {gain} times the calibrated path's gain: read its size as a "
+                     "trend")
+    return " (" + ", ".join(parts) + ")"
 
 
 def _where_it_reads(name, edges, freqs, components=None):

@@ -3,9 +3,10 @@ features, and the robust χ² between two feature sets.
 
 A setup's bearing force (:func:`cmsim.machine.model_force`) is simulated once per seed and
 cached by its dynamics; what acts after the dynamics — the shaft forces of unbalance and
-misalignment, and the measurement chain (the rig's housing path and white sensor noise, or a
-calibrated machine's path and background; path-free, the record's own broadband floor,
-:func:`record_floor`) — is applied to the cached force without a new simulation. Features
+misalignment, and the measurement chain (the rig's housing path and white sensor noise;
+path-free, the record's own broadband floor, :func:`record_floor`) — is applied to the
+cached force without a new simulation. (Against a calibrated machine a record is judged
+against the machine's own baseline instead: :mod:`cmsim.discrepancy.judge`.) Features
 are :func:`cmsim.features.relative_features` (plus ``level_db`` when the record's unit is
 known), as the record's.
 """
@@ -16,7 +17,6 @@ import math
 import warnings
 from concurrent.futures import CancelledError
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import replace
 
 import numpy as np
 
@@ -29,15 +29,12 @@ from cmsim.machine import Background, model_force, rotating_force, static_load
 from cmsim.run import signal_info
 from cmsim.sensors import housing_acceleration
 from cmsim.spectra.floor import running_median_floor, segment_psd
+from cmsim.spectra.misfit import Z_CAP, misfit, robust_loss
 
 __all__ = ["simulate_setup", "sensor_signal", "record_floor", "feature_floor", "path_free",
            "chi2", "loss", "rises", "Evaluator", "Budget", "Z_CAP", "RISING", "DB_FLOOR",
            "LOG_FLOOR", "LEVEL_REF", "FLOOR_MEDIAN_HZ"]
 
-#: A feature adds at most Z_CAP² to the χ² (robust: a misfit the catalogue cannot mend, such
-#: as an unknown transfer path next to a fault, does not hide what another cause explains) —
-#: except where it rises (:func:`rises`).
-Z_CAP = 4.0
 
 #: Features whose χ² keeps rising beyond Z_CAP, linearly (Huber's loss, continuous in value
 #: and slope), against any nominal model: the overall level, whose direction every cause
@@ -190,13 +187,6 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="
     forces (at the rate of that bearing's shaft) and chain."""
     fr = rig_frequencies(setup.rig, setup.op).bearing(bearing).shaft_hz
     force, rotating = _shaft_forces(force, fs, fr, setup.shaft_forces, seed)
-    if setup.machine is not None:   # a machine's rotating forces have gains of their own
-        gain = setup.background_gain * setup.background_level
-        return setup.machine.sensor_signal(force, edge, n, seed, speed_rpm=setup.op.speed_rpm,
-                                           frequency_factor=setup.frequency_factor,
-                                           noise_gain=gain, line_gain=gain,
-                                           white_noise=setup.white_noise,
-                                           rotating=(fr, rotating) if rotating else None)
     if rotating:
         force = force + rotating_force(force.size, fs, fr, rotating)
     return sensor_signal(force, edge, n, fs, setup.housing, setup.noise_ratio, noise_ref_rms,
@@ -237,7 +227,9 @@ def weight(name):
 
 
 def chi2(meas, sim, sigma, names, calibrated=False):
-    """Robust χ² of ``sim`` against ``meas`` over ``names`` (inf when ``sim`` is None).
+    """Robust χ² of ``sim`` against ``meas`` over ``names`` (inf when ``sim`` is None): THE
+    misfit (:func:`cmsim.spectra.misfit.misfit`), each feature weighted by :func:`weight` and
+    rising where it :func:`rises`.
 
     Parameters
     ----------
@@ -256,13 +248,14 @@ def chi2(meas, sim, sigma, names, calibrated=False):
     """
     if sim is None:
         return math.inf
-    total = 0.0
-    for k in names:
-        s = sim.get(k, math.nan)
-        if not math.isfinite(s):
-            s = meas[k] - 3.0 * sigma[k]
-        total += weight(k) * loss(k, abs(meas[k] - s) / sigma[k], calibrated)
-    return total
+    names = list(names)
+    if not names:
+        return 0.0
+    return float(misfit(np.array([meas[k] for k in names]),
+                        np.array([sim.get(k, math.nan) for k in names]),
+                        np.array([sigma[k] for k in names]),
+                        np.array([weight(k) for k in names]),
+                        np.array([rises(k, calibrated) for k in names]))[0][0])
 
 
 def loss(name, z, calibrated=False):
@@ -282,9 +275,7 @@ def loss(name, z, calibrated=False):
     -------
     float
     """
-    if z <= Z_CAP:
-        return z * z
-    return Z_CAP * (2.0 * z - Z_CAP) if rises(name, calibrated) else Z_CAP * Z_CAP
+    return robust_loss(z, rises(name, calibrated))
 
 
 def rises(name, calibrated=False):
@@ -344,7 +335,6 @@ class Evaluator:
         self.simulated = set()
         self.workers = check_workers(workers)
         self._helpers = None
-        self._machine = None
         self.freqs = record.model_frequencies()
         self.sensor_bearing = signal_info(record.model_signal).component
         self.bearings = list(record.rig.bearing_names)
@@ -387,7 +377,7 @@ class Evaluator:
         run = self._forces(setup, seed)
         if run is None:
             return None
-        if self.ref_rms is None and setup.machine is None:  # the healthy level fixes the noise
+        if self.ref_rms is None:                   # the healthy level fixes the noise
             self.ref_rms = float(np.std(sensor_signal(*run, self.fs, setup.housing, 0.0,
                                                       None, seed)))
         return _chain(setup, *run, self.fs, seed, self.ref_rms, self.floor,
@@ -403,9 +393,8 @@ class Evaluator:
                 self.cache[key] = None
             else:
                 f = relative_features(x, self.record.fs_hz, self.freqs, self.bearings)
-                if self.scale is not None:
-                    scale = self.scale if setup.machine is not None else 1.0
-                    f["level_db"] = 20.0 * math.log10(max(float(np.std(x)) * scale, 1e-30)
+                if self.scale is not None:            # the model's signal is in m/s²
+                    f["level_db"] = 20.0 * math.log10(max(float(np.std(x)), 1e-30)
                                                       / LEVEL_REF)
                 self.cache[key] = f
         return self.cache[key]
@@ -414,20 +403,18 @@ class Evaluator:
         """Features of one run of ``setup`` per seed of ``seeds`` (None where it diverged),
         every ``workers``-th seed's run made by the same helper process alongside."""
         keys = [(setup.dynamics_key(), setup.chain_key(), s) for s in seeds]
-        if self.ref_rms is None and setup.machine is None and keys[0] not in self.cache:
+        if self.ref_rms is None and keys[0] not in self.cache:
             self.row(setup, seeds[0])              # the healthy level first, for every process
         todo = [i for i, k in enumerate(keys) if k not in self.cache]
         away = [i for i in todo if i % self.workers]
         new = {(keys[i][0], seeds[i]) for i in todo} - self.simulated
-        if not self._helpers:
-            self._machine = setup.machine          # the one machine the helpers will hold
-        if away and setup.machine is self._machine and self.count + len(new) <= self.budget:
+        if away and self.count + len(new) <= self.budget:
             self.count += len(new)
             self.simulated |= new
             sent = {}
             for i in away:
                 sent.setdefault(i % self.workers, []).append(i)
-            pending = [(self._helper(w).submit(_helper_rows, replace(setup, machine=None),
+            pending = [(self._helper(w).submit(_helper_rows, setup,
                                                [seeds[i] for i in idx], self.ref_rms), idx)
                        for w, idx in sent.items()]
             for i in todo:
@@ -490,8 +477,6 @@ def _adopt(ev):
 
 
 def _helper_rows(setup, seeds, ref_rms):
-    """Features of one run of ``setup`` (its machine the helper's) per seed, in a helper."""
+    """Features of one run of ``setup`` per seed, in a helper."""
     _HELPER.ref_rms = ref_rms
-    if _HELPER._machine is not None:
-        setup = replace(setup, machine=_HELPER._machine)
     return [_HELPER.row(setup, s) for s in seeds]

@@ -29,6 +29,10 @@ from cmsim.dynamics import simulate
 from cmsim.errors import ParameterError
 from cmsim.losses import LossSettings
 from cmsim.machine.background import Background, BackgroundLine
+from cmsim.frequencies import rig_frequencies
+from cmsim.machine.baseline import Baseline
+from cmsim.machine.change import Change, apply_change
+from cmsim.machine.library import SignatureLibrary
 from cmsim.machine.path import TransferPath
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.rig.codec import drop_none
@@ -37,8 +41,17 @@ from cmsim.run import signal_info
 __all__ = ["Machine", "model_force", "static_load", "rotating_force",
            "MACHINE_FORMAT_VERSION", "EDGE_S"]
 
-#: Version written in a machine file; :meth:`Machine.load` refuses other versions.
-MACHINE_FORMAT_VERSION = 1
+#: Version written in a machine file; :meth:`Machine.load` reads it and version 1 (a twin
+#: without its baseline's samples nor a signature library, which compare cannot judge a
+#: record with: it asks for a new calibration), and refuses any other.
+MACHINE_FORMAT_VERSION = 2
+
+#: Tables a machine file of :data:`MACHINE_FORMAT_VERSION` must hold (a file cut short
+#: lacks one and is refused, naming it: the baseline's samples are written last). Its
+#: ``library`` is optional (:func:`cmsim.machine.calibrate` does not build it; ``cmsim
+#: calibrate`` does).
+REQUIRED_TABLES = ("machine", "operating", "rig", "path", "background", "spread",
+                   "fit_quality", "baseline")
 
 #: Simulated time dropped at each end of a model force (filter edges), s.
 EDGE_S = 0.05
@@ -172,6 +185,12 @@ class Machine:
         The baseline records and the segments used.
     notes : tuple of str
         What was assumed (an unidentified path gain, an undocumented load ...).
+    baseline : Baseline or None
+        The healthy record(s) it was calibrated on: the healthy prediction of every
+        comparison and the healthy stretches of its dataset records (None: a version-1
+        machine file).
+    library : SignatureLibrary or None
+        What each cause does to the baseline's features (None: not built yet).
     """
 
     name: str
@@ -192,6 +211,8 @@ class Machine:
     fit_quality: dict = field(default_factory=dict)
     calibrated_on: tuple = ()
     notes: tuple = ()
+    baseline: Baseline | None = None
+    library: SignatureLibrary | None = None
 
     @property
     def shaft_hz(self):
@@ -258,17 +279,28 @@ class Machine:
         info = signal_info(self.model_signal)
         return (f"F_{info.component}_x", f"F_{info.component}_y")
 
-    def sensor_channel(self, run, seed):
-        """``run`` with the machine's sensor channel added: the model force behind it through
-        the machine's path plus its background (``run`` made at :attr:`fs_hz` on
-        :attr:`rig`; its shaft-order lines follow the run's speed).
+    def sensor_channel(self, run, seed, healthy=None):
+        """``run`` with the machine's sensor channel added (``run`` made at :attr:`fs_hz` on
+        :attr:`rig`).
+
+        With the machine's baseline (every machine :func:`~cmsim.machine.calibrate` makes):
+        a stretch of the baseline, drawn from ``seed``, with the change from ``healthy`` to
+        ``run`` laid on it (:func:`cmsim.machine.change.apply_change`) — the machine's own
+        healthy signal and what the model says the run's faults and operating point change
+        on it. ``healthy`` is the same model run (the same seed, duration and warm-up) on the
+        machine's rig at its operating point without the run's faults; None when ``run`` is that
+        run itself (the stretch alone). Without a baseline (a version-1 machine file): the
+        model force through the machine's path plus its background (its shaft-order lines
+        follow the run's speed).
 
         Parameters
         ----------
         run : cmsim.run.Run
             A simulated run holding the force of :attr:`model_signal`'s bearing.
         seed : int
-            Seed of the background.
+            Seed of the baseline stretch (or of the background).
+        healthy : cmsim.run.Run, optional
+            The healthy reference run (see above).
 
         Returns
         -------
@@ -279,22 +311,70 @@ class Machine:
                                  f"{self.name!r}, calibrated at {self.fs_hz:g} Hz",
                                  param="machine")
         info = signal_info(self.model_signal)
-        force = np.asarray(run[f"F_{info.component}_{info.direction}"], dtype=float)
-        y = self.sensor_signal(force, 0, force.size, seed,
-                               speed_rpm=run.operating_point.speed_rpm)
+        name = f"F_{info.component}_{info.direction}"
+        force = np.asarray(run[name], dtype=float)
+        meta = {"name": self.name, "channel": self.channel, "unit": self.unit,
+                "model_signal": self.model_signal}
+        if self.baseline is None:
+            y = self.sensor_signal(force, 0, force.size, seed,
+                                   speed_rpm=run.operating_point.speed_rpm)
+            return run.with_signals(**{self.channel: y}).with_meta(
+                machine={**meta, "made_as": "model force through the path + background"})
+        rng = np.random.default_rng([int(seed), 104729])
+        piece = self.baseline.piece(force.size, rng)[None, :]
+        if healthy is not None:
+            base = np.asarray(healthy[name], dtype=float)
+            freqs = rig_frequencies(self.rig, self.op)
+            gmf = freqs.gmf_hz
+            change = Change(force=force, healthy=base,
+                            shaft_hz=freqs.bearing(info.component).shaft_hz,
+                            input_hz=freqs.fr1_hz,
+                            pin_hz=() if not gmf else tuple(
+                                k * gmf for k in range(1, int(0.5 * self.fs_hz / gmf) + 1)))
+            piece = apply_change(self, piece, change, rng)
+        y = piece[0] - piece[0].mean()
         return run.with_signals(**{self.channel: y}).with_meta(
-            machine={"name": self.name, "channel": self.channel, "unit": self.unit,
-                     "model_signal": self.model_signal})
+            machine={**meta, "made_as": "baseline stretch + the model's change"
+                     + ("" if healthy is not None else " (none: the machine's healthy state)")})
+
+    def needs_reference(self, op, faults=(), profile=None, rig=None):
+        """Whether a run at ``op`` with ``faults`` (a speed ``profile``, on ``rig``) needs a
+        healthy reference run for :meth:`sensor_channel`: the machine has a baseline and the
+        run is not the machine's healthy state (a fault, another operating point, a run-up,
+        another rig — a clearance the dataset varies).
+
+        Parameters
+        ----------
+        op : OperatingPoint
+        faults : sequence of Fault
+        profile : SpeedProfile, optional
+        rig : Rig, optional
+            The run's rig (default the machine's).
+        """
+        if self.baseline is None:
+            return False
+        return bool(faults) or profile is not None or (rig is not None and rig != self.rig) \
+            or not (
+            math.isclose(op.speed_rpm, self.op.speed_rpm, rel_tol=1e-9)
+            and math.isclose(op.torque_nm, self.op.torque_nm, rel_tol=1e-9, abs_tol=1e-12)
+            and math.isclose(op.radial_load_n, self.op.radial_load_n, rel_tol=1e-9,
+                             abs_tol=1e-12))
 
     def with_rig(self, rig):
         """The same machine on another model rig (a fault, another clearance)."""
         return replace(self, rig=rig)
 
+    def with_library(self, library):
+        """The same machine with its signature library."""
+        return replace(self, library=library)
+
     # ------------------------------------------------------------------ file
     def to_dict(self):
         """Plain nested dict (TOML-ready) with a format version."""
         return {
-            "format_version": MACHINE_FORMAT_VERSION,
+            # a machine without its baseline's samples (made in Python, or read from a
+            # version-1 file) is what version 1 holds
+            "format_version": MACHINE_FORMAT_VERSION if self.baseline is not None else 1,
             "machine": {"name": self.name, "channel": self.channel,
                         "model_signal": self.model_signal, "fs_hz": self.fs_hz,
                         "unit": self.unit,
@@ -312,6 +392,8 @@ class Machine:
             "background": self.background.to_dict(),
             "spread": {k: [float(m), float(s)] for k, (m, s) in self.spread.items()},
             "fit_quality": _finite(self.fit_quality),
+            **({"library": self.library.to_dict()} if self.library is not None else {}),
+            **({"baseline": self.baseline.to_dict()} if self.baseline is not None else {}),
         }
 
     @classmethod
@@ -327,10 +409,16 @@ class Machine:
         if version is None and "machine" not in data:
             raise ParameterError("not a machine file (no format_version nor [machine] table; "
                                  "cmsim calibrate --out writes one)", param="machine")
-        if version != MACHINE_FORMAT_VERSION:
+        if version not in (1, MACHINE_FORMAT_VERSION):
             raise ParameterError(f"machine format_version {version!r} is not supported (this "
-                                 f"cmsim reads version {MACHINE_FORMAT_VERSION})",
+                                 f"cmsim reads versions 1 and {MACHINE_FORMAT_VERSION})",
                                  param="machine")
+        if version == MACHINE_FORMAT_VERSION:
+            missing = [t for t in REQUIRED_TABLES if t not in data]
+            if missing:
+                raise ParameterError(f"not a whole machine file (it lacks "
+                                     f"{', '.join(repr(t) for t in missing)}: cut short? cmsim "
+                                     "calibrate --out writes one)", param="machine")
         try:
             m, o, p, b = data["machine"], data["operating"], data["path"], data["background"]
             scale = float(m["unit_scale"])
@@ -351,7 +439,10 @@ class Machine:
                 shaft_gain={int(k): float(v) for k, v in m.get("shaft_gain", {}).items()},
                 spread={k: (float(v[0]), float(v[1])) for k, v in data.get("spread", {}).items()},
                 fit_quality=dict(data.get("fit_quality", {})),
-                calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())))
+                calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())),
+                baseline=Baseline.from_dict(data["baseline"]) if "baseline" in data else None,
+                library=(SignatureLibrary.from_dict(data["library"]) if "library" in data
+                         else None))
         except KeyError as exc:
             raise ParameterError(f"not a machine file (it lacks {exc.args[0]!r})",
                                  param="machine") from None

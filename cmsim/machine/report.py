@@ -13,7 +13,7 @@ from scipy.signal import welch
 from cmsim._io import atomic_write_text
 from cmsim.machine.machine import model_force
 
-__all__ = ["write_calibration_report"]
+__all__ = ["write_calibration_report", "detectability_rows"]
 
 
 def _psd_db(x, fs, nperseg):
@@ -50,7 +50,37 @@ def _figure(machine, records, seed):
     return base64.b64encode(buf.getvalue()).decode()
 
 
-def write_calibration_report(machine, records, out_dir, seed=0):
+def detectability_rows(detectable, components=None):
+    """The detectability table in words: ``(fault, where, seen from)`` per row of
+    :func:`cmsim.discrepancy.judge.detectability` (sizes in mm, amplitudes as they are).
+
+    Parameters
+    ----------
+    detectable : sequence of dict
+        Its rows.
+    components : dict, optional
+        Model component → the machine's name for it.
+
+    Returns
+    -------
+    list of (str, str, str)
+    """
+    out = []
+    for d in detectable:
+        where = (components or {}).get(d["component"], d["component"]) or "-"
+        unit, k = ("mm", 1e3) if d["parameter"].endswith("_m") else ("", 1.0)
+        label = d["parameter"].rsplit("_", 1)[0] if unit else d["parameter"]
+        seen = ("not named at any size up to "
+                f"{k * d['largest_tried']:.3g}{' ' + unit if unit else ''}"
+                if d["smallest"] is None else
+                f"{label.replace('_', ' ')} about {k * d['smallest']:.2g}"
+                f"{' ' + unit if unit else ''}")
+        out.append((d["cause"].replace("_", " "), str(where).replace("_", "-"), seen))
+    return out
+
+
+def write_calibration_report(machine, records, out_dir, seed=0, detectable=(),
+                             consistency=None):
     """Write ``calibration.html`` into ``out_dir``; returns its path.
 
     Parameters
@@ -63,6 +93,10 @@ def write_calibration_report(machine, records, out_dir, seed=0):
         Directory (created if missing).
     seed : int
         Seed of the twin drawn in the figure.
+    detectable : sequence of dict
+        :func:`cmsim.discrepancy.judge.detectability` of the machine.
+    consistency : dict, optional
+        :func:`cmsim.discrepancy.judge.baseline_consistency` of the machine.
 
     Returns
     -------
@@ -78,6 +112,16 @@ def write_calibration_report(machine, records, out_dir, seed=0):
         for k, z in sorted((q.get("z") or {}).items(), key=lambda kv: -abs(kv[1])))
     notes = "".join(f"<li>{html.escape(n)}</li>" for n in machine.notes)
     on = "".join(f"<li>{html.escape(c)}</li>" for c in machine.calibrated_on)
+    det = "".join(f"<tr><td>{html.escape(a)}</td><td>{html.escape(b)}</td>"
+                  f"<td>{html.escape(c)}</td></tr>"
+                  for a, b, c in detectability_rows(detectable, machine.components))
+    cons = "" if consistency is None else (
+        f"<p>The baseline judged against itself (its odd segments against its even ones, as "
+        f"compare judges a record): χ² per feature {consistency['chi2_per_feature']:.2f}, "
+        f"worst {html.escape(str(consistency['worst_feature']))} z "
+        f"{consistency['worst_z']:+.1f}"
+        f"{' — not stationary: healthy records may read as departures' if consistency['departs'] else ''}"
+        f".</p>")
     wobble = ("not identifiable" if machine.speed_wobble is None
               else f"{100 * machine.speed_wobble:.2f} % rms")
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>cmsim calibrate</title>
@@ -88,6 +132,12 @@ def write_calibration_report(machine, records, out_dir, seed=0):
 {wobble}; {len(machine.background.lines)} background lines.</p>
 <ul>{on}</ul><ul>{notes}</ul>
 <img src="data:image/png;base64,{png}" alt="baseline and twin">
+<h2>What this sensor can see</h2>
+<p>The smallest size of each fault that a comparison against this machine names, read on
+its signature library (the baseline with the fault's change at the calibrated path's gain,
+a 10-s record's fit segments; a noiseless estimate).</p>
+<table><tr><th>fault</th><th>where</th><th>seen from</th></tr>{det}</table>
+{cons}
 <h2>Twin against held-out baseline segments</h2>
 <p>Worst z {q.get('worst_z', float('nan')):.2f} ({html.escape(str(q.get('worst_feature')))}),
 χ² per feature {q.get('chi2_per_feature', float('nan')):.2f}; z = (twin − baseline) / the

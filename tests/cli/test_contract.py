@@ -1175,21 +1175,18 @@ def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
         measured_windows(folder)
 
 
-def test_calibrate_warns_when_the_twin_misses_its_own_baseline():
-    """A twin that misses its held-out baseline by more than compare lets a record depart
-    before calling it unexplained is said so (the SpectraQuest twins read chi2/feature 4-10
-    and were written without a word); a twin within it is not."""
+def test_calibrate_warns_when_its_baseline_departs_from_itself():
+    """A baseline whose odd segments depart from its even ones as compare judges a record
+    (the same σ and χ², discrepancy.judge.baseline_consistency) is said so, naming the worst
+    feature; a stationary one is not."""
     from types import SimpleNamespace
 
-    from cmsim.cli.calibrate import _warn_fit
+    from cmsim.cli.calibrate import _warn_consistency
     said = []
     args = SimpleNamespace(warn=said.append)
-    z = {"kurtosis_log": -11.5, "tsa_residual_kurtosis_log": -12.1, "shape_b2_db": 3.2,
-         "gmf1_rel_db": 0.4}
-    _warn_fit(args, {"chi2_per_feature": 6.07, "z": z, "worst_feature":
-                     "tsa_residual_kurtosis_log", "worst_z": -12.1})
-    assert len(said) == 1 and "6.07" in said[0] and "3 features" in said[0]
-    assert "tsa_residual_kurtosis_log z -12.1" in said[0]
-    _warn_fit(args, {"chi2_per_feature": 1.16, "z": {"shape_b2_db": 4.4},
-                     "worst_feature": "shape_b2_db", "worst_z": 4.4})
+    _warn_consistency(args, {"chi2_per_feature": 6.07, "worst_feature": "kurtosis_log",
+                             "worst_z": -12.1, "departs": True})
+    assert len(said) == 1 and "6.07" in said[0] and "kurtosis_log z -12.1" in said[0]
+    _warn_consistency(args, {"chi2_per_feature": 1.16, "worst_feature": "shape_b2_db",
+                             "worst_z": 2.4, "departs": False})
     assert len(said) == 1

@@ -115,3 +115,42 @@ def test_records_default_to_the_machines_operating_point(tmp_path):
                        channels=["DE"])
     op = spec.record_operating_point(spec.record(0))
     assert (op.speed_rpm, op.radial_load_n, op.torque_nm) == (1797.0, 98.0, 0.0)
+
+
+def test_through_a_machine_with_its_baseline_a_record_is_a_stretch_of_it_plus_the_change(
+        tmp_path):
+    """A machine that keeps its baseline (every calibrated machine): a healthy record at the
+    machine's operating point is a stretch of that baseline, sample for sample (the real
+    machine's own signal: what sim-to-real trains on); a faulty record is a stretch with the
+    fault's change laid on it — the same stretch with a ball-pass family added (its BPFO
+    line over the stretch's own), never the model force through the path."""
+    from cmsim.frequencies import rig_frequencies
+    from cmsim.machine.baseline import Baseline
+
+    rng = np.random.default_rng(8)
+    t = np.arange(int(3 * FS)) / FS
+    own = 0.05 * rng.standard_normal(t.size) + 0.2 * np.cos(2 * np.pi * 123.0 * t)
+    machine = dataclasses.replace(_machine(), baseline=Baseline((own,), FS))
+    data = _spec_dict(tmp_path)
+    machine.save(tmp_path / "m.toml")
+    spec = DatasetSpec.from_dict(data, base_dir=tmp_path)
+    assert spec.machine.baseline is not None            # the spec read the baseline back
+    generate_dataset(spec, tmp_path / "ds", workers=1)
+    bpfo = rig_frequencies(machine.rig, machine.op).bearing("1b1").bpfo_hz
+    kinds = set()
+    for r in load(tmp_path / "ds"):
+        x = np.asarray(r.signals["DE"], dtype=float)
+        n = x.size
+        stretch = machine.baseline.piece(n, np.random.default_rng([r.meta["record"]["seed"],
+                                                                    104729]))
+        if not r.meta["labels"]["faults"]:
+            kinds.add("healthy")
+            np.testing.assert_allclose(x, stretch - stretch.mean(), atol=1e-6)
+            continue
+        kinds.add("fault")
+        amp = np.abs(np.fft.rfft(x * np.hanning(n))) * 2 / np.hanning(n).sum()
+        own_amp = np.abs(np.fft.rfft(stretch * np.hanning(n))) * 2 / np.hanning(n).sum()
+        k = int(round(bpfo * n / FS))
+        assert amp[k - 2:k + 3].max() > 10 * own_amp[k - 2:k + 3].max()   # +20 dB over it
+        assert np.abs(amp[120:127] - own_amp[120:127]).max() < 0.1 * own_amp[120:127].max()
+    assert kinds == {"healthy", "fault"}

@@ -11,14 +11,13 @@ import math
 import os
 import shutil
 import wave
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from cmsim.discrepancy import CAUSES, Cause, compare, register_cause
 from cmsim.discrepancy.causes import applicable_causes
-from cmsim.discrepancy.compare import DEFAULT_BUDGET, _calibration_bias
+from cmsim.discrepancy.compare import DEFAULT_BUDGET
 from cmsim.discrepancy.ranking import MIN_SIGNATURE_DELTA_CHI2
 from cmsim.measured import RECORDING_KEYS, data_root, estimate_shaft_hz, read_record
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
@@ -415,31 +414,3 @@ def test_the_finding_reads_as_an_engineer_says_it():
     assert "at the bound" in describe("bearing_ball", "drive_end", {"size_m": hi}, {})
     assert describe("none", None, {}, {}).startswith("no departure")
     assert "no cause" in describe("unexplained", None, {}, {})
-
-
-def _twin_biases(bias, twin_sd, trials=3000, n_held=5, n_twin=6, seed=0):
-    """(bias, σ) pairs :func:`_calibration_bias` reads back from calibrations of one feature
-    whose twin is off by ``bias`` (baseline spread 1), drawn as calibrate measures them."""
-    rng = np.random.default_rng(seed)
-    out = []
-    for _ in range(trials):
-        base = rng.standard_normal(2 * n_held)          # fit and held-out segments
-        twin = bias + twin_sd * rng.standard_normal(n_twin)
-        spread, model = np.std(base, ddof=1), np.std(twin, ddof=1)
-        d = twin.mean() - base[1::2].mean()
-        machine = SimpleNamespace(spread={"f": (0.0, spread)}, fit_quality={
-            "z": {"f": d / spread}, "z_with_model_spread": {"f": d / math.hypot(spread, model)},
-            "held_out_segments": n_held, "twin_segments": n_twin})
-        out.append(_calibration_bias(machine, "f"))
-    return np.array(out)
-
-
-def test_the_calibration_bias_is_read_back_with_the_scatter_of_its_means():
-    """A twin off by 3 spreads reads a bias of 3 on average; the σ it states is the scatter
-    of that read-back (the two means' scatter, 1/5 + 2²/6), whether or not the twin is off."""
-    scatter = 1.0 / 5 + 2.0 ** 2 / 6               # variance of d
-    for true in (0.0, 3.0):
-        got = _twin_biases(true, 2.0)
-        assert abs(np.mean(got[:, 0]) - true) < 0.1
-        assert 0.8 * scatter < np.var(got[:, 0]) < 1.2 * scatter
-        assert 0.8 * scatter < np.mean(got[:, 1] ** 2) < 1.25 * scatter

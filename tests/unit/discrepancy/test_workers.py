@@ -3,9 +3,10 @@ dealt out by seed to helper processes; the comparison must not change with their
 
 Tier: equality against the one-process comparison (every number of the result), on a record
 whose nominal model is the documented path (the healthy level the sensor noise refers to is
-read first, then shared) and on one against a calibrated machine (the helpers hold its path);
-both with a budget that runs out during the ranking, so that the budget's accounting is
-checked too (a run made by a helper is counted once, where one process counts it).
+read first, then shared), with a budget that runs out during the ranking, so that the
+budget's accounting is checked too (a run made by a helper is counted once, where one
+process counts it); and a machine's signature library, whose entries are dealt out to
+worker processes.
 """
 
 import json
@@ -40,13 +41,25 @@ def test_documented_path_comparison_is_the_same_on_two_processes():
 
 
 @pytest.mark.slow
-def test_machine_comparison_is_the_same_on_two_and_three_processes():
+def test_a_signature_library_is_the_same_on_one_and_two_processes():
+    """The library's entries are dealt out to worker processes: the same tables, bit for
+    bit, as one process makes."""
+    import numpy as np
+
+    from cmsim.discrepancy import CAUSES
+    from cmsim.discrepancy.signatures import build_library
+
     baseline = hidden_effect_record(None, 4, sim_seed=9, duration_s=2.0).record
     machine = calibrate([baseline], seed=4)
-    record = hidden_effect_record("bearing_outer_race", 4, duration_s=2.0).record
-    one = compare(record, machine=machine, budget=24, workers=1)
-    _same(one, compare(record, machine=machine, budget=24, workers=2))
-    _same(one, compare(record, machine=machine, budget=24, workers=3))
+    causes = [CAUSES[c]() for c in ("bearing_outer_race", "noise", "unbalance")]
+    one = build_library(machine, causes=causes, n_sizes=3, seed=2, workers=1)
+    two = build_library(machine, causes=causes, n_sizes=3, seed=2, workers=2)
+    assert one.names == two.names
+    assert np.array_equal(one.realisation, two.realisation, equal_nan=True)
+    assert [(e.cause, e.component, e.variant) for e in one.entries] == \
+        [(e.cause, e.component, e.variant) for e in two.entries]
+    for a, b in zip(one.entries, two.entries):
+        assert np.array_equal(a.features, b.features, equal_nan=True)
 
 
 def test_helpers_stop_with_the_evaluator_and_runs_are_counted_once():

@@ -1,0 +1,480 @@
+"""A machine's signature library: each cause of the catalogue, over a grid of its sizes, laid on
+the machine's own healthy baseline as the model says it changes it.
+
+For every cause that applies to the machine's rig, on every component it may sit on, the
+cause extends the machine's nominal setup (:class:`~cmsim.discrepancy.causes.ModelSetup`) at
+:data:`N_SIZES` values log-spaced over its bounds (:func:`value_grid`); the model is run with
+the cause and without it on the same seed (:func:`cmsim.machine.model_force`), and the
+difference is laid on :data:`LIBRARY_SEGMENTS` of the baseline's segments
+(:func:`cmsim.machine.change.apply_change`: lines the healthy model makes changed on the
+baseline's own lines, the rest of the change through the calibrated path; a speed fluctuation
+warps the baseline; a transfer path refilters it; noise and background add to it). The
+features of those segments (:func:`cmsim.features.relative_features`, plus ``level_db``
+when the machine's unit is known) are averaged: one row of the library per value.
+
+**Nuisances profiled with each cause** (:data:`BEARING_VARIANTS`). How a bearing defect shows
+depends on how many rollers carry the load: with a clearance, the load zone is narrow and
+an inner-race or ball defect hits hard once per revolution (kurtosis high, strong shaft-rate
+sidebands); in line contact or under a preload every roller is loaded and the defect hits at
+every pass (a family, little kurtosis). A machine's clearance is rarely documented, so a
+bearing defect's entries are computed for the documented clearance and for each variant,
+each change relative to the healthy model *of that variant*: a comparison takes the variant
+that fits the record best (a profile likelihood), so a family that stands out over the
+baseline is not vetoed by a statistic the model makes differently under another load zone.
+
+**The realisation spread.** A record of a healthy machine differs from its baseline by more
+than the segment-to-segment spread within one record: the cages' phases and the slip of a
+run are the same over its segments and differ from run to run. The library measures it as
+the model's own, twice, and keeps the larger: the healthy model with :data:`REALISATIONS`
+other seeds laid on the baseline as a change, and those runs through the machine's twin
+(path and background, :meth:`~cmsim.machine.Machine.sensor_signal`) — the change operator
+keeps a baseline's envelope lines where two healthy runs differ only by their cages'
+phases, which on a gear rig's four bearings move them by 10 dB from run to run.
+
+Layering: builds on :mod:`cmsim.machine` (the change operator, the library's container) and
+the cause catalogue (:mod:`cmsim.discrepancy.causes`).
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import replace
+
+import numpy as np
+
+from cmsim.datasets.pool import check_workers, process_pool
+from cmsim.discrepancy.causes import ModelSetup, applicable_causes
+from cmsim.discrepancy.evaluator import _shaft_forces
+from cmsim.errors import IntegrationDiverged, ParameterError
+from cmsim.faults import SpeedFluctuation
+from cmsim.frequencies import rig_frequencies
+from cmsim.machine import model_force
+from cmsim.machine.calibration import feature_rows
+from cmsim.machine.change import Change, apply_change
+from cmsim.machine.library import SignatureEntry, SignatureLibrary
+from cmsim.run import signal_info
+
+__all__ = ["build_library", "value_grid", "predicted_rows", "change_of",
+           "simulate_entry", "operating_shift",
+           "N_SIZES", "LIBRARY_SEGMENTS", "REALISATIONS", "BEARING_VARIANTS", "GRIDS",
+           "PATH_GAINS"]
+
+#: Values of each cause's parameter in the library (log-spaced over its bounds).
+N_SIZES = 8
+
+#: Baseline segments each prediction is averaged over (spread over the baseline).
+LIBRARY_SEGMENTS = 8
+
+#: Other healthy runs of the model that measure the realisation spread.
+REALISATIONS = 4
+
+#: Factors on the calibrated path's gain for a cause whose change is impacts ringing the
+#: structure (:attr:`~cmsim.discrepancy.causes.Cause.rings_structure`): where its impacts
+#: ring, a healthy baseline rarely pins the path (a bearing rig's path gain is a prior
+#: there), and the gain and the defect's size trade off — the model's outer-race spall on
+#: CWRU's drive end lifted its BPFO envelope line 24 dB over the baseline's at the smallest
+#: size of the grid (0.03 mm) where the 0.18-mm record lifts it 22 dB.
+PATH_GAINS = (0.1, 0.3, 1.0, 3.0)
+
+#: Clearances of the bearing-defect variants besides the documented one, m: line contact
+#: (every roller under a load within its contact stiffness) and a light preload (every
+#: roller loaded): the load zone's extent and the number of rollers loaded.
+BEARING_VARIANTS = (0.0, -5e-6)
+
+#: Parameter ranges of the library where they differ from a cause's fitted bounds: the
+#: noise and background causes scale the machine's own background (below 1.3 times it, the
+#: baseline's spread covers it), a transfer path that moved by less than 8 % is within the
+#: calibration's uncertainty.
+GRIDS = {"noise": (0.13, 10.0), "transfer_path": ((0.3, 0.92), (1.08, 3.0))}
+
+
+def value_grid(cause, n=N_SIZES):
+    """(parameter name, values) of a cause's entries: ``n`` values log-spaced over the bounds
+    of its first parameter (or :data:`GRIDS`; a two-sided range split in two halves).
+
+    Parameters
+    ----------
+    cause : Cause
+    n : int
+        Values.
+
+    Returns
+    -------
+    (str, tuple of float)
+
+    Examples
+    --------
+    >>> from cmsim.discrepancy.causes import CAUSES
+    >>> name, v = value_grid(CAUSES["bearing_inner_race"](), 3)
+    >>> name, [round(x * 1e3, 2) for x in v]
+    ('size_m', [0.03, 0.3, 3.0])
+    """
+    p = cause.params[0]
+    span = GRIDS.get(cause.name, p.bounds)
+    if isinstance(span[0], tuple):
+        half = max(2, n // 2)
+        values = np.concatenate([np.geomspace(*span[0], half), np.geomspace(*span[1], half)])
+    elif p.log_scale:
+        values = np.geomspace(span[0], span[1], n)
+    else:
+        values = np.linspace(span[0], span[1], n)
+    return p.name, tuple(float(v) for v in values)
+
+
+def _nanmean(rows):
+    with warnings.catch_warnings():               # a column NaN in every row stays NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(rows, axis=0)
+
+
+def change_of(setup, healthy, force_of, fs_hz, seed):
+    """The :class:`~cmsim.machine.change.Change` a setup makes relative to a healthy one.
+
+    Parameters
+    ----------
+    setup, healthy : ModelSetup
+        The setup with the cause and the healthy setup it extends.
+    force_of : callable
+        ``force_of(setup)`` → (force with edges, edge, n) of the machine's sensor bearing
+        (:func:`cmsim.machine.model_force`), or None if it diverged.
+    fs_hz : float
+        Sample rate, Hz.
+    seed : int
+        Seed of the shaft forces' phase.
+
+    Returns
+    -------
+    Change or None
+        None when a run diverged.
+    """
+    machine = healthy.machine
+    freqs = rig_frequencies(setup.rig, setup.op)
+    fr = freqs.bearing(signal_info(machine.model_signal).component).shaft_hz
+    fluct = sum(f.relative_amplitude for f in setup.faults if isinstance(f, SpeedFluctuation))
+    dyn = replace(setup, faults=tuple(f for f in setup.faults
+                                      if not isinstance(f, SpeedFluctuation)))
+    force = base = None
+    edge, rotating = 0, ()
+    moved = dyn.dynamics_key() != healthy.dynamics_key()
+    if moved or setup.shaft_forces:
+        h = force_of(healthy)
+        c = force_of(dyn) if moved else h
+        if h is None or c is None:
+            return None
+        base, edge = h[0], h[1]
+        force = c[0]
+        if setup.shaft_forces:
+            force, rotating = _shaft_forces(force, fs_hz, fr, setup.shaft_forces, seed)
+    return Change(force=force, healthy=base, edge=edge, rotating=tuple(rotating), shaft_hz=fr,
+                  input_hz=setup.op.speed_rpm / 60.0, frequency_factor=setup.frequency_factor,
+                  white_noise=setup.white_noise,
+                  background_gain=max(1.0, setup.background_gain * setup.background_level),
+                  speed_fluctuation=fluct, pin_hz=_mesh_harmonics(freqs, fs_hz))
+
+
+def _mesh_harmonics(freqs, fs_hz):
+    """The mesh harmonics below the Nyquist frequency (none on a bearing rig), Hz."""
+    if not freqs.gmf_hz:
+        return ()
+    return tuple(k * freqs.gmf_hz for k in range(1, int(0.5 * fs_hz / freqs.gmf_hz) + 1))
+
+
+class _Library:
+    """Forces and predicted features of one machine (in this process or a worker)."""
+
+    def __init__(self, machine, segs, seed):
+        self.machine = machine
+        self.segs = segs
+        self.seed = seed
+        self.fs = machine.fs_hz
+        self.freqs = rig_frequencies(machine.rig, machine.op)
+        self.bearings = list(machine.rig.bearing_names)
+        self.forces = {}
+
+    def force(self, setup, seed=None):
+        seed = self.seed if seed is None else seed
+        key = (setup.dynamics_key(), seed)
+        if key not in self.forces:
+            k, n = self.segs.shape
+            try:
+                self.forces[key] = model_force(setup.rig, setup.op, self.machine.model_signal,
+                                               self.fs, k * n / self.fs, seed,
+                                               faults=setup.faults,
+                                               mixed_friction=setup.mixed_friction)
+            except (IntegrationDiverged, ParameterError):
+                self.forces[key] = None
+        return self.forces[key]
+
+    def features(self, change, rng_key, signals=False):
+        """Mean features of the baseline's segments with ``change`` laid on them (and the
+        segments, with ``signals``)."""
+        y = apply_change(self.machine, self.segs, change, np.random.default_rng(rng_key))
+        names, rows = feature_rows(y, self.fs, self.freqs, self.bearings,
+                                   self.machine.unit_scale)
+        return (names, _nanmean(rows), y) if signals else (names, _nanmean(rows))
+
+    def entry(self, job):
+        """(names, {path gain: rows}) of one library entry: per path gain, the mean features
+        at each value (None where a run diverged)."""
+        cause, comp, healthy, values, gains, index = job
+        names, out = None, {g: [] for g in gains}
+        for j, v in enumerate(values):
+            try:
+                setup = cause.extend(healthy, {**cause.start(healthy.rig),
+                                               cause.params[0].name: v}, comp)
+                change = change_of(setup, healthy, self.force, self.fs, self.seed)
+            except ParameterError:
+                change = None
+            for i, g in enumerate(gains):
+                if change is None:
+                    out[g].append(None)
+                    continue
+                names, mean = self.features(replace(change, path_gain=g),
+                                            [self.seed, index, j, i])
+                out[g].append(mean)
+        return names, out
+
+    def realisation(self, job):
+        """(names, mean features of the baseline with another healthy run of the model laid
+        on it, mean features of that run through the twin)."""
+        healthy, seed, index = job
+        h, c = self.force(healthy), self.force(healthy, seed)
+        if h is None or c is None:
+            return None, None, None
+        names, laid = self.features(Change(force=c[0], healthy=h[0], edge=h[1],
+                                           pin_hz=_mesh_harmonics(self.freqs, self.fs)),
+                                    [self.seed, 999_983, index])
+        k, n = self.segs.shape
+        twin = self.machine.sensor_signal(c[0], c[1], k * n, seed)
+        got, rows = feature_rows(twin.reshape(k, n), self.fs, self.freqs, self.bearings,
+                                 self.machine.unit_scale)
+        return names, laid, _nanmean(rows) if got == names else None
+
+
+#: The library of a worker process (:func:`_adopt`).
+_WORKER = None
+
+
+def _adopt(lib):
+    global _WORKER
+    _WORKER = lib
+
+
+def _work(kind, job):
+    return getattr(_WORKER, kind)(job)
+
+
+def _variant_label(label, gain):
+    """A variant's label with its path gain: ``"line contact"``, ``"documented; path x0.3"``."""
+    return label if gain == 1.0 else f"{label}; path x{gain:g}"
+
+
+def _parse_variant(label):
+    """(variant label, path gain) of :func:`_variant_label` output."""
+    if "; path x" in label:
+        base, g = label.split("; path x")
+        return base, float(g)
+    return label, 1.0
+
+
+def _variants(cause, nominal):
+    """(label, healthy setup) of each nuisance variant a cause's entries are computed for."""
+    out = [("documented", nominal)]
+    if cause.kind == "bearing":
+        documented = {b.clearance_m for s in nominal.rig.shafts
+                      for b in (s.bearing_1, s.bearing_2)}
+        for c in BEARING_VARIANTS:
+            if documented != {c}:
+                label = ("line contact" if c == 0 else
+                         f"{abs(c) * 1e6:g} um {'clearance' if c > 0 else 'preload'}")
+                out.append((label, replace(nominal, rig=nominal.rig.with_clearance(c))))
+    return out
+
+
+def build_library(machine, *, causes=None, n_sizes=N_SIZES, n_segments=LIBRARY_SEGMENTS,
+                  seed=0, workers=1, progress=None):
+    """The signature library of a calibrated machine (module docstring).
+
+    Parameters
+    ----------
+    machine : cmsim.machine.Machine
+        Calibrated, with its baseline.
+    causes : sequence of Cause, optional
+        Default: every registered cause that applies to the machine's rig.
+    n_sizes : int
+        Values per cause.
+    n_segments : int
+        Baseline segments each prediction is averaged over.
+    seed : int
+        Seed of the model runs.
+    workers : int
+        Processes (the entries dealt out among them; the library is the same with one).
+    progress : callable, optional
+        ``progress(done, total)`` after each entry.
+
+    Returns
+    -------
+    SignatureLibrary
+    """
+    if machine.baseline is None:
+        raise ParameterError("the machine holds no baseline samples (a version-1 machine "
+                             "file): run cmsim calibrate again", param="machine")
+    segs = machine.baseline.segments(machine.segment_s, n_segments)
+    lib = _Library(machine, segs, int(seed))
+    nominal = ModelSetup(rig=machine.rig, op=machine.op, machine=machine)
+    names, base_rows = feature_rows(segs, machine.fs_hz, lib.freqs, lib.bearings,
+                                    machine.unit_scale)
+    all_rows = machine.baseline.segments(machine.segment_s)
+    _, spread_rows = feature_rows(all_rows, machine.fs_hz, lib.freqs, lib.bearings,
+                                  machine.unit_scale)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        spread = np.nanstd(spread_rows, axis=0, ddof=1)
+    jobs, meta = [], []
+    for cause in (list(causes) if causes is not None else applicable_causes(machine.rig)):
+        pname, values = value_grid(cause, n_sizes)
+        for comp in cause.components(machine.rig, signal_info(machine.model_signal).component):
+            gains = PATH_GAINS if cause.rings_structure else (1.0,)
+            for label, healthy in _variants(cause, nominal):
+                jobs.append(("entry", (cause, comp, healthy, values, gains, len(jobs))))
+                meta.append((cause.name, comp, label, pname, values))
+    real_jobs = [("realisation", (nominal, int(seed) + 7777 * j, j))
+                 for j in range(REALISATIONS + 1)]
+    results = _run(lib, real_jobs + jobs, workers, progress)
+    base_mean = _nanmean(base_rows)
+    laid = [r[1] for r in results[:len(real_jobs)][1:] if r[1] is not None]
+    twin = [r[2] for r in results[:len(real_jobs)] if r[2] is not None]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        spreads = [np.nanstd(np.vstack(rows), axis=0, ddof=1)
+                   for rows in (laid + [base_mean], twin) if len(rows) >= 2]
+        realisation = (np.nanmax(np.vstack(spreads), axis=0) if spreads
+                       else np.zeros(len(names)))
+    entries = []
+    for (cause, comp, label, pname, values), (got, by_gain) in zip(meta,
+                                                                   results[len(real_jobs):]):
+        for g, rows in by_gain.items():
+            table = np.array([r if r is not None and got == names
+                              else np.full(len(names), np.nan) for r in rows], dtype=float)
+            entries.append(SignatureEntry(cause, comp, _variant_label(label, g), pname,
+                                          values, table))
+    return SignatureLibrary(names=tuple(names), mean=base_mean, spread=spread,
+                            realisation=realisation, entries=tuple(entries),
+                            segment_s=machine.segment_s, segments=int(segs.shape[0]),
+                            speed_rpm=machine.op.speed_rpm, torque_nm=machine.op.torque_nm,
+                            radial_load_n=machine.op.radial_load_n, seed=int(seed))
+
+
+def _run(lib, jobs, workers, progress):
+    """Every job's result, in order, on ``workers`` processes (this one alone with 1)."""
+    workers = check_workers(workers)
+    out = [None] * len(jobs)
+    t0 = time.perf_counter()
+    if workers == 1:
+        for i, (kind, job) in enumerate(jobs):
+            out[i] = getattr(lib, kind)(job)
+            if progress is not None:
+                progress(i + 1, len(jobs), time.perf_counter() - t0)
+        return out
+    with process_pool(workers, initializer=_adopt, initargs=(lib,)) as pool:
+        futures = [pool.submit(_work, kind, job) for kind, job in jobs]
+        for i, fut in enumerate(futures):
+            out[i] = fut.result()
+            if progress is not None:
+                progress(i + 1, len(jobs), time.perf_counter() - t0)
+    return out
+
+
+def simulate_entry(machine, library, cause, component, variant, value):
+    """One prediction of the library's kind, simulated anew: the machine's baseline segments
+    (those the library was computed on) with ``cause`` at ``value`` on ``component`` under the
+    nuisance ``variant`` — what refines a leading cause's size between the grid's points.
+
+    Parameters
+    ----------
+    machine : cmsim.machine.Machine
+        The machine (with its baseline).
+    library : SignatureLibrary
+        Its library (segments, seed).
+    cause : Cause
+        The cause.
+    component : str or None
+        Where it sits.
+    variant : str
+        A nuisance variant's label (of the library's entries).
+    value : float
+        The cause's first parameter.
+
+    Returns
+    -------
+    (list of str, numpy.ndarray, numpy.ndarray) or None
+        Feature names, their means, the predicted segments (k, n); None if a run diverged
+        or the variant is unknown.
+    """
+    segs = machine.baseline.segments(library.segment_s, library.segments)
+    lib = _Library(machine, segs, library.seed)
+    nominal = ModelSetup(rig=machine.rig, op=machine.op, machine=machine)
+    label, gain = _parse_variant(variant)
+    healthy = dict(_variants(cause, nominal)).get(label)
+    if healthy is None:
+        return None
+    try:
+        setup = cause.extend(healthy, {**cause.start(healthy.rig), cause.params[0].name: value},
+                             component)
+    except ParameterError:
+        return None
+    change = change_of(setup, healthy, lib.force, lib.fs, lib.seed)
+    if change is None:
+        return None
+    return lib.features(replace(change, path_gain=gain), [library.seed, 424_242],
+                        signals=True)
+
+
+def operating_shift(machine, library, op):
+    """What the model says another operating point changes on the baseline's features: the
+    healthy model at ``op`` against the healthy model at the machine's (the same seed) laid
+    on the library's segments, less the library's reference — the shift of every feature a
+    record at ``op`` is read with (its speed stays the baseline's: the record's lines are
+    read at its own speed).
+
+    Parameters
+    ----------
+    machine : cmsim.machine.Machine
+    library : SignatureLibrary
+    op : OperatingPoint
+        The record's documented operating point.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_features,) or None
+        None when a run diverged.
+    """
+    segs = machine.baseline.segments(library.segment_s, library.segments)
+    lib = _Library(machine, segs, library.seed)
+    nominal = ModelSetup(rig=machine.rig, op=machine.op, machine=machine)
+    moved = replace(nominal, op=replace(op, speed_rpm=machine.op.speed_rpm))
+    change = change_of(moved, nominal, lib.force, lib.fs, lib.seed)
+    if change is None:
+        return None
+    names, mean = lib.features(change, [library.seed, 31_337])
+    if list(names) != list(library.names):
+        return None
+    return mean - library.mean
+
+
+def predicted_rows(library, cause, component=None):
+    """The entries of ``cause`` (on ``component``, any when None) of a library.
+
+    Parameters
+    ----------
+    library : SignatureLibrary
+    cause : str
+    component : str, optional
+
+    Returns
+    -------
+    list of SignatureEntry
+    """
+    return [e for e in library.entries if e.cause == cause
+            and (component is None or e.component == component)]

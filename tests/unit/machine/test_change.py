@@ -1,0 +1,147 @@
+"""A cause's change laid on a machine's baseline (cmsim.machine.change).
+
+Tier (a) closed form: a machine with a flat path and a white background, baseline segments of
+white noise and known lines, forces made of known sinusoids. What the model adds arrives
+through the path's gain, in power, on the baseline's level; what it takes away is taken from
+the baseline's own line in proportion (the path cancels); noise, rotating forces and a speed
+fluctuation add what their closed forms say; a change with nothing in it is no change.
+"""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.special import jv
+
+from cmsim.machine import Background, Machine, TransferPath
+from cmsim.machine.change import Change, apply_change, warp_speed
+from cmsim.rig import OperatingPoint, Rig
+from cmsim.spectra.floor import segment_psd
+
+FS = 4096.0
+N = 4096                      # 1-s segments: 1-Hz bins
+K = 8
+GAIN = 0.5                    # flat path, sensor unit per N
+NOISE = 1e-4                  # white background PSD, unit²/Hz
+SHAFT_HZ = 25.0
+
+
+@pytest.fixture(scope="module")
+def machine():
+    rig = Rig.paper_2016()
+    f = (0.0, FS / 2)
+    return Machine(name="flat", rig=rig, channel="acc", model_signal="accel_1b1_y",
+                   fs_hz=FS, op=OperatingPoint(60.0 * SHAFT_HZ, 50.0),
+                   path=TransferPath("F_1b1_y", f, (GAIN, GAIN)),
+                   background=Background(f, (NOISE, NOISE)), shaft_gain={1: 2.0})
+
+
+def _baseline(rng, lines=()):
+    t = np.arange(N) / FS
+    segs = rng.standard_normal((K, N)) * math.sqrt(NOISE * FS / 2)
+    for f0, a in lines:
+        segs += a * np.cos(2 * np.pi * f0 * t + rng.uniform(0, 2 * np.pi, (K, 1)))
+    return segs
+
+
+def _power(segs, f0, half=3):
+    """Power of the PSD's bins within ± half of ``f0`` (unit²)."""
+    freq, psd = segment_psd(list(segs), FS)
+    sel = np.abs(freq - f0) <= half
+    return float(psd[sel].sum() * (freq[1] - freq[0]))
+
+
+def _forces(rng, healthy_lines, cause_lines, edge=256):
+    t = (np.arange(K * N + 2 * edge) - edge) / FS
+    noise = 1e-3 * rng.standard_normal(t.size)            # a common broadband, same seed
+    h = noise + sum(a * np.cos(2 * np.pi * f0 * t) for f0, a in healthy_lines)
+    c = noise + sum(a * np.cos(2 * np.pi * f0 * t) for f0, a in cause_lines)
+    return h, c, edge
+
+
+def test_a_change_with_nothing_in_it_is_the_baseline(machine):
+    segs = _baseline(np.random.default_rng(1), [(300.0, 0.05)])
+    out = apply_change(machine, segs, Change(), np.random.default_rng(2))
+    assert np.allclose(out, segs, rtol=0, atol=1e-12)
+
+
+def test_what_the_model_adds_arrives_through_the_path_gain(machine):
+    """A line at 700 Hz the cause makes (2 N) and the healthy model does not: the baseline
+    gains a line of G·2 N = 1.0 (power 0.5) there."""
+    rng = np.random.default_rng(3)
+    segs = _baseline(rng)
+    h, c, edge = _forces(rng, [(300.0, 1.0)], [(300.0, 1.0), (700.0, 2.0)])
+    out = apply_change(machine, segs, Change(force=c, healthy=h, edge=edge), rng)
+    added = _power(out, 700.0) - _power(segs, 700.0)
+    assert added == pytest.approx(0.5 * (GAIN * 2.0) ** 2, rel=0.1)
+
+
+def test_what_the_model_takes_away_leaves_the_baseline_s_line_in_proportion(machine):
+    """A healthy model line at 300 Hz halved by the cause (power ×1/4); the baseline shows
+    its own line there at another level (0.2, not G·1 N = 0.5): the baseline's line excess
+    falls to a quarter, whatever the path's gain (the path cancels)."""
+    rng = np.random.default_rng(5)
+    segs = _baseline(rng, [(300.0, 0.2)])
+    h, c, edge = _forces(rng, [(300.0, 1.0)], [(300.0, 0.5)])
+    out = apply_change(machine, segs, Change(force=c, healthy=h, edge=edge), rng)
+    floor = NOISE * 7                                       # 7 bins of the white floor
+    before, after = _power(segs, 300.0) - floor, _power(out, 300.0) - floor
+    assert after / before == pytest.approx(0.25, rel=0.1)
+
+
+def test_a_line_the_baseline_never_showed_is_not_taken_away(machine):
+    """The same halving where the baseline has no line: its bins there are its noise, which
+    no cause removes."""
+    rng = np.random.default_rng(7)
+    segs = _baseline(rng)
+    h, c, edge = _forces(rng, [(300.0, 1.0)], [(300.0, 0.5)])
+    out = apply_change(machine, segs, Change(force=c, healthy=h, edge=edge), rng)
+    assert _power(out, 300.0) == pytest.approx(_power(segs, 300.0), rel=0.01)   # not 1/4
+
+
+def test_white_noise_adds_its_density(machine):
+    """White noise of 3 times the background's RMS: the PSD grows by 9 times the
+    background's density."""
+    rng = np.random.default_rng(9)
+    segs = _baseline(rng)
+    out = apply_change(machine, segs, Change(white_noise=3.0), rng)
+    _, p0 = segment_psd(list(segs), FS)
+    _, p1 = segment_psd(list(out), FS)
+    assert float(np.mean(p1 - p0)) == pytest.approx(9.0 * NOISE, rel=0.05)
+
+
+def test_a_rotating_force_adds_its_power_through_the_shaft_gain(machine):
+    """A 0.3-N force at 1× through the machine's gain there (2 per N): a line of amplitude
+    0.6 (power 0.18) added to the baseline's own 1× line (0.1, power 0.005)."""
+    rng = np.random.default_rng(11)
+    segs = _baseline(rng, [(SHAFT_HZ, 0.1)])
+    out = apply_change(machine, segs, Change(rotating=((1, 0.3, 0.0),), shaft_hz=SHAFT_HZ),
+                       rng)
+    assert _power(out, SHAFT_HZ, 1) - _power(segs, SHAFT_HZ, 1) == pytest.approx(
+        0.5 * (2.0 * 0.3) ** 2, rel=0.05)
+
+
+def test_a_speed_fluctuation_modulates_the_baseline_s_lines():
+    """A 400-Hz tone read at a speed fluctuating by a = 0.5 % at 10 Hz: phase modulated with
+    index β = a·f0/f = 0.2; the first sidebands stand J1(β)/J0(β) of the carrier."""
+    t = np.arange(N) / FS
+    x = np.cos(2 * np.pi * 400.0 * t)
+    y = warp_speed(x, FS, 0.005, 10.0, 0.3)
+    spec = np.abs(np.fft.rfft(y * np.hanning(N)))
+    freq = np.fft.rfftfreq(N, 1 / FS)
+    amp = {f: spec[np.argmin(np.abs(freq - f))] for f in (390.0, 400.0, 410.0)}
+    beta = 0.005 * 400.0 / 10.0
+    want = jv(1, beta) / jv(0, beta)
+    assert amp[410.0] / amp[400.0] == pytest.approx(want, rel=0.05)
+    assert amp[390.0] / amp[400.0] == pytest.approx(want, rel=0.05)
+
+
+def test_forces_of_another_length_are_refused(machine):
+    from cmsim.errors import ParameterError
+
+    with pytest.raises(ParameterError, match="same length"):
+        Change(force=np.zeros(10), healthy=np.zeros(11))
+    with pytest.raises(ParameterError, match="hold"):
+        apply_change(machine, np.zeros((2, 64)), Change(force=np.zeros(10),
+                                                        healthy=np.zeros(10)),
+                     np.random.default_rng(0))
