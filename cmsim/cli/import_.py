@@ -36,7 +36,7 @@ def register(sub):
     p.add_argument("--channel", nargs="+", metavar="NAME",
                    help="names of a file's unnamed channels (a WAV's, in order), or the "
                         "channels to document of files that name theirs")
-    add_recording_options(p)
+    add_recording_options(p, trust=False)       # import reads no lines: nothing to trust
     p.set_defaults(func=run, text=text)
 
 
@@ -48,6 +48,7 @@ def run(args):
     if out.exists() and not args.force:
         raise CLIError(f"--out {out}: exists; give --force to overwrite it", option="--out")
     values = recording_values(args)
+    values.pop("trust_metadata")
     keep = None
     if out.exists():                               # --force: keep what import does not write
         try:

@@ -17,11 +17,12 @@ The answer key never enters it.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, RecordWarning
 from cmsim.frequencies import RigFrequencies, rig_frequencies
 from cmsim.measured.consistency import check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
@@ -33,7 +34,7 @@ from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_p
 from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
                                    read_metadata, recording_entry, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
-                                   SPEED_TOLERANCE, agreed, agreed_unit)
+                                   SPEED_TOLERANCE, agreed, agreed_unit, speed_uncertainty)
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 
@@ -234,23 +235,26 @@ def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
                          allowed="a number > 0: fs_hz, or \"fs_hz\" in metadata.json")
 
 
-def _check_against_lines(x, fs, speed_rpm, frequencies, notes, path, fs_source,
-                         speed_source):
+def _check_against_lines(x, fs, speed_rpm, frequencies, notes, doubts, path, fs_source,
+                         speed_source, speed_tolerance, trust):
     """The stated sample rate and speed checked against the record's own lines
-    (:func:`~cmsim.measured.consistency.check_rate_and_speed`); what was checked, or that
-    nothing could be, goes to the notes."""
-    found = check_rate_and_speed(x, fs, speed_rpm, frequencies, where=path,
-                                 fs_source=fs_source, speed_source=speed_source)
-    if found is None:
-        notes.append("sample rate and speed not checked against the signal: no shaft or "
-                     "bearing lines stand clear of the floor")
+    (:func:`~cmsim.measured.consistency.check_rate_and_speed`): a strong contradiction
+    refuses the record, a weaker one goes to ``doubts`` and is warned
+    (:class:`~cmsim.errors.RecordWarning`), what was checked (or that nothing could be) to
+    the notes; the check's outcome."""
+    check = check_rate_and_speed(x, fs, speed_rpm, frequencies, where=path,
+                                 fs_source=fs_source, speed_source=speed_source,
+                                 speed_tolerance=speed_tolerance, trust=trust)
+    if check.verdict == "contradicted":
+        doubts.append(check.message)
+        warnings.warn(check.message, RecordWarning, stacklevel=3)
     else:
-        notes.append(f"sample rate and speed agree with the signal's {found.family.name} "
-                     f"lines ({found.level_db:.0f} dB over the floor)")
+        notes.append(check.message)
+    return check
 
 
 def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
-                calibration=None):
+                calibration=None, trust_metadata=False):
     """Read a measured recording into a :class:`MeasuredRecord`.
 
     Channel names, sample rate, unit, shaft speed and calibration come from the file where
@@ -283,10 +287,17 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     calibration : float, optional
         Physical units per stored sample value (a WAV in counts or volts), applied to every
         channel, when neither the file nor ``metadata.json`` states it.
+    trust_metadata : bool
+        Read the stated sample rate and speed as they are, without checking them against
+        the record's lines (the user knows them to be right).
 
     Returns
     -------
     MeasuredRecord
+        Its meta holds ``rate_check`` (the check's outcome,
+        :class:`~cmsim.measured.consistency.RateCheck`), ``speed_uncertainty`` (relative)
+        and ``warnings``: what the user should hear (a contradiction too weak to refuse
+        the record).
 
     Raises
     ------
@@ -295,7 +306,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         ``fs_hz``; unknown channel (the message lists the file's); a value two sources
         state differently; no way to get the sample rate; a damaged file or channel
         (:mod:`~cmsim.measured.readers`, too few, non-finite or constant samples); a sample
-        rate or speed its own lines contradict
+        rate or speed its own lines contradict strongly
         (:func:`~cmsim.measured.consistency.check_rate_and_speed`).
     """
     p = resolve_path(path)
@@ -338,7 +349,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         ('metadata.json "fs_hz"', "record", entry.get("fs_hz") or meta.get("fs_hz")),
         ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
     near = sensor.get("near")
-    inferred, notes = {}, []
+    inferred, notes, doubts = {}, [], []
     rig_given = rig is not None
     if rig is None:
         if full is None:
@@ -355,9 +366,12 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     lines = documented_frequencies(geometry, 1.0)
     if rig_given and not lines.bearings and lines.gmf_hz is None:
         lines = rig_frequencies(rig, OperatingPoint(speed_rpm=60.0))
+    uncertainty = speed_uncertainty(entry, speed_from)
+    check = None
     if speed is not None:             # before anything is computed on them
-        _check_against_lines(x, fs, speed, lines, notes, p, fs_from or "the inferred rate",
-                             speed_from)
+        check = _check_against_lines(x, fs, speed, lines, notes, doubts, p,
+                                     fs_from or "the inferred rate", speed_from, uncertainty,
+                                     trust_metadata)
     if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
         speed, how = refine_speed(x, fs, speed, teeth)
         if how is not None:
@@ -376,7 +390,9 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                    "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
                    "radial_load_n": op.radial_load_n,
                    "radial_load_angle_rad": op.radial_load_angle_rad},
-               "rig": rig.to_dict(), "notes": notes, "inferred": inferred},
+               "rig": rig.to_dict(), "notes": notes, "inferred": inferred,
+               "warnings": doubts, "speed_uncertainty": uncertainty,
+               "rate_check": check.to_dict() if check is not None else None},
               source="measured")
     return MeasuredRecord(
         run=run, channel=channel, rig=rig, op=op, model_signal=f"accel_{bearing}_{axis}",
@@ -401,7 +417,7 @@ def _channel_units(path, signals, file_units, sensors, channel, channel_unit, un
 
 
 def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
-             calibration=None):
+             calibration=None, trust_metadata=False):
     """Any record cmsim writes or reads, as a :class:`~cmsim.run.Run` with its rig and
     operating point: a run (``cmsim simulate``, ``cmsim sweep``), a dataset record
     (``cmsim dataset``) or a measured recording (:func:`read_record`, with every check it
@@ -425,6 +441,8 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
     calibration : float, optional
         Physical units per stored sample value of a measured recording
         (:func:`read_record`).
+    trust_metadata : bool
+        Read a measured recording's stated rate and speed unchecked (:func:`read_record`).
 
     Returns
     -------
@@ -452,7 +470,7 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
         run = Run.load(p)
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
         return run, (None if "t" in npz_names(p) else sorted(run.signals)[0])
-    rec = read_record(p, channel=channel, **stated)
+    rec = read_record(p, channel=channel, trust_metadata=trust_metadata, **stated)
     return rec.run, rec.channel
 
 
