@@ -57,8 +57,8 @@ def run(args):
             raise CLIError(f"--out {out}: not valid JSON ({' '.join(str(exc).split())}); "
                            f"repair or remove it", option="--out") from None
     try:
-        meta, undocumented, skipped = folder_metadata(args.dir, channels=args.channel,
-                                                      keep=keep, **values)
+        meta, undocumented, skipped, unreadable = folder_metadata(
+            args.dir, channels=args.channel, keep=keep, **values)
     except ParameterError as exc:
         if exc.param not in ("record", "dataset"):
             raise
@@ -67,6 +67,8 @@ def run(args):
     if skipped:
         args.warn(f"left out {', '.join(skipped)}: written by cmsim (a run or dataset "
                   f"record), they state their own rate, speed and rig and need no metadata")
+    for name, why in unreadable:
+        args.warn(f"left out {name}: {why}")
     for what in undocumented:
         option = next((o for k, o in _OPTION_OF.items() if k in what), "an option")
         args.warn(f"{what} undocumented (give {option}, or edit {out.name})")
@@ -77,7 +79,8 @@ def run(args):
             "recordings": [{k: r.get(k) for k in ("file", "n_samples", "fs_hz",
                                                   "shaft_speed_rpm", "channels")}
                            for r in recs],
-            "undocumented": list(undocumented), "skipped": list(skipped)}
+            "undocumented": list(undocumented), "skipped": list(skipped),
+            "unreadable": dict(unreadable)}
 
 
 #: What import reports undocumented → the option that gives it.

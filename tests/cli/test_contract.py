@@ -1147,8 +1147,8 @@ def test_evaluate_skips_a_damaged_record_and_counts_it(damage, files, tmp_path, 
 @pytest.mark.parametrize("damage", ["truncated", "deleted"])
 def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
     """A folder of measured recordings with one damaged: the others are scored (exit 0),
-    the damaged one is named in a warning and counted; sim-to-real, which scores a test
-    folder whole, refuses it naming the file."""
+    the damaged one is named in a warning and counted; sim-to-real's test windows leave it
+    out too, naming it (one record never stops a batch: issue 48)."""
     import shutil
 
     from cmsim.measured import data_root
@@ -1170,9 +1170,8 @@ def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
     assert list(res["unreadable"]) == ["OR_vload3_100lb"]
     assert len(res["warnings"]) == 1 and "OR_vload3_100lb" in res["warnings"][0]
     from cmsim.diagnostics.syn2real import measured_windows
-    from cmsim.errors import ParameterError
-    with pytest.raises(ParameterError, match="OR_vload3_100lb"):
-        measured_windows(folder)
+    test = measured_windows(folder, max_windows=2)
+    assert list(test.skipped) == ["OR_vload3_100lb"] and len(set(test.groups)) == 6
 
 
 def test_calibrate_warns_when_the_twin_misses_its_own_baseline():

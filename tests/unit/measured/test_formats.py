@@ -351,7 +351,8 @@ def test_import_names_a_wavs_channels(tmp_path):
         w.setsampwidth(2)
         w.setframerate(12000)
         w.writeframes(x.tobytes())
-    meta, undocumented, _ = folder_metadata(folder, channels=["DE", "FE"], calibration=1e-3)
+    meta, undocumented, _, _ = folder_metadata(folder, channels=["DE", "FE"],
+                                               calibration=1e-3)
     rec = meta["recordings"][0]
     assert rec["channels"] == ["DE", "FE"] and rec["fs_hz"] == 12000.0
     assert rec["calibration"] == 1e-3
@@ -509,7 +510,7 @@ def test_unit_means_every_unstated_channel_in_read_record_as_in_import(tmp_path)
     np.savez(folder / "r.npz", DE=sig["DE"], FE=sig["FE"])
     rec = read_record(folder / "r.npz", channel="DE", rig=_bearing_rig(), fs_hz=12000.0,
                       unit="g")
-    meta, _, _ = folder_metadata(folder, fs_hz=12000.0, unit="g")
+    meta, _, _, _ = folder_metadata(folder, fs_hz=12000.0, unit="g")
     assert rec.run.meta["units"] == {"DE": "g", "FE": "g"}
     assert {c: s["unit"] for c, s in meta["sensors"].items()} == rec.run.meta["units"]
 
