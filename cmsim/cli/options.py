@@ -29,9 +29,10 @@ FAULT_NAMES = ("outer_race", "inner_race", "ball", "wear", "off_size_ball", "rol
                "speed_fluctuation", "torque_ripple")
 
 
-#: The unit table's units for --help (cmsim.measured.schema ACCELERATION_UNITS + OTHER_UNITS;
-#: not imported at start-up, it pulls in the measured stack; tests check the two agree).
-UNIT_NAMES = ("g", "m/s2", "m/s^2", "m/s²", "mm/s2", "mm/s^2", "V", "mV")
+#: The unit table's units for --help (cmsim.measured.schema.known_units(); not imported at
+#: start-up, it pulls in the measured stack; tests check the two agree).
+UNIT_NAMES = ("g", "m/s2", "m/s^2", "m/s²", "mm/s2", "mm/s^2", "m/s", "mm/s", "in/s", "ips",
+              "m", "mm", "um", "µm", "mil", "V", "mV")
 
 
 def number(name):
@@ -188,8 +189,9 @@ def add_recording_options(p, *, trust=True):
                    help="sample rate of the recording, Hz, when neither the file nor "
                         "metadata.json states it (one they state must agree)")
     p.add_argument("--speed-rpm", type=number("speed_rpm"), metavar="RPM",
-                   help="input-shaft speed, rpm, when neither the file nor metadata.json "
-                        "states it (default: found in the signal)")
+                   help="input-shaft speed, rpm: replaces what the file or metadata.json "
+                        "states (a warning says so) and is used as given (default: theirs, "
+                        "refined from the signal; else found in the signal)")
     p.add_argument("--unit", metavar="UNIT",
                    help="unit of every channel whose file and metadata.json state none (as "
                         "--calibration applies to every channel; one they state must "

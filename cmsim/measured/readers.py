@@ -20,7 +20,9 @@ Types, and what each states:
   ``name (unit)`` states the unit; a first column named ``t`` or ``time``, bare or with
   its unit (``time_s``, ``Time (s)``, ``time [ms]``; any case) is the time axis, not a
   channel: its steps must be even (within :data:`CSV_STEP_TOLERANCE`), and give the
-  rate.
+  rate. A file whose first line is all numbers has no header: every row is data, the
+  channels are named as a WAV's (``names``, else ``ch0``, ...) and a first column rising in
+  even steps is the time in seconds.
 * ``.wav`` — one channel per WAV channel, named by ``names`` (the entry's ``channels``) when
   they match in number, else ``ch0``, ``ch1``, ...; the header rate is the sample rate. The
   samples are read as stored (integer counts of a PCM file, floats of a float file). A
@@ -214,9 +216,35 @@ def _time_rate(path, name, t, unit="s"):
     return _rate_of_step(step, digits=12)
 
 
+def _is_number(text, decimal):
+    try:
+        float(text.strip().replace(decimal, ".") if decimal != "." else text.strip())
+    except ValueError:
+        return False
+    return True
+
+
+def _csv_has_header(path, sep, decimal):
+    """False when every field of the first line is a number: a CSV written without a header
+    row (its first row is data, not channel names)."""
+    with open(path, newline="", encoding="utf-8", errors="replace") as fh:
+        first = next(csv.reader(fh, delimiter=sep), [])
+    return not (first and all(_is_number(c, decimal) for c in first if c.strip()))
+
+
+def _evenly_rising(t):
+    """Whether a column is a time base: at least 8 values rising in even steps (within
+    :data:`CSV_STEP_TOLERANCE`), what no vibration channel does."""
+    steps = np.diff(np.asarray(t, dtype=float))
+    step = steps.mean() if steps.size >= 7 else 0.0
+    return bool(step > 0 and np.all(np.abs(steps - step) <= CSV_STEP_TOLERANCE * step))
+
+
 def _read_csv(path, names=None):
     import pandas as pd
     sep, decimal = _csv_dialect(path)
+    if not _csv_has_header(path, sep, decimal):
+        return _read_csv_headerless(path, sep, decimal, names)
     df = pd.read_csv(path, sep=sep, decimal=decimal)
     cols = [str(c) for c in df.columns]
     rate = None
@@ -235,6 +263,24 @@ def _read_csv(path, names=None):
             units[name] = unit
         signals[name] = df[col].to_numpy(dtype=float)
     return SignalFile(signals, rate, units, rate_from="its time column")
+
+
+def _read_csv_headerless(path, sep, decimal, names):
+    """A CSV without a header row: every row is data. A first column rising in even steps
+    (with others beside it) is the time base, in seconds; the channels are named by
+    ``names`` (the entry's ``channels``) when they match in number, else ``ch0``,
+    ``ch1``, ... as a WAV's are."""
+    import pandas as pd
+    data = pd.read_csv(path, sep=sep, decimal=decimal, header=None).to_numpy(dtype=float)
+    rate = None
+    if data.shape[1] > 1 and data.shape[0] > 1 and _evenly_rising(data[:, 0]):
+        rate = _time_rate(path, "column 1", data[:, 0])
+        data = data[:, 1:]
+    names = list(names or [])
+    if len(names) != data.shape[1]:
+        names = [f"ch{i}" for i in range(data.shape[1])]
+    return SignalFile({n: data[:, i] for i, n in enumerate(names)}, rate, {},
+                      rate_from="its first column (rising evenly: the time, in s)")
 
 
 def _write_csv(path, signals, rate_hz, units):

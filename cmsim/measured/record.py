@@ -32,7 +32,7 @@ from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
                                       model_rig)
 from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
 from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
-                                   read_metadata, recording_entry, unit_scale_of)
+                                   read_metadata, recording_entry, unit_kind, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
                                    SPEED_TOLERANCE, agreed, agreed_unit, speed_uncertainty)
 from cmsim.rig import OperatingPoint, Rig
@@ -253,6 +253,42 @@ def _check_against_lines(x, fs, speed_rpm, frequencies, notes, doubts, path, fs_
     return check
 
 
+#: Quantity of a channel's unit → how often it is differentiated to an acceleration.
+DIFFERENTIATIONS = {"velocity": "once", "displacement": "twice"}
+
+
+def _to_acceleration(x, fs_hz, quantity, factor):
+    """A velocity (``factor`` to m/s) or displacement (to m) channel as an acceleration in
+    m/s²: differentiated in the frequency domain (× j2πf per time), exact up to the Nyquist
+    frequency; the record is mirrored first, so its two ends meet without a jump."""
+    y = (np.asarray(x, dtype=float) - np.mean(x)) * factor
+    n = y.size
+    z = np.concatenate([y, y[::-1]])
+    jw = 2j * np.pi * np.fft.rfftfreq(z.size, 1.0 / fs_hz)
+    order = 1 if quantity == "velocity" else 2
+    return np.fft.irfft(np.fft.rfft(z) * jw ** order, z.size)[:n]
+
+
+def _stated_speed(path, file_rpm, entry, speed_rpm, notes, doubts):
+    """``(speed, where from)``: the caller's ``speed_rpm`` when given — it replaces what the
+    file and metadata.json state, and a value it replaces is warned of
+    (:class:`~cmsim.errors.RecordWarning`) and noted — else the file's and the metadata's,
+    which must agree (:func:`~cmsim.measured.stated.agreed`)."""
+    rpm_doc, rpm_key = documented_speed(entry)
+    if speed_rpm is None:
+        return agreed(path, "speed", [("the file", "record", file_rpm),
+                                      (rpm_key, "record", rpm_doc)], SPEED_TOLERANCE, " rpm")
+    for what, value in (("the file", file_rpm), (rpm_key, rpm_doc)):
+        if value is not None and abs(float(value) / float(speed_rpm) - 1.0) > 1e-9:
+            gap = 100 * (float(speed_rpm) / float(value) - 1)
+            text = (f"record {path}: speed_rpm {float(speed_rpm):g} replaces {float(value):g} "
+                    f"rpm, the speed {what} states ({gap:+.2g} %)")
+            doubts.append(text)
+            notes.append(text)
+            warnings.warn(text, RecordWarning, stacklevel=3)
+    return float(speed_rpm), "speed_rpm"
+
+
 def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
                 calibration=None, trust_metadata=False):
     """Read a measured recording into a :class:`MeasuredRecord`.
@@ -279,7 +315,8 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     fs_hz : float, optional
         Sample rate, Hz, when neither the file nor ``metadata.json`` states it.
     speed_rpm : float, optional
-        Input-shaft speed, rpm, when neither the file nor ``metadata.json`` states it.
+        Input-shaft speed, rpm: replaces what the file and ``metadata.json`` state (a value
+        it replaces is warned of), and is used as given (not refined from the signal).
     unit : str, optional
         Unit of every channel whose file and ``metadata.json`` state none (``g``,
         ``m/s^2``, ``V``; :func:`~cmsim.measured.schema.checked_unit`), as ``calibration``
@@ -334,28 +371,28 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         signals = {k: scale * v for k, v in signals.items()}
     channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, str(p))
     sensor = dict(sensors.get(channel) or {})
-    sensor_unit = agreed_unit(p, channel, [
-        ("the file", "record", f.units.get(channel)),
-        ('metadata.json "sensors"', "record", sensor.get("unit")),
-        ("unit", "unit", unit)])
+    stated_units = [("the file", "record", f.units.get(channel)),
+                    ('metadata.json "sensors"', "record", sensor.get("unit")),
+                    ("unit", "unit", unit)]
+    sensor_unit = agreed_unit(p, channel, stated_units)
+    quantity, unit_factor = unit_kind(sensor_unit, f"record {p}: channel {channel!r} ("
+                                      + next((w for w, _, u in stated_units if u), "") + ")")
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
-    rpm_doc, rpm_key = documented_speed(entry)
-    speed, speed_from = agreed(p, "speed", [
-        ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
-        ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
+    inferred, notes, doubts = {}, [], []
+    speed, speed_from = _stated_speed(p, f.speed_rpm, entry, speed_rpm, notes, doubts)
     fs, fs_from = agreed(p, "sample rate", [
         (f.rate_from, "record", f.rate_hz),
         ('metadata.json "fs_hz"', "record", entry.get("fs_hz") or meta.get("fs_hz")),
         ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
     near = sensor.get("near")
-    inferred, notes, doubts = {}, [], []
     rig_given = rig is not None
     if rig is None:
         if full is None:
             raise ParameterError(f"record {p}: {NO_GEOMETRY}", param="rig",
                                  allowed="a rig TOML, or metadata.json with geometry")
-        rig, components, notes = model_rig(geometry, near)
+        rig, components, rig_notes = model_rig(geometry, near)
+        notes[:0] = rig_notes
     else:
         components = {b: b for b in rig.bearing_names}
     teeth = None
@@ -363,6 +400,15 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
     fs = _sample_rate(fs, x, speed, teeth, inferred, notes, meta)
+    if quantity in DIFFERENTIATIONS:          # the model's quantity is an acceleration
+        x = signals[channel] = _to_acceleration(x, fs, quantity, unit_factor)
+        text = (f"record {p}: channel {channel!r} is a {quantity} in {sensor_unit!r}; the "
+                f"model's sensors measure acceleration, so it is differentiated "
+                f"{DIFFERENTIATIONS[quantity]} (x j2\u03c0f) to m/s^2")
+        sensor_unit = sensor["unit"] = "m/s^2"
+        notes.append(text)
+        doubts.append(text)
+        warnings.warn(text, RecordWarning, stacklevel=2)
     lines = documented_frequencies(geometry, 1.0)
     if rig_given and not lines.bearings and lines.gmf_hz is None:
         lines = rig_frequencies(rig, OperatingPoint(speed_rpm=60.0))
@@ -372,7 +418,8 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         check = _check_against_lines(x, fs, speed, lines, notes, doubts, p,
                                      fs_from or "the inferred rate", speed_from, uncertainty,
                                      trust_metadata)
-    if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
+    if "fs_hz" not in inferred and speed_rpm is None:   # the caller's speed is the speed;
+                                                        # an inferred rate is scaled by it
         speed, how = refine_speed(x, fs, speed, teeth)
         if how is not None:
             inferred["speed_rpm"] = {"value": speed, "how": how}
