@@ -36,6 +36,7 @@ PARAM_TO_DEST = {
     "correlation_s": "slip_correlation_s", "n_steps": "steps", "torques_nm": "torque_nm",
     "speeds_rpm": "speed_rpm", "friction_coefficient": "friction", "frictions": "friction",
     "clearances_m": "clearance_m", "max_freq_hz": "max_hz", "signals": "signal",
+    "signal": "channel",
     "mesh": "mesh", "method": "method", "centres": "centres",
     "noise_rms": "sensor_noise", "fs_out_hz": "sensor_fs_hz",
     "algorithm": "algorithm", "dataset": "dir", "record": "run",

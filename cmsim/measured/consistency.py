@@ -257,6 +257,9 @@ class RateCheck:
     message : str
         One line for the notes (``agrees``, ``unchecked``, ``trusted``) or a warning
         (``contradicted``).
+    speed_scale : float
+        Factor on the stated speed at which the lines stand highest (1 unless the speed's
+        uncertainty exceeds :data:`LINE_TOLERANCE`: a nominal speed is searched).
     """
 
     verdict: str
@@ -264,6 +267,7 @@ class RateCheck:
     ratio: float = 1.0
     evidence: tuple = field(default_factory=tuple)
     message: str = ""
+    speed_scale: float = 1.0
 
     @property
     def level_db(self):
@@ -275,7 +279,8 @@ class RateCheck:
         return {"verdict": self.verdict,
                 "family": self.family.family.name if self.family is not None else None,
                 "ratio": self.ratio, "level_db": self.level_db,
-                "evidence": list(self.evidence), "message": self.message}
+                "evidence": list(self.evidence), "message": self.message,
+                "speed_scale": self.speed_scale}
 
 
 def _ratio_text(rho):
@@ -553,7 +558,7 @@ def _speed_scale(spectra, families, shaft_hz, uncertainty):
     :data:`LINE_TOLERANCE`, at which the families' lines stand highest on average: a
     nominal speed is searched, not read with windows as wide as its uncertainty (wide
     windows let every family find some line)."""
-    n = int(np.ceil(uncertainty / LINE_TOLERANCE - 1e-9))
+    n = int(np.floor(uncertainty / LINE_TOLERANCE + 1e-9))
     if n < 1:
         return 1.0
     best, scale = -np.inf, 1.0
@@ -589,27 +594,38 @@ def family_verdicts(x, fs_hz, shaft_hz, frequencies, speed_tolerance=0.0):
     -------
     list of FamilyVerdict
     """
+    return _verdicts_and_scale(x, fs_hz, shaft_hz, frequencies, speed_tolerance)[0]
+
+
+def _verdicts_and_scale(x, fs_hz, shaft_hz, frequencies, speed_tolerance):
+    """:func:`family_verdicts` and the factor on the stated speed they were read at."""
     families = line_families(frequencies)
     spectra = {False: _log_spectrum(amplitude_spectrum(x, fs_hz, window="hann")),
                True: _envelope_log_spectrum(x, fs_hz, max(f.order for f in families)
                                             * shaft_hz)}
-    shaft_hz = shaft_hz * _speed_scale(spectra, families, shaft_hz, float(speed_tolerance))
-    return [family_verdict(*spectra[f.envelope], f, f.order * shaft_hz,
+    scale = _speed_scale(spectra, families, shaft_hz, float(speed_tolerance))
+    return [family_verdict(*spectra[f.envelope], f, f.order * shaft_hz * scale,
                            LINE_TOLERANCE + (BEARING_SLIP if f.slip else 0.0))
-            for f in families]
+            for f in families], scale
+
+
+def _echoes(v, w):
+    """Whether ``v``'s lines at its ratio are harmonics (1-4) of a sibling ``w``'s at the
+    stated values, within two bearing lines' windows: one bearing's BPFI and BPFO stand
+    near a small ratio (2 × BPFI = 3.02 × BPFO on a 6205, 2.93 × on MFPT's), so one
+    family's comb can read the other's."""
+    q = v.ratio * v.family.order / w.family.order
+    return any(abs(q / n - 1.0) <= 2 * (LINE_TOLERANCE + BEARING_SLIP) for n in (1, 2, 3, 4))
 
 
 def _speaking(verdicts):
     """The verdicts that speak: lines clear of the floor, at least two in the spectrum;
-    of one bearing's families only the one whose lines stand highest (the other reads the
-    harmonics it shares with it)."""
+    a bearing family that stands at another ratio on the harmonics of a sibling family
+    standing clear where the metadata puts it is left out (:func:`_echoes`)."""
     clear = [v for v in verdicts if v.level_db >= CLEAR_LINE_DB and v.n_lines >= 2]
-    best = {}
-    for v in clear:
-        if v.family.slip and v.level_db > getattr(best.get(v.family.source), "level_db",
-                                                  -np.inf):
-            best[v.family.source] = v
-    return [v for v in clear if not v.family.slip or best[v.family.source] is v]
+    return [v for v in clear if v.ratio == 1.0 or not v.family.slip or not any(
+        w is not v and w.family.source == v.family.source and w.stated_db >= CLEAR_LINE_DB
+        and _echoes(v, w) for w in clear)]
 
 
 def _decide(verdicts):
@@ -624,7 +640,8 @@ def _decide(verdicts):
     top = max(strong or against, key=lambda v: v.level_db)
     rho = top.ratio
     same = [v for v in against if v.ratio == rho]
-    backing = [v for v in clear if v is not top and v.backs(rho, top.level_db)]
+    backing = [v for v in clear if v.family.source != top.family.source
+               and v.backs(rho, top.level_db)]
     if backing:
         return "agrees", max(backing, key=lambda v: v.stated_db), 1.0, False
     rival = any(v.ratio != rho and v.level_db >= top.level_db - CONFIRM_MARGIN_DB
@@ -680,7 +697,8 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     if trust:
         return RateCheck("trusted", message="sample rate and speed trusted as stated "
                                             "(trust_metadata): not checked against the signal")
-    verdicts = family_verdicts(x, fs_hz, speed_rpm / 60.0, frequencies, speed_tolerance)
+    verdicts, scale = _verdicts_and_scale(x, fs_hz, speed_rpm / 60.0, frequencies,
+                                          speed_tolerance)
     verdict, fam, rho, refuse = _decide(verdicts)
     evidence = tuple(v.describe() for v in _speaking(verdicts))
     if verdict == "unchecked":
@@ -693,18 +711,20 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
                 f"({fam.stated_db:.0f} dB over the floor)")
         if others:
             note += "; not with " + "; ".join(others)
-        return RateCheck(verdict, fam, 1.0, evidence, note)
+        return RateCheck(verdict, fam, 1.0, evidence, note, scale)
     r = _ratio_text(rho)
     what = (f"record {where}: its {fam.describe()}, where {fs_source} {fs_hz:g} Hz and "
             f"{speed_source} {speed_rpm:g} put them")
     fits = f"{fs_source} {fs_hz / rho:g} Hz or {speed_source} {speed_rpm * rho:g} would fit"
     if refuse:
         raise ParameterError(
-            f"{what}, and no family of lines stands where they are stated ("
-            + "; ".join(evidence) + f"): the sample rate or the speed stated (file, "
+            f"{what}, and no family of lines stands where they are stated"
+            + "".join(f"; {e}" for e in evidence if e != fam.describe()) + f": the sample rate or the speed stated (file, "
             f"metadata.json or options) is wrong; {fits} (if they are right, trust_metadata "
             f"reads the record as stated)", param="record",
             allowed=f"sample rate {fs_hz / rho:g} Hz or speed {speed_rpm * rho:g} rpm")
+    others = [e for e in evidence if e != fam.describe()]
+    also = f" (also: {'; '.join(others)})" if others else ""
     return RateCheck(verdict, fam, rho, evidence,
-                     f"{what} ({'; '.join(evidence)}): the sample rate or the speed may be "
-                     f"wrong by {r} ({fits}); not refused, the evidence is not strong enough")
+                     f"{what}{also}: the sample rate or the speed may be wrong by {r} "
+                     f"({fits}); not refused, the evidence is not strong enough", scale)

@@ -24,7 +24,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError, RecordWarning
 from cmsim.frequencies import RigFrequencies, rig_frequencies
-from cmsim.measured.consistency import check_rate_and_speed
+from cmsim.measured.consistency import BEARING_SLIP, check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
                                       refine_speed, sample_rate_from_note)
 from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
@@ -34,7 +34,8 @@ from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_p
 from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
                                    read_metadata, recording_entry, unit_kind, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
-                                   SPEED_TOLERANCE, agreed, agreed_unit, speed_uncertainty)
+                                   MEASURED_SPEED_UNCERTAINTY, SPEED_TOLERANCE, agreed,
+                                   agreed_unit, speed_uncertainty)
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 
@@ -59,8 +60,9 @@ class MeasuredRecord:
     channel : str
         Channel compared with the model (default: the first sensor near a documented
         bearing, else the first channel).
-    rig : cmsim.rig.Rig
-        Model rig (:func:`~cmsim.measured.model_rig.model_rig`, or the user's).
+    rig : cmsim.rig.Rig or None
+        Model rig (:func:`~cmsim.measured.model_rig.model_rig`, or the user's); None for a
+        recording without geometry read with ``model=False`` (a spectrum's).
     op : cmsim.rig.OperatingPoint
         Operating point of the model: speed (documented or inferred), torque and radial load
         with the model's assumptions (:func:`~cmsim.measured.model_rig.model_operating_point`).
@@ -269,6 +271,25 @@ def _to_acceleration(x, fs_hz, quantity, factor):
     return np.fft.irfft(np.fft.rfft(z) * jw ** order, z.size)[:n]
 
 
+def _refined_speed(x, fs, speed, teeth, check, uncertainty, inferred):
+    """``(speed, its uncertainty)``: refined by the shaft comb where it stands clear
+    (:func:`~cmsim.measured.inference.refine_speed`), else, for a nominal speed, moved to
+    where the check found the rig's lines standing highest within its uncertainty
+    (:attr:`~cmsim.measured.consistency.RateCheck.speed_scale`); what was refined goes to
+    ``inferred``."""
+    refined, how = refine_speed(x, fs, speed, teeth)
+    if how is None and check is not None and check.verdict == "agrees" \
+            and check.speed_scale != 1.0:
+        refined = speed * check.speed_scale
+        how = (f"the nominal {speed:g} rpm searched within its {100 * uncertainty:g} %: the "
+               f"rig's lines ({check.family.family.name} and the others) stand highest "
+               f"{100 * (check.speed_scale - 1):+.0f} % from it")
+    if how is None:
+        return speed, uncertainty
+    inferred["speed_rpm"] = {"value": refined, "how": how}
+    return refined, min(uncertainty, MEASURED_SPEED_UNCERTAINTY)
+
+
 def _stated_speed(path, file_rpm, entry, speed_rpm, notes, doubts):
     """``(speed, where from)``: the caller's ``speed_rpm`` when given — it replaces what the
     file and metadata.json state, and a value it replaces is warned of
@@ -289,8 +310,29 @@ def _stated_speed(path, file_rpm, entry, speed_rpm, notes, doubts):
     return float(speed_rpm), "speed_rpm"
 
 
+def _model_of(path, rig, full, geometry, near, notes, model):
+    """``(rig, components)``: the rig given, else the model of the documented geometry
+    (:func:`~cmsim.measured.model_rig.model_rig`, its notes first in ``notes``); without
+    geometry, refused — or, when no ``model`` is asked for, ``(None, {})`` and a note."""
+    if rig is not None:
+        return rig, {b: b for b in rig.bearing_names}
+    try:
+        if full is None:
+            raise ParameterError(f"record {path}: {NO_GEOMETRY}", param="rig",
+                                 allowed="a rig TOML, or metadata.json with geometry")
+        rig, components, rig_notes = model_rig(geometry, near)
+    except ParameterError as exc:
+        if model or exc.param not in ("rig", "geometry"):
+            raise
+        notes.append("no geometry documented: read without a model (spectra name the shaft "
+                     "harmonics only)")
+        return None, {}
+    notes[:0] = rig_notes
+    return rig, components
+
+
 def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
-                calibration=None, trust_metadata=False):
+                calibration=None, trust_metadata=False, model=True):
     """Read a measured recording into a :class:`MeasuredRecord`.
 
     Channel names, sample rate, unit, shaft speed and calibration come from the file where
@@ -327,14 +369,19 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     trust_metadata : bool
         Read the stated sample rate and speed as they are, without checking them against
         the record's lines (the user knows them to be right).
+    model : bool
+        Build the model rig; False reads a recording without geometry all the same (its
+        :attr:`MeasuredRecord.rig` is then None: a spectrum, not a comparison).
 
     Returns
     -------
     MeasuredRecord
         Its meta holds ``rate_check`` (the check's outcome,
-        :class:`~cmsim.measured.consistency.RateCheck`), ``speed_uncertainty`` (relative)
-        and ``warnings``: what the user should hear (a contradiction too weak to refuse
-        the record).
+        :class:`~cmsim.measured.consistency.RateCheck`), ``speed_uncertainty`` (relative:
+        the stated speed's, smaller once refined from the signal), ``line_tolerance`` (that
+        plus the rolling elements' slip: how far a line of the record may stand from where
+        the speed puts it; a spectrum's labels read it) and ``warnings``: what the user
+        should hear (a contradiction too weak to refuse the record, a value replaced).
 
     Raises
     ------
@@ -387,16 +434,9 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
     near = sensor.get("near")
     rig_given = rig is not None
-    if rig is None:
-        if full is None:
-            raise ParameterError(f"record {p}: {NO_GEOMETRY}", param="rig",
-                                 allowed="a rig TOML, or metadata.json with geometry")
-        rig, components, rig_notes = model_rig(geometry, near)
-        notes[:0] = rig_notes
-    else:
-        components = {b: b for b in rig.bearing_names}
+    rig, components = _model_of(p, rig, full, geometry, near, notes, model)
     teeth = None
-    if rig.gears is not None:
+    if rig is not None and rig.gears is not None:
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
     fs = _sample_rate(fs, x, speed, teeth, inferred, notes, meta)
@@ -420,14 +460,14 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                                      trust_metadata)
     if "fs_hz" not in inferred and speed_rpm is None:   # the caller's speed is the speed;
                                                         # an inferred rate is scaled by it
-        speed, how = refine_speed(x, fs, speed, teeth)
-        if how is not None:
-            inferred["speed_rpm"] = {"value": speed, "how": how}
-    op = model_operating_point(entry, rig, speed, notes)
+        speed, uncertainty = _refined_speed(x, fs, speed, teeth, check, uncertainty, inferred)
+    op = (model_operating_point(entry, rig, speed, notes) if rig is not None
+          else documented_operating_point(entry, speed))
 
     direction = str(sensor.get("direction", "")).lower()
     axis = "x" if ("horizontal" in direction or "3 o'clock" in direction) else "y"
-    bearing = next((b for b in rig.bearing_names if components.get(b) == near), "1b1")
+    bearing = next((b for b in (rig.bearing_names if rig is not None else ())
+                    if components.get(b) == near), "1b1")
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
               {"fs_hz": fs, "channel": channel, "sensor": sensor or None,
@@ -437,8 +477,10 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                    "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
                    "radial_load_n": op.radial_load_n,
                    "radial_load_angle_rad": op.radial_load_angle_rad},
-               "rig": rig.to_dict(), "notes": notes, "inferred": inferred,
+               "rig": rig.to_dict() if rig is not None else None, "notes": notes,
+               "inferred": inferred,
                "warnings": doubts, "speed_uncertainty": uncertainty,
+               "line_tolerance": uncertainty + BEARING_SLIP,
                "rate_check": check.to_dict() if check is not None else None},
               source="measured")
     return MeasuredRecord(
@@ -517,7 +559,7 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
         run = Run.load(p)
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
         return run, (None if "t" in npz_names(p) else sorted(run.signals)[0])
-    rec = read_record(p, channel=channel, trust_metadata=trust_metadata, **stated)
+    rec = read_record(p, channel=channel, trust_metadata=trust_metadata, model=False, **stated)
     return rec.run, rec.channel
 
 

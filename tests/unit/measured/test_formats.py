@@ -557,7 +557,7 @@ def test_spectrum_says_the_speed_was_inferred_and_from_what(tmp_path, capsys):
     assert out["inferred"] == {} and "warnings" not in out
 
 
-@pytest.mark.parametrize("command", ["spectrum", "compare"])
+@pytest.mark.parametrize("command", ["compare"])
 def test_no_metadata_and_no_rig_says_how_to_get_a_rig(tmp_path, capsys, command):
     np.savez(tmp_path / "rec.npz", DE=_signals(8000)["DE"])
     status, err, lines = _error(capsys, [command, str(tmp_path / "rec.npz"), "--fs-hz",
@@ -565,3 +565,20 @@ def test_no_metadata_and_no_rig_says_how_to_get_a_rig(tmp_path, capsys, command)
     assert status == 2 and err["option"] == "--rig" and len(lines) == 1
     assert "the recording has no geometry: give --rig FILE.toml" in err["error"]
     assert "neither bearing geometry" not in err["error"]
+
+
+def test_a_spectrum_without_geometry_names_the_shaft_only(tmp_path, capsys):
+    """Issue 48: a recording with neither metadata.json nor --rig was refused by spectrum
+    ("give --rig"); a spectrum needs no model: it is shown, its peaks named by the shaft
+    rate alone, and says so."""
+    t = np.arange(24000) / 12000.0
+    x = np.sin(2 * np.pi * 30.0 * t) + 0.5 * np.sin(2 * np.pi * 60.0 * t)
+    np.savez(tmp_path / "rec.npz",
+             DE=x + 0.01 * np.random.default_rng(0).standard_normal(t.size))
+    argv = ["spectrum", str(tmp_path / "rec.npz"), "--fs-hz", "12000", "--speed-rpm", "1800"]
+    assert main(argv + ["--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["bearing"] is None and out["families"] == {"fr": 30.0}
+    assert {p["label"] for p in out["peaks"][:2]} == {"1fr", "2fr"}, out["peaks"][:3]
+    assert main(argv) == 0
+    assert "no geometry, peaks named by the shaft rate only" in capsys.readouterr().out
