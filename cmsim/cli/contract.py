@@ -96,7 +96,8 @@ class Parser(argparse.ArgumentParser):
 
 def ranged(rng):
     """argparse type: a number within ``rng`` (a :class:`~cmsim.rig.ranges.Range`), else a
-    message with the range; its ``allowed`` attribute holds the range as text.
+    message with the range; its ``allowed`` attribute holds the range as text, its
+    ``range`` the range itself.
 
     Examples
     --------
@@ -115,6 +116,7 @@ def ranged(rng):
 
     parse.__name__ = "int" if rng.integer else "float"
     parse.allowed = rng.allowed
+    parse.range = rng
     return parse
 
 
