@@ -18,7 +18,7 @@ from cmsim._io import atomic_write_text
 from cmsim.measured.readers._common import (TIME_NAME, TIME_STEP_TOLERANCE, SignalFile,
                                             time_rate)
 
-__all__ = ["read", "write"]
+__all__ = []   # read and write: through READERS and WRITERS of the package
 
 
 _CSV_UNIT = re.compile(r"^(.*\S)\s*(?:\[([^\]]*)\]|\(([^)]*)\))$")
@@ -63,19 +63,7 @@ def _evenly_rising(t):
 
 
 def read(path, names=None):
-    """Channels of a ``.csv`` file and what it states (module docstring).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    names : sequence of str, optional
-        Channel names for a file that stores none (the entry's ``channels``).
-
-    Returns
-    -------
-    SignalFile
-    """
+    """Channels of a ``.csv`` file and what it states (module docstring)."""
     import pandas as pd
     sep, decimal = _csv_dialect(path)
     if not _csv_has_header(path, sep, decimal):
@@ -119,19 +107,7 @@ def _read_headerless(path, sep, decimal, names):
 
 
 def write(path, signals, rate_hz, units):
-    """Write channels to a ``.csv`` file that :func:`read` reads back the same, atomically.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    signals : dict of str to numpy.ndarray
-        Channel name → samples, shape (n,) each, of one length.
-    rate_hz : float
-        Sample rate, Hz.
-    units : dict of str to str
-        Channel name → unit (channels without one are absent).
-    """
+    """Write channels to a ``.csv`` file that :func:`read` reads back the same, atomically."""
     import pandas as pd
     n = len(next(iter(signals.values())))
     cols = {"time_s": np.arange(n) / float(rate_hz)}

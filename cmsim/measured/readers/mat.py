@@ -21,7 +21,7 @@ from cmsim.errors import ParameterError
 from cmsim.measured.readers._common import (TIME_NAME, SignalFile, channel_1d, one_rate,
                                             time_rate)
 
-__all__ = ["read", "write"]
+__all__ = []   # read and write: through READERS and WRITERS of the package
 
 
 #: Scalar names of a ``.mat`` file that hold the sample rate, Hz.
@@ -40,19 +40,7 @@ def _mat_channels(path, name, a):
 
 
 def read(path, names=None):
-    """Channels of a MATLAB ``.mat`` file and what it states (module docstring).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    names : sequence of str, optional
-        Channel names for a file that stores none (the entry's ``channels``).
-
-    Returns
-    -------
-    SignalFile
-    """
+    """Channels of a MATLAB ``.mat`` file and what it states (module docstring)."""
     try:
         variables = loadmat(path, squeeze_me=True, simplify_cells=True)
     except NotImplementedError:            # a v7.3 file: HDF5 inside
@@ -108,19 +96,7 @@ def _read_mat73(path):
 
 
 def write(path, signals, rate_hz, units):
-    """Write channels to a MATLAB ``.mat`` file that :func:`read` reads back the same, atomically.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    signals : dict of str to numpy.ndarray
-        Channel name → samples, shape (n,) each, of one length.
-    rate_hz : float
-        Sample rate, Hz.
-    units : dict of str to str
-        Channel name → unit (channels without one are absent).
-    """
+    """Write channels to a MATLAB ``.mat`` file that :func:`read` reads back the same, atomically."""
     out = {k: v.reshape(-1, 1) for k, v in signals.items()}
     out["fs_hz"] = float(rate_hz)
     if units:

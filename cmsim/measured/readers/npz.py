@@ -14,7 +14,7 @@ import numpy as np
 from cmsim._io import atomic_savez
 from cmsim.measured.readers._common import SignalFile, channel_1d
 
-__all__ = ["read", "write", "npz_names"]
+__all__ = ["npz_names"]   # read and write: through READERS and WRITERS
 
 
 #: Array names of a saved run (and of :func:`write`'s ``.npz``) that are not channels.
@@ -22,19 +22,7 @@ _NOT_CHANNELS = ("t", "meta", "source", "fs_hz", "units")
 
 
 def read(path, names=None):
-    """Channels of an ``.npz`` file and what it states (module docstring).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    names : sequence of str, optional
-        Channel names for a file that stores none (the entry's ``channels``).
-
-    Returns
-    -------
-    SignalFile
-    """
+    """Channels of an ``.npz`` file and what it states (module docstring)."""
     with np.load(path, allow_pickle=False) as z:
         signals = {k: channel_1d(path, k, z[k]) for k in z.files if k not in _NOT_CHANNELS}
         rate = float(z["fs_hz"]) if "fs_hz" in z.files and z["fs_hz"].ndim == 0 else None
@@ -43,19 +31,7 @@ def read(path, names=None):
 
 
 def write(path, signals, rate_hz, units):
-    """Write channels to an ``.npz`` file that :func:`read` reads back the same, atomically.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    signals : dict of str to numpy.ndarray
-        Channel name → samples, shape (n,) each, of one length.
-    rate_hz : float
-        Sample rate, Hz.
-    units : dict of str to str
-        Channel name → unit (channels without one are absent).
-    """
+    """Write channels to an ``.npz`` file that :func:`read` reads back the same, atomically."""
     atomic_savez(path, **signals, fs_hz=np.float64(rate_hz), units=np.array(json.dumps(units)))
 
 

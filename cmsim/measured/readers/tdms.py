@@ -12,23 +12,11 @@ import numpy as np
 from cmsim._io import atomic_write_bytes
 from cmsim.measured.readers._common import SignalFile, one_rate, optional_module, rate_of_step
 
-__all__ = ["read", "write"]
+__all__ = []   # read and write: through READERS and WRITERS of the package
 
 
 def read(path, names=None):
-    """Channels of an NI ``.tdms`` file and what it states (module docstring).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    names : sequence of str, optional
-        Channel names for a file that stores none (the entry's ``channels``).
-
-    Returns
-    -------
-    SignalFile
-    """
+    """Channels of an NI ``.tdms`` file and what it states (module docstring)."""
     nptdms = optional_module("nptdms", "tdms", path)
     f = nptdms.TdmsFile.read(str(path))
     groups = [g for g in f.groups() if any(len(c) for c in g.channels())]
@@ -48,19 +36,7 @@ def read(path, names=None):
 
 
 def write(path, signals, rate_hz, units):
-    """Write channels to an NI ``.tdms`` file that :func:`read` reads back the same, atomically.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    signals : dict of str to numpy.ndarray
-        Channel name → samples, shape (n,) each, of one length.
-    rate_hz : float
-        Sample rate, Hz.
-    units : dict of str to str
-        Channel name → unit (channels without one are absent).
-    """
+    """Write channels to an NI ``.tdms`` file that :func:`read` reads back the same, atomically."""
     nptdms = optional_module("nptdms", "tdms", path)
     chans = []
     for name, v in signals.items():

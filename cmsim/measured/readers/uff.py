@@ -18,7 +18,7 @@ import numpy as np
 from cmsim.errors import ParameterError
 from cmsim.measured.readers._common import SignalFile, one_rate, optional_module, rate_of_step
 
-__all__ = ["read", "write"]
+__all__ = []   # read and write: through READERS and WRITERS of the package
 
 
 def _uff_text(value):
@@ -27,19 +27,7 @@ def _uff_text(value):
 
 
 def read(path, names=None):
-    """Channels of a UFF (``.uff``/``.unv``) file and what it states (module docstring).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    names : sequence of str, optional
-        Channel names for a file that stores none (the entry's ``channels``).
-
-    Returns
-    -------
-    SignalFile
-    """
+    """Channels of a UFF (``.uff``/``.unv``) file and what it states (module docstring)."""
     pyuff = optional_module("pyuff", "uff", path)
     uff = pyuff.UFF(str(path))
     types = [int(t) for t in np.atleast_1d(uff.get_set_types())]
@@ -75,19 +63,7 @@ def read(path, names=None):
 
 
 def write(path, signals, rate_hz, units):
-    """Write channels to a UFF (``.uff``/``.unv``) file that :func:`read` reads back the same, atomically.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    signals : dict of str to numpy.ndarray
-        Channel name → samples, shape (n,) each, of one length.
-    rate_hz : float
-        Sample rate, Hz.
-    units : dict of str to str
-        Channel name → unit (channels without one are absent).
-    """
+    """Write channels to a UFF (``.uff``/``.unv``) file that :func:`read` reads back the same, atomically."""
     pyuff = optional_module("pyuff", "uff", path)
     sets = []
     for i, (name, v) in enumerate(signals.items()):

@@ -21,7 +21,7 @@ from cmsim._io import atomic_write_bytes
 from cmsim.errors import ParameterError
 from cmsim.measured.readers._common import SignalFile
 
-__all__ = ["read", "write"]
+__all__ = []   # read and write: through READERS and WRITERS of the package
 
 
 #: Prefix of the WAV ``LIST/INFO`` comment cmsim writes and reads.
@@ -56,19 +56,7 @@ def _wav_comment(path):
 
 
 def read(path, names=None):
-    """Channels of a ``.wav`` file and what it states (module docstring).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    names : sequence of str, optional
-        Channel names for a file that stores none (the entry's ``channels``).
-
-    Returns
-    -------
-    SignalFile
-    """
+    """Channels of a ``.wav`` file and what it states (module docstring)."""
     rate, x = wavfile.read(path)
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
@@ -87,19 +75,7 @@ def read(path, names=None):
 
 def write(path, signals, rate_hz, units):
     """Float32 WAV at full scale ±1: the samples divided by the largest magnitude, that
-    factor stated as the calibration in a ``LIST/INFO`` comment with the names and units.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-    signals : dict of str to numpy.ndarray
-        Channel name → samples, shape (n,) each, of one length.
-    rate_hz : float
-        Sample rate, Hz.
-    units : dict of str to str
-        Channel name → unit (channels without one are absent).
-    """
+    factor stated as the calibration in a ``LIST/INFO`` comment with the names and units."""
     if float(rate_hz) != round(float(rate_hz)) or not 0 < rate_hz < 2 ** 32:
         raise ParameterError(f"a WAV header holds a whole sample rate, got {rate_hz:g} Hz; "
                              f"write .npz, .uff or .mat instead", param="rate_hz",
