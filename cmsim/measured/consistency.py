@@ -640,8 +640,8 @@ def _decide(verdicts):
     top = max(strong or against, key=lambda v: v.level_db)
     rho = top.ratio
     same = [v for v in against if v.ratio == rho]
-    backing = [v for v in clear if v.family.source != top.family.source
-               and v.backs(rho, top.level_db)]
+    backing = [v for v in clear if v.backs(rho, top.level_db) and (   # a sibling backs only
+        v.family.source != top.family.source or v.stated_db >= top.level_db)]  # over its echo
     if backing:
         return "agrees", max(backing, key=lambda v: v.stated_db), 1.0, False
     rival = any(v.ratio != rho and v.level_db >= top.level_db - CONFIRM_MARGIN_DB
