@@ -27,7 +27,7 @@ def read(path, names=None):
         signals = {k: channel_1d(path, k, z[k]) for k in z.files if k not in _NOT_CHANNELS}
         rate = float(z["fs_hz"]) if "fs_hz" in z.files and z["fs_hz"].ndim == 0 else None
         units = json.loads(str(z["units"])) if "units" in z.files else {}
-    return SignalFile(signals, rate, units, rate_from="its fs_hz array")
+    return SignalFile(signals, rate, units, rate_from="its \"fs_hz\" array")
 
 
 def write(path, signals, rate_hz, units):

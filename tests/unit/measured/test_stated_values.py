@@ -113,3 +113,13 @@ def test_units_of_the_cwru_metadata_still_read(tmp_path):
     if (CWRU / "metadata.json").is_file():
         shutil.copytree(CWRU, tmp_path / "cwru")
         assert read_record(tmp_path / "cwru" / "normal_0.npz").unit_scale == 9.80665
+
+
+def test_a_file_key_is_not_read_as_an_option(tmp_path, capsys):
+    """An .npz states its rate in an array named fs_hz: a message quotes the key (it read
+    "its --fs-hz array" on the command line, an option the file does not have)."""
+    x = np.random.default_rng(2).standard_normal(8192)
+    np.savez(tmp_path / "r.npz", DE=x, fs_hz=np.float64(12000.0))
+    assert main(["spectrum", str(tmp_path / "r.npz"), "--fs-hz", "48000", "--json"]) == 2
+    err = json.loads(capsys.readouterr().out)["error"]
+    assert 'its "fs_hz" array says sample rate 12000 Hz but --fs-hz says 48000 Hz' in err, err
