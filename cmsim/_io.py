@@ -1,7 +1,8 @@
 """Atomic file writes: write to a temporary file beside the target, then rename.
 
 The file gets the permissions an ordinary ``open(path, "w")`` would give (0o666 less the
-umask), not the owner-only mode of the temporary file.
+umask), not the owner-only mode of the temporary file; a folder assembled beside its target
+(:func:`staging_dir`) those of ``mkdir`` (0o777 less the umask), not ``mkdtemp``'s 0o700.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["atomic_write", "atomic_write_text", "atomic_write_bytes", "atomic_savez",
-           "READ_ERRORS", "finite"]
+           "staging_dir", "READ_ERRORS", "finite"]
 
 #: What reading a file a user brings can raise when the file is missing, truncated, of the
 #: wrong kind or holds the wrong keys (an ``.npz`` cut short raises ``BadZipFile`` or
@@ -50,6 +51,26 @@ def _umask():
     mask = os.umask(0o022)
     os.umask(mask)
     return mask
+
+
+def staging_dir(target, suffix):
+    """A new hidden folder beside ``target`` (``.<name>.XXXX<suffix>``) to assemble it in
+    and rename into place, with the permissions ``mkdir`` would give ``target``.
+
+    Parameters
+    ----------
+    target : pathlib.Path
+        The folder it will become.
+    suffix : str
+        End of its name (``.export``).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=suffix, dir=target.parent))
+    os.chmod(stage, 0o777 & ~_umask())
+    return stage
 
 
 def atomic_write(path, write):

@@ -12,7 +12,8 @@ import math
 import numbers
 import re
 
-__all__ = ["ParameterError", "IntegrationDiverged", "WorkersDied", "check_range", "within",
+__all__ = ["ParameterError", "RecordWarning", "IntegrationDiverged", "WorkersDied",
+           "check_range", "within",
            "check_choice", "check_type", "format_range", "format_value"]
 
 _LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
@@ -39,6 +40,12 @@ class ParameterError(ValueError):
             param = m.group(1) if m else None
         self.param = param
         self.allowed = allowed
+
+
+class RecordWarning(UserWarning):
+    """A measured record is read, but something it states is doubtful (its lines
+    contradict its sample rate or speed, weakly): the user should hear it. The command
+    line prints each as a warning (with ``--json``, in the object's ``warnings``)."""
 
 
 class IntegrationDiverged(RuntimeError):

@@ -39,7 +39,7 @@ import numpy as np
 from cmsim.errors import ParameterError, check_range, check_type
 
 __all__ = ["BearingFrequencies", "RigFrequencies", "bearing_frequencies", "rig_frequencies",
-           "peak_families", "cage_speed_ratios", "FAMILY_KEYS"]
+           "peak_families", "cage_speed_ratios", "FAMILY_KEYS", "lines_above_nyquist"]
 
 #: Keys of a families dict (see :meth:`RigFrequencies.families` and :mod:`cmsim.spectra.labels`).
 FAMILY_KEYS = ("GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF")
@@ -348,3 +348,44 @@ def peak_families(freqs, bearing=None):
         freqs = RigFrequencies.from_dict(freqs)
     check_type("freqs", freqs, RigFrequencies)
     return freqs.families(bearing)
+
+
+def lines_above_nyquist(freqs, fs_hz, *, rate="fs_hz", speed="speed_rpm"):
+    """One line per characteristic frequency of ``freqs`` above the Nyquist frequency of a
+    record sampled at ``fs_hz``: the gear mesh, the ball passes over each race. A record
+    that misses them holds none of what condition monitoring reads there (an anti-alias
+    filtered record has nothing there; one that is not, aliases).
+
+    Parameters
+    ----------
+    freqs : RigFrequencies
+        At the fastest speed of the record.
+    fs_hz : float
+        Sample rate of the record, Hz.
+    rate, speed : str
+        Names of the rate and the speed, for the message (a command line's options).
+
+    Returns
+    -------
+    list of str
+        Empty when every line lies under the Nyquist frequency.
+
+    Examples
+    --------
+    >>> from cmsim.rig import OperatingPoint, Rig
+    >>> lines_above_nyquist(rig_frequencies(Rig.paper_2016(), OperatingPoint(1000.0)), 75e3)
+    []
+    >>> print(lines_above_nyquist(rig_frequencies(Rig.paper_2016(), OperatingPoint(1e5)),
+    ...                           75e3)[0])  # doctest: +ELLIPSIS
+    the gear mesh (GMF 46667 Hz) lies above the Nyquist frequency 37500 Hz of fs_hz 75000: ...
+    """
+    nyquist = 0.5 * float(fs_hz)
+    lines = []
+    if freqs.gmf_hz is not None:
+        lines.append(("the gear mesh", "GMF", freqs.gmf_hz))
+    for name, b in freqs.bearings.items():
+        lines += [(f"bearing {name}'s outer-race ball pass", "BPFO", b.bpfo_hz),
+                  (f"bearing {name}'s inner-race ball pass", "BPFI", b.bpfi_hz)]
+    return [f"{what} ({short} {f:.0f} Hz) lies above the Nyquist frequency {nyquist:.0f} Hz of "
+            f"{rate} {float(fs_hz):g}: the record holds none of its lines; raise {rate} above "
+            f"{2 * f:.0f} Hz or lower {speed}" for what, short, f in lines if f >= nyquist]

@@ -17,6 +17,7 @@ import json
 import os
 import re
 import sys
+import warnings
 
 import numpy as np
 
@@ -24,7 +25,7 @@ from cmsim.cli import (calibrate, compare, dataset, evaluate, export, import_, l
                        mesh_table, modes, report, simulate, spectrum, sweep)
 from cmsim.cli.contract import (CLIError, Parser, check_paths, finite, option_named_in,
                                 options_of, subparsers, user_message)
-from cmsim.errors import IntegrationDiverged, ParameterError, WorkersDied
+from cmsim.errors import IntegrationDiverged, ParameterError, RecordWarning, WorkersDied
 
 __all__ = ["main", "build_parser", "COMMANDS"]
 
@@ -123,7 +124,7 @@ def _main(argv):
         args.notice_compile = lambda integrates=True: _notice_compile(args, integrates)
         try:
             check_paths(args, args.command, options)
-            res = args.func(args)
+            res = _run_warned(args)
         except ParameterError as exc:
             msg, option = user_message(exc, options)
             raise CLIError(msg, 2, option=option) from None
@@ -158,6 +159,25 @@ def _main(argv):
     else:
         print(json.dumps(finite(res)))
     return 0
+
+
+def _run_warned(args):
+    """``args.func(args)`` with every :class:`~cmsim.errors.RecordWarning` the library
+    issues (a measured record read despite a doubt) said through ``args.warn``, once per
+    text; other warnings pass on as they came."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", RecordWarning)
+        try:
+            return args.func(args)
+        finally:
+            said = set()
+            for w in caught:
+                if issubclass(w.category, RecordWarning):
+                    if str(w.message) not in said:
+                        said.add(str(w.message))
+                        args.warn(str(w.message))
+                else:
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def _fail(parser, args, message, status, option=None, extra=None):

@@ -36,6 +36,7 @@ PARAM_TO_DEST = {
     "correlation_s": "slip_correlation_s", "n_steps": "steps", "torques_nm": "torque_nm",
     "speeds_rpm": "speed_rpm", "friction_coefficient": "friction", "frictions": "friction",
     "clearances_m": "clearance_m", "max_freq_hz": "max_hz", "signals": "signal",
+    "signal": "channel",
     "mesh": "mesh", "method": "method", "centres": "centres",
     "noise_rms": "sensor_noise", "fs_out_hz": "sensor_fs_hz",
     "algorithm": "algorithm", "dataset": "dir", "record": "run",
@@ -95,7 +96,8 @@ class Parser(argparse.ArgumentParser):
 
 def ranged(rng):
     """argparse type: a number within ``rng`` (a :class:`~cmsim.rig.ranges.Range`), else a
-    message with the range; its ``allowed`` attribute holds the range as text.
+    message with the range; its ``allowed`` attribute holds the range as text, its
+    ``range`` the range itself.
 
     Examples
     --------
@@ -114,6 +116,7 @@ def ranged(rng):
 
     parse.__name__ = "int" if rng.integer else "float"
     parse.allowed = rng.allowed
+    parse.range = rng
     return parse
 
 

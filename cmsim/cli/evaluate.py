@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, ranged
+from cmsim.cli.options import add_trust_option
 from cmsim.errors import ParameterError
 from cmsim.rig import RANGES, Range
 
@@ -42,6 +43,7 @@ def register(sub):
                    help="sim-to-real: random state of the learned model (default 0)")
     p.add_argument("--report", type=Path, metavar="OUT.html",
                    help="write an HTML page with the plots")
+    add_trust_option(p)
     p.set_defaults(func=run, text=text)
 
 
@@ -60,7 +62,7 @@ def run(args):
                        "--help)", option="--algorithm")
     func = load_algorithm(args.algorithm)
     try:
-        dataset = load_dataset(args.dir)
+        dataset = load_dataset(args.dir, trust_metadata=args.trust_metadata)
     except ParameterError as exc:  # the message starts with the directory
         raise CLIError(f"DIR {exc}", option="DIR") from None
     if len(dataset.manifest) == 0:
@@ -125,9 +127,15 @@ def _syn2real(args):
             raise CLIError(f"--train {d}: the dataset has no ok record", option="--train")
     try:
         test = measured_windows(args.test, window=args.window,
-                                max_windows=args.max_test_windows)
+                                max_windows=args.max_test_windows,
+                                trust_metadata=args.trust_metadata)
     except (ParameterError, OSError, ValueError, KeyError) as exc:
         raise CLIError(f"--test {args.test}: {exc}", option="--test") from None
+    if test.skipped:
+        rid, why = next(iter(test.skipped.items()))
+        n = len(test.skipped) + len(set(test.groups))
+        args.warn(f"--test {args.test}: {len(test.skipped)} of {n} records could not be read "
+                  f"and were skipped (first: {rid}: {why})")
     out = evaluate_syn2real(args.train, args.test, args.classifier, test=test,
                             seed=args.seed or 0)
     out["train"] = [str(d) for d in args.train]
@@ -144,6 +152,8 @@ def _text_syn2real(res):
              f"{ms(res['macro_auroc'])}",
              "recall: " + ", ".join(f"{c} {ms(v)}" for c, v in res["per_class_recall"].items()),
              "confusion (rows truth, summed over runs): " + str(res["confusion_matrix"])]
+    lines += [f"test record {rid} skipped: {why}"
+              for rid, why in res.get("skipped_test_records", {}).items()]
     return "\n".join(lines)
 
 

@@ -26,8 +26,9 @@ def register(sub):
                                    "and, for a dataset, "
                                    "labels.csv (label, severity, operating point, group, "
                                    "split). A dataset as parquet is one row per window "
-                                   "(windows.parquet, for pandas, pyarrow and HuggingFace "
-                                   "datasets). Default channels: those a real machine "
+                                   "(windows.parquet alone, each window with its record's "
+                                   "labels: the folder loads as one table in pandas, pyarrow "
+                                   "and HuggingFace datasets). Default channels: those a real machine "
                                    "measures (accelerations, tacho); name simulated ones "
                                    "(dte_um, F_1b1_loa) with --channels.")
     p.add_argument("source", type=Path, metavar="RUN|DATASET",

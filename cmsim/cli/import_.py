@@ -36,7 +36,7 @@ def register(sub):
     p.add_argument("--channel", nargs="+", metavar="NAME",
                    help="names of a file's unnamed channels (a WAV's, in order), or the "
                         "channels to document of files that name theirs")
-    add_recording_options(p)
+    add_recording_options(p, trust=False)       # import reads no lines: nothing to trust
     p.set_defaults(func=run, text=text)
 
 
@@ -48,6 +48,7 @@ def run(args):
     if out.exists() and not args.force:
         raise CLIError(f"--out {out}: exists; give --force to overwrite it", option="--out")
     values = recording_values(args)
+    values.pop("trust_metadata")
     keep = None
     if out.exists():                               # --force: keep what import does not write
         try:
@@ -56,8 +57,8 @@ def run(args):
             raise CLIError(f"--out {out}: not valid JSON ({' '.join(str(exc).split())}); "
                            f"repair or remove it", option="--out") from None
     try:
-        meta, undocumented, skipped = folder_metadata(args.dir, channels=args.channel,
-                                                      keep=keep, **values)
+        meta, undocumented, skipped, unreadable = folder_metadata(
+            args.dir, channels=args.channel, keep=keep, **values)
     except ParameterError as exc:
         if exc.param not in ("record", "dataset"):
             raise
@@ -66,6 +67,8 @@ def run(args):
     if skipped:
         args.warn(f"left out {', '.join(skipped)}: written by cmsim (a run or dataset "
                   f"record), they state their own rate, speed and rig and need no metadata")
+    for name, why in unreadable:
+        args.warn(f"left out {name}: {why}")
     for what in undocumented:
         option = next((o for k, o in _OPTION_OF.items() if k in what), "an option")
         args.warn(f"{what} undocumented (give {option}, or edit {out.name})")
@@ -76,7 +79,8 @@ def run(args):
             "recordings": [{k: r.get(k) for k in ("file", "n_samples", "fs_hz",
                                                   "shaft_speed_rpm", "channels")}
                            for r in recs],
-            "undocumented": list(undocumented), "skipped": list(skipped)}
+            "undocumented": list(undocumented), "skipped": list(skipped),
+            "unreadable": dict(unreadable)}
 
 
 #: What import reports undocumented → the option that gives it.

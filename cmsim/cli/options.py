@@ -19,7 +19,8 @@ from cmsim.rig.plausibility import load_warnings
 __all__ = ["number", "add_rig_options", "load_rig", "add_sampling_options", "add_mesh_options",
            "mesh_argument", "prepare_tables", "add_fault_options", "faults_of", "add_losses_option",
            "check_losses_options", "resolved_setup", "operating_point", "operating_warnings",
-           "add_recording_options", "recording_values", "FAULT_NAMES", "UNIT_NAMES"]
+           "add_recording_options", "add_trust_option", "recording_values", "FAULT_NAMES",
+           "UNIT_NAMES"]
 
 #: The catalogue's names for --help (cmsim.faults.FAULT_TYPES; not imported at start-up, it
 #: pulls in the mesh-stiffness stack; tests check the two agree).
@@ -28,9 +29,10 @@ FAULT_NAMES = ("outer_race", "inner_race", "ball", "wear", "off_size_ball", "rol
                "speed_fluctuation", "torque_ripple")
 
 
-#: The unit table's units for --help (cmsim.measured.schema ACCELERATION_UNITS + OTHER_UNITS;
-#: not imported at start-up, it pulls in the measured stack; tests check the two agree).
-UNIT_NAMES = ("g", "m/s2", "m/s^2", "m/s²", "mm/s2", "mm/s^2", "V", "mV")
+#: The unit table's units for --help (cmsim.measured.schema.known_units(); not imported at
+#: start-up, it pulls in the measured stack; tests check the two agree).
+UNIT_NAMES = ("g", "m/s2", "m/s^2", "m/s²", "mm/s2", "mm/s^2", "m/s", "mm/s", "in/s", "ips",
+              "m", "mm", "um", "µm", "mil", "V", "mV")
 
 
 def number(name):
@@ -170,16 +172,26 @@ def prepare_tables(args, rig, mesh, torques_nm=()):
 
 
 # ---------------------------------------------------------------------- recordings
-def add_recording_options(p):
-    """Add --fs-hz, --speed-rpm, --unit and --calibration to the parser ``p``: what a
-    measured recording's file and metadata.json do not state (compare, calibrate, spectrum,
-    import; :func:`cmsim.measured.read_record`)."""
+def add_trust_option(p):
+    """Add --trust-metadata to the parser ``p``: every command that reads measured
+    recordings (``trust_metadata`` of :func:`cmsim.measured.read_record`)."""
+    p.add_argument("--trust-metadata", action="store_true",
+                   help="read the stated sample rate and speed as they are: no check "
+                        "against the recording's own lines (which refuses a record they "
+                        "contradict strongly and warns of a weaker contradiction)")
+
+
+def add_recording_options(p, *, trust=True):
+    """Add --fs-hz, --speed-rpm, --unit, --calibration and (with ``trust``) --trust-metadata
+    to the parser ``p``: what a measured recording's file and metadata.json do not state
+    (compare, calibrate, spectrum, import; :func:`cmsim.measured.read_record`)."""
     p.add_argument("--fs-hz", type=number("record_fs_hz"), metavar="HZ",
                    help="sample rate of the recording, Hz, when neither the file nor "
                         "metadata.json states it (one they state must agree)")
     p.add_argument("--speed-rpm", type=number("speed_rpm"), metavar="RPM",
-                   help="input-shaft speed, rpm, when neither the file nor metadata.json "
-                        "states it (default: found in the signal)")
+                   help="input-shaft speed, rpm: replaces what the file or metadata.json "
+                        "states (a warning says so) and is used as given (default: theirs, "
+                        "refined from the signal; else found in the signal)")
     p.add_argument("--unit", metavar="UNIT",
                    help="unit of every channel whose file and metadata.json state none (as "
                         "--calibration applies to every channel; one they state must "
@@ -187,6 +199,8 @@ def add_recording_options(p):
     p.add_argument("--calibration", type=number("calibration"), metavar="C",
                    help="physical units per stored sample value (a WAV in counts or volts), "
                         "when neither the file nor metadata.json states it")
+    if trust:
+        add_trust_option(p)
 
 
 def ranged_unit(text):
@@ -203,10 +217,12 @@ def ranged_unit(text):
 
 def recording_values(args):
     """The keyword arguments of :func:`cmsim.measured.read_record` that the recording
-    options of ``args`` give (``fs_hz``, ``speed_rpm``, ``unit``, ``calibration``)."""
+    options of ``args`` give (``fs_hz``, ``speed_rpm``, ``unit``, ``calibration``,
+    ``trust_metadata``)."""
     unit = None if args.unit is None else ranged_unit(args.unit)
     return {"fs_hz": args.fs_hz, "speed_rpm": args.speed_rpm, "unit": unit,
-            "calibration": args.calibration}
+            "calibration": args.calibration,
+            "trust_metadata": bool(getattr(args, "trust_metadata", False))}
 
 
 # ---------------------------------------------------------------------- faults

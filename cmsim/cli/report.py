@@ -27,7 +27,7 @@ def register(sub):
 
 def run(args):
     """Build the report."""
-    from cmsim.report import DEFAULT_SIGNALS, build_report
+    from cmsim.datasets.report import DEFAULT_SIGNALS, build_report
 
     try:
         res = build_report(args.dir, tuple(args.signal) if args.signal else DEFAULT_SIGNALS,

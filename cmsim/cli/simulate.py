@@ -81,6 +81,21 @@ def _speed_profile(args):
     return SpeedProfile.ramp(args.speed_rpm, args.ramp_to_rpm, ramp_s, start_s=start_s)
 
 
+def _warn_nyquist(args, rig, op):
+    """Warn when the mesh or a ball pass at the run's fastest speed lies above the Nyquist
+    frequency of the record written (the sensor rate, else --fs-hz)."""
+    from cmsim.frequencies import lines_above_nyquist, rig_frequencies
+
+    top = max(op.speed_rpm, args.ramp_to_rpm or 0.0)
+    sensor = args.sensor_fs_hz is not None
+    freqs = rig_frequencies(rig, dataclasses.replace(op, speed_rpm=top))
+    for text in dict.fromkeys(lines_above_nyquist(
+            freqs, args.sensor_fs_hz if sensor else args.fs_hz,
+            rate="fs_out_hz" if sensor else "fs_hz",
+            speed="ramp_to_rpm" if top > op.speed_rpm else "speed_rpm")):
+        args.warn(text)
+
+
 def run(args):
     """Simulate, optionally add the sensors, write the run; the summary as a dict."""
     from cmsim.dynamics import simulate
@@ -121,6 +136,7 @@ def run(args):
         op = dataclasses.replace(op, radial_load_angle_rad=machine.op.radial_load_angle_rad)
     faults = faults_of(args, rig)
     profile = _speed_profile(args)
+    _warn_nyquist(args, rig, op)
     mesh = mesh_argument(args, rig, [op.torque_nm],
                          **({"default": twin_mesh(rig)} if machine is not None else {}))
     check_losses_options(args)

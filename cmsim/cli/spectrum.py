@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cmsim.cli.contract import load_file, ranged
+from cmsim.cli.contract import CLIError, load_file, ranged
 from cmsim.cli.options import add_recording_options, recording_values
 from cmsim.errors import ParameterError
 from cmsim.cli.output import inferred_lines, save_figure, warn_inferred
@@ -19,18 +19,21 @@ def register(sub):
                                    "measured recording with its metadata.json), with its "
                                    "largest peaks named k·GMF ± m·BPF ± n·fr from the "
                                    "record's own rig and operating point.")
-    p.add_argument("run", type=Path, metavar="RECORD",
+    p.add_argument("record", type=Path, metavar="RECORD",
                    help="a run (cmsim simulate, sweep), a dataset record (cmsim dataset) or "
                         "a measured recording (.npz/.csv/.wav/.mat/.uff/.tdms; what the file "
                         "does not state from metadata.json beside it, else from the options "
-                        "below)")
+                        "below); a relative path is also looked up under $CMSIM_DATA")
     p.add_argument("--rig", metavar="FILE.toml",
                    help="model rig of a measured recording (default: built from its "
                         "metadata.json geometry)")
     add_recording_options(p)
-    p.add_argument("--signal", help="signal name (default: F_1b1_loa of a simulated run, "
-                                    "the first channel of a dataset record, the compared "
-                                    "channel of a measured recording)")
+    p.add_argument("--channel", metavar="NAME",
+                   help="channel (signal) name (default: F_1b1_loa of a simulated run, the "
+                        "first channel of a dataset record, the compared channel of a "
+                        "measured recording)")
+    p.add_argument("--signal", dest="signal_alias", metavar="NAME",
+                   help="the old name of --channel (deprecated)")
     p.add_argument("--kind", default="amplitude", choices=("amplitude", "envelope", "order"),
                    help="spectrum kind")
     p.add_argument("--band-hz", type=ranged(Range(0.0, 1.0e7, unit="Hz")), nargs=2,
@@ -53,12 +56,18 @@ def run(args):
     """The spectrum's labelled peaks (and its figure)."""
     from cmsim.spectra.run_spectrum import run_spectrum
 
+    if args.signal_alias is not None:
+        if args.channel is not None:
+            raise CLIError("--signal is the old name of --channel: give one of them",
+                           option="--signal")
+        args.warn("--signal is deprecated: it is now --channel, as in compare and calibrate")
+        args.channel = args.signal_alias
     run_, default_signal = _read(args)
-    signal = args.signal or default_signal or "F_1b1_loa"
+    signal = args.channel or default_signal or "F_1b1_loa"
     spec = run_spectrum(run_, signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
                         resolution_hz=args.resolution_hz, bearing=args.bearing,
                         max_peaks=args.top, threshold_db=args.threshold_db)
-    out = {"run": str(args.run), "signal": spec.signal, "kind": spec.kind, "unit": spec.unit,
+    out = {"run": str(args.record), "signal": spec.signal, "kind": spec.kind, "unit": spec.unit,
            "resolution_hz": spec.resolution_hz, "bearing": spec.bearing,
            "families": spec.families, "band_hz": list(spec.band_hz) if spec.band_hz else None,
            "max_hz": spec.max_hz, "n_peaks": len(spec.peaks), "peaks": spec.peak_records(),
@@ -82,12 +91,12 @@ _RECORDING_PARAMS = ("record", "rig", "fs_hz", "speed_rpm", "unit", "calibration
 
 
 def _read(args):
-    """The record of ``args.run`` as a run (:func:`cmsim.measured.read_run`, with --rig and
+    """The record of ``args.record`` as a run (:func:`cmsim.measured.read_run`, with --rig and
     the recording options): a measured recording's error names the file itself
     (``RECORD ...``) or the option; a cmsim file that does not load is named here."""
     from cmsim.measured import read_run
 
-    path = args.run
+    path = args.record
     rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None
     try:
         return read_run(path, rig=rig, **recording_values(args))
@@ -114,11 +123,13 @@ def text(res):
     fr = res["families"].get("fr") or 1.0
     families = (", ".join(f"{k} {v / fr:.3f}" for k, v in res["families"].items()) + " orders"
                 if order else ", ".join(f"{k} {v:.3f} Hz" for k, v in res["families"].items()))
+    named = (f"families of bearing {res['bearing']}: " if res["bearing"] is not None
+             else "no geometry, peaks named by the shaft rate only: ")
     lines = [f"{res['kind']} spectrum of {res['signal']} [{res['unit']}], resolution "
              + (f"{res['resolution_hz'] / fr:.4g} orders (angle from the "
                 f"{res.get('angle_from', 'nominal speed')})" if order
                 else f"{res['resolution_hz']:.4g} Hz")
-             + f", families of bearing {res['bearing']}: " + families]
+             + ", " + named + families]
     lines += inferred_lines(res.get("inferred"))
     if res["band_hz"]:
         lines.append(f"demodulation band {res['band_hz'][0]:.0f}-{res['band_hz'][1]:.0f} Hz")

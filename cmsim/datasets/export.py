@@ -28,8 +28,11 @@ holds float32 at full scale, its calibration factor, channels and units in cmsim
   ``split`` (:func:`cmsim.datasets.windows.split_of`).
 
 A dataset exported as ``parquet`` is the windowed layout instead
-(:mod:`cmsim.datasets.windows`, ``windows.parquet``) with the same ``labels.csv``; a single
-run has no windowed layout and is refused as ``parquet``. The
+(:mod:`cmsim.datasets.windows`, ``windows.parquet``) and nothing else: every window carries
+its record's labels (label, severity, operating point, group, split), so the folder loads as
+one table (``pandas.read_parquet(out)``, ``pyarrow.dataset.dataset(out)``, HuggingFace
+``load_dataset("parquet", data_dir=out)``); a single run has no windowed layout and is
+refused as ``parquet``. The
 default channels are those a real machine could measure (:func:`cmsim.run.is_measurable`).
 The folder is assembled beside ``out`` and renamed into place when complete: an interrupted
 export leaves no ``out``; an existing ``out`` is replaced only with ``force``, and never when
@@ -70,7 +73,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cmsim._io import atomic_write_bytes, atomic_write_text, finite
+from cmsim._io import atomic_write_bytes, atomic_write_text, finite, staging_dir
 from cmsim.datasets.load import Dataset, load
 from cmsim.datasets.plan import fault_answer_key
 from cmsim.datasets.windows import check_fractions, split_of
@@ -382,7 +385,7 @@ def export(source, out, fmt, channels=None, *, force=False, window=None, hop=Non
                              "none", param="group_by")
     check_fractions(fractions)
     out.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.", suffix=".export", dir=out.parent))
+    stage = staging_dir(out, ".export")
     try:
         if kind == "run":
             res = _export_run(src, stage, fmt, channels,
@@ -441,18 +444,18 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
         raise ParameterError(f"group_by must be a manifest column {list(ds.manifest.columns)}, "
                              f"got {group_by!r}", param="group_by")
     res = {"channels": chans, "units": units, "fs_hz": ds.fs_hz, "records": len(ds)}
-    if windowed:
-        res["windows"] = ds.to_parquet(stage / "windows.parquet", window=2048 if window is None
-                                       else window, hop=hop, channels=chans, group_by=group_by,
-                                       seed=seed, fractions=fractions)
+    if windowed:           # the windows carry every record's labels: Parquet alone, so
+        res["windows"] = ds.to_parquet(   # the folder loads as a folder (pandas, pyarrow, HF)
+            stage / "windows.parquet", window=2048 if window is None else window, hop=hop,
+            channels=chans, group_by=group_by, seed=seed, fractions=fractions)
         res["windows"]["path"] = str(stage.parent / out_name / "windows.parquet")
         res["files"] = 1
+        return res
     rows, entries, geometries = [], [], {}
     for rec in ds:
         r = rec.row
-        file = None if windowed else f"{rec.record_id}.{fmt}"
-        if file is not None:
-            _write_signals(stage / file, {c: rec.signals[c] for c in chans}, rec.fs_hz, units)
+        file = f"{rec.record_id}.{fmt}"
+        _write_signals(stage / file, {c: rec.signals[c] for c in chans}, rec.fs_hz, units)
         group = str(r[group_by])
         n = int(r["n_samples"]) if r.get("n_samples") is not None else None
         rows.append({"record_id": rec.record_id, "file": file, "label": r.get("fault_label"),
@@ -461,32 +464,27 @@ def _export_dataset(ds, stage, fmt, channels, windowed, window, hop, group_by, s
                      "torque_nm": r.get("torque_nm"), "radial_load_n": r.get("radial_load_n"),
                      "fs_hz": rec.fs_hz, "n_samples": n, "group": group,
                      "split": split_of(group, seed, fractions)})
-        if file is not None:
-            entries.append({"file": file, "n_samples": n, "fs_hz": rec.fs_hz,
-                            "shaft_speed_rpm": r.get("speed_rpm"),
-                            "torque_nm": r.get("torque_nm"),
-                            "radial_load_n": r.get("radial_load_n"), "channels": chans,
-                            **_answer_key(r.get("fault_label"), r.get("fault_component"),
-                                          r.get("fault_severity"))})
-            geometries.setdefault(json.dumps(rig_geometry(rec.rig), sort_keys=True),
-                                  rec.record_id)
+        entries.append({"file": file, "n_samples": n, "fs_hz": rec.fs_hz,
+                        "shaft_speed_rpm": r.get("speed_rpm"), "torque_nm": r.get("torque_nm"),
+                        "radial_load_n": r.get("radial_load_n"), "channels": chans,
+                        **_answer_key(r.get("fault_label"), r.get("fault_component"),
+                                      r.get("fault_severity"))})
+        geometries.setdefault(json.dumps(rig_geometry(rec.rig), sort_keys=True), rec.record_id)
     import pandas as pd
     atomic_write_text(stage / "labels.csv", pd.DataFrame(
         rows, columns=["record_id", "file", "label", "fault_component", "severity",
                        "speed_rpm", "torque_nm", "radial_load_n", "fs_hz", "n_samples",
                        "group", "split"]).to_csv(index=False))
-    if not windowed:
-        name = str(ds.spec.get("name") or ds.directory.name)
-        meta = {"dataset": name, "source": f"cmsim export of dataset {name}",
-                "fs_hz": ds.fs_hz,
-                "channels": {c: f"cmsim simulated {c}" for c in chans},
-                "sensors": _sensors(chans, units),
-                "geometry": json.loads(next(iter(geometries))) if geometries else None,
-                "recordings": entries}
-        if len(geometries) > 1:
-            meta["geometry_note"] = (f"the records' rigs differ ({len(geometries)} bearing or "
-                                     f"gear geometries): this is record "
-                                     f"{next(iter(geometries.values()))}'s")
-        _write_metadata(stage, meta)
-        res["files"] = len(entries)
+    name = str(ds.spec.get("name") or ds.directory.name)
+    meta = {"dataset": name, "source": f"cmsim export of dataset {name}", "fs_hz": ds.fs_hz,
+            "channels": {c: f"cmsim simulated {c}" for c in chans},
+            "sensors": _sensors(chans, units),
+            "geometry": json.loads(next(iter(geometries))) if geometries else None,
+            "recordings": entries}
+    if len(geometries) > 1:
+        meta["geometry_note"] = (f"the records' rigs differ ({len(geometries)} bearing or gear "
+                                 f"geometries): this is record "
+                                 f"{next(iter(geometries.values()))}'s")
+    _write_metadata(stage, meta)
+    res["files"] = len(entries)
     return res

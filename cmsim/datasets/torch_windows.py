@@ -10,7 +10,9 @@ shape (channels, window), ``label_index`` the position of the window's label in
 chosen ones, so a train and a test loader over parts of one dataset number the labels alike;
 or the ``classes`` given), ``group`` the record id.
 
-torch is imported when an item is made, not with this module (``pip install cmsim[torch]``).
+torch is imported when a dataset is made, not with this module: without it the constructor
+raises one :class:`ModuleNotFoundError` naming the extra (``pip install cmsim[torch]``),
+not the first item a DataLoader asks for.
 
 >>> from torch.utils.data import DataLoader                       # doctest: +SKIP
 >>> wins = WindowDataset("out/ci", window=2048)                   # doctest: +SKIP
@@ -29,6 +31,17 @@ from cmsim.datasets.windows import check_window, check_window_fits, window_start
 from cmsim.errors import ParameterError
 
 __all__ = ["WindowDataset"]
+
+
+def _torch():
+    """The torch module, or one error naming the extra that installs it."""
+    try:
+        import torch
+    except ImportError:
+        raise ModuleNotFoundError("cmsim.datasets.torch_windows.WindowDataset needs PyTorch, "
+                                  "an optional dependency: pip install cmsim[torch]",
+                                  name="torch") from None
+    return torch
 
 
 class WindowDataset:
@@ -60,6 +73,7 @@ class WindowDataset:
 
     def __init__(self, dataset, channels=None, window=2048, hop=None, label="fault_label",
                  records=None, include_simulated=False, classes=None, cache_records=4):
+        _torch()
         self.dataset = dataset if isinstance(dataset, Dataset) else load(Path(dataset))
         ds = self.dataset
         self.channels = ds.select_channels(channels, include_simulated)
@@ -112,8 +126,7 @@ class WindowDataset:
         i : int
             Window index, ``0 <= i < len(self)`` (negative counts from the end).
         """
-        import torch
-
+        torch = _torch()
         n = len(self.index)
         if not -n <= int(i) < n:
             raise IndexError(f"window {i} out of range [0, {n})")

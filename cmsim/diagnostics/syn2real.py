@@ -38,7 +38,7 @@ classes), the confusion matrix, and record-level votes (majority of a record's w
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -88,6 +88,9 @@ class WindowSet:
         Shaft rate of each window's record, Hz.
     fs_hz : float
         Sample rate, Hz.
+    skipped : dict of str to str
+        Records left out, record id → why (a measured record that could not be read or
+        whose metadata its own lines refuse: one never stops the others).
     """
 
     x: np.ndarray
@@ -96,6 +99,7 @@ class WindowSet:
     orders: np.ndarray
     shaft_hz: np.ndarray
     fs_hz: float
+    skipped: dict = field(default_factory=dict)
 
     def __len__(self):
         return len(self.y)
@@ -123,10 +127,11 @@ def _orders(bf):
     return np.array([bf.bpfo_hz / fr, bf.bpfi_hz / fr, bf.bsf_hz / fr, bf.ftf_hz / fr])
 
 
-def _assemble(parts, fs_hz):
+def _assemble(parts, fs_hz, skipped=None):
     xs, ys, gs, os_, fs = zip(*parts)
     return WindowSet(np.concatenate(xs), np.concatenate(ys), np.concatenate(gs),
-                     np.concatenate(os_), np.concatenate(fs), float(fs_hz))
+                     np.concatenate(os_), np.concatenate(fs), float(fs_hz),
+                     dict(skipped or {}))
 
 
 def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None,
@@ -194,8 +199,10 @@ def _measured_channel(folder, bearing):
 
 
 def measured_windows(folder, channel=None, window=None, hop=None, bearing=None,
-                     max_windows=None):
-    """Windows of a folder of measured records (``metadata.json`` schema).
+                     max_windows=None, trust_metadata=False):
+    """Windows of a folder of measured records (``metadata.json`` schema). A record that
+    cannot be read (missing, damaged, its metadata refused by its own lines) is left out
+    and named in :attr:`WindowSet.skipped`; the others are windowed.
 
     Parameters
     ----------
@@ -210,15 +217,25 @@ def measured_windows(folder, channel=None, window=None, hop=None, bearing=None,
         Bearing key of ``geometry.bearings`` (default the first).
     max_windows : int, optional
         At most this many windows per record (the first ones; tests).
+    trust_metadata : bool
+        Read every record's stated rate and speed unchecked
+        (:func:`cmsim.measured.read_record`).
 
     Returns
     -------
     WindowSet
         Labels from the answer key, for scoring only; the features never read them.
+
+    Raises
+    ------
+    ParameterError
+        No record of the folder could be read (the first one's reason), a channel missing
+        from a record, records at different rates, a record shorter than the window.
     """
-    ds = load_measured(folder)
-    if ds.unreadable:                      # a test set is scored whole, or not at all
-        raise ParameterError(next(iter(ds.unreadable.values())), param="dataset")
+    ds = load_measured(folder, trust_metadata=trust_metadata)
+    if not len(ds):
+        raise ParameterError(next(iter(ds.unreadable.values()), f"{folder}: no recording"),
+                             param="dataset")
     ch, key = _measured_channel(folder, bearing) if channel is None else (channel, bearing)
     parts, fs0 = [], None
     for rec in ds:
@@ -237,7 +254,7 @@ def measured_windows(folder, channel=None, window=None, hop=None, bearing=None,
         parts.append((w, np.full(n, label, dtype=object),
                       np.full(n, f"real:{rec.record_id}", dtype=object),
                       np.tile(_orders(bf), (n, 1)), np.full(n, bf.shaft_hz)))
-    return _assemble(parts, fs0)
+    return _assemble(parts, fs0, ds.unreadable)
 
 
 # ---------------------------------------------------------------------- features
@@ -536,6 +553,7 @@ def evaluate_syn2real(train_dirs, test_folder, classifier="forest", *, window=No
     return {"classifier": classifier, "test": str(test_folder), "window": int(win),
             "train_hop": int(train_hop or win // 2), "test_hop": int(test_hop or win),
             "n_test_windows": int(len(test)), "n_test_records": int(len(set(test.groups))),
+            "skipped_test_records": dict(test.skipped),
             "balanced_accuracy": summary["balanced_accuracy"],
             "per_class_recall": summary["per_class_recall"],
             "macro_auroc": summary["macro_auroc"],

@@ -7,6 +7,7 @@ import base64
 import html
 import io
 import json
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -55,7 +56,7 @@ def _figure(spectra, title_after):
         if spectra.get(key) is not None:
             ax.plot(*_norm_spectrum(spectra[key], fs), lw=0.6, color="tab:red", alpha=0.8,
                     label="simulated")
-        ax.set_title(title)
+        ax.set_title("\n".join(textwrap.wrap(title, 90)), fontsize=9)
         ax.set_ylabel("dB re median level")
         ax.set_xlabel("frequency, Hz")
         ax.legend(loc="upper right")
@@ -102,26 +103,27 @@ def write_report(comparison, out_dir):
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     d = comparison.to_dict()
-    after = ("after: extended by " + d["finding"] + " " + json.dumps(d["parameters"])
+    after = ("after: extended by " + d["finding"] + _in_words(d["parameters"], " (", ")")
              if d["finding"] not in ("none", "unexplained") else
              "after: no extension (" + ("no significant discrepancy" if d["finding"] == "none"
                                        else "no cause explains the departure") + ")")
     named = (f" on {html.escape(str(d['component']))}" if d["component"] else "") + (
-        " " + html.escape(json.dumps(d["parameters"])) if d["parameters"] else "")
+        html.escape(_in_words(d["parameters"], " (", ")")))
     png = _figure(comparison.spectra, after)
     rows = "".join(f"<tr><td>{html.escape(feature_label(x))}</td><td>{x['measured']:.3g}</td>"
                    f"<td>{x['simulated']:.3g}</td><td>{x['z']:.2f}</td></tr>"
                    for x in d["discrepancies"])
-    causes = "".join(f"<tr><td>{html.escape(c['name'])}</td><td>{c['component']}</td>"
+    causes = "".join(f"<tr><td>{html.escape(c['name'])}</td>"
+                     f"<td>{html.escape(str(c['component'] or '—'))}</td>"
                      f"<td>{c['delta_chi2']:.1f}</td><td>{c['judged_on']}</td>"
                      f"<td>{c['delta_chi2_all']:.1f}</td>"
-                     f"<td>{html.escape(json.dumps(c['parameters']))}</td></tr>"
+                     f"<td>{html.escape(_in_words(c['parameters']))}</td></tr>"
                      for c in d["causes"])
     not_judged = ("; spectral shape and levels not judged (no documented path): "
                   + html.escape(", ".join(d["not_judged"])) if d.get("not_judged") else "")
     ties = ("; near tie with " + html.escape(", ".join(
-        f"{t['name']} ({t['component']})" for t in d["near_ties"]))
-        if d.get("near_ties") else "")
+        t["name"] + (f" ({t['component']})" if t.get("component") else "")
+        for t in d["near_ties"])) if d.get("near_ties") else "")
     departures = ("; departs from the model in " + html.escape(", ".join(d["departures"]))
                   if d.get("departures") else "")
     g = d["gain"]
@@ -134,7 +136,8 @@ def write_report(comparison, out_dir):
 held-out segments: χ²/feature {g['before']:.3g} → {g['after']:.3g} (relative
 {g['relative']:.2f}; a record like the model's own sits near {g['baseline_level']:g});
 {d['simulations']} simulations, {d['wall_s']:.1f} s.</p>
-<p>Record: {html.escape(json.dumps(d['record']))}<br>Inferred: {html.escape(json.dumps(d['inferred']))}</p>
+<p>Record: {html.escape(_in_words(d['record']))}<br>Inferred:
+{html.escape(_in_words(d['inferred']) or "nothing")}</p>
 <img src="data:image/png;base64,{png}" alt="spectra">
 <h2>Largest discrepancies (nominal model, fit segments)</h2>
 <table><tr><th>feature</th><th>measured</th><th>simulated</th><th>z</th></tr>{rows}</table>
@@ -146,6 +149,22 @@ held-out segments: χ²/feature {g['before']:.3g} → {g['after']:.3g} (relative
     atomic_write_text(path, page)
     atomic_write_text(out / "compare.json", json.dumps(_plain(d), indent=1))
     return path
+
+
+def _in_words(values, before="", after=""):
+    """A mapping as a reader reads it: ``size_m 0.0003, depth_m 0.0002`` (nested mappings
+    in parentheses, numbers to 4 significant digits, None as "—"), between ``before`` and
+    ``after``; "" for an empty one. The report shows no raw JSON (compare.json holds it)."""
+    def one(v):
+        if isinstance(v, dict):
+            return "(" + _in_words(v) + ")"
+        if isinstance(v, (list, tuple)):
+            return ", ".join(one(x) for x in v)
+        if isinstance(v, (float, np.floating)):
+            return f"{float(v):.4g}"
+        return "—" if v is None else str(v)
+    text = ", ".join(f"{k} {one(v)}" for k, v in (values or {}).items())
+    return f"{before}{text}{after}" if text else ""
 
 
 def _plain(obj):

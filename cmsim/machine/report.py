@@ -35,12 +35,13 @@ def _figure(machine, records, seed):
     fig, axes = plt.subplots(2, 1, figsize=(9, 7))
     axes[0].plot(*_psd_db(x, fs, nper), lw=0.6, color="k", label="baseline")
     axes[0].plot(*_psd_db(y, fs, nper), lw=0.6, color="tab:red", alpha=0.8, label="twin")
-    axes[0].set_ylabel(f"PSD, dB re 1 {machine.unit or 'unit'}²/Hz")
+    unit = _unit_symbol(machine.unit)
+    axes[0].set_ylabel(f"PSD, dB re 1 {unit}²/Hz")
     axes[0].set_title("baseline and its twin (new seeds)")
     axes[0].legend(loc="upper right")
     f = np.asarray(machine.path.freq_hz)
     axes[1].semilogy(f, machine.path.gain, color="tab:blue")
-    axes[1].set_ylabel(f"|H|, {machine.unit or 'unit'}/N")
+    axes[1].set_ylabel(f"|H|, {unit}/N")
     axes[1].set_xlabel("frequency, Hz")
     axes[1].set_title(f"transfer path {machine.path.source} → {machine.channel}")
     fig.tight_layout()
@@ -48,6 +49,13 @@ def _figure(machine, records, seed):
     fig.savefig(buf, format="png", dpi=90)
     plt.close(fig)
     return base64.b64encode(buf.getvalue()).decode()
+
+
+def _unit_symbol(unit):
+    """The unit's symbol for an axis label: its first word (``"g (believed)"`` → ``g``, so
+    a label reads ``g²/Hz``, not ``g (believed)²/Hz``), ``unit`` when none is known."""
+    words = str(unit or "").split()
+    return words[0] if words and words[0].lower() != "unknown" else "unit"
 
 
 def detectability_rows(detectable, components=None):
@@ -115,13 +123,15 @@ def write_calibration_report(machine, records, out_dir, seed=0, detectable=(),
     det = "".join(f"<tr><td>{html.escape(a)}</td><td>{html.escape(b)}</td>"
                   f"<td>{html.escape(c)}</td></tr>"
                   for a, b, c in detectability_rows(detectable, machine.components))
-    cons = "" if consistency is None else (
-        f"<p>The baseline judged against itself (its odd segments against its even ones, as "
-        f"compare judges a record): χ² per feature {consistency['chi2_per_feature']:.2f}, "
-        f"worst {html.escape(str(consistency['worst_feature']))} z "
-        f"{consistency['worst_z']:+.1f}"
-        f"{' — not stationary: healthy records may read as departures' if consistency['departs'] else ''}"
-        f".</p>")
+    cons = ""
+    if consistency is not None:
+        moved = (" — not stationary: healthy records may read as departures"
+                 if consistency["departs"] else "")
+        cons = (f"<p>The baseline judged against itself (its odd segments against its even "
+                f"ones, as compare judges a record): χ² per feature "
+                f"{consistency['chi2_per_feature']:.2f}, worst "
+                f"{html.escape(str(consistency['worst_feature']))} z "
+                f"{consistency['worst_z']:+.1f}{moved}.</p>")
     wobble = ("not identifiable" if machine.speed_wobble is None
               else f"{100 * machine.speed_wobble:.2f} % rms")
     page = f"""<!doctype html><html><head><meta charset="utf-8"><title>cmsim calibrate</title>

@@ -6,8 +6,8 @@ in reading order:
 
 * :mod:`~cmsim.measured.schema` — the keys the pipeline reads, the answer key it never reads,
   unit constants (lbf, inch, g);
-* :mod:`~cmsim.measured.readers` — file I/O, reader and writer of each type side by side
-  (``.npz``, ``.csv``, ``.wav``, ``.mat``, ``.uff``/``.unv``, ``.tdms``; one function each);
+* :mod:`~cmsim.measured.readers` — file I/O, one module per type with its reader and writer
+  side by side (``.npz``, ``.csv``, ``.wav``, ``.mat``, ``.uff``/``.unv``, ``.tdms``);
 * :mod:`~cmsim.measured.stated` — one rule for what the file, ``metadata.json`` and the
   caller state (rate, speed, unit, calibration): the first gives it, the others must agree;
 * :mod:`~cmsim.measured.importing` — a folder of recordings documented as ``metadata.json``

@@ -1,45 +1,61 @@
 """A record's stated sample rate and speed checked against its own lines.
 
 A sample rate wrong by a factor k scales every line of the spectrum by k; a speed wrong by k
-moves every predicted line by 1/k. Either way the lines the rig makes — shaft harmonics, the
-bearing defect families — stand at a ratio ρ ≠ 1 of where the metadata puts them, while at
-ρ = 1 they all fit. :func:`check_rate_and_speed` finds ρ from the signal, family by family,
-and refuses a record whose clearest family says ρ ≠ 1.
+moves every line the rig makes by 1/k. Either way the lines — the shaft combs, the mesh
+harmonics, each documented bearing's defect families — stand at a ratio ρ ≠ 1 of where the
+metadata puts them, while at ρ = 1 they fit. The rule (:func:`check_rate_and_speed`):
 
-For one family (fundamental u = order × stated shaft rate, harmonics k·u) the ratio is
-decided by the lines that only one of two neighbouring fundamentals predicts
-(:func:`exclusive_contrast_db`), tested in this order:
+**The stated values stand unless they explain none of the record's structure and another
+ratio explains it strongly.** Every family whose lines stand clear of the floor
+(:data:`CLEAR_LINE_DB`, at least two of its lines in the spectrum) gives a verdict
+(:func:`family_verdict`): the ratio its lines stand at, how high, and whether the
+contradiction is strong. Then
 
-* **the stated lines missing** — the stated comb predicts k·u for k not a multiple of m (the
-  first two: u and 3u for m = 2) that a comb at m·u does not; if these stand
-  :data:`MISSING_MARGIN_DB` below the lines at m·u and one of those stands clear
-  (:data:`CLEAR_LINE_DB`), the fundamental is m·u (the stated rate is m times too low);
-* **lines between the stated ones** — a comb at u/m also predicts j·u/m for j not a multiple
-  of m (the first two: u/2 and 3u/2); if these stand clear and as high as the stated lines
-  (within :data:`SUBCOMB_MARGIN_DB`), the fundamental is u/m (the stated rate is m times
-  too high). The missing-line test goes first because a lower comb predicts the stated
-  lines too: it must not be taken where they are absent.
+* a family at ρ = 1 whose lines stand within :data:`CONFIRM_MARGIN_DB` of the highest
+  contradicting family's confirms the stated values: they stand (a contradiction is noted);
+* otherwise, with no family at a different ratio as high, the record is **refused** when
+  the contradiction is strong and corroborated — a strong verdict of an amplitude-spectrum
+  comb (shaft, output shaft, mesh: a wrong rate or speed moves them all, and nothing else
+  puts a comb exactly 2ᵏ times off), or a strong verdict that another source of lines
+  agrees with (the two shafts, the mesh and each bearing family are sources; a shaft's comb
+  in the amplitude and in the envelope spectrum are one);
+* any other contradiction is a **warning** naming the evidence: a lone bearing family (its
+  harmonics can fall on another family's at a ratio 2ᵏ — an outer race's 6th BPFO harmonic
+  lies within 1 % of 4 × BPFI on a 6205 — and the bearing making them may be undocumented),
+  or lines between the stated ones that stand under the stated lines (a machine's own
+  sub-harmonics: half orders of a loose or rubbing rotor, a healthy CWRU record's 0.5× and
+  1.5×).
 
-Steps of 2 (:data:`STEPS`) are taken until neither test moves the fundamental (4 = 2·2),
-within [1/:data:`LARGEST_FACTOR`, :data:`LARGEST_FACTOR`]. A family speaks only when its
-lines stand :data:`CLEAR_LINE_DB` over the local floor at its ratio, and the one whose lines
-stand highest decides (a healthy record's or a gearbox's shaft comb, a faulty bearing's
-defect family in the envelope spectrum). A harmonic of the true fundamental always fits a
-too-high stated rate too, which is why the lines *between* the stated ones decide, never
-the stated lines alone. The mesh comb is not a family of its own (:func:`line_families`).
+One family's ratio (:func:`family_ratio`) is decided by the lines that only one of two
+neighbouring fundamentals predicts (:func:`exclusive_contrast_db`), in steps of 2 within
+[1/:data:`LARGEST_FACTOR`, :data:`LARGEST_FACTOR`]:
 
-Known limit: a record whose every family is weak (below :data:`CLEAR_LINE_DB` at any ratio)
-is not checked (:func:`check_rate_and_speed` returns None and the reader notes it).
+* **the stated lines missing** — the stated comb predicts k·u for odd k (the first two: u,
+  3u) that a comb at 2u does not; if these stand :data:`MISSING_MARGIN_DB` below the lines
+  at 2u and one of those stands clear, the fundamental is 2u. The contradiction is *strong*
+  when the stated odd lines are absent (under :data:`ABSENT_LINE_DB`, the level of the
+  largest of a few noise bins) and the lines at 2u stand :data:`REFUSE_LINE_DB` high;
+* **lines between the stated ones** — a comb at u/2 also predicts u/2, 3u/2; if these stand
+  clear and within :data:`SUBCOMB_MARGIN_DB` of the stated lines, the fundamental is u/2.
+  The contradiction is *strong* when they stand at least :data:`SUBCOMB_STRONG_DB` above
+  the stated lines: the stated comb is the weaker half of the structure.
 
-Line prominence: the largest amplitude within ±:data:`LINE_TOLERANCE` of the line (the stated
-speed may be nominal, bearings slip) over the median of the surrounding ±10 % (at least 25
-bins) of a Hann amplitude spectrum; bearing families are read in the envelope spectrum of the
-kurtogram's band.
+The missing-line test goes first because a lower comb predicts the stated lines too. A step
+of 3 is not taken: a gear rig's 3rd shaft harmonic often stands well above the 1st and 2nd.
+
+Line prominence: the largest amplitude within the line's tolerance ± :data:`LINE_WINDOW_BINS`
+bins over the median of the surrounding ±10 % (at least 25 bins) of a Hann amplitude
+spectrum. The tolerance is the stated speed's own uncertainty (a measured speed is known to
+a fraction of a per cent, a nominal one to a motor's slip,
+:func:`cmsim.measured.stated.speed_uncertainty`), at least :data:`LINE_TOLERANCE`, plus the
+rolling elements' slip (:data:`BEARING_SLIP`) for a bearing family. Bearing families are read
+in the envelope spectrum of the kurtogram's band, and each shaft's comb there too (an
+inner-race or a tooth fault modulates the band at its shaft's rate).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -49,46 +65,58 @@ from cmsim.spectra.envelope import envelope_spectrum
 from cmsim.spectra.kurtogram import kurtogram
 from cmsim.spectra.lines import line_window
 
-__all__ = ["LineFamily", "FamilyVerdict", "line_families", "line_prominence_db",
-           "exclusive_contrast_db", "family_ratio", "lowest_fundamental", "family_verdicts",
-           "check_rate_and_speed", "REFUSE_LINE_DB",
-           "LINE_TOLERANCE", "SUBCOMB_MARGIN_DB", "MISSING_MARGIN_DB", "CLEAR_LINE_DB",
-           "LARGEST_FACTOR", "STEPS"]
+__all__ = ["LineFamily", "FamilyVerdict", "RateCheck", "line_families", "line_prominence_db",
+           "exclusive_contrast_db", "family_ratio", "family_verdict", "lowest_fundamental",
+           "family_verdicts", "check_rate_and_speed", "REFUSE_LINE_DB", "LINE_TOLERANCE",
+           "BEARING_SLIP", "SUBCOMB_MARGIN_DB", "SUBCOMB_STRONG_DB", "MISSING_MARGIN_DB",
+           "ABSENT_LINE_DB", "CLEAR_LINE_DB", "CONFIRM_MARGIN_DB", "LARGEST_FACTOR", "STEPS"]
 
-#: Half-width of the window a line is looked for in, relative to its frequency (a nominal
-#: speed and an induction motor's slip differ by about 1 %; bearings slip 1-2 %).
-LINE_TOLERANCE = 0.015
+#: Least half-width of the window a line is looked for in, relative to its frequency (a
+#: speed stated more precisely still meets a line's own wobble).
+LINE_TOLERANCE = 0.01
 
-#: Bins beyond that tolerance on each side of the window (the one line rule,
+#: Slip of the rolling elements added to a bearing family's tolerance (1-2 %, Randall &
+#: Antoni 2011; the shared records' race lines sit −1.4 % to +0.35 % of their nominal values).
+BEARING_SLIP = 0.01
+
+#: Bins beyond the tolerance on each side of the window (the one line rule,
 #: :func:`cmsim.spectra.lines.line_window`, at 2 bins: a stated rate four times the true one
 #: puts the low lines a few bins from 0, where the rule's 1.5 bins miss the Hann lobe's top).
 LINE_WINDOW_BINS = 2.0
 
 #: Lines between the stated ones standing within this of the stated lines, dB, make the
-#: lower fundamental the true one.
+#: lower fundamental the family's ratio.
 SUBCOMB_MARGIN_DB = 5.0
 
+#: Lines between the stated ones standing this much above the stated lines, dB, make the
+#: lower fundamental a strong contradiction (honest records' own half orders stand 4-7 dB
+#: under the stated lines; a stated speed twice the true one puts the true 1× and 3× there).
+SUBCOMB_STRONG_DB = 0.0
+
 #: Stated lines this far below the lines of a fundamental m times higher, dB, make that
-#: fundamental the true one.
+#: fundamental the family's ratio.
 MISSING_MARGIN_DB = 5.5
 
-#: Least prominence, dB over the local floor, of a family's lines for it to speak (the
-#: largest of ~40 bins of pure noise stands about 7 dB over their median).
+#: Stated lines under this prominence, dB, are absent (the largest of ~40 bins of pure noise
+#: stands about 7 dB over their median): a strong contradiction of the higher fundamental.
+ABSENT_LINE_DB = 10.0
+
+#: Least prominence, dB over the local floor, of a family's lines for it to speak.
 CLEAR_LINE_DB = 15.0
 
-#: Least prominence, dB, of the deciding family for a record to be refused: between
-#: CLEAR_LINE_DB and this a family at another ratio leaves the check undecided. A faulty
-#: ball's cage-modulated comb put a simulated 0.4-s ball-fault record's BPFO family at
-#: 1/2 × 17 dB over its floor (a valid record refused); the weakest doctored real record
-#: that must be refused stands 20.3 dB (MFPT IR_vload4 at fs × 2).
+#: Least prominence, dB, of a strong contradiction's lines for it to refuse a record.
 REFUSE_LINE_DB = 20.0
+
+#: A family whose lines at the stated values speak against a contradiction
+#: (:meth:`FamilyVerdict.backs`) and stand within this of the contradicting lines, dB,
+#: confirms the stated values (at a wrong rate or speed, a family's lines that fall on
+#: other lines by chance stand 9 dB or more under the family that moved).
+CONFIRM_MARGIN_DB = 6.0
 
 #: Largest factor between the stated and the found fundamental that is tested.
 LARGEST_FACTOR = 4
 
-#: Factors a fundamental is moved by, one step at a time (4 = 2·2). A step of 3 is not
-#: taken: a gear rig's 3rd shaft harmonic often stands well above the 1st and 2nd, which
-#: reads as "the stated lines are missing" at 3×.
+#: Factors a fundamental is moved by, one step at a time (4 = 2·2).
 STEPS = (2,)
 
 
@@ -99,19 +127,41 @@ class LineFamily:
     Attributes
     ----------
     name : str
-        ``"shaft"`` or ``"<bearing> BPFO"`` / ``"<bearing> BPFI"``.
+        ``"shaft"``, ``"output shaft"``, ``"mesh"``, ``"<bearing> BPFO"`` /
+        ``"<bearing> BPFI"``; ``" (envelope)"`` appended when read in the envelope.
     order : float
         Fundamental as a multiple of the input-shaft rate.
     harmonics : int
         Harmonics read (1..harmonics).
     envelope : bool
-        Read in the envelope spectrum (bearing defects) instead of the amplitude spectrum.
+        Read in the envelope spectrum instead of the amplitude spectrum.
+    source : str
+        What makes the lines (``"input shaft"``, ``"mesh"``, ``"drive_end BPFO"``): two
+        families of one source do not corroborate each other.
+    slip : bool
+        The lines slip with the rolling elements (:data:`BEARING_SLIP` added).
     """
 
     name: str
     order: float
     harmonics: int
     envelope: bool = False
+    source: str = ""
+    slip: bool = False
+
+    def on_shaft_orders(self, m):
+        """Whether the family's fundamental over ``m`` is a whole shaft order (a mesh of an
+        even tooth count at ``m`` = 2): the lines a ratio of ``m`` (or 1/``m``) moves it
+        between are then shaft harmonics, which a gear record holds whatever its rate, and
+        the family cannot tell that ratio.
+
+        Parameters
+        ----------
+        m : float
+            The ratio (> 1).
+        """
+        q = self.order / m
+        return not self.slip and q >= 1.0 - 1e-9 and abs(q - round(q)) < 1e-6
 
 
 @dataclass(frozen=True)
@@ -125,11 +175,116 @@ class FamilyVerdict:
         Found fundamental / stated fundamental (1 when they agree).
     level_db : float
         Mean prominence of the family's lines at the found fundamental, dB over the floor.
+    strong : bool
+        A ratio ≠ 1 of strong evidence (module docstring).
+    stated_db : float
+        Mean prominence of the lines at the stated fundamental, dB.
+    between_db : float
+        Mean prominence of the lines that decided the first step, dB: the stated odd lines
+        for a higher fundamental, the lines between the stated ones for a lower one (NaN at
+        ratio 1).
+    n_lines : int
+        Lines of the family at ratio 1 that fall in the spectrum.
+    odd_db : float
+        Mean prominence of the stated fundamental's own lines (k = 1, 3: those no comb at
+        twice the fundamental makes), dB.
     """
 
     family: LineFamily
     ratio: float
     level_db: float
+    strong: bool = False
+    stated_db: float = float("nan")
+    between_db: float = float("nan")
+    n_lines: int = 0
+    odd_db: float = float("nan")
+
+    def backs(self, rho, against_db):
+        """Whether the family's lines at the stated values speak strongly against a ratio
+        ``rho`` whose lines stand ``against_db`` high: against a higher one, the stated
+        fundamental's own lines stand :data:`REFUSE_LINE_DB` high (a comb at ``rho`` times
+        it cannot make them); against a lower one, the family stands that high at ratio 1,
+        the lines between its own lower; either way within :data:`CONFIRM_MARGIN_DB` of
+        the contradicting lines. Where the lines told apart would be shaft harmonics at
+        ``rho`` (:meth:`LineFamily.on_shaft_orders`: a mesh of an even tooth count), they
+        must stand as high as the contradicting lines: a mesh's lines are a gear record's
+        strongest, its shaft harmonics there are not.
+
+        Parameters
+        ----------
+        rho : float
+            The ratio a contradiction puts the lines at.
+        against_db : float
+            Prominence of the contradicting lines, dB.
+        """
+        own = self.odd_db if rho > 1.0 else (self.stated_db if self.ratio == 1.0
+                                             else float("nan"))
+        if self.family.on_shaft_orders(max(rho, 1.0 / rho)):
+            return own >= max(against_db, REFUSE_LINE_DB)
+        return own >= REFUSE_LINE_DB and self.stated_db >= against_db - CONFIRM_MARGIN_DB
+
+    def describe(self):
+        """The verdict in words (``shaft lines at 1/2 x: ...``), for notes and messages."""
+        r = _ratio_text(self.ratio)
+        if self.ratio == 1.0:
+            return f"{self.family.name} lines where stated ({self.level_db:.0f} dB)"
+        if self.ratio > 1.0:
+            why = (f"the stated odd lines {self.between_db:.0f} dB, i.e. absent"
+                   if self.between_db < ABSENT_LINE_DB
+                   else f"the stated odd lines only {self.between_db:.0f} dB")
+        else:
+            why = (f"lines between the stated ones {self.between_db:.0f} dB against the "
+                   f"stated lines' {self.stated_db:.0f} dB")
+        return f"{self.family.name} lines at {r} x ({self.level_db:.0f} dB over the floor; {why})"
+
+
+@dataclass(frozen=True)
+class RateCheck:
+    """The outcome of :func:`check_rate_and_speed` for a record that is not refused.
+
+    Attributes
+    ----------
+    verdict : str
+        ``"agrees"`` (a family confirms the stated values), ``"unchecked"`` (no family's
+        lines stand clear), ``"contradicted"`` (a contradiction too weak or too lone to
+        refuse the record: warn), ``"trusted"`` (the caller trusts the stated values).
+    family : FamilyVerdict or None
+        The confirming family (``agrees``) or the strongest contradicting one.
+    ratio : float
+        The ratio the contradicting lines stand at (1 when none).
+    evidence : tuple of str
+        Each speaking family's verdict in words.
+    message : str
+        One line for the notes (``agrees``, ``unchecked``, ``trusted``) or a warning
+        (``contradicted``).
+    speed_scale : float
+        Factor on the stated speed at which the lines stand highest (1 unless the speed's
+        uncertainty exceeds :data:`LINE_TOLERANCE`: a nominal speed is searched).
+    """
+
+    verdict: str
+    family: FamilyVerdict | None = None
+    ratio: float = 1.0
+    evidence: tuple = field(default_factory=tuple)
+    message: str = ""
+    speed_scale: float = 1.0
+
+    @property
+    def level_db(self):
+        """Prominence of the deciding family's lines, dB (NaN without one)."""
+        return self.family.level_db if self.family is not None else float("nan")
+
+    def to_dict(self):
+        """JSON-ready: verdict, family, ratio, level_db, evidence, message."""
+        return {"verdict": self.verdict,
+                "family": self.family.family.name if self.family is not None else None,
+                "ratio": self.ratio, "level_db": self.level_db,
+                "evidence": list(self.evidence), "message": self.message,
+                "speed_scale": self.speed_scale}
+
+
+def _ratio_text(rho):
+    return f"{rho:g}" if rho >= 1 else f"1/{1 / rho:g}"
 
 
 def line_families(frequencies):
@@ -143,21 +298,38 @@ def line_families(frequencies):
     Returns
     -------
     list of LineFamily
-        The shaft comb (4 harmonics) and BPFO and BPFI (2 each, envelope) of every bearing.
-        The mesh comb is not a family of its own: its lines are shaft orders (Z1·k), so the
-        lines between them are shaft harmonics too and cannot tell a ratio; a gear rig's
-        shaft comb (strong, with the mesh's modulation) decides for it.
+        The input shaft's comb (4 harmonics) in the amplitude and the envelope spectrum; with
+        gears, the output shaft's (its bearings turn at its rate) likewise and the mesh
+        harmonics (3); each documented bearing's BPFO and BPFI (3 each, envelope, at the
+        rate of the shaft that carries it, which the frequencies already hold; bearings of
+        one geometry on one shaft are one family, and a bearing's two families one source:
+        the ratio of its BPFI to its BPFO is often near a small fraction — 3/2 on a 6205 —
+        so each can fall on the other's harmonics).
     """
-    out = [LineFamily("shaft", 1.0, 4)]
+    fr = frequencies.fr1_hz
+    out = [LineFamily("shaft", 1.0, 4, source="input shaft"),
+           LineFamily("shaft (envelope)", 1.0, 4, True, source="input shaft")]
+    if frequencies.fr2_hz is not None:
+        o = frequencies.fr2_hz / fr
+        out += [LineFamily("output shaft", o, 4, source="output shaft"),
+                LineFamily("output shaft (envelope)", o, 4, True, source="output shaft")]
+    if frequencies.gmf_hz is not None:
+        out.append(LineFamily("mesh", frequencies.gmf_hz / fr, 3, source="mesh"))
+    seen = {}                       # bearings of one geometry make one set of lines
     for name, b in (frequencies.bearings or {}).items():
-        out.append(LineFamily(f"{name} BPFO", float(b.bpfo_hz) / frequencies.fr1_hz, 2, True))
-        out.append(LineFamily(f"{name} BPFI", float(b.bpfi_hz) / frequencies.fr1_hz, 2, True))
+        key = (round(b.bpfo_hz / fr, 9), round(b.bpfi_hz / fr, 9))
+        seen.setdefault(key, []).append(name)
+    for (bpfo, bpfi), names in seen.items():
+        name = "/".join(names)
+        for what, order in (("BPFO", bpfo), ("BPFI", bpfi)):
+            out.append(LineFamily(f"{name} {what}", order, 3, True,
+                                  source=f"bearing {name}", slip=True))
     return out
 
 
-def line_prominence_db(freq, log_amp, f_hz):
-    """Prominence of the line nearest ``f_hz``: the largest bin within ±:data:`LINE_TOLERANCE`
-    ± :data:`LINE_WINDOW_BINS` (:func:`cmsim.spectra.lines.line_window`) over the median of
+def line_prominence_db(freq, log_amp, f_hz, tolerance=LINE_TOLERANCE):
+    """Prominence of the line nearest ``f_hz``: the largest bin within ±``tolerance`` ±
+    :data:`LINE_WINDOW_BINS` (:func:`cmsim.spectra.lines.line_window`) over the median of
     its ±10 % (>= 25 bins), dB; NaN outside the spectrum.
 
     Parameters
@@ -168,9 +340,11 @@ def line_prominence_db(freq, log_amp, f_hz):
         log10 of the amplitude.
     f_hz : float
         Line frequency, Hz.
+    tolerance : float
+        Relative half-width of the window (the speed's uncertainty, a bearing's slip).
     """
     df = freq[1]
-    sel = line_window(freq, f_hz, LINE_TOLERANCE, LINE_WINDOW_BINS)
+    sel = line_window(freq, f_hz, tolerance, LINE_WINDOW_BINS)
     idx = np.flatnonzero(sel) if sel is not None else np.empty(0, int)
     if idx.size == 0 or idx[0] < 2 or idx[-1] >= log_amp.size - 1:
         return float("nan")
@@ -184,7 +358,8 @@ def _mean(values):
     return float(np.mean(v)) if v else float("nan")
 
 
-def exclusive_contrast_db(freq, log_amp, low_hz, m, harmonics, n_exclusive=2):
+def exclusive_contrast_db(freq, log_amp, low_hz, m, harmonics, n_exclusive=2,
+                          tolerance=LINE_TOLERANCE):
     """Lines a comb at ``low_hz`` predicts and one at ``m·low_hz`` does not, against the
     lines of the higher comb.
 
@@ -200,6 +375,8 @@ def exclusive_contrast_db(freq, log_amp, low_hz, m, harmonics, n_exclusive=2):
         Harmonics of the higher comb read.
     n_exclusive : int
         Exclusive lines read (the first ones).
+    tolerance : float
+        Relative half-width of each line's window.
 
     Returns
     -------
@@ -210,9 +387,9 @@ def exclusive_contrast_db(freq, log_amp, low_hz, m, harmonics, n_exclusive=2):
     higher_peak_db : float
         Prominence of the higher comb's strongest line, dB.
     """
-    exclusive = [line_prominence_db(freq, log_amp, j * low_hz)
+    exclusive = [line_prominence_db(freq, log_amp, j * low_hz, tolerance)
                  for j in range(1, m * harmonics) if j % m][:n_exclusive]
-    higher = [line_prominence_db(freq, log_amp, k * m * low_hz)
+    higher = [line_prominence_db(freq, log_amp, k * m * low_hz, tolerance)
               for k in range(1, harmonics + 1)]
     peak = max((h for h in higher if h == h), default=float("nan"))
     return _mean(exclusive), _mean(higher), peak
@@ -226,11 +403,41 @@ def _lower_fits(exclusive_db, higher_db, higher_peak_db):
 
 def _higher_fits(exclusive_db, higher_db, higher_peak_db):
     """The higher comb has a clear line and the lower one's own lines are missing: the
-    higher fundamental is the true one."""
-    return higher_peak_db >= CLEAR_LINE_DB and exclusive_db - higher_db < -MISSING_MARGIN_DB
+    higher fundamental is the true one. Lines that stand :data:`REFUSE_LINE_DB` high are
+    not missing, however much higher the others stand (a simulated record's ball-pass
+    comb: its odd harmonics 30 dB under the even ones, 46 dB over the floor)."""
+    return (higher_peak_db >= CLEAR_LINE_DB and exclusive_db < REFUSE_LINE_DB
+            and exclusive_db - higher_db < -MISSING_MARGIN_DB)
 
 
-def family_ratio(freq, log_amp, stated_hz, harmonics):
+def _steps(freq, log_amp, stated_hz, harmonics, tolerance, lower=True):
+    """``(ratio, first step)`` of a family: the ratio found step by step (module
+    docstring) and the contrast of its first step, ``(exclusive_db, higher_db,
+    higher_peak_db)`` (None at ratio 1); ``lower`` False: no lower fundamental."""
+    ratio, first = 1.0, None
+    moved = True
+    while moved:
+        moved = False
+        for m in STEPS:            # missing lines first: a lower comb predicts them too
+            if ratio >= 1.0 and ratio * m <= LARGEST_FACTOR:
+                c = exclusive_contrast_db(freq, log_amp, stated_hz * ratio, m, harmonics,
+                                          tolerance=tolerance)
+                if _higher_fits(*c):
+                    first = first or c
+                    ratio *= m
+                    moved = True
+                    continue
+            if lower and ratio <= 1.0 and ratio / m >= 1.0 / LARGEST_FACTOR:
+                c = exclusive_contrast_db(freq, log_amp, stated_hz * ratio / m, m, harmonics,
+                                          tolerance=tolerance)
+                if _lower_fits(*c):
+                    first = first or c
+                    ratio /= m
+                    moved = True
+    return ratio, first
+
+
+def family_ratio(freq, log_amp, stated_hz, harmonics, tolerance=LINE_TOLERANCE):
     """Found / stated fundamental of one family, and its lines' level there.
 
     Parameters
@@ -241,6 +448,8 @@ def family_ratio(freq, log_amp, stated_hz, harmonics):
         Fundamental the metadata predicts, Hz.
     harmonics : int
         Harmonics read.
+    tolerance : float
+        Relative half-width of each line's window.
 
     Returns
     -------
@@ -248,22 +457,48 @@ def family_ratio(freq, log_amp, stated_hz, harmonics):
         Ratio (a power of 2 within [1/4, 4], or 1) and mean prominence of the
         lines at the found fundamental, dB.
     """
-    ratio = 1.0
-    moved = True
-    while moved:
-        moved = False
-        for m in STEPS:            # missing lines first: a lower comb predicts them too
-            if ratio >= 1.0 and ratio * m <= LARGEST_FACTOR and _higher_fits(
-                    *exclusive_contrast_db(freq, log_amp, stated_hz * ratio, m, harmonics)):
-                ratio *= m
-                moved = True
-            elif ratio <= 1.0 and ratio / m >= 1.0 / LARGEST_FACTOR and _lower_fits(
-                    *exclusive_contrast_db(freq, log_amp, stated_hz * ratio / m, m, harmonics)):
-                ratio /= m
-                moved = True
-    level = _mean(line_prominence_db(freq, log_amp, k * stated_hz * ratio)
-                  for k in range(1, harmonics + 1))
-    return ratio, level
+    ratio, _ = _steps(freq, log_amp, stated_hz, harmonics, tolerance)
+    return ratio, _mean(line_prominence_db(freq, log_amp, k * stated_hz * ratio, tolerance)
+                        for k in range(1, harmonics + 1))
+
+
+def family_verdict(freq, log_amp, family, stated_hz, tolerance=LINE_TOLERANCE):
+    """One family's :class:`FamilyVerdict` (module docstring).
+
+    Parameters
+    ----------
+    freq, log_amp : numpy.ndarray, shape (n,)
+        Spectrum (:func:`line_prominence_db`).
+    family : LineFamily
+    stated_hz : float
+        Fundamental the metadata predicts, Hz.
+    tolerance : float
+        Relative half-width of each line's window.
+
+    Returns
+    -------
+    FamilyVerdict
+    """
+    h = family.harmonics
+
+    def at(f_hz):
+        return line_prominence_db(freq, log_amp, f_hz, tolerance)
+
+    ratio, first = _steps(freq, log_amp, stated_hz, h, tolerance,
+                          not family.on_shaft_orders(2))
+    stated = [at(k * stated_hz) for k in range(1, h + 1)]
+    level = _mean(at(k * stated_hz * ratio) for k in range(1, h + 1))
+    strong, between = False, float("nan")
+    if ratio > 1.0:                 # the stated odd lines absent, the higher comb high
+        exclusive, _, peak = first
+        between = exclusive
+        strong = exclusive < ABSENT_LINE_DB and peak >= REFUSE_LINE_DB
+    elif ratio < 1.0:               # the final comb's own lowest lines over the stated ones
+        m = int(round(1.0 / ratio))
+        between = _mean([at(j * stated_hz * ratio) for j in range(1, 2 * m) if j % m][:2])
+        strong = between - _mean(stated) >= SUBCOMB_STRONG_DB and between >= REFUSE_LINE_DB
+    return FamilyVerdict(family, ratio, level, strong, _mean(stated), between,
+                         sum(s == s for s in stated), _mean(stated[0:3:2]))
 
 
 def lowest_fundamental(freq, log_amp, f_hz, harmonics, *, lo_hz):
@@ -318,8 +553,27 @@ def _envelope_log_spectrum(x, fs_hz, highest_hz):
     return _log_spectrum(envelope_spectrum(x, fs_hz, band, window="hann"))
 
 
-def family_verdicts(x, fs_hz, shaft_hz, frequencies):
-    """Every family's ratio and level (see the module docstring).
+def _speed_scale(spectra, families, shaft_hz, uncertainty):
+    """The factor within ±``uncertainty`` of the stated speed, in steps of
+    :data:`LINE_TOLERANCE`, at which the families' lines stand highest on average: a
+    nominal speed is searched, not read with windows as wide as its uncertainty (wide
+    windows let every family find some line)."""
+    n = int(np.floor(uncertainty / LINE_TOLERANCE + 1e-9))
+    if n < 1:
+        return 1.0
+    best, scale = -np.inf, 1.0
+    for c in 1.0 + LINE_TOLERANCE * np.arange(-n, n + 1):
+        levels = [line_prominence_db(*spectra[f.envelope], k * f.order * shaft_hz * c,
+                                     LINE_TOLERANCE + (BEARING_SLIP if f.slip else 0.0))
+                  for f in families for k in range(1, f.harmonics + 1)]
+        score = _mean(levels)
+        if score > best:
+            best, scale = score, float(c)
+    return scale
+
+
+def family_verdicts(x, fs_hz, shaft_hz, frequencies, speed_tolerance=0.0):
+    """Every family's verdict (see the module docstring).
 
     Parameters
     ----------
@@ -331,29 +585,77 @@ def family_verdicts(x, fs_hz, shaft_hz, frequencies):
         Stated input-shaft rate, Hz.
     frequencies : cmsim.frequencies.RigFrequencies
         The rig's characteristic frequencies at 1 Hz (:func:`line_families`).
+    speed_tolerance : float
+        Relative uncertainty of the stated speed: beyond :data:`LINE_TOLERANCE`, the
+        speed is searched within it first (the lines read at the speed where they stand
+        highest); a bearing family's window adds :data:`BEARING_SLIP`.
 
     Returns
     -------
     list of FamilyVerdict
     """
+    return _verdicts_and_scale(x, fs_hz, shaft_hz, frequencies, speed_tolerance)[0]
+
+
+def _verdicts_and_scale(x, fs_hz, shaft_hz, frequencies, speed_tolerance):
+    """:func:`family_verdicts` and the factor on the stated speed they were read at."""
     families = line_families(frequencies)
-    raw = _log_spectrum(amplitude_spectrum(x, fs_hz, window="hann"))
-    env = None
-    if any(f.envelope for f in families):
-        env = _envelope_log_spectrum(x, fs_hz, max(f.order for f in families if f.envelope)
-                                     * shaft_hz)
-    out = []
-    for f in families:
-        freq, log_amp = env if f.envelope else raw
-        ratio, level = family_ratio(freq, log_amp, f.order * shaft_hz, f.harmonics)
-        out.append(FamilyVerdict(f, ratio, level))
-    return out
+    spectra = {False: _log_spectrum(amplitude_spectrum(x, fs_hz, window="hann")),
+               True: _envelope_log_spectrum(x, fs_hz, max(f.order for f in families)
+                                            * shaft_hz)}
+    scale = _speed_scale(spectra, families, shaft_hz, float(speed_tolerance))
+    return [family_verdict(*spectra[f.envelope], f, f.order * shaft_hz * scale,
+                           LINE_TOLERANCE + (BEARING_SLIP if f.slip else 0.0))
+            for f in families], scale
+
+
+def _echoes(v, w):
+    """Whether ``v``'s lines at its ratio are harmonics (1-4) of a sibling ``w``'s at the
+    stated values, within two bearing lines' windows: one bearing's BPFI and BPFO stand
+    near a small ratio (2 × BPFI = 3.02 × BPFO on a 6205, 2.93 × on MFPT's), so one
+    family's comb can read the other's."""
+    q = v.ratio * v.family.order / w.family.order
+    return any(abs(q / n - 1.0) <= 2 * (LINE_TOLERANCE + BEARING_SLIP) for n in (1, 2, 3, 4))
+
+
+def _speaking(verdicts):
+    """The verdicts that speak: lines clear of the floor, at least two in the spectrum;
+    a bearing family that stands at another ratio on the harmonics of a sibling family
+    standing clear where the metadata puts it is left out (:func:`_echoes`)."""
+    clear = [v for v in verdicts if v.level_db >= CLEAR_LINE_DB and v.n_lines >= 2]
+    return [v for v in clear if v.ratio == 1.0 or not v.family.slip or not any(
+        w is not v and w.family.source == v.family.source and w.stated_db >= CLEAR_LINE_DB
+        and _echoes(v, w) for w in clear)]
+
+
+def _decide(verdicts):
+    """``(verdict, family, ratio, refuse)`` of the speaking families (module docstring)."""
+    clear = _speaking(verdicts)
+    if not clear:
+        return "unchecked", None, 1.0, False
+    against = [v for v in clear if v.ratio != 1.0]
+    if not against:
+        return "agrees", max(clear, key=lambda v: v.level_db), 1.0, False
+    strong = [v for v in against if v.strong]
+    top = max(strong or against, key=lambda v: v.level_db)
+    rho = top.ratio
+    same = [v for v in against if v.ratio == rho]
+    backing = [v for v in clear if v.backs(rho, top.level_db) and (   # a sibling backs only
+        v.family.source != top.family.source or v.stated_db >= top.level_db)]  # over its echo
+    if backing:
+        return "agrees", max(backing, key=lambda v: v.stated_db), 1.0, False
+    rival = any(v.ratio != rho and v.level_db >= top.level_db - CONFIRM_MARGIN_DB
+                for v in strong)
+    sources = {v.family.source for v in same}
+    refuse = top.strong and not rival and (not top.family.envelope or len(sources) >= 2)
+    return "contradicted", top, rho, refuse
 
 
 def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="fs_hz",
-                         speed_source="shaft_speed_rpm"):
-    """Refuse a record whose lines stand at a ratio ≠ 1 of where its sample rate and speed
-    put them.
+                         speed_source="shaft_speed_rpm", speed_tolerance=0.0,
+                         trust=False):
+    """Refuse a record whose lines stand strongly at a ratio ≠ 1 of where its sample rate
+    and speed put them and nowhere where they do; say what is weaker.
 
     Parameters
     ----------
@@ -372,42 +674,57 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     speed_source : str
         Where the speed came from (``"shaft_speed_rpm"``, ``"speed_rpm"`` of a command
         line, ``"the file"``).
+    speed_tolerance : float
+        Relative uncertainty of the stated speed
+        (:func:`cmsim.measured.stated.speed_uncertainty`).
+    trust : bool
+        Trust the stated values: nothing is checked (``trust_metadata`` of
+        :func:`cmsim.measured.read_record`, ``--trust-metadata``).
 
     Returns
     -------
-    FamilyVerdict or None
-        The deciding family (ratio 1), or None when no family's lines stand clear (nothing
-        to check against) or the clearest, at another ratio, stands under
-        :data:`REFUSE_LINE_DB` or is a bearing family no other family agrees with
-        (undecided): the harmonics of a strong defect family, on a bearing the metadata may
-        not even name, can fall on another family's at a ratio 2^k (an outer race's 6th
-        BPFO harmonic lies within 1 % of 4 × BPFI on a 6205; the independent angle-domain
-        generator's valid records read BPFI at 4 ×), while a wrong rate or speed moves the
-        shaft comb too.
+    RateCheck
+        ``agrees``, ``unchecked``, ``contradicted`` (its message a warning naming the
+        evidence) or ``trusted``.
 
     Raises
     ------
     ParameterError
-        The deciding family's lines stand at a ratio ρ ≠ 1: the sample rate is ρ times too
-        high or the speed ρ times too low (the message gives both corrections).
+        The stated values explain none of the record's lines and another ratio ρ explains
+        them strongly (module docstring): the message names the evidence and both
+        corrections (the sample rate ρ times too high, or the speed ρ times too low).
     """
-    verdicts = [v for v in family_verdicts(x, fs_hz, speed_rpm / 60.0, frequencies)
-                if v.level_db >= CLEAR_LINE_DB]
-    if not verdicts:
-        return None
-    best = max(verdicts, key=lambda v: v.level_db)
-    rho = best.ratio
-    if rho == 1.0:
-        return best
-    if best.level_db < REFUSE_LINE_DB:          # too weak a family to refuse a record on
-        return None
-    if best.family.envelope and not any(v is not best and v.ratio == rho for v in verdicts):
-        return None                # one bearing family alone, no second one agrees: undecided
-    ratio = f"{rho:g}" if rho >= 1 else f"1/{1 / rho:g}"
-    raise ParameterError(
-        f"record {where}: its {best.family.name} lines stand at {ratio} x where {fs_source} "
-        f"{fs_hz:g} Hz and {speed_source} {speed_rpm:g} put them ({best.level_db:.0f} dB "
-        f"over the floor there, not at the stated lines): the sample rate or the speed "
-        f"stated (file, metadata.json or options) is wrong; {fs_source} {fs_hz / rho:g} Hz "
-        f"or {speed_source} {speed_rpm * rho:g} would fit", param="record",
-        allowed=f"sample rate {fs_hz / rho:g} Hz or speed {speed_rpm * rho:g} rpm")
+    if trust:
+        return RateCheck("trusted", message="sample rate and speed trusted as stated "
+                                            "(trust_metadata): not checked against the signal")
+    verdicts, scale = _verdicts_and_scale(x, fs_hz, speed_rpm / 60.0, frequencies,
+                                          speed_tolerance)
+    verdict, fam, rho, refuse = _decide(verdicts)
+    evidence = tuple(v.describe() for v in _speaking(verdicts))
+    if verdict == "unchecked":
+        return RateCheck(verdict, message="sample rate and speed not checked against the "
+                                          "signal: no shaft, mesh or bearing lines stand "
+                                          "clear of the floor")
+    if verdict == "agrees":
+        others = [e for e in evidence if " at " in e]
+        note = (f"sample rate and speed agree with the signal's {fam.family.name} lines "
+                f"({fam.stated_db:.0f} dB over the floor)")
+        if others:
+            note += "; not with " + "; ".join(others)
+        return RateCheck(verdict, fam, 1.0, evidence, note, scale)
+    r = _ratio_text(rho)
+    what = (f"record {where}: its {fam.describe()}, where {fs_source} {fs_hz:g} Hz and "
+            f"{speed_source} {speed_rpm:g} put them")
+    fits = f"{fs_source} {fs_hz / rho:g} Hz or {speed_source} {speed_rpm * rho:g} would fit"
+    if refuse:
+        raise ParameterError(
+            f"{what}, and no family of lines stands where they are stated"
+            + "".join(f"; {e}" for e in evidence if e != fam.describe()) + f": the sample rate or the speed stated (file, "
+            f"metadata.json or options) is wrong; {fits} (if they are right, trust_metadata "
+            f"reads the record as stated)", param="record",
+            allowed=f"sample rate {fs_hz / rho:g} Hz or speed {speed_rpm * rho:g} rpm")
+    others = [e for e in evidence if e != fam.describe()]
+    also = f" (also: {'; '.join(others)})" if others else ""
+    return RateCheck(verdict, fam, rho, evidence,
+                     f"{what}{also}: the sample rate or the speed may be wrong by {r} "
+                     f"({fits}); not refused, the evidence is not strong enough", scale)

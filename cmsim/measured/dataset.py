@@ -50,6 +50,9 @@ class MeasuredDataset:
     ----------
     folder : str or pathlib.Path
         Folder with ``metadata.json`` and one signal file per recording.
+    trust_metadata : bool
+        Read every recording's stated rate and speed unchecked
+        (:func:`~cmsim.measured.record.read_record`).
 
     Attributes
     ----------
@@ -58,7 +61,8 @@ class MeasuredDataset:
     folder : pathlib.Path
     manifest : pandas.DataFrame
         One row per recording: ``record_id``, ``status`` ("ok", or "unreadable" for a
-        recording whose file is missing or damaged, with the reason in ``error``), ``path``,
+        recording whose file is missing or damaged, or whose stated rate or speed its own
+        lines refuse, with the reason in ``error``), ``path``,
         ``fs_hz``, ``speed_rpm``, ``radial_load_n`` (documented or inferred values), and the
         answer key ``fault_label``, ``fault_severity`` (m or NaN) for scoring. One bad
         recording does not make the folder unusable: the others are read.
@@ -66,7 +70,7 @@ class MeasuredDataset:
         What was not documented and was inferred or assumed (e.g. the sample rate).
     """
 
-    def __init__(self, folder):
+    def __init__(self, folder, trust_metadata=False):
         import pandas as pd
 
         folder = Path(folder)
@@ -83,7 +87,7 @@ class MeasuredDataset:
                 raise ParameterError(f"{folder}/metadata.json: a recording has no file",
                                      param="dataset")
             try:
-                rec = read_record(folder / r["file"])
+                rec = read_record(folder / r["file"], trust_metadata=trust_metadata)
             except READ_ERRORS as exc:     # ParameterError included: named, with the fix
                 why = " ".join(str(exc).split()) or type(exc).__name__
                 if str(r["file"]) not in why:
@@ -150,15 +154,17 @@ def _unreadable_row(recording, why):
             "fault_severity": key["fault_severity"]}
 
 
-def load_measured(folder):
+def load_measured(folder, trust_metadata=False):
     """:class:`MeasuredDataset` of a folder with ``metadata.json``.
 
     Parameters
     ----------
     folder : str or pathlib.Path
+    trust_metadata : bool
+        Read every recording's stated rate and speed unchecked.
 
     Returns
     -------
     MeasuredDataset
     """
-    return MeasuredDataset(folder)
+    return MeasuredDataset(folder, trust_metadata=trust_metadata)

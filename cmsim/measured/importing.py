@@ -11,7 +11,12 @@ The geometry and the answer key are left for the user to add: nothing in a signa
 states them; every key of an existing ``metadata.json`` that import does not produce
 itself (geometry, sensor positions, a recording's condition or answer key) is kept. A file
 cmsim wrote (an ``.npz`` with a ``meta`` array: a run or a dataset record) states its own
-rate, speed and rig and needs no metadata: it is left out and named.
+rate, speed and rig and needs no metadata: it is left out and named. A file that cannot
+be read, or whose statements disagree with the folder's metadata, is left out and named
+with the reason; the others are documented (one bad file never stops the folder). A
+``metadata.json`` that cmsim wrote itself (``source`` starting ``cmsim``: an earlier import
+or an export) holds copies of what the files stated: where a file states a value, the file
+wins over that copy (the file was re-recorded or re-exported), and nothing is refused.
 :func:`write_folder_metadata` writes the result atomically and never overwrites an
 existing file unless told to.
 """
@@ -109,13 +114,16 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
         rate``).
     skipped : list of str
         Files cmsim wrote (runs, dataset records), left out: they need no metadata.
+    unreadable : list of (str, str)
+        Files left out, with why: a file that cannot be read, or whose statements disagree
+        with the folder's metadata.
 
     Raises
     ------
     ParameterError
-        No measured recording in the folder; a file that cannot be read; a
-        ``metadata.json`` that is not valid; a channel not in a file; two sources that
-        disagree.
+        No measured recording in the folder, or none readable (the first one's reason); a
+        ``metadata.json`` that is not valid; a channel not in a file; an argument that a
+        file's statement contradicts.
     """
     folder = Path(folder)
     unit = checked_unit(unit)
@@ -132,41 +140,39 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
                              f"files){found}", param="dataset",
                              allowed="a folder with signal files")
     sensors_stated = stated.get("sensors") if isinstance(stated.get("sensors"), dict) else {}
-    recordings, units, unit_from, undocumented = [], {}, {}, []
+    own = str(stated.get("source") or "").startswith("cmsim")
+    recordings, units, unit_from, undocumented, unreadable = [], {}, {}, [], []
     for path in files:
-        doc = recording_entry(stated, path.name, where)
-        f = read_file(path, channels or doc.get("channels"))
-        names = _channel_names(path, f, channels)
-        first = f.signals[names[0]]
-        rate, _ = agreed(path, "sample rate", [
-            (f.rate_from, "record", f.rate_hz),
-            ('metadata.json "fs_hz"', "record", doc.get("fs_hz") or stated.get("fs_hz")),
-            ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
-        rpm_doc, rpm_key = documented_speed(doc)
-        speed, _ = agreed(path, "speed", [("the file", "record", f.speed_rpm),
-                                          (rpm_key, "record", rpm_doc),
-                                          ("speed_rpm", "speed_rpm", speed_rpm)],
-                          SPEED_TOLERANCE, " rpm")
-        scale, _ = agreed(path, "units per stored value", [
-            ("the file", "record", f.calibration),
-            ('metadata.json "calibration"', "record", doc.get("calibration")),
-            ("calibration", "calibration", calibration)], CALIBRATION_TOLERANCE)
-        entry = {"file": path.name, "n_samples": int(first.size), "fs_hz": rate,
-                 "shaft_speed_rpm": speed, "channels": names}
-        if scale is not None and f.calibration is None:
-            entry["calibration"] = scale
+        try:
+            entry, names, f = _documented(path, stated, where, channels, own, fs_hz, speed_rpm,
+                                          calibration)
+            found = {}                    # one unit per channel name over the folder
+            for name in names:
+                sensor = sensors_stated.get(name) if isinstance(sensors_stated.get(name),
+                                                                dict) else {}
+                doc_unit = None if own and f.units.get(name) else sensor.get("unit")
+                found[name] = agreed_unit(path, name, [
+                    (unit_from.get(name), "record", units.get(name)),
+                    ("the file", "record", f.units.get(name)),
+                    ('metadata.json "sensors"', "record", doc_unit), ("unit", "unit", unit)])
+        except ParameterError as exc:
+            if exc.param != "record":             # an argument's fault: every file's
+                raise
+            unreadable.append((path.name, " ".join(str(exc).split())))
+            continue
         recordings.append(entry)
         undocumented += [f"{path.name}: {what}" for what, v in
-                         (("sample rate", rate), ("shaft speed", speed)) if v is None]
-        for name in names:                # one unit per channel name over the folder
-            u = agreed_unit(path, name, [(unit_from.get(name), "record", units.get(name)),
-                                         ("the file", "record", f.units.get(name)),
-                                         ('metadata.json "sensors"', "record",
-                                          (sensors_stated.get(name) or {}).get("unit")),
-                                         ("unit", "unit", unit)])
+                         (("sample rate", entry["fs_hz"]),
+                          ("shaft speed", entry["shaft_speed_rpm"])) if v is None]
+        for name, u in found.items():
             if u is not None and name not in units:
                 units[name] = u
                 unit_from[name] = path.name if f.units.get(name) else "unit"
+    if not recordings:
+        name, why = unreadable[0]
+        raise ParameterError(f"{folder}: no recording could be read ({len(unreadable)} "
+                             f"left out; first: {why})", param="dataset",
+                             allowed="a folder with a readable signal file")
     rates = {r["fs_hz"] for r in recordings}
     all_channels = sorted({c for r in recordings for c in r["channels"]})
     undocumented += [f"unit of {c}" for c in all_channels if c not in units]
@@ -180,7 +186,40 @@ def folder_metadata(folder, *, fs_hz=None, speed_rpm=None, channels=None, unit=N
                             "unit": units.get(c)} for c in all_channels},
             "geometry": {"gears": None, "bearings": None},
             "recordings": recordings}
-    return _merged(keep, meta), undocumented, skipped
+    return _merged(keep, meta), undocumented, skipped, unreadable
+
+
+def _documented(path, stated, where, channels, own, fs_hz, speed_rpm, calibration):
+    """``(recordings entry, channel names, SignalFile)`` of one file: what it states, then
+    the folder's metadata (a copy cmsim wrote, ``own``, only where the file is silent),
+    then the arguments, by the rule of :mod:`~cmsim.measured.stated`."""
+    doc = recording_entry(stated, path.name, where)
+    f = read_file(path, channels or doc.get("channels"))
+    names = _channel_names(path, f, channels)
+    first = f.signals[names[0]]
+    doc_rate = doc.get("fs_hz") or stated.get("fs_hz")
+    rpm_doc, rpm_key = documented_speed(doc)
+    doc_scale = doc.get("calibration")
+    if own:                         # cmsim's copy of what the file stated: the file wins
+        doc_rate = None if f.rate_hz is not None else doc_rate
+        rpm_doc = None if f.speed_rpm is not None else rpm_doc
+        doc_scale = None if f.calibration is not None else doc_scale
+    rate, _ = agreed(path, "sample rate", [
+        (f.rate_from, "record", f.rate_hz), ('metadata.json "fs_hz"', "record", doc_rate),
+        ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
+    speed, _ = agreed(path, "speed", [("the file", "record", f.speed_rpm),
+                                      (rpm_key, "record", rpm_doc),
+                                      ("speed_rpm", "speed_rpm", speed_rpm)],
+                      SPEED_TOLERANCE, " rpm")
+    scale, _ = agreed(path, "units per stored value", [
+        ("the file", "record", f.calibration),
+        ('metadata.json "calibration"', "record", doc_scale),
+        ("calibration", "calibration", calibration)], CALIBRATION_TOLERANCE)
+    entry = {"file": path.name, "n_samples": int(first.size), "fs_hz": rate,
+             "shaft_speed_rpm": speed, "channels": names}
+    if scale is not None and f.calibration is None:
+        entry["calibration"] = scale
+    return entry, names, f
 
 
 def _merged(kept, made):

@@ -27,14 +27,16 @@ import re
 import numpy as np
 
 from cmsim.measured.consistency import lowest_fundamental
+from cmsim.measured.stated import NOMINAL_SPEED_UNCERTAINTY
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["estimate_shaft_hz", "refine_speed", "infer_sample_rate", "sample_rate_from_note",
            "SPEED_SEARCH_FRACTION", "MIN_COMB_DB", "MIN_SPEED_CHANGE", "NOTE_AGREEMENT"]
 
 #: Half-width of the search around a documented speed, relative (a stored nominal speed and
-#: an induction motor's slip under load differ by a few per cent at most).
-SPEED_SEARCH_FRACTION = 0.03
+#: an induction motor's slip under load differ by a few per cent at most: the uncertainty of
+#: a nominal speed, :data:`cmsim.measured.stated.NOMINAL_SPEED_UNCERTAINTY`).
+SPEED_SEARCH_FRACTION = NOMINAL_SPEED_UNCERTAINTY
 
 #: Least comb prominence (mean line level over the spectrum's median), dB, for a refined
 #: speed to replace the documented one.
@@ -156,7 +158,11 @@ def refine_speed(x, fs_hz, speed_rpm, teeth=None):
 
 def infer_sample_rate(x, shaft_hz, teeth):
     """Sample rate of a gear record with an undocumented rate: its mesh comb in cycles per
-    sample, scaled by the documented input-shaft rate.
+    sample, scaled by the documented input-shaft rate. The comb found is moved to its true
+    fundamental by the lines between its own, as an undocumented speed is
+    (:func:`~cmsim.measured.consistency.lowest_fundamental`): on a 5-s cut of a gearbox
+    record the comb at twice the shaft rate (the 2nd mesh harmonic, the even shaft lines)
+    can fit best, and the rate would come out half the true one.
 
     Parameters
     ----------
@@ -176,8 +182,10 @@ def infer_sample_rate(x, shaft_hz, teeth):
     score : float
         Comb prominence, dB over the median level.
     """
-    nu, score = estimate_shaft_hz(x, 1.0, lo_hz=2e-4, hi_hz=0.45 / (3 * teeth[0]),
-                                  teeth=teeth)
+    lo = 2e-4
+    nu, score = estimate_shaft_hz(x, 1.0, lo_hz=lo, hi_hz=0.45 / (3 * teeth[0]), teeth=teeth)
+    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), 1.0, window="hann")
+    nu *= lowest_fundamental(freq, np.log10(np.maximum(amp, 1e-300)), nu, 4, lo_hz=lo)
     return shaft_hz / nu, nu, score
 
 

@@ -17,13 +17,14 @@ The answer key never enters it.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, RecordWarning
 from cmsim.frequencies import RigFrequencies, rig_frequencies
-from cmsim.measured.consistency import check_rate_and_speed
+from cmsim.measured.consistency import BEARING_SLIP, check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
                                       refine_speed, sample_rate_from_note)
 from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
@@ -31,9 +32,10 @@ from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
                                       model_rig)
 from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
 from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
-                                   read_metadata, recording_entry, unit_scale_of)
+                                   read_metadata, recording_entry, unit_kind, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
-                                   SPEED_TOLERANCE, agreed, agreed_unit)
+                                   MEASURED_SPEED_UNCERTAINTY, SPEED_TOLERANCE, agreed,
+                                   agreed_unit, speed_uncertainty)
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
 
@@ -58,8 +60,9 @@ class MeasuredRecord:
     channel : str
         Channel compared with the model (default: the first sensor near a documented
         bearing, else the first channel).
-    rig : cmsim.rig.Rig
-        Model rig (:func:`~cmsim.measured.model_rig.model_rig`, or the user's).
+    rig : cmsim.rig.Rig or None
+        Model rig (:func:`~cmsim.measured.model_rig.model_rig`, or the user's); None for a
+        recording without geometry read with ``model=False`` (a spectrum's).
     op : cmsim.rig.OperatingPoint
         Operating point of the model: speed (documented or inferred), torque and radial load
         with the model's assumptions (:func:`~cmsim.measured.model_rig.model_operating_point`).
@@ -234,23 +237,102 @@ def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
                          allowed="a number > 0: fs_hz, or \"fs_hz\" in metadata.json")
 
 
-def _check_against_lines(x, fs, speed_rpm, frequencies, notes, path, fs_source,
-                         speed_source):
+def _check_against_lines(x, fs, speed_rpm, frequencies, notes, doubts, path, fs_source,
+                         speed_source, speed_tolerance, trust):
     """The stated sample rate and speed checked against the record's own lines
-    (:func:`~cmsim.measured.consistency.check_rate_and_speed`); what was checked, or that
-    nothing could be, goes to the notes."""
-    found = check_rate_and_speed(x, fs, speed_rpm, frequencies, where=path,
-                                 fs_source=fs_source, speed_source=speed_source)
-    if found is None:
-        notes.append("sample rate and speed not checked against the signal: no shaft or "
-                     "bearing lines stand clear of the floor")
+    (:func:`~cmsim.measured.consistency.check_rate_and_speed`): a strong contradiction
+    refuses the record, a weaker one goes to ``doubts`` and is warned
+    (:class:`~cmsim.errors.RecordWarning`), what was checked (or that nothing could be) to
+    the notes; the check's outcome."""
+    check = check_rate_and_speed(x, fs, speed_rpm, frequencies, where=path,
+                                 fs_source=fs_source, speed_source=speed_source,
+                                 speed_tolerance=speed_tolerance, trust=trust)
+    if check.verdict == "contradicted":
+        doubts.append(check.message)
+        warnings.warn(check.message, RecordWarning, stacklevel=3)
     else:
-        notes.append(f"sample rate and speed agree with the signal's {found.family.name} "
-                     f"lines ({found.level_db:.0f} dB over the floor)")
+        notes.append(check.message)
+    return check
+
+
+#: Quantity of a channel's unit → how often it is differentiated to an acceleration.
+DIFFERENTIATIONS = {"velocity": "once", "displacement": "twice"}
+
+
+def _to_acceleration(x, fs_hz, quantity, factor):
+    """A velocity (``factor`` to m/s) or displacement (to m) channel as an acceleration in
+    m/s²: differentiated in the frequency domain (× j2πf per time), exact up to the Nyquist
+    frequency; the record is mirrored first, so its two ends meet without a jump."""
+    y = (np.asarray(x, dtype=float) - np.mean(x)) * factor
+    n = y.size
+    z = np.concatenate([y, y[::-1]])
+    jw = 2j * np.pi * np.fft.rfftfreq(z.size, 1.0 / fs_hz)
+    order = 1 if quantity == "velocity" else 2
+    return np.fft.irfft(np.fft.rfft(z) * jw ** order, z.size)[:n]
+
+
+def _refined_speed(x, fs, speed, teeth, check, uncertainty, inferred):
+    """``(speed, its uncertainty)``: refined by the shaft comb where it stands clear
+    (:func:`~cmsim.measured.inference.refine_speed`), else, for a nominal speed, moved to
+    where the check found the rig's lines standing highest within its uncertainty
+    (:attr:`~cmsim.measured.consistency.RateCheck.speed_scale`); what was refined goes to
+    ``inferred``."""
+    refined, how = refine_speed(x, fs, speed, teeth)
+    if how is None and check is not None and check.verdict == "agrees" \
+            and check.speed_scale != 1.0:
+        refined = speed * check.speed_scale
+        how = (f"the nominal {speed:g} rpm searched within its {100 * uncertainty:g} %: the "
+               f"rig's lines ({check.family.family.name} and the others) stand highest "
+               f"{100 * (check.speed_scale - 1):+.0f} % from it")
+    if how is None:
+        return speed, uncertainty
+    inferred["speed_rpm"] = {"value": refined, "how": how}
+    return refined, min(uncertainty, MEASURED_SPEED_UNCERTAINTY)
+
+
+def _stated_speed(path, file_rpm, entry, speed_rpm, notes, doubts):
+    """``(speed, where from)``: the caller's ``speed_rpm`` when given — it replaces what the
+    file and metadata.json state, and a value it replaces is warned of
+    (:class:`~cmsim.errors.RecordWarning`) and noted — else the file's and the metadata's,
+    which must agree (:func:`~cmsim.measured.stated.agreed`)."""
+    rpm_doc, rpm_key = documented_speed(entry)
+    if speed_rpm is None:
+        return agreed(path, "speed", [("the file", "record", file_rpm),
+                                      (rpm_key, "record", rpm_doc)], SPEED_TOLERANCE, " rpm")
+    for what, value in (("the file", file_rpm), (rpm_key, rpm_doc)):
+        if value is not None and abs(float(value) / float(speed_rpm) - 1.0) > 1e-9:
+            gap = 100 * (float(speed_rpm) / float(value) - 1)
+            text = (f"record {path}: speed_rpm {float(speed_rpm):g} replaces {float(value):g} "
+                    f"rpm, the speed {what} states ({gap:+.2g} %)")
+            doubts.append(text)
+            notes.append(text)
+            warnings.warn(text, RecordWarning, stacklevel=3)
+    return float(speed_rpm), "speed_rpm"
+
+
+def _model_of(path, rig, full, geometry, near, notes, model):
+    """``(rig, components)``: the rig given, else the model of the documented geometry
+    (:func:`~cmsim.measured.model_rig.model_rig`, its notes first in ``notes``); without
+    geometry, refused — or, when no ``model`` is asked for, ``(None, {})`` and a note."""
+    if rig is not None:
+        return rig, {b: b for b in rig.bearing_names}
+    try:
+        if full is None:
+            raise ParameterError(f"record {path}: {NO_GEOMETRY}", param="rig",
+                                 allowed="a rig TOML, or metadata.json with geometry")
+        rig, components, rig_notes = model_rig(geometry, near)
+    except ParameterError as exc:
+        if model or exc.param not in ("rig", "geometry"):
+            raise
+        notes.append("no geometry documented: read without a model (spectra name the shaft "
+                     "harmonics only)")
+        return None, {}
+    notes[:0] = rig_notes
+    return rig, components
 
 
 def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
-                calibration=None):
+                calibration=None, trust_metadata=False, model=True):
     """Read a measured recording into a :class:`MeasuredRecord`.
 
     Channel names, sample rate, unit, shaft speed and calibration come from the file where
@@ -275,7 +357,8 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     fs_hz : float, optional
         Sample rate, Hz, when neither the file nor ``metadata.json`` states it.
     speed_rpm : float, optional
-        Input-shaft speed, rpm, when neither the file nor ``metadata.json`` states it.
+        Input-shaft speed, rpm: replaces what the file and ``metadata.json`` state (a value
+        it replaces is warned of), and is used as given (not refined from the signal).
     unit : str, optional
         Unit of every channel whose file and ``metadata.json`` state none (``g``,
         ``m/s^2``, ``V``; :func:`~cmsim.measured.schema.checked_unit`), as ``calibration``
@@ -283,10 +366,22 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     calibration : float, optional
         Physical units per stored sample value (a WAV in counts or volts), applied to every
         channel, when neither the file nor ``metadata.json`` states it.
+    trust_metadata : bool
+        Read the stated sample rate and speed as they are, without checking them against
+        the record's lines (the user knows them to be right).
+    model : bool
+        Build the model rig; False reads a recording without geometry all the same (its
+        :attr:`MeasuredRecord.rig` is then None: a spectrum, not a comparison).
 
     Returns
     -------
     MeasuredRecord
+        Its meta holds ``rate_check`` (the check's outcome,
+        :class:`~cmsim.measured.consistency.RateCheck`), ``speed_uncertainty`` (relative:
+        the stated speed's, smaller once refined from the signal), ``line_tolerance`` (that
+        plus the rolling elements' slip: how far a line of the record may stand from where
+        the speed puts it; a spectrum's labels read it) and ``warnings``: what the user
+        should hear (a contradiction too weak to refuse the record, a value replaced).
 
     Raises
     ------
@@ -295,7 +390,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         ``fs_hz``; unknown channel (the message lists the file's); a value two sources
         state differently; no way to get the sample rate; a damaged file or channel
         (:mod:`~cmsim.measured.readers`, too few, non-finite or constant samples); a sample
-        rate or speed its own lines contradict
+        rate or speed its own lines contradict strongly
         (:func:`~cmsim.measured.consistency.check_rate_and_speed`).
     """
     p = resolve_path(path)
@@ -323,50 +418,56 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
         signals = {k: scale * v for k, v in signals.items()}
     channel, x = _channel(signals, sensors, geometry.get("bearings") or {}, channel, str(p))
     sensor = dict(sensors.get(channel) or {})
-    sensor_unit = agreed_unit(p, channel, [
-        ("the file", "record", f.units.get(channel)),
-        ('metadata.json "sensors"', "record", sensor.get("unit")),
-        ("unit", "unit", unit)])
+    stated_units = [("the file", "record", f.units.get(channel)),
+                    ('metadata.json "sensors"', "record", sensor.get("unit")),
+                    ("unit", "unit", unit)]
+    sensor_unit = agreed_unit(p, channel, stated_units)
+    quantity, unit_factor = unit_kind(sensor_unit, f"record {p}: channel {channel!r} ("
+                                      + next((w for w, _, u in stated_units if u), "") + ")")
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
-    rpm_doc, rpm_key = documented_speed(entry)
-    speed, speed_from = agreed(p, "speed", [
-        ("the file", "record", f.speed_rpm), (rpm_key, "record", rpm_doc),
-        ("speed_rpm", "speed_rpm", speed_rpm)], SPEED_TOLERANCE, " rpm")
+    inferred, notes, doubts = {}, [], []
+    speed, speed_from = _stated_speed(p, f.speed_rpm, entry, speed_rpm, notes, doubts)
     fs, fs_from = agreed(p, "sample rate", [
         (f.rate_from, "record", f.rate_hz),
         ('metadata.json "fs_hz"', "record", entry.get("fs_hz") or meta.get("fs_hz")),
         ("fs_hz", "fs_hz", fs_hz)], HEADER_RATE_TOLERANCE, " Hz")
     near = sensor.get("near")
-    inferred, notes = {}, []
     rig_given = rig is not None
-    if rig is None:
-        if full is None:
-            raise ParameterError(f"record {p}: {NO_GEOMETRY}", param="rig",
-                                 allowed="a rig TOML, or metadata.json with geometry")
-        rig, components, notes = model_rig(geometry, near)
-    else:
-        components = {b: b for b in rig.bearing_names}
+    rig, components = _model_of(p, rig, full, geometry, near, notes, model)
     teeth = None
-    if rig.gears is not None:
+    if rig is not None and rig.gears is not None:
         teeth = (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth)
 
     fs = _sample_rate(fs, x, speed, teeth, inferred, notes, meta)
+    if quantity in DIFFERENTIATIONS:          # the model's quantity is an acceleration
+        x = signals[channel] = _to_acceleration(x, fs, quantity, unit_factor)
+        text = (f"record {p}: channel {channel!r} is a {quantity} in {sensor_unit!r}; the "
+                f"model's sensors measure acceleration, so it is differentiated "
+                f"{DIFFERENTIATIONS[quantity]} (x j2\u03c0f) to m/s^2")
+        sensor_unit = sensor["unit"] = "m/s^2"
+        notes.append(text)
+        doubts.append(text)
+        warnings.warn(text, RecordWarning, stacklevel=2)
     lines = documented_frequencies(geometry, 1.0)
     if rig_given and not lines.bearings and lines.gmf_hz is None:
         lines = rig_frequencies(rig, OperatingPoint(speed_rpm=60.0))
+    uncertainty = speed_uncertainty(entry, speed_from)
+    check = None
     if speed is not None:             # before anything is computed on them
-        _check_against_lines(x, fs, speed, lines, notes, p, fs_from or "the inferred rate",
-                             speed_from)
-    if "fs_hz" not in inferred:       # an inferred rate is scaled by the documented speed
-        speed, how = refine_speed(x, fs, speed, teeth)
-        if how is not None:
-            inferred["speed_rpm"] = {"value": speed, "how": how}
-    op = model_operating_point(entry, rig, speed, notes)
+        check = _check_against_lines(x, fs, speed, lines, notes, doubts, p,
+                                     fs_from or "the inferred rate", speed_from, uncertainty,
+                                     trust_metadata)
+    if "fs_hz" not in inferred and speed_rpm is None:   # the caller's speed is the speed;
+                                                        # an inferred rate is scaled by it
+        speed, uncertainty = _refined_speed(x, fs, speed, teeth, check, uncertainty, inferred)
+    op = (model_operating_point(entry, rig, speed, notes) if rig is not None
+          else documented_operating_point(entry, speed))
 
     direction = str(sensor.get("direction", "")).lower()
     axis = "x" if ("horizontal" in direction or "3 o'clock" in direction) else "y"
-    bearing = next((b for b in rig.bearing_names if components.get(b) == near), "1b1")
+    bearing = next((b for b in (rig.bearing_names if rig is not None else ())
+                    if components.get(b) == near), "1b1")
     n = x.size
     run = Run(np.arange(n) / fs, {c: v for c, v in signals.items() if v.size == n},
               {"fs_hz": fs, "channel": channel, "sensor": sensor or None,
@@ -376,7 +477,11 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                    "speed_rpm": op.speed_rpm, "torque_nm": op.torque_nm,
                    "radial_load_n": op.radial_load_n,
                    "radial_load_angle_rad": op.radial_load_angle_rad},
-               "rig": rig.to_dict(), "notes": notes, "inferred": inferred},
+               "rig": rig.to_dict() if rig is not None else None, "notes": notes,
+               "inferred": inferred,
+               "warnings": doubts, "speed_uncertainty": uncertainty,
+               "line_tolerance": uncertainty + BEARING_SLIP,
+               "rate_check": check.to_dict() if check is not None else None},
               source="measured")
     return MeasuredRecord(
         run=run, channel=channel, rig=rig, op=op, model_signal=f"accel_{bearing}_{axis}",
@@ -401,7 +506,7 @@ def _channel_units(path, signals, file_units, sensors, channel, channel_unit, un
 
 
 def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=None,
-             calibration=None):
+             calibration=None, trust_metadata=False):
     """Any record cmsim writes or reads, as a :class:`~cmsim.run.Run` with its rig and
     operating point: a run (``cmsim simulate``, ``cmsim sweep``), a dataset record
     (``cmsim dataset``) or a measured recording (:func:`read_record`, with every check it
@@ -425,6 +530,8 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
     calibration : float, optional
         Physical units per stored sample value of a measured recording
         (:func:`read_record`).
+    trust_metadata : bool
+        Read a measured recording's stated rate and speed unchecked (:func:`read_record`).
 
     Returns
     -------
@@ -452,7 +559,7 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
         run = Run.load(p)
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
         return run, (None if "t" in npz_names(p) else sorted(run.signals)[0])
-    rec = read_record(p, channel=channel, **stated)
+    rec = read_record(p, channel=channel, trust_metadata=trust_metadata, model=False, **stated)
     return rec.run, rec.channel
 
 

@@ -26,7 +26,8 @@ __all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_
            "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
            "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
            "documented_radial_load_n", "unit_scale_of", "rig_geometry",
-           "documented_speed", "SPEED_KEYS", "checked_unit", "OTHER_UNITS"]
+           "documented_speed", "SPEED_KEYS", "checked_unit", "OTHER_UNITS", "VELOCITY_UNITS",
+           "DISPLACEMENT_UNITS", "UNKNOWN_UNIT", "known_units", "unit_kind"]
 
 #: Keys of a ``recordings[]`` entry the pipeline reads; everything else is ignored.
 RECORDING_KEYS = ("file", "n_samples", "fs_hz", "shaft_speed_rpm", "shaft_speed_hz",
@@ -291,11 +292,78 @@ def documented_radial_load_n(entry):
 #: Units a channel may be given in that have no scale to m/s² (compared by shape only).
 OTHER_UNITS = ("V", "mV")
 
+#: Velocity units and their factor to m/s (a velocity record is differentiated to the
+#: model's quantity, an acceleration, and the record says so).
+VELOCITY_UNITS = {"m/s": 1.0, "mm/s": 1e-3, "in/s": INCH_M, "ips": INCH_M}
+
+#: Displacement units and their factor to m (differentiated twice).
+DISPLACEMENT_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "mil": 1e-3 * INCH_M}
+
+#: What a metadata ``unit`` says when the unit is not known: no unit, not a wrong one.
+UNKNOWN_UNIT = "unknown"
+
+
+def known_units():
+    """Every unit the table knows, in the order ``--help`` lists them: accelerations,
+    velocities, displacements, then units without a scale (volts).
+
+    Returns
+    -------
+    tuple of str
+    """
+    return (tuple(ACCELERATION_UNITS) + tuple(VELOCITY_UNITS) + tuple(DISPLACEMENT_UNITS)
+            + OTHER_UNITS)
+
+
+def unit_kind(unit, where="unit"):
+    """``(quantity, factor)`` of a channel's unit: ``("acceleration", factor to m/s²)``,
+    ``("velocity", factor to m/s)``, ``("displacement", factor to m)``, ``("other",
+    None)`` for volts, ``(None, None)`` for no unit or ``"unknown"``. The first word is
+    read (``"g (believed)"`` is ``g``), in any case but a unit's own (``mm`` is not ``Mm``).
+
+    Parameters
+    ----------
+    unit : str or None
+        The unit a file, metadata.json or the caller states.
+    where : str
+        What states it, for the message (``record x.csv: channel 'DE' (the file)``).
+
+    Returns
+    -------
+    (str or None, float or None)
+
+    Raises
+    ------
+    ParameterError
+        A unit the table does not know (``furlongs``), listing the known ones.
+
+    Examples
+    --------
+    >>> unit_kind("mm/s")
+    ('velocity', 0.001)
+    >>> unit_kind("g (believed)")
+    ('acceleration', 9.80665)
+    """
+    text = str(unit or "").strip()
+    word = text.split()[0] if text else ""
+    if not word or word.lower() == UNKNOWN_UNIT:
+        return None, None
+    for kind, table in (("acceleration", ACCELERATION_UNITS), ("velocity", VELOCITY_UNITS),
+                        ("displacement", DISPLACEMENT_UNITS)):
+        found = table.get(word, table.get(word.lower()))
+        if found is not None:
+            return kind, float(found)
+    if word.lower() in {u.lower() for u in OTHER_UNITS}:
+        return "other", None
+    known = ", ".join(known_units())
+    raise ParameterError(f"{where} is in {text!r}, a unit cmsim does not know; known: {known} "
+                         f"(or \"{UNKNOWN_UNIT}\"): correct the unit where it is written",
+                         param="record", allowed=known)
+
 
 def checked_unit(unit, param="unit"):
-    """``unit`` (stripped) when the unit table knows it (:data:`ACCELERATION_UNITS`,
-    :data:`OTHER_UNITS`, any case), None when empty or None; anything else is refused,
-    listing the known units.
+    """``unit`` (stripped) when the unit table knows it (:func:`known_units`, any case),
+    None when empty or None; anything else is refused, listing the known units.
 
     Parameters
     ----------
@@ -316,7 +384,7 @@ def checked_unit(unit, param="unit"):
     if unit is None:
         return None
     text = str(unit).strip()
-    known = tuple(ACCELERATION_UNITS) + OTHER_UNITS
+    known = known_units()
     if text.lower() not in {k.lower() for k in known}:
         raise ParameterError(f"{param} {unit!r} is not a unit cmsim knows; allowed: "
                              f"{', '.join(known)}", param=param, allowed=", ".join(known))

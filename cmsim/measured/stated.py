@@ -14,8 +14,9 @@ from __future__ import annotations
 from cmsim.errors import ParameterError
 from cmsim.measured.schema import unit_scale_of
 
-__all__ = ["agreed", "agreed_unit", "HEADER_RATE_TOLERANCE", "SPEED_TOLERANCE",
-           "CALIBRATION_TOLERANCE"]
+__all__ = ["agreed", "agreed_unit", "speed_uncertainty", "HEADER_RATE_TOLERANCE",
+           "SPEED_TOLERANCE", "CALIBRATION_TOLERANCE", "MEASURED_SPEED_UNCERTAINTY",
+           "NOMINAL_SPEED_UNCERTAINTY"]
 
 #: Largest relative difference between two statements of a record's sample rate (file
 #: header, metadata.json, the caller) that still agree.
@@ -27,6 +28,15 @@ SPEED_TOLERANCE = 1e-2
 
 #: Largest relative difference between two statements of a calibration factor.
 CALIBRATION_TOLERANCE = 1e-6
+
+#: Relative uncertainty of a measured speed (a file's tachometer value, a metadata speed
+#: that is not a nominal one, a caller's): a stored mean differs from the actual speed by a
+#: few rpm (CWRU's "a few rpm", Smith & Randall 2015).
+MEASURED_SPEED_UNCERTAINTY = 0.005
+
+#: Relative uncertainty of a nominal speed (``shaft_speed_*_nominal``: a set-point or
+#: nameplate value): an induction motor's slip under load moves it by a few per cent.
+NOMINAL_SPEED_UNCERTAINTY = 0.03
 
 
 def agreed(path, quantity, statements, tolerance, unit=""):
@@ -75,6 +85,45 @@ def agreed(path, quantity, statements, tolerance, unit=""):
                 param=param if param != "record" else param0,
                 allowed=f"{quantity} = {float(v0):g}{unit}")
     return float(v0), what0
+
+
+def speed_uncertainty(entry, source):
+    """Relative uncertainty of a record's stated speed: :data:`NOMINAL_SPEED_UNCERTAINTY`
+    when the metadata states it as a nominal value (read from a ``*_nominal`` key, or equal
+    to the entry's nominal speed), else :data:`MEASURED_SPEED_UNCERTAINTY`.
+
+    Parameters
+    ----------
+    entry : dict
+        Readable keys of the recording entry.
+    source : str or None
+        Where the speed came from (``metadata.json "shaft_speed_rpm"``, ``the file``,
+        ``speed_rpm`` of the caller).
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> speed_uncertainty({"shaft_speed_rpm": 1500.0, "shaft_speed_rpm_nominal": 1500.0},
+    ...                   'metadata.json "shaft_speed_rpm"')
+    0.03
+    >>> speed_uncertainty({"shaft_speed_rpm": 1797.0}, 'metadata.json "shaft_speed_rpm"')
+    0.005
+    """
+    if source and source.startswith("metadata.json"):
+        if "_nominal" in source:
+            return NOMINAL_SPEED_UNCERTAINTY
+        nominal = [factor * float(entry[k]) for k, factor in
+                   (("shaft_speed_rpm_nominal", 1.0), ("shaft_speed_hz_nominal", 60.0))
+                   if entry.get(k) is not None]
+        stated = [factor * float(entry[k]) for k, factor in
+                  (("shaft_speed_rpm", 1.0), ("shaft_speed_hz", 60.0))
+                  if entry.get(k) is not None]
+        if nominal and stated and abs(stated[0] / nominal[0] - 1.0) < 1e-9:
+            return NOMINAL_SPEED_UNCERTAINTY
+    return MEASURED_SPEED_UNCERTAINTY
 
 
 def agreed_unit(path, channel, statements):

@@ -219,7 +219,7 @@ def _label(k, m, n, tpl):
 
 def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, max_sideband=3,
                 threshold_db=15.0, floor_bins=None, dynamic_range_db=80.0, min_freq=0.0,
-                max_peaks=None, templates=TEMPLATES):
+                max_peaks=None, templates=TEMPLATES, relative_tolerance=0.0):
     """Find the significant peaks of a spectrum and name them (see the module docstring).
 
     Parameters
@@ -243,6 +243,10 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
         Peak detection, see :func:`find_peaks`.
     templates : tuple of FamilyTemplate
         Lattices to try, in tie-break order.
+    relative_tolerance : float
+        Added to ``tolerance_hz`` in proportion to each candidate's frequency (>= 0): the
+        uncertainty of the speed every family scales with (a nominal speed's 3 % moves a
+        line at f by up to 0.03·f).
 
     Returns
     -------
@@ -260,6 +264,7 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     if max_harmonic is not None:
         max_harmonic = positive_int("max_harmonic", max_harmonic, lo=1, hi=1000)
     msb = positive_int("max_sideband", max_sideband, lo=0, hi=20)
+    rel = check_range("relative_tolerance", relative_tolerance, 0.0, 0.5)
     peaks = find_peaks(freq, amp, threshold_db=threshold_db, floor_bins=floor_bins,
                        dynamic_range_db=dynamic_range_db, min_freq=min_freq,
                        max_peaks=max_peaks)
@@ -273,7 +278,7 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     rows = []
     for f_pk, a_pk in zip(peaks["frequency_hz"], peaks["amplitude"]):
         err = np.abs(cf - f_pk)
-        hit = np.flatnonzero(err <= tol)
+        hit = np.flatnonzero(err <= tol + rel * cf)
         db_max = 20.0 * math.log10(a_pk / a_max) if a_pk > 0 else -math.inf
         if hit.size == 0:
             rows.append(("?", "unlabelled", 0, 0, 0, math.nan, math.nan, db_max))
@@ -301,7 +306,7 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     with np.errstate(divide="ignore"):
         out["db_re_max"] = 20.0 * np.log10(out["amplitude"].to_numpy() / a_max)
     out = out[_COLUMNS].reset_index(drop=True)
-    out.attrs = {"families": dict(fam), "tolerance_hz": tol}
+    out.attrs = {"families": dict(fam), "tolerance_hz": tol, "relative_tolerance": rel}
     return out
 
 

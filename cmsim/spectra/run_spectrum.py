@@ -95,8 +95,8 @@ class RunSpectrum:
         Unit of the signal.
     families : dict of str to float
         Base frequencies used for the labels, Hz.
-    bearing : str
-        Bearing whose frequencies were used.
+    bearing : str or None
+        Bearing whose frequencies were used (None: a record without geometry).
     peaks : pandas.DataFrame
         :func:`~cmsim.spectra.labels.label_peaks` rows below ``max_hz``, largest first;
         ``frequency_hz`` always in Hz (plus ``order`` for ``kind="order"``).
@@ -141,7 +141,7 @@ class RunSpectrum:
 
 def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
                  resolution_hz=None, bearing=None, max_peaks=20, threshold_db=15.0,
-                 max_sideband=3):
+                 max_sideband=3, relative_tolerance=None):
     """Spectrum of ``run[signal]`` with its peaks named k·GMF ± m·BPF ± n·fr.
 
     Parameters
@@ -170,10 +170,16 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         Least height of a peak above the noise floor, dB.
     max_sideband : int
         Largest |m|, |n| of a label (0-20).
+    relative_tolerance : float, optional
+        Relative tolerance of a label (:func:`~cmsim.spectra.labels.label_peaks`); default
+        the run's ``line_tolerance`` (a measured record's: its speed's uncertainty and the
+        bearings' slip), else 0 (a simulated run's lines stand where its speed puts them).
 
     Returns
     -------
     RunSpectrum
+        Of a measured record without geometry (no ``rig`` in its meta), the peaks are named
+        by the shaft rate alone (``bearing`` None).
     """
     if not isinstance(signal, str) or signal not in run.signals:
         raise ParameterError(f"signal must be one of the run's signals {run.names}, "
@@ -185,12 +191,18 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         raise ParameterError(f"band_hz applies to kind='envelope' only (kind={kind!r})")
     f_max = 0.5 * fs if max_hz is None else check_range("max_hz", max_hz, 0.0, 0.5 * fs,
                                                         lo_open=True, unit="Hz")
-    freqs, _ = run_families(run)
-    bearing_names = freqs.bearing_names
-    brg = signal_bearing(signal, bearing_names) if bearing is None else bearing
-    if brg not in bearing_names:
-        raise ParameterError(f"bearing must be one of {list(bearing_names)}, got {bearing!r}")
-    fam = freqs.families(brg)
+    if run.rig is None and run.operating_point is not None:   # no geometry: the shaft only
+        brg, fam = None, {"fr": run.operating_point.shaft_hz}
+    else:
+        freqs, _ = run_families(run)
+        bearing_names = freqs.bearing_names
+        brg = signal_bearing(signal, bearing_names) if bearing is None else bearing
+        if brg not in bearing_names:
+            raise ParameterError(f"bearing must be one of {list(bearing_names)}, got "
+                                 f"{bearing!r}")
+        fam = freqs.families(brg)
+    rel = (float(run.meta.get("line_tolerance") or 0.0) if relative_tolerance is None
+           else relative_tolerance)
     x = np.asarray(run[signal], dtype=float)
     res = None if resolution_hz is None else check_range("resolution_hz", resolution_hz, 0.0,
                                                          lo_open=True, unit="Hz")
@@ -233,7 +245,8 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         lab_fam = {k: v / fr for k, v in fam.items()}
         scale = fr
         extra["n_revolutions"] = int(osp.n_revolutions)
-    peaks = label_peaks(lab_f, a, lab_fam, threshold_db=threshold_db, max_sideband=max_sideband)
+    peaks = label_peaks(lab_f, a, lab_fam, threshold_db=threshold_db, max_sideband=max_sideband,
+                        relative_tolerance=rel)
     if kind == "order":
         peaks.insert(1, "order", peaks["frequency_hz"].to_numpy())
         peaks["frequency_hz"] = peaks["order"] * scale

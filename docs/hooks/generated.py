@@ -23,7 +23,7 @@ from mkdocs.structure.files import File
 #: their API page. ``cmsim`` holds the top-level modules (errors, run, frequencies, ...).
 #: A part missing here is listed after these, so a new one is never left out.
 UNITS = {
-    "cmsim": "Top level: errors, runs, frequencies, sensors, reports",
+    "cmsim": "Top level: errors, runs, frequencies, sensors",
     "cmsim.rig": "Rig parameters",
     "cmsim.bearings": "Bearings",
     "cmsim.mesh_stiffness": "Mesh stiffness",

@@ -250,3 +250,20 @@ def test_python_m_cmsim_is_the_command(tmp_path):
     done = python_m("export", "missing.npz", "--format", "npz", "--out", "x", "--json")
     assert done.returncode == 2
     assert json.loads(done.stdout)["option"] == "RUN|DATASET"
+
+
+def test_simulate_warns_when_the_mesh_lies_above_the_nyquist(capsys):
+    """Issue 48: at 100000 rpm the paper rig's mesh (46.7 kHz) lies above the default
+    75-kHz record's Nyquist frequency; the run is written with a warning naming the option
+    to raise (--fs-hz, or --sensor-fs-hz for the sensor record). None at 1000 rpm."""
+    argv = ["simulate", "--torque-nm", "50", "--duration-s", "0.02", "--warmup-s", "0.01",
+            "--json"]
+    assert main(argv + ["--speed-rpm", "100000"]) == 0
+    said = json.loads(capsys.readouterr().out)["warnings"]
+    assert any("GMF 46667 Hz" in w and "--fs-hz 75000" in w and "raise --fs-hz" in w
+               for w in said), said
+    assert main(argv + ["--speed-rpm", "30000", "--sensor-fs-hz", "25000"]) == 0
+    said = json.loads(capsys.readouterr().out)["warnings"]
+    assert any("GMF 14000 Hz" in w and "--sensor-fs-hz 25000" in w for w in said), said
+    assert main(argv + ["--speed-rpm", "1000"]) == 0
+    assert "warnings" not in json.loads(capsys.readouterr().out)

@@ -223,7 +223,9 @@ CATALOGUE = [
     R("spectrum-meta-not-json", "spectrum {bad_meta}", "RECORD"),
     R("spectrum-meta-bad-rig", "spectrum {bad_rig_meta}", "RECORD"),
     R("spectrum-table-file", "spectrum {tables}", "RECORD"),
-    R("spectrum-signal", "spectrum {run} --signal nosuch", "--signal"),
+    R("spectrum-signal", "spectrum {run} --channel nosuch", "--channel"),
+    R("spectrum-signal-and-channel", "spectrum {run} --channel a --signal b", "--signal",
+      "old name of --channel"),
     R("spectrum-bearing", "spectrum {run} --bearing 9z9", "--bearing"),
     R("spectrum-kind", "spectrum {run} --kind cepstrum", "--kind"),
     R("spectrum-band-reversed", "spectrum {run} --kind envelope --band-hz 500 100", "--band-hz"),
@@ -426,8 +428,8 @@ CATALOGUE = [
     # ---- issue 28: recordings in the formats labs produce, what options state for them
     R("compare-fs-option-disagrees", "compare {record} --fs-hz 48000", "--fs-hz",
       '"fs_hz" says sample rate 12000 Hz', "48000 Hz"),
-    R("compare-speed-option-disagrees", "compare {record} --speed-rpm 900", "--speed-rpm",
-      "1797 rpm", "900 rpm"),
+    # (--speed-rpm beside a documented speed is no longer bad input: it replaces it, with a
+    # warning; issue 48, tests/unit/measured/test_stated_values.py)
     R("compare-unit-option-disagrees", "compare {rec_unit_g} --unit V", "--unit", "'g'",
       "'V'"),
     R("calibrate-fs-option-disagrees", "calibrate {record} --fs-hz 48000 --out "
@@ -473,7 +475,7 @@ CATALOGUE = [
     R("spectrum-record-all-zero", "spectrum {rec_zero}", "RECORD", "constant"),
     R("spectrum-record-nan", "spectrum {rec_nan}", "RECORD", "non-finite"),
     R("spectrum-wav-header-rate", "spectrum {rec_wav_rate}", "RECORD", "48000 Hz"),
-    R("spectrum-measured-signal", "spectrum {record} --signal nosuch", "--signal", "DE"),
+    R("spectrum-measured-signal", "spectrum {record} --channel nosuch", "--channel", "DE"),
     R("evaluate-measured-record-nan", "evaluate {rec_nan_dir} --algorithm envelope",
       "rec.npz", "non-finite"),
     R("evaluate-measured-fs-text", "evaluate {rec_fs_text_dir} --algorithm envelope",
@@ -978,7 +980,7 @@ def test_every_option_is_validated():
     # export's RUN|DATASET is a file or a folder, its --channels are checked against the
     # source, --group-by against the manifest
     free_text = {"signal", "bearing", "fault", "algorithm", "scheduler", "record", "channel",
-                 "baseline", "source", "channels", "group_by", "unit"}
+                 "baseline", "source", "channels", "group_by", "unit", "signal_alias"}
     for command, sub in contract.subparsers(parser).items():
         for a in sub._actions:
             if isinstance(a, (argparse._HelpAction, argparse._StoreTrueAction)):
@@ -1147,8 +1149,8 @@ def test_evaluate_skips_a_damaged_record_and_counts_it(damage, files, tmp_path, 
 @pytest.mark.parametrize("damage", ["truncated", "deleted"])
 def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
     """A folder of measured recordings with one damaged: the others are scored (exit 0),
-    the damaged one is named in a warning and counted; sim-to-real, which scores a test
-    folder whole, refuses it naming the file."""
+    the damaged one is named in a warning and counted; sim-to-real's test windows leave it
+    out too, naming it (one record never stops a batch: issue 48)."""
     import shutil
 
     from cmsim.measured import data_root
@@ -1168,11 +1170,11 @@ def test_evaluate_skips_a_damaged_measured_recording(damage, tmp_path, capsys):
     m = res["metrics"]
     assert (m["n_records"], m["n_scored"], m["records_unreadable"]) == (6, 6, 1)
     assert list(res["unreadable"]) == ["OR_vload3_100lb"]
-    assert len(res["warnings"]) == 1 and "OR_vload3_100lb" in res["warnings"][0]
+    skipped = [w for w in res["warnings"] if "could not be read" in w]   # (IR_vload1_0lb's
+    assert len(skipped) == 1 and "OR_vload3_100lb" in skipped[0]         # lines warn too)
     from cmsim.diagnostics.syn2real import measured_windows
-    from cmsim.errors import ParameterError
-    with pytest.raises(ParameterError, match="OR_vload3_100lb"):
-        measured_windows(folder)
+    test = measured_windows(folder, max_windows=2)
+    assert list(test.skipped) == ["OR_vload3_100lb"] and len(set(test.groups)) == 6
 
 
 def test_calibrate_warns_when_its_baseline_departs_from_itself():

@@ -31,7 +31,7 @@ def cli_json(capsys, argv):
 
 
 def test_json_contract(capsys, run_file):
-    status, res = cli_json(capsys, ["spectrum", str(run_file), "--signal", "F_1b1_loa",
+    status, res = cli_json(capsys, ["spectrum", str(run_file), "--channel", "F_1b1_loa",
                                     "--max-hz", "3000", "--top", "6"])
     assert status == 0
     for key in ("signal", "kind", "resolution_hz", "families", "peaks", "unit", "bearing"):
@@ -68,13 +68,13 @@ def test_other_kinds_and_shaft_two(capsys, run_file):
     status, res = cli_json(capsys, ["spectrum", str(run_file), "--kind", "envelope",
                                     "--band-hz", "1000", "3000", "--top", "3"])
     assert status == 0 and res["band_hz"] == [1000.0, 3000.0]
-    status, res = cli_json(capsys, ["spectrum", str(run_file), "--signal", "F_2b1_oloa"])
+    status, res = cli_json(capsys, ["spectrum", str(run_file), "--channel", "F_2b1_oloa"])
     assert status == 0 and res["bearing"] == "2b1"
     assert res["families"]["fr"] == pytest.approx(1000 / 60)   # 28:28 gears
 
 
 @pytest.mark.parametrize("extra, words", [
-    (["--signal", "F_9b9_loa"], ["signal must be one of", "F_1b1_loa", "dte_um"]),
+    (["--channel", "F_9b9_loa"], ["--channel must be one of", "F_1b1_loa", "dte_um"]),
     (["--resolution-hz", "1"], ["record too short", "--resolution-hz=1", "75000 samples"]),
     (["--kind", "order", "--resolution-hz", "1"], ["record too short", "revolutions"]),
     (["--band-hz", "100", "200"], ["--band-hz", "envelope"]),
@@ -155,3 +155,34 @@ def test_order_spectrum_of_a_run_up_follows_its_tacho(capsys, tmp_path):
     out = capsys.readouterr().out
     assert "orders (angle from the tacho)" in out and "GMF 28.000" in out
     assert out.splitlines()[1].split()[0] == "order"
+
+
+def test_signal_is_the_deprecated_name_of_channel(capsys, run_file):
+    """--signal still works, as --channel, with a warning that it is deprecated (every
+    other command calls it --channel)."""
+    status, res = cli_json(capsys, ["spectrum", str(run_file), "--signal", "F_2b1_oloa"])
+    assert status == 0 and res["signal"] == "F_2b1_oloa"
+    assert any("--signal is deprecated" in w for w in res["warnings"]), res["warnings"]
+
+
+def test_a_relative_record_is_found_under_cmsim_data(capsys, run_file, monkeypatch):
+    """spectrum, like compare, looks a relative record up under $CMSIM_DATA."""
+    monkeypatch.setenv("CMSIM_DATA", str(run_file.parent))
+    monkeypatch.chdir(run_file.parent.parent)
+    status, res = cli_json(capsys, ["spectrum", run_file.name])
+    assert status == 0 and res["n_peaks"] > 0, res
+
+
+def test_labels_of_a_measured_record_allow_for_its_speed_and_slip(capsys):
+    """Issue 48: the BPFO comb of MFPT's outer-race record (80.1 and 160.1 Hz, 1 % under
+    its nominal-speed values) was "?" with a one-bin tolerance; it is labelled within the
+    stated speed's uncertainty and the bearing's slip (the record's line_tolerance)."""
+    from cmsim.measured import data_root
+    path = data_root() / "mfpt_bearing" / "OR_vload1_25lb.npz"
+    if not path.is_file():
+        pytest.skip("shared data absent")
+    status, res = cli_json(capsys, ["spectrum", str(path), "--kind", "envelope", "--top",
+                                    "3", "--max-hz", "400"])
+    assert status == 0
+    top = {round(p["frequency_hz"]): p["label"] for p in res["peaks"]}
+    assert top[80] in ("1BPF", "1BPFO") and top[160] in ("2BPF", "2BPFO"), top

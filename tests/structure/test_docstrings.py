@@ -94,7 +94,7 @@ UNDOCUMENTED = frozenset({
     "cmsim.mesh_stiffness.table.MeshStiffnessTable.load",
     "cmsim.mesh_stiffness.table_set.MeshTableSet.save",
     "cmsim.mesh_stiffness.table_set.MeshTableSet.load",
-    "cmsim.report.sweep_run_files",
+    "cmsim.datasets.report.sweep_run_files",
     "cmsim.run.Run.load",
     "cmsim.spectra.run_spectrum.signal_bearing",
     "cmsim.studies.model_abc.gmf_harmonics",

@@ -50,7 +50,6 @@ LAYERS = [
     ("studies", {"studies"}),
     ("diagnostics", {"diagnostics"}),
     ("discrepancy", {"discrepancy"}),
-    ("report", {"report", "plots"}),
     ("cli", {"cli", "__main__"}),
 ]
 LAYER_OF = {unit: i for i, (_, units) in enumerate(LAYERS) for unit in units}

@@ -325,5 +325,37 @@ def test_dataset_exported_as_parquet_is_the_windowed_layout(made, tmp_path):
     assert res["windows"]["rows"] == len(df) and res["windows"]["path"].startswith(
         str(tmp_path / "out"))
     assert df["group"].nunique() == 1 and df["split"].nunique() == 1   # one rig, one split
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["labels.csv",
-                                                                     "windows.parquet"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["windows.parquet"]
+
+
+def test_the_windowed_folder_loads_as_a_folder(made, tmp_path):
+    """Issue 48: a labels.csv inside the windowed folder broke every folder loader; the
+    folder holds Parquet alone and loads whole with pandas and pyarrow (and HuggingFace's
+    parquet loader, where installed), every window with its record's labels."""
+    import pyarrow.dataset as pds
+
+    export(made, tmp_path / "out", "parquet", window=256)
+    one = pd.read_parquet(tmp_path / "out" / "windows.parquet")
+    whole = pd.read_parquet(tmp_path / "out")
+    assert len(whole) == len(one) and list(whole["label"]) == list(one["label"])
+    assert pds.dataset(tmp_path / "out").to_table().num_rows == len(one)
+    labels = load(made).manifest.set_index("record_id")["fault_label"]
+    assert all(whole["label"] == labels.loc[whole["record_id"]].to_numpy())
+    hf = pytest.importorskip("datasets")
+    if not hasattr(hf, "load_dataset"):            # the repo's datasets/ folder, not the library
+        pytest.skip("HuggingFace datasets is not installed")
+    hds = hf.load_dataset("parquet", data_dir=str(tmp_path / "out"), split="train",
+                          cache_dir=str(tmp_path / "hf"))
+    assert hds.num_rows == len(one)
+
+
+def test_export_folders_have_the_permissions_of_mkdir(made, tmp_path):
+    """An export folder was created 0700 (mkdtemp's mode, kept through the rename): other
+    users of a shared machine could not read it. It gets 0777 less the umask, as mkdir."""
+    import os
+    mask = os.umask(0o022)
+    try:
+        export(made, tmp_path / "out", "npz")
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "out").stat().st_mode & 0o777 == 0o755

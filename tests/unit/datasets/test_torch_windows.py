@@ -1,7 +1,9 @@
 """The PyTorch dataset over a generated dataset (issue 28) yields the windows of to_arrays.
 
-Test tier: behaviour contract (no physics, trains nothing). Skipped without torch. The
-dataset has 3 records of 0.02 s.
+Test tier: behaviour contract (no physics, trains nothing). Every test but the one of the
+missing extra needs torch (CI installs it: .ci/run): a test that skipped where torch was
+absent let a planted swap of window and hop through (issue 48). The dataset has 3 records
+of 0.02 s.
 """
 
 import numpy as np
@@ -65,6 +67,7 @@ def test_shuffled_items_are_the_same_windows(made):
 def test_label_indices_do_not_depend_on_the_chosen_records(made):
     """A train and a test loader over parts of one dataset number the labels alike: classes
     come from the whole dataset (or are given)."""
+    pytest.importorskip("torch")
     ds = load(made)
     labels = dict(zip(ds.manifest["record_id"], ds.manifest["fault_label"]))
     assert len(set(labels.values())) == 2
@@ -78,3 +81,28 @@ def test_label_indices_do_not_depend_on_the_chosen_records(made):
     with pytest.raises(ParameterError, match="classes") as err:
         WindowDataset(ds, window=256, classes=["ball"])
     assert err.value.param == "classes"
+
+
+def test_window_and_hop_are_not_swapped(made):
+    """Windows of 128 samples every 32 (hop a quarter of the window): item k starts 32·k
+    samples into its record and is 128 long, as to_arrays cuts it (the class of a planted
+    bug: window and hop swapped)."""
+    pytest.importorskip("torch")
+    ds = load(made)
+    X, _, _ = ds.to_arrays(["accel_1b1_y"], window=128, hop=32)
+    wins = WindowDataset(ds, ["accel_1b1_y"], window=128, hop=32)
+    assert (wins.window, wins.hop) == (128, 32) and len(wins) == len(X)
+    first = ds.record(0).signals["accel_1b1_y"]
+    for k in (0, 1, 3):
+        np.testing.assert_array_equal(wins[k][0].numpy()[0], first[32 * k:32 * k + 128])
+    np.testing.assert_array_equal(wins.index[:4, 1], [0, 32, 64, 96])
+
+
+def test_without_torch_the_constructor_names_the_extra(made, monkeypatch):
+    """Without torch, making the dataset fails at once, naming the extra (it failed at the
+    first item with a bare ModuleNotFoundError)."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "torch", None)          # import torch -> ImportError
+    with pytest.raises(ModuleNotFoundError, match=r"pip install cmsim\[torch\]"):
+        WindowDataset(load(made), window=128)

@@ -189,3 +189,27 @@ def test_one_shared_record_is_already_leakage(train, test, shared):
     rest = [g for g in test if g != shared]
     if rest:
         check_disjoint(_windows_of(train), _windows_of(rest))
+
+
+@needs_cwru
+def test_a_refused_test_record_is_skipped_and_counted(cwru_small, tmp_path, capsys):
+    """Issue 48: one test record whose metadata its own lines refuse (the outer-race record
+    labelled 48 kHz) no longer stops the sim-to-real benchmark: it is left out, counted in
+    a warning and named in the result; --trust-metadata reads it as stated."""
+    import shutil
+
+    folder = tmp_path / "cwru"
+    shutil.copytree(CWRU, folder)
+    meta = json.loads((folder / "metadata.json").read_text())
+    next(r for r in meta["recordings"] if r["file"] == "OR007_at6_0.npz")["fs_hz"] = 48000.0
+    (folder / "metadata.json").write_text(json.dumps(meta))
+    argv = ["evaluate", "--train", str(cwru_small), "--test", str(folder), "--classifier",
+            "envelope", "--max-test-windows", "2", "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out["skipped_test_records"]) == ["OR007_at6_0"]
+    assert "would fit" in out["skipped_test_records"]["OR007_at6_0"]
+    assert out["n_test_records"] == 6
+    assert any("1 of 7 records could not be read" in w for w in out["warnings"]), out
+    assert main(argv + ["--trust-metadata"]) == 2        # read: its rate is not the others'
+    assert "different sample rates" in json.loads(capsys.readouterr().out)["error"]

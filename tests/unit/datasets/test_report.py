@@ -14,7 +14,7 @@ import pytest
 from cmsim.cli import main
 from cmsim.datasets import PARQUET_NAME, RECORDS_DIR, DatasetSpec, generate_dataset
 from cmsim.errors import ParameterError
-from cmsim.report import build_report
+from cmsim.datasets.report import build_report
 
 TINY = DatasetSpec([("speed_rpm", [1000.0]), ("torque_nm", [10.0, 100.0])], duration_s=0.05,
                    seed=7)

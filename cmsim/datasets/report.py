@@ -41,13 +41,12 @@ from pathlib import Path
 import numpy as np
 
 from cmsim._io import atomic_write_bytes, atomic_write_text
-from cmsim.datasets import RECORDS_DIR, read_rows
-from cmsim.datasets.manifest import read_spec
+from cmsim.datasets.manifest import RECORDS_DIR, read_rows, read_spec
 from cmsim.errors import ParameterError, check_range
 from cmsim.features import N_GMF_HARMONICS, gmf_levels
 from cmsim.frequencies import rig_frequencies
+from cmsim.datasets.sweep_plots import plot_orbit_family, plot_trace_family
 from cmsim.losses.plots import run_loss_rows, run_losses_figure
-from cmsim.plots import plot_orbit_family, plot_trace_family
 from cmsim.run import Run
 from cmsim.spectra._checks import positive_int
 from cmsim.spectra.amplitude import amplitude_spectrum

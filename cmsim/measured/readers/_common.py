@@ -1,0 +1,125 @@
+"""What every format's reader shares: :class:`SignalFile`, 1-D channels, a sample rate
+from a step or a time base, an optional library named by its extra."""
+
+from __future__ import annotations
+
+import importlib
+import math
+import re
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+
+from cmsim.errors import ParameterError
+
+__all__ = ["SignalFile", "channel_1d", "optional_module", "rate_of_step", "time_rate",
+           "one_rate", "TIME_NAME", "TIME_STEP_TOLERANCE"]
+
+
+class SignalFile(NamedTuple):
+    """What one signal file holds and states.
+
+    Attributes
+    ----------
+    signals : dict of str to numpy.ndarray
+        Channel name → float64 samples, shape (n,) each, in the file's physical unit.
+    rate_hz : float or None
+        Sample rate the file states, Hz.
+    units : dict of str to str
+        Channel → unit the file states (channels it is silent on are absent).
+    speed_rpm : float or None
+        Shaft speed the file states, rpm (a CWRU ``XnnnRPM``).
+    calibration : float or None
+        Factor the reader applied to the stored samples (a WAV's stated calibration).
+    rate_from : str
+        Where the rate is stated, for messages (``"the WAV header"``).
+    """
+
+    signals: dict
+    rate_hz: float | None = None
+    units: dict = {}
+    speed_rpm: float | None = None
+    calibration: float | None = None
+    rate_from: str = "the file header"
+
+
+def channel_1d(path, name, a):
+    """A stored array as a 1-D channel: (n,), (n, 1) and (1, n) are one channel; any other
+    shape is refused (a silently dropped channel would let another one be compared)."""
+    a = np.asarray(a)
+    if a.ndim == 2 and 1 in a.shape:
+        a = a.reshape(-1)
+    if a.ndim != 1:
+        raise ParameterError(f"record {path}: channel {name!r} has shape {a.shape}; store "
+                             f"one 1-D array per channel (e.g. {name}_0, {name}_1, ... for "
+                             f"the columns)", param="record", allowed="1-D arrays")
+    return np.asarray(a, dtype=float)
+
+
+def optional_module(module, extra, path):
+    """``import module``, or one line naming the extra that installs it."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise ParameterError(f"record {path}: reading and writing {Path(path).suffix} files "
+                             f"needs {module}, an optional dependency: pip install "
+                             f"cmsim[{extra}]", param="record",
+                             allowed=f"{module} installed (cmsim[{extra}])") from None
+
+
+def rate_of_step(step, digits=None):
+    """The sample rate of a sample spacing ``step`` (s); with ``digits``, the spacing was
+    printed with that many significant digits, and the rate is the one with the fewest
+    digits whose spacing prints the same (1.95313e-05 s → 51200 Hz, not 51199.87)."""
+    rate = 1.0 / float(step)
+    if digits is None:
+        return rate
+    ulp = 10.0 ** (math.floor(math.log10(abs(step))) - digits + 1)
+    for k in range(1, 16):
+        r = float(f"{rate:.{k}g}")
+        if abs(1.0 / r - step) <= 0.5000001 * ulp:
+            return r
+    return rate
+
+
+#: A CSV time column's name (``t``, ``time``, ``time_s``, ``Time (s)``, ``time [ms]``, any
+#: case) → group 1 the unit (``s`` when none is written).
+TIME_NAME = re.compile(r"^(?:t|time)(?:_(s|ms)|\s*\[\s*(s|ms)\s*\]|\s*\(\s*(s|ms)\s*\))?$",
+                       re.IGNORECASE)
+
+#: Largest relative departure of one time step of a CSV from the mean step that still
+#: counts as evenly spaced (time stamps printed to 2 significant digits of the step).
+TIME_STEP_TOLERANCE = 0.1
+
+
+def time_rate(path, name, t, unit="s"):
+    """The sample rate of a time column or vector ``t`` (unit ``s`` or ``ms``; a CSV's time
+    column, a ``.mat`` file's ``t``), checked for even steps: a gap or a jump back is
+    refused, naming where."""
+    t = np.asarray(t, dtype=float) * (1e-3 if unit.lower() == "ms" else 1.0)
+    steps = np.diff(t)
+    step = (t[-1] - t[0]) / (t.size - 1)
+    bad = np.flatnonzero(~(np.abs(steps - step) <= TIME_STEP_TOLERANCE * abs(step)))
+    if step <= 0 or not np.isfinite(step) or bad.size:
+        i = int(bad[0]) if bad.size else 0
+        raise ParameterError(
+            f"record {path}: time {name!r} is not evenly spaced (step {i} from "
+            f"{t[i]:.9g} s to {t[i + 1]:.9g} s, the mean step is {step:.6g} s); cmsim reads "
+            f"evenly sampled records: export without gaps, or cut the record at the gap",
+            param="record", allowed="evenly spaced time stamps")
+    return rate_of_step(step, digits=12)
+
+
+def one_rate(path, rates, tolerance=0.0):
+    """The one sample rate of a file's channels (or of its rate statements: a ``.mat``
+    file's ``fs`` and time vector), refused when two differ by more than ``tolerance``
+    (relative)."""
+    values = sorted(set(rates.values()))
+    if values and values[-1] - values[0] > tolerance * values[0]:
+        raise ParameterError(f"record {path}: states different sample rates ("
+                             + ", ".join(f"{k} {v:g} Hz" for k, v in rates.items())
+                             + "); export the channels of one rate to one file, or "
+                               "correct the one that is wrong",
+                             param="record", allowed="one sample rate per file")
+    return values[0] if values else None

@@ -1,0 +1,48 @@
+"""The HTML reports a user reads (issue 48): no raw JSON, no "None" in a table, titles that
+fit their figure, axis units without the metadata's remarks.
+
+Test tier: behaviour (no physics judged). One comparison with a report, read as text.
+"""
+
+import json
+import re
+
+import numpy as np
+
+from cmsim.cli import main
+from cmsim.discrepancy.report import _in_words
+from cmsim.discrepancy.synthetic import hidden_effect_record
+from cmsim.machine.report import _unit_symbol
+
+
+def test_values_read_as_words():
+    assert _in_words({"size_m": 0.000312345, "bearing": "1b1", "x": None}) == \
+        "size_m 0.0003123, bearing 1b1, x —"
+    assert _in_words({"speed_rpm": {"value": 1797.0, "how": "comb"}}, "(", ")") == \
+        "(speed_rpm (value 1797, how comb))"
+    assert _in_words({}) == "" and _in_words(None, "(", ")") == ""
+
+
+def test_an_axis_unit_drops_the_metadatas_remark():
+    assert _unit_symbol("g (believed)") == "g" and _unit_symbol("m/s^2") == "m/s^2"
+    assert _unit_symbol(None) == "unit" and _unit_symbol("unknown") == "unit"
+
+
+def test_the_compare_report_shows_no_json_and_no_none(tmp_path, capsys):
+    h = hidden_effect_record("bearing_outer_race", 1003)
+    folder = tmp_path / "rec"
+    folder.mkdir()
+    np.savez(folder / "r.npz", DE=np.asarray(h.record.run["DE"], np.float32))
+    geometry = {"gears": None, "bearings": {"de": {
+        "n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04}}}
+    (folder / "metadata.json").write_text(json.dumps({
+        "fs_hz": 12000.0, "sensors": {"DE": {"near": "de", "unit": "g (believed)"}},
+        "geometry": geometry,
+        "recordings": [{"file": "r.npz", "shaft_speed_rpm": h.record.op.speed_rpm}]}))
+    assert main(["compare", str(folder / "r.npz"), "--budget", "12", "--report",
+                 str(tmp_path / "rep"), "--json"]) == 0
+    capsys.readouterr()
+    page = (tmp_path / "rep" / "compare.html").read_text()
+    text = re.sub(r'src="data:[^"]*"', "", page)
+    assert not re.search(r'\{&quot;|\{"', text), "raw JSON in the report"
+    assert ">None<" not in text and "(None)" not in text
