@@ -122,7 +122,7 @@ def _simulated_channels(channels, machine=None):
     return sorted(out)
 
 
-def simulate_record(spec, index):
+def simulate_record(spec, index, plan=None):
     """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
     docstring). Raises what :func:`cmsim.dynamics.simulate` raises (e.g.
     :class:`~cmsim.errors.IntegrationDiverged`).
@@ -133,6 +133,8 @@ def simulate_record(spec, index):
         The spec.
     index : int
         Record number.
+    plan : RecordPlan, optional
+        The record's plan, when the caller has drawn it (:meth:`DatasetSpec.record`).
 
     Returns
     -------
@@ -141,7 +143,7 @@ def simulate_record(spec, index):
     meta : dict
         JSON-ready meta of the record.
     """
-    plan = spec.record(index)
+    plan = spec.record(index) if plan is None else plan
     rig = spec.record_rig(plan)
     op = spec.record_operating_point(plan)
     profile = None
@@ -248,7 +250,7 @@ def run_record(spec, index, out_dir):
     row["pid"] = os.getpid()
     path = out / row["path"]
     try:
-        arrays, meta = simulate_record(spec, index)
+        arrays, meta = simulate_record(spec, index, plan)
     except Exception as exc:               # noqa: BLE001 - a failed record, the rest go on
         row.update(status="failed", error=" ".join(f"{type(exc).__name__}: {exc}".split()),
                    wall_s=time.perf_counter() - start)

@@ -38,7 +38,7 @@ import numpy as np
 
 from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, SPEC_NAME, consolidate,
-                                     done_indices, open_directory)
+                                     done_indices, open_directory, read_rows)
 from cmsim.datasets.pool import check_start_method, check_workers, run_tasks, scheduler_client
 from cmsim.datasets.records import run_record
 from cmsim.datasets.spec import DatasetSpec
@@ -246,7 +246,9 @@ def _generate(spec, out, start, *, workers, client, progress, method, verify, fo
         (out / sub).mkdir(exist_ok=True)
     _remove_temporary(out)
     kept = open_directory(spec, out, force)
-    done, adopted = done_indices(spec, out, verify)
+    # the manifest is read once: for what is done, then to fold this run's rows into
+    known = read_rows(out)
+    done, adopted = done_indices(spec, out, verify, known)
     adopted += kept
     t_resume = time.perf_counter() - start
     pending = [i for i in range(spec.n_records) if i not in done]
@@ -271,7 +273,7 @@ def _generate(spec, out, start, *, workers, client, progress, method, verify, fo
                                   postfix=lambda k, r: f"{k} {r['status']}")
     finally:
         t_c = time.perf_counter()
-        consolidate(out)
+        consolidate(out, known)
         _remove_temporary(out)             # a worker killed mid-write (Dask retries it)
         t_consolidate = time.perf_counter() - t_c
     timing = {k: 0.0 for k in (*_TIMING_KEYS, "busy")}

@@ -185,11 +185,11 @@ def test_failed_record_is_marked_and_the_rest_go_on(tmp_path, monkeypatch):
     import cmsim.datasets.records as gen
     real = gen.simulate_record
 
-    def flaky(spec, index):
+    def flaky(spec, index, plan=None):
         if index == 2:
             from cmsim.errors import IntegrationDiverged
             raise IntegrationDiverged("integration diverged at t = 0.01 s (test)")
-        return real(spec, index)
+        return real(spec, index, plan)
 
     monkeypatch.setattr(gen, "simulate_record", flaky)      # forked workers inherit it
     s = generate_dataset(DatasetSpec.from_dict(SMALL), tmp_path / "f", workers=2,
