@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import sys
@@ -56,6 +57,21 @@ PROFILE_STEP_S = 1e-4
 MAX_ROTATION_DEVIATION_RAD = 0.5
 
 
+def max_displacement_m(model):
+    """The largest displacement of a translational DOF a run of ``model`` may reach before it
+    counts as diverged, m (100 × the largest bearing clearance, at least 1 mm)."""
+    return max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
+
+
+def diverged_at(t, max_disp, substeps):
+    """The :class:`IntegrationDiverged` of a run that diverged at time ``t`` (s)."""
+    return IntegrationDiverged(
+        f"the integration diverged at t = {t:.6g} s (a displacement exceeded {max_disp:g} m, "
+        f"a rotation deviation {MAX_ROTATION_DEVIATION_RAD:g} rad, or a value became "
+        f"non-finite); use a smaller step (substeps > {substeps} or a higher fs_hz) or check "
+        f"the rig parameters")
+
+
 class _Integrator:
     """The fixed-step kernel run in chunks with one scratch state (bit-identical to one call).
 
@@ -77,7 +93,7 @@ class _Integrator:
         self.params = model.kernel_params if self.split is None else self.split.kernel_params
         self.progress = progress
         self.wall = 0.0
-        self.max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
+        self.max_disp = max_displacement_m(model)
         self.mask = model.translational_mask
 
     def chunks(self, y0, t0, h, n_out, substeps, chunk_steps=CHUNK_STEPS):
@@ -108,12 +124,7 @@ class _Integrator:
                                    self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
             self.wall += time.perf_counter() - start
             if status >= 0:
-                raise IntegrationDiverged(
-                    f"the integration diverged at t = {t0 + (first + status) * substeps * h:.6g}"
-                    f" s (a displacement exceeded {self.max_disp:g} m, a rotation deviation "
-                    f"{MAX_ROTATION_DEVIATION_RAD:g} rad, or a value became non-finite); use a "
-                    f"smaller step (substeps > {substeps} or a higher fs_hz) or check the rig "
-                    f"parameters")
+                raise diverged_at(t0 + (first + status) * substeps * h, self.max_disp, substeps)
             skip = 1 if m0 else 0
             yield m0, states[skip:], diag[skip:]
             y = states[-1].copy()
@@ -466,10 +477,16 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
                         cage_phases_rad=cage_phases_rad, profile=profile, faults=faults,
                         loads=loads, friction_table=friction_table,
                         damping_table=damping_table, losses=losses, record=record)
-    stats = {}
     if on_start is not None:
         on_start(setup.warmup_s + setup.duration_s)
     compile_s = compile_kernels()       # after on_start: a front end announces the compile
+    return integrate_prepared(setup, progress, compile_s)
+
+
+def integrate_prepared(setup, progress=None, compile_s=0.0):
+    """Integrate a :class:`RunSetup` alone and return its :class:`~cmsim.run.Run`
+    (:func:`simulate`'s time loop; ``progress`` as there, ``compile_s`` for the meta)."""
+    stats = {}
     try:
         states, diag, wall, n_warm, aa = _integrate_run(
             setup.model, setup.y0, setup.dt, setup.warmup_s, setup.fs_hz, setup.n_rec,
@@ -697,6 +714,15 @@ def finish_run(setup, states, diag, wall, n_warm, aa, stats, compile_s=0.0):
     return run
 
 
+@functools.lru_cache(maxsize=16)
+def decimation(substeps, fs_hz, warmup_s):
+    """``(anti-alias filter, warm-up samples)`` of a run recorded at ``fs_hz`` (Hz) after
+    ``warmup_s`` (s) and integrated at ``substeps`` > 1 steps per sample: the centred filter
+    needs half its length of integration before the first sample (designed once per rate)."""
+    aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
+    return aa, max(int(round(warmup_s * fs_hz)), math.ceil(aa.half_length / substeps))
+
+
 def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress,
                    q_cols, d_cols, split=None):
     """The run's integration: ``(states, diag, wall_s, n_warm, anti_alias)`` of the recorded
@@ -708,9 +734,7 @@ def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stat
         states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
                                        report, split)
         return states[n_warm:, :model.n_dof], diag[n_warm:], wall, n_warm, None
-    aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
-    # the centred filter needs half its length of integration before the first sample
-    n_warm = max(int(round(warmup_s * fs_hz)), math.ceil(aa.half_length / substeps))
+    aa, n_warm = decimation(substeps, fs_hz, warmup_s)
     report = None if progress is None else (lambda done, total: progress(
         done * dt / substeps, total * dt / substeps))
     states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme, stats,

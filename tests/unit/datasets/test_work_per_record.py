@@ -42,9 +42,13 @@ def test_each_record_is_drawn_once(tmp_path, monkeypatch):
     for sub in (RECORDS_DIR, ROWS_DIR):
         (tmp_path / sub).mkdir()
     calls = _counting(monkeypatch, DatasetSpec, "record")
-    row = run_record(spec, 1, tmp_path)          # the task a worker runs
+    row = run_record(spec, 1, tmp_path)          # a worker's task of one record
     assert row["status"] == "ok"
     assert len(calls) == 1
+    # a dataset run draws the plans in the parent, once, and hands them to the workers
+    calls.clear()
+    s = generate_dataset(spec, tmp_path / "d", workers=1, start_method="fork")
+    assert s.records_written == 3 and len(calls) == 3
 
 
 def test_a_resume_reads_the_manifest_once(tmp_path, monkeypatch):
