@@ -34,7 +34,7 @@ from cmsim._io import atomic_savez
 from cmsim.datasets.manifest import RECORDS_DIR, file_sha256, json_default, write_row
 from cmsim.datasets.spec import mesh_key
 from cmsim.dynamics.batch import simulate_batch
-from cmsim.dynamics.simulation import prepare_run
+from cmsim.dynamics.simulation import integrate_prepared, prepare_run
 from cmsim.dynamics.profiles import SpeedProfile
 from cmsim.faults import fault_frequencies
 from cmsim.features import N_GMF_HARMONICS, run_features
@@ -42,7 +42,9 @@ from cmsim.frequencies import rig_frequencies
 from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
-__all__ = ["simulate_record", "simulate_records", "run_record", "run_records", "base_row", "manifest_features", "FEATURE_SIGNALS",
+__all__ = ["simulate_record", "simulate_records", "run_record", "run_records",
+           "default_batch_size", "BATCH_SIZE", "BATCH_FROM_RECORDS", "base_row",
+           "manifest_features", "FEATURE_SIGNALS",
            "FORMAT"]
 
 #: Signals of a full-run record whose features go into its manifest row (those it has).
@@ -181,11 +183,43 @@ def _record_arrays(spec, plan, rig, op, profile, run, setup_s):
     return {c: np.asarray(run[c], dtype=np.float32) for c in channels}, meta
 
 
-def simulate_records(spec, plans):
-    """Simulate records of ``spec`` together (:func:`cmsim.dynamics.batch.simulate_batch`:
-    those of one kernel layout in one time loop); per record, in order, ``(arrays, meta)``
-    (:func:`simulate_record`) or the exception it raised. A record's arrays do not depend on
-    the records it is simulated with.
+#: Most records a worker integrates together (:func:`cmsim.dynamics.batch.simulate_batch`):
+#: numba's vector body over the records is 8 lanes (AVX-512) unrolled four times, so 32 fill
+#: it; more only adds memory (about 7 MB per record at 25.6 kHz for 1 s).
+BATCH_SIZE = 32
+
+#: Specs of fewer records run each record alone on the single-run kernel (a batch of one):
+#: a batch pays for its loops over the records from about 16 on (``benchmarks/bench_batch.py``).
+BATCH_FROM_RECORDS = 64
+
+
+def default_batch_size(spec):
+    """Records a dataset of ``spec`` integrates together by default: :data:`BATCH_SIZE`, or 1
+    (each alone, the single-run kernel) for a spec of fewer than :data:`BATCH_FROM_RECORDS`
+    records.
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+
+    Returns
+    -------
+    int
+    """
+    return BATCH_SIZE if spec.n_records >= BATCH_FROM_RECORDS else 1
+
+
+def simulate_records(spec, plans, batch_size=None):
+    """Simulate records of ``spec`` together; per record, in order, ``(arrays, meta)``
+    (:func:`simulate_record`) or the exception it raised.
+
+    With ``batch_size`` 1 each record runs alone on the single-run kernel
+    (:func:`cmsim.dynamics.simulation.integrate_prepared`, the reference); otherwise those of
+    one kernel layout share one time loop (:func:`cmsim.dynamics.batch.simulate_batch`). A
+    record's arrays do not depend on the records it is simulated with: bit for bit the same
+    in any batch (of any size above 1), and within 1e-9 of each signal's range of the
+    single-run kernel's.
 
     Parameters
     ----------
@@ -193,11 +227,14 @@ def simulate_records(spec, plans):
         The spec.
     plans : sequence of RecordPlan
         Its records (:meth:`DatasetSpec.record`).
+    batch_size : int, optional
+        1: each record alone; larger: together (default :func:`default_batch_size`).
 
     Returns
     -------
     list of tuple or Exception
     """
+    batch_size = default_batch_size(spec) if batch_size is None else batch_size
     out = [None] * len(plans)
     setups, todo = [], []
     for i, plan in enumerate(plans):
@@ -210,7 +247,7 @@ def simulate_records(spec, plans):
         setups.append(setup)
         todo.append((i, plan, rig, op, profile, time.perf_counter() - t0))
     t0 = time.perf_counter()
-    runs = simulate_batch(setups)
+    runs = simulate_batch(setups) if batch_size > 1 else [_alone(s) for s in setups]
     # what the batch spent besides integrating (filters, signals), shared out
     around = (time.perf_counter() - t0
               - sum(r.meta["wall_s"] for r in runs if not isinstance(r, Exception)))
@@ -226,10 +263,18 @@ def simulate_records(spec, plans):
     return out
 
 
+def _alone(setup):
+    """A record's run on the single-run kernel, or the exception it raised."""
+    try:
+        return integrate_prepared(setup)
+    except Exception as exc:               # noqa: BLE001 - a failed record, the rest go on
+        return exc
+
+
 def simulate_record(spec, index, plan=None):
     """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
-    docstring), bit for bit as a dataset run makes it (a batch of one,
-    :func:`simulate_records`). Raises what :func:`cmsim.dynamics.simulate` raises (e.g.
+    docstring), bit for bit as a dataset run of ``spec`` makes it by default
+    (:func:`simulate_records` with :func:`default_batch_size`). Raises what :func:`cmsim.dynamics.simulate` raises (e.g.
     :class:`~cmsim.errors.IntegrationDiverged`).
 
     Parameters
@@ -286,7 +331,7 @@ def manifest_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS,
     return out
 
 
-def run_records(spec, indices, out_dir, plans=None):
+def run_records(spec, indices, out_dir, plans=None, batch_size=None):
     """Worker task: simulate records ``indices`` of ``spec`` together
     (:func:`simulate_records`), write each one's file then its sidecar row; return the rows
     in order (status ``"ok"``, or ``"failed"`` with the error: a failed record does not stop
@@ -306,6 +351,8 @@ def run_records(spec, indices, out_dir, plans=None):
         The dataset directory.
     plans : sequence of RecordPlan, optional
         The records' plans, when the caller has drawn them (:meth:`DatasetSpec.record`).
+    batch_size : int, optional
+        As :func:`simulate_records`.
 
     Returns
     -------
@@ -320,7 +367,7 @@ def run_records(spec, indices, out_dir, plans=None):
         row["record_key"] = spec.record_key(plan)
         row["pid"] = os.getpid()
         rows.append(row)
-    results = simulate_records(spec, plans)
+    results = simulate_records(spec, plans, batch_size)
     spent = (time.perf_counter() - start) / max(len(plans), 1)
     with ThreadPoolExecutor(max_workers=min(len(rows), 16) or 1) as pool:
         done = list(pool.map(lambda rr: _write_record(spec, out, *rr, spent),

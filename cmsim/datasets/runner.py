@@ -41,7 +41,7 @@ from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, SPEC_NAME, consolidate,
                                      done_indices, open_directory, read_rows)
 from cmsim.datasets.pool import check_start_method, check_workers, run_tasks, scheduler_client
-from cmsim.datasets.records import run_records
+from cmsim.datasets.records import default_batch_size, run_records
 from cmsim.datasets.spec import DatasetSpec
 from cmsim.dynamics.batch import kernel_layout, simulate_batch
 from cmsim.dynamics.simulation import prepare_run
@@ -117,12 +117,6 @@ class DatasetSummary:
                 "failed": [{"record_id": r, "error": e} for r, e in self.failed]}
 
 
-#: Most records a worker integrates together (:func:`cmsim.dynamics.batch.simulate_batch`):
-#: numba's vector body over the records is 8 lanes (AVX-512) unrolled four times, so 32
-#: fill it; more only adds memory (about 10 MB per record at 25.6 kHz for 1 s).
-BATCH_SIZE = 32
-
-
 def _batch_key(plan):
     """What records of one batch share, read from the plan: the kinds of their faults (and
     the bearing a bearing fault sits in) and whether it is a run-up — what sets the kernels'
@@ -133,12 +127,12 @@ def _batch_key(plan):
 
 def _batches(plans, workers, batch_size, batchable):
     """The pending records' plans in batches: records of one :func:`_batch_key` together, in
-    index order, at most ``batch_size`` (default :data:`BATCH_SIZE`, and no more than spreads
-    the records over ``workers`` when known); one by one for a key the batch kernel does not
-    take (``batchable[key]`` False: nothing to share, and an interruption then loses no
-    finished run)."""
-    size = batch_size or BATCH_SIZE
-    if batch_size is None and workers:
+    index order, at most ``batch_size``, in parts of even size (no more than spreads the
+    records over ``workers`` when known); one by one for ``batch_size`` 1 and for a key the
+    batch kernel does not take (``batchable[key]`` False: nothing to share, and an
+    interruption then loses no finished run)."""
+    size = batch_size
+    if workers:
         size = max(1, min(size, -(-len(plans) // int(workers))))
     groups = {}
     for plan in plans:
@@ -146,6 +140,7 @@ def _batches(plans, workers, batch_size, batchable):
     out = []
     for key, group in groups.items():
         step = size if batchable.get(key, False) else 1
+        step = -(-len(group) // -(-len(group) // step))        # even parts
         out += [group[j:j + step] for j in range(0, len(group), step)]
     return sorted(out, key=lambda part: part[0].index)
 
@@ -212,8 +207,11 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
         records are kept).
     batch_size : int, optional
         Most records a worker integrates together in one time loop (default
-        :data:`BATCH_SIZE`, fewer when that spreads the records over the workers; 1: each
-        alone). A record's arrays do not depend on it.
+        :func:`~cmsim.datasets.records.default_batch_size`; fewer when that spreads the
+        records over the workers). 1: each record alone on the single-run kernel (the
+        reference). A record's arrays are bit for bit the same for every batch size above 1,
+        on any number of workers, resumed or not, and within 1e-9 of each signal's range of
+        the single-run kernel's.
 
     Returns
     -------
@@ -324,9 +322,10 @@ def _generate(spec, out, start, *, workers, client, progress, method, verify, fo
                 t_warm = time.perf_counter() - t_w
             batchable = {k: s is not None and kernel_layout(s) is not None
                          for k, s in first.items()}
-            tasks = [(part[0].record_id, (spec, [p.index for p in part], str(out), part))
-                     for part in _batches(plans, workers if client is None else None,
-                                          batch_size, batchable)]
+            size = default_batch_size(spec) if batch_size is None else batch_size
+            tasks = [(part[0].record_id, (spec, [p.index for p in part], str(out), part, size))
+                     for part in _batches(plans, workers if client is None else None, size,
+                                          batchable)]
             n_workers = run_tasks(run_records, tasks, record_all, workers=workers,
                                   start_method=method, scheduler=client,
                                   progress=progress, desc=spec.name, unit="rec",

@@ -289,31 +289,22 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
     mesh_on = S.m_int[0, MI_ON] != 0
     faulty = S.b_def.shape[1] > 0 or S.m_int[0, MI_FAULTY_BALLS] != 0
     if mesh_on or faulty:
-        # the runs' own contacts, each on contiguous copies of its state and forces (the
-        # single-run kernels, the same arithmetic in the same order)
-        y1, g1, d1 = B.y1, B.g1, B.d1
+        # the runs' own contacts through the single-run kernels (the same arithmetic in the
+        # same order), on each run's column of the state and the forces
         for l in range(n_runs):
-            for i in range(y.shape[0]):
-                y1[i] = y[i, l]
-            for i in range(n):
-                g1[i] = g[i, l]
-            for i in range(d1.shape[0]):
-                d1[i] = diag[i, l]
             P = lane_params(S, l)
             W = lane_work(V, l)
+            yl = y[:, l]
+            gl = g[:, l]
+            dl = diag[:, l]
             if faulty and moved:
-                defect_forces_jit(t, B.tau[l], y1, n, g1, P, W, W.slip_cos, W.slip_sin, d1,
+                defect_forces_jit(t, B.tau[l], yl, n, gl, P, W, W.slip_cos, W.slip_sin, dl,
                                   want_diag)
             elif faulty:
-                defect_forces_jit(t, B.tau[l], y1, n, g1, P, W, P.b_cos, P.b_sin, d1,
+                defect_forces_jit(t, B.tau[l], yl, n, gl, P, W, P.b_cos, P.b_sin, dl,
                                   want_diag)
             if mesh_on:
-                mesh_forces_jit(B.tau[l], B.sr[l], y1, n, g1, P, W, d1, want_diag)
-            for i in range(n):
-                g[i, l] = g1[i]
-            if want_diag:
-                for i in range(d1.shape[0]):
-                    diag[i, l] = d1[i]
+                mesh_forces_jit(B.tau[l], B.sr[l], yl, n, gl, P, W, dl, want_diag)
     _springs(y, n, g, S.spring_ends[0], L.springs)
     _accelerations(y, n, g, L.minv, L.omega, B.ar, dydt, row)
 

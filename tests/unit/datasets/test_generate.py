@@ -185,10 +185,11 @@ def test_failed_record_is_marked_and_the_rest_go_on(tmp_path, monkeypatch):
     import cmsim.datasets.records as gen
     real = gen.simulate_records
 
-    def flaky(spec, plans):
+    def flaky(spec, plans, batch_size=None):
         from cmsim.errors import IntegrationDiverged
         return [IntegrationDiverged("integration diverged at t = 0.01 s (test)")
-                if plan.index == 2 else res for plan, res in zip(plans, real(spec, plans))]
+                if plan.index == 2 else res
+                for plan, res in zip(plans, real(spec, plans, batch_size))]
 
     monkeypatch.setattr(gen, "simulate_records", flaky)     # forked workers inherit it
     s = generate_dataset(DatasetSpec.from_dict(SMALL), tmp_path / "f", workers=2,
