@@ -43,7 +43,7 @@ from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
 __all__ = ["simulate_record", "simulate_records", "run_record", "run_records",
-           "default_batch_size", "BATCH_SIZE", "BATCH_FROM_RECORDS", "base_row",
+           "DEFAULT_BATCH_SIZE", "base_row",
            "manifest_features", "FEATURE_SIGNALS",
            "FORMAT"]
 
@@ -183,31 +183,14 @@ def _record_arrays(spec, plan, rig, op, profile, run, setup_s):
     return {c: np.asarray(run[c], dtype=np.float32) for c in channels}, meta
 
 
-#: Most records a worker integrates together (:func:`cmsim.dynamics.batch.simulate_batch`):
-#: numba's vector body over the records is 8 lanes (AVX-512) unrolled four times, so 32 fill
-#: it; more only adds memory (about 7 MB per record at 25.6 kHz for 1 s).
-BATCH_SIZE = 32
-
-#: Specs of fewer records run each record alone on the single-run kernel (a batch of one):
-#: a batch pays for its loops over the records from about 16 on (``benchmarks/bench_batch.py``).
-BATCH_FROM_RECORDS = 64
-
-
-def default_batch_size(spec):
-    """Records a dataset of ``spec`` integrates together by default: :data:`BATCH_SIZE`, or 1
-    (each alone, the single-run kernel) for a spec of fewer than :data:`BATCH_FROM_RECORDS`
-    records.
-
-    Parameters
-    ----------
-    spec : DatasetSpec
-        The spec.
-
-    Returns
-    -------
-    int
-    """
-    return BATCH_SIZE if spec.n_records >= BATCH_FROM_RECORDS else 1
+#: Records a dataset integrates together by default: 1, each record alone on the single-run
+#: kernel. Measured on the 2-core build machine (``benchmarks/bench_batch.py``,
+#: docs/benchmarks.md), batches of 8-64 records of ``datasets/gear_faults.toml`` made 0.7-0.95
+#: of its records per hour: the tooth contacts, a third of a step, still run record by record
+#: inside the batch, so the vectorised rest cannot pay for the batch's loops. A larger
+#: ``batch_size`` is the batch kernel (:mod:`cmsim.dynamics.batch`), bit for bit the same
+#: records for every size above 1.
+DEFAULT_BATCH_SIZE = 1
 
 
 def simulate_records(spec, plans, batch_size=None):
@@ -228,13 +211,13 @@ def simulate_records(spec, plans, batch_size=None):
     plans : sequence of RecordPlan
         Its records (:meth:`DatasetSpec.record`).
     batch_size : int, optional
-        1: each record alone; larger: together (default :func:`default_batch_size`).
+        1: each record alone; larger: together (default :data:`DEFAULT_BATCH_SIZE`).
 
     Returns
     -------
     list of tuple or Exception
     """
-    batch_size = default_batch_size(spec) if batch_size is None else batch_size
+    batch_size = DEFAULT_BATCH_SIZE if batch_size is None else batch_size
     out = [None] * len(plans)
     setups, todo = [], []
     for i, plan in enumerate(plans):
@@ -273,9 +256,9 @@ def _alone(setup):
 
 def simulate_record(spec, index, plan=None):
     """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
-    docstring), bit for bit as a dataset run of ``spec`` makes it by default
-    (:func:`simulate_records` with :func:`default_batch_size`). Raises what :func:`cmsim.dynamics.simulate` raises (e.g.
-    :class:`~cmsim.errors.IntegrationDiverged`).
+    docstring), bit for bit as a dataset run makes it by default
+    (:func:`simulate_records` with :data:`DEFAULT_BATCH_SIZE`). Raises what
+    :func:`cmsim.dynamics.simulate` raises (e.g. :class:`~cmsim.errors.IntegrationDiverged`).
 
     Parameters
     ----------
@@ -414,11 +397,11 @@ def run_record(spec, index, out_dir):
     Parameters
     ----------
     spec : DatasetSpec
-        The spec.
+        The spec the record belongs to.
     index : int
-        Record number.
+        Its number in the spec.
     out_dir : str or Path
-        The dataset directory.
+        The dataset directory it is written to.
 
     Returns
     -------

@@ -41,10 +41,10 @@ from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, SPEC_NAME, consolidate,
                                      done_indices, open_directory, read_rows)
 from cmsim.datasets.pool import check_start_method, check_workers, run_tasks, scheduler_client
-from cmsim.datasets.records import default_batch_size, run_records
+from cmsim.datasets.records import DEFAULT_BATCH_SIZE, run_records
 from cmsim.datasets.spec import DatasetSpec
 from cmsim.dynamics.batch import kernel_layout, simulate_batch
-from cmsim.dynamics.simulation import prepare_run
+from cmsim.dynamics.simulation import integrate_prepared, prepare_run
 from cmsim.errors import ParameterError, check_type
 from cmsim.sensors import housing_acceleration
 
@@ -163,17 +163,25 @@ def _first_runs(spec, plans):
     return out
 
 
-def _warm_kernels(spec, setups):
+def _warm_kernels(spec, setups, batch_size):
     """Compile/load the kernels here before forking workers: the 3-sample runs of
-    :func:`_first_runs` (faulty bearings take their own kernels; runs the batch kernel does
-    not take, the single-run one), and the housing path's kernel when the records have
-    accelerometers."""
+    :func:`_first_runs` as the workers will run them (alone on the single-run kernel for
+    ``batch_size`` 1, else in a batch; faulty bearings take their own kernels), and the
+    housing path's kernel when the records have accelerometers."""
     if any(c.startswith("accel_") for c in spec.channels or ()):
         try:
             housing_acceleration(np.zeros(8), spec.fs_hz, spec.rig.housing)
         except Exception:                  # noqa: BLE001 - the record reports it
             pass
-    simulate_batch([s for s in setups if s is not None])
+    setups = [s for s in setups if s is not None]
+    if batch_size > 1:
+        simulate_batch(setups)
+        return
+    for setup in setups:
+        try:
+            integrate_prepared(setup)
+        except Exception:                  # noqa: BLE001 - the record reports it
+            pass
 
 
 def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=None,
@@ -206,10 +214,10 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
         ``on_record_done(row)`` after each record (an exception stops the run; the finished
         records are kept).
     batch_size : int, optional
-        Most records a worker integrates together in one time loop (default
-        :func:`~cmsim.datasets.records.default_batch_size`; fewer when that spreads the
-        records over the workers). 1: each record alone on the single-run kernel (the
-        reference). A record's arrays are bit for bit the same for every batch size above 1,
+        Most records a worker integrates together in one time loop, fewer when that spreads
+        the records over the workers (default
+        :data:`~cmsim.datasets.records.DEFAULT_BATCH_SIZE`, 1: each record alone on the
+        single-run kernel, the reference). A record's arrays are bit for bit the same for every batch size above 1,
         on any number of workers, resumed or not, and within 1e-9 of each signal's range of
         the single-run kernel's.
 
@@ -315,14 +323,14 @@ def _generate(spec, out, start, *, workers, client, progress, method, verify, fo
     try:
         if pending:
             plans = [spec.record(i) for i in pending]      # drawn once, here
+            size = DEFAULT_BATCH_SIZE if batch_size is None else batch_size
             first = _first_runs(spec, plans)
             if client is None and method == "fork":
                 t_w = time.perf_counter()
-                _warm_kernels(spec, first.values())
+                _warm_kernels(spec, first.values(), size)
                 t_warm = time.perf_counter() - t_w
             batchable = {k: s is not None and kernel_layout(s) is not None
                          for k, s in first.items()}
-            size = default_batch_size(spec) if batch_size is None else batch_size
             tasks = [(part[0].record_id, (spec, [p.index for p in part], str(out), part, size))
                      for part in _batches(plans, workers if client is None else None, size,
                                           batchable)]

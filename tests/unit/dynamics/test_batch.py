@@ -50,6 +50,16 @@ def _bearing_runs():
             for i, (rpm, load, fault) in enumerate(cases)]
 
 
+def _near_reference(setups, runs):
+    """Each run within 1e-9 of each signal's range of the single-run kernel's."""
+    for setup, run in zip(setups, runs):
+        ref = integrate_prepared(setup)
+        assert run.meta["scheme"] == ref.meta["scheme"]
+        for name in ref.signals:
+            span = np.ptp(ref[name]) + 1e-300
+            assert np.max(np.abs(run[name] - ref[name])) <= 1e-9 * span, name
+
+
 def _same(a, b):
     assert sorted(a.signals) == sorted(b.signals)
     for name in a.signals:
@@ -77,22 +87,14 @@ def test_a_run_is_the_same_alone_and_in_any_batch(gear):
 
 def test_a_run_agrees_with_the_single_run_kernel(gear):
     runs, together = gear
-    for setup, run in zip(runs, together):
-        ref = integrate_prepared(setup)
-        assert run.meta["scheme"] == ref.meta["scheme"] == "rk4"
-        for name in ref.signals:
-            span = np.ptp(ref[name]) + 1e-300
-            assert np.max(np.abs(run[name] - ref[name])) <= 1e-9 * span, name
+    assert {r.meta["scheme"] for r in together} == {"rk4"}
+    _near_reference(runs, together)
 
 
 def test_bearing_defects_batch_like_the_single_run_kernel():
     runs = _bearing_runs()
     together = simulate_batch(runs)
-    for setup, run in zip(runs, together):
-        ref = integrate_prepared(setup)
-        for name in ref.signals:
-            span = np.ptp(ref[name]) + 1e-300
-            assert np.max(np.abs(run[name] - ref[name])) <= 1e-9 * span, name
+    _near_reference(runs, together)
     _same(simulate_batch(runs[1:2])[0], together[1])
 
 
@@ -125,9 +127,4 @@ def test_a_run_up_batches_with_its_own_profile():
                         warmup_s=0.01, profile=SpeedProfile.ramp(rpm, rpm + 300.0, DURATION,
                                                                  start_s=0.01))
             for rpm in (800.0, 1200.0)]
-    out = simulate_batch(runs)
-    for setup, run in zip(runs, out):
-        ref = integrate_prepared(setup)
-        for name in ref.signals:
-            span = np.ptp(ref[name]) + 1e-300
-            assert np.max(np.abs(run[name] - ref[name])) <= 1e-9 * span, name
+    _near_reference(runs, simulate_batch(runs))
