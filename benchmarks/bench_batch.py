@@ -1,4 +1,4 @@
-"""Records per hour against batch size, and `cmsim dataset` against the one-record bound (issue 49).
+"""Records per hour against batch size; `cmsim dataset` against the one-record bound (issue 49).
 
 python benchmarks/bench_batch.py [--spec datasets/gear_faults.toml] [--records N]
                                  [--sizes 1,8,16,32,64] [--rounds R] [--command]

@@ -186,8 +186,8 @@ def _record_arrays(spec, plan, rig, op, profile, run, setup_s):
 #: Records a dataset integrates together by default: 1, each record alone on the single-run
 #: kernel. Measured on the 2-core build machine (``benchmarks/bench_batch.py``,
 #: docs/benchmarks.md), batches of 8-64 records of ``datasets/gear_faults.toml`` made 0.7-0.95
-#: of its records per hour: the tooth contacts, a third of a step, still run record by record
-#: inside the batch, so the vectorised rest cannot pay for the batch's loops. A larger
+#: of its records per hour: the tooth contacts, half of a batch's step, still run record by
+#: record inside the batch, so the vectorised rest cannot pay for the batch's loops. A larger
 #: ``batch_size`` is the batch kernel (:mod:`cmsim.dynamics.batch`), bit for bit the same
 #: records for every size above 1.
 DEFAULT_BATCH_SIZE = 1
@@ -352,10 +352,11 @@ def run_records(spec, indices, out_dir, plans=None, batch_size=None):
         rows.append(row)
     results = simulate_records(spec, plans, batch_size)
     spent = (time.perf_counter() - start) / max(len(plans), 1)
-    with ThreadPoolExecutor(max_workers=min(len(rows), 16) or 1) as pool:
-        done = list(pool.map(lambda rr: _write_record(spec, out, *rr, spent),
+    if len(rows) == 1:                     # (starting a thread costs more than it saves)
+        return [_write_record(spec, out, rows[0], results[0], spent)]
+    with ThreadPoolExecutor(max_workers=min(len(rows), 16)) as pool:
+        return list(pool.map(lambda rr: _write_record(spec, out, *rr, spent),
                              zip(rows, results)))
-    return done
 
 
 def _write_record(spec, out, row, result, spent):

@@ -217,9 +217,9 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
         Most records a worker integrates together in one time loop, fewer when that spreads
         the records over the workers (default
         :data:`~cmsim.datasets.records.DEFAULT_BATCH_SIZE`, 1: each record alone on the
-        single-run kernel, the reference). A record's arrays are bit for bit the same for every batch size above 1,
-        on any number of workers, resumed or not, and within 1e-9 of each signal's range of
-        the single-run kernel's.
+        single-run kernel, the reference). A record's arrays are bit for bit the same for
+        every batch size above 1, on any number of workers, resumed or not, and within 1e-9
+        of each signal's range of the single-run kernel's.
 
     Returns
     -------
