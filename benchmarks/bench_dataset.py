@@ -64,6 +64,28 @@ def cpu_info():
     return name, cores, os.getloadavg()
 
 
+def simd_width():
+    """The vector width numba's LLVM uses for the batch kernel's loops over the records: the
+    Hertz ball sum (:func:`cmsim.dynamics._batch_kernels._ball_sums`) compiled here afresh
+    (the cached kernel cannot be inspected) and its square roots read from the assembly."""
+    import re
+
+    import llvmlite.binding as llvm
+    from numba import njit
+
+    from cmsim.dynamics._batch_kernels import _ball_sums
+    probe = njit(cache=False, error_model="numpy", _nrt=False)(_ball_sums.py_func)
+    b = 32
+    probe(0, 9, np.random.rand(4, 8, b), np.random.rand(4, 9, b), np.random.rand(4, 9, b),
+          np.random.rand(b), np.random.rand(b), np.zeros(b), np.zeros(b), True)
+    asm = "".join(probe.inspect_asm().values())
+    for reg, bits in (("zmm", 512), ("ymm", 256), ("xmm", 128)):
+        if re.search(rf"vsqrtpd\s+%{reg}", asm):
+            return (f"{bits}-bit vectors ({bits // 64} float64 lanes, {reg}) on "
+                    f"{llvm.get_host_cpu_name()}")
+    return f"scalar (no packed square root) on {llvm.get_host_cpu_name()}"
+
+
 def load_spec(path, records):
     from cmsim.datasets import DatasetSpec
     raw = tomllib.loads(Path(path).read_text())
@@ -246,7 +268,7 @@ def bench_stages(spec, n, tmp):
     out = Path(tmp) / "stages"
     for sub in (RECORDS_DIR, ROWS_DIR):
         (out / sub).mkdir(parents=True, exist_ok=True)
-    records.run_record(spec, 0, out)                   # warm: kernels, caches
+    records.run_records(spec, [0], out, batch_size=1)  # warm: kernels, caches
     clock = StageClock()
     # (a stage's function that this version of cmsim does not have is left out)
     originals = [(_resolve(owner), attr, clock.wrap(_resolve(owner), attr, stage))
@@ -254,7 +276,7 @@ def bench_stages(spec, n, tmp):
     try:
         t0, w0 = cpu(), time.perf_counter()
         for i in range(1, n + 1):
-            row = records.run_record(spec, i, out)
+            row, = records.run_records(spec, [i], out, batch_size=1)     # one alone
             assert row["status"] == "ok", row["error"]
         total, wall = cpu() - t0, time.perf_counter() - w0
     finally:
@@ -351,6 +373,7 @@ def main(argv=None):
     name, cores, load = cpu_info()
     print(f"CPU: {name}, {cores} cores usable; load average {load[0]:.2f} {load[1]:.2f} "
           f"{load[2]:.2f} (times below are CPU time unless marked wall)")
+    print(f"SIMD of the batch kernel: {simd_width()}")
     spec = load_spec(args.spec, max(n_run, n_split + 1))
     h, n_steps, k, scheme = record_steps(spec)
     print(f"spec {Path(args.spec).name}: {spec.fs_hz:g} Hz x {k} substeps = "

@@ -34,12 +34,11 @@ def register(sub):
 def run(args):
     """Generate (or resume) the dataset."""
     from cmsim.datasets import DatasetSpec, generate_dataset
-    from cmsim.datasets.manifest import read_rows
     from cmsim.datasets.pool import check_scheduler
 
+    # (a resumed directory's manifest is input as well: generate_dataset reads it once,
+    # before any work, and names a corrupt one)
     spec = load_file("SPEC", args.spec, DatasetSpec.load, "a dataset spec TOML file")
-    if Path(args.out).is_dir():           # a resumed directory's manifest is input as well
-        read_rows(args.out)
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
     args.notice_compile()

@@ -107,7 +107,7 @@ def read_spec(out_dir):
         return None
 
 
-def read_rows(out_dir):
+def read_rows(out_dir, known=None):
     """Every manifest row of ``out_dir`` as a DataFrame (Parquet plus unconsolidated
     sidecars; the latest row of a record wins), sorted by index; None if there is none.
 
@@ -115,12 +115,17 @@ def read_rows(out_dir):
     ----------
     out_dir : str or Path
         The dataset directory.
+    known : DataFrame, optional
+        Rows read before from the same directory (its Parquet file unchanged since): they
+        stand in for the Parquet file, and only the sidecars are read.
     """
     import pandas as pd
 
     out = Path(out_dir)
     frames = []
-    if (out / PARQUET_NAME).is_file():
+    if known is not None:
+        frames.append(known)
+    elif (out / PARQUET_NAME).is_file():
         frames.append(_read_parquet(out / PARQUET_NAME))
     side = _read_sidecars(out)
     if side:
@@ -178,13 +183,17 @@ def _write_parquet(out, df):
     atomic_write_bytes(out / PARQUET_NAME, buf.getvalue())
 
 
-def consolidate(out_dir):
+def consolidate(out_dir, known=None):
     """Fold the sidecar rows into ``manifest.parquet`` (atomic), then remove them.
 
     Parameters
     ----------
     out_dir : str or Path
         The dataset folder.
+    known : DataFrame, optional
+        The directory's rows as :func:`read_rows` gave them earlier under the same
+        directory lock (the Parquet file has not changed since): only the sidecars are read
+        then, not the manifest again (a resumed 100 000-record dataset reads it once).
 
     Returns
     -------
@@ -195,9 +204,11 @@ def consolidate(out_dir):
     names = [e.name for e in os.scandir(out / ROWS_DIR)] if (out / ROWS_DIR).is_dir() else []
     names = [n for n in names if n.endswith(".json") and not n.startswith(".")]
     if not names and (out / PARQUET_NAME).is_file():
+        if known is not None:
+            return len(known)
         import pyarrow.parquet as pq
         return pq.ParquetFile(out / PARQUET_NAME).metadata.num_rows
-    df = read_rows(out)
+    df = read_rows(out, known)
     if df is None:
         return 0
     _write_parquet(out, df)
@@ -286,7 +297,7 @@ def _keep_matching(spec, out):
     return len(keep)
 
 
-def done_indices(spec, out_dir, verify):
+def done_indices(spec, out_dir, verify, rows=None):
     """Indices already done in ``out_dir`` (ok with their file intact, or failed), and how
     many were adopted from record files without a row.
 
@@ -298,6 +309,8 @@ def done_indices(spec, out_dir, verify):
         The dataset directory.
     verify : bool
         Also compare every ok file's SHA-256 with its row (reads every file).
+    rows : DataFrame, optional
+        The directory's rows, already read (:func:`read_rows`); read here when not given.
 
     Returns
     -------
@@ -305,7 +318,7 @@ def done_indices(spec, out_dir, verify):
     adopted : int
     """
     out = Path(out_dir)
-    df = read_rows(out)
+    df = read_rows(out) if rows is None else rows
     done, seen = set(), set()
     if df is not None:
         df = df[df["spec_digest"] == spec.digest] if "spec_digest" in df else df.iloc[:0]

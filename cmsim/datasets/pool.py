@@ -194,7 +194,7 @@ class _SignalsRaise(_SignalHandlers):
 
 
 def run_tasks(fn, tasks, on_result, *, workers, start_method=None, scheduler=None,
-              progress=False, desc="run", unit="run", postfix=None):
+              progress=False, desc="run", unit="run", postfix=None, total=None, units=None):
     """Call ``fn(*args)`` for every ``(key, args)`` of ``tasks``; results to ``on_result``.
 
     Parameters
@@ -222,6 +222,11 @@ def run_tasks(fn, tasks, on_result, *, workers, start_method=None, scheduler=Non
         Progress bar label and unit.
     postfix : callable, optional
         ``postfix(key, result)`` → text shown beside the bar.
+    total : int, optional
+        The bar's length in ``unit`` (default: one per task).
+    units : callable, optional
+        ``units(result)`` → how many ``unit`` a task's result advances the bar (default 1:
+        a task that makes a batch of records advances it by its records).
 
     Returns
     -------
@@ -241,12 +246,12 @@ def run_tasks(fn, tasks, on_result, *, workers, start_method=None, scheduler=Non
     bar = None
     with _SignalsRaise():
         try:
-            bar = tqdm(total=len(tasks), disable=not progress, file=sys.stderr, unit=unit,
-                       desc=desc, dynamic_ncols=True, delay=0.0)
+            bar = tqdm(total=len(tasks) if total is None else total, disable=not progress,
+                       file=sys.stderr, unit=unit, desc=desc, dynamic_ncols=True, delay=0.0)
 
             def done(key, res):
                 on_result(key, res)
-                bar.update(1)
+                bar.update(1 if units is None else units(res))
                 if postfix is not None:
                     bar.set_postfix_str(str(postfix(key, res)), refresh=False)
 

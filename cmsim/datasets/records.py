@@ -11,9 +11,10 @@ manifest row, rig, operating point, faults, the answer key, timing):
   (:meth:`Run.load <cmsim.run.Run.load>` reads it; ``cmsim report`` draws it), and its
   manifest row also carries the features of :data:`FEATURE_SIGNALS`.
 
-:func:`run_record` is the task a worker runs: it writes the record file atomically, then
-its row as a sidecar (``DIR/rows/<record_id>.json``), also for a failed record (with its
-error); the runner folds the sidecars into the Parquet manifest
+:func:`run_records` is the task a worker runs: it simulates a batch of records in one time
+loop (:func:`simulate_records`; a record's arrays do not depend on its batch), writes each
+record file atomically, then its row as a sidecar (``DIR/rows/<record_id>.json``), also for a
+failed record (with its error); the runner folds the sidecars into the Parquet manifest
 (:mod:`cmsim.datasets.manifest`).
 """
 
@@ -24,6 +25,7 @@ import math
 import os
 import time
 import traceback
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -31,7 +33,8 @@ import numpy as np
 from cmsim._io import atomic_savez
 from cmsim.datasets.manifest import RECORDS_DIR, file_sha256, json_default, write_row
 from cmsim.datasets.spec import mesh_key
-from cmsim.dynamics import simulate
+from cmsim.dynamics.batch import simulate_batch
+from cmsim.dynamics.simulation import integrate_prepared, prepare_run, simulate
 from cmsim.dynamics.profiles import SpeedProfile
 from cmsim.faults import fault_frequencies
 from cmsim.features import N_GMF_HARMONICS, run_features
@@ -39,7 +42,9 @@ from cmsim.frequencies import rig_frequencies
 from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
-__all__ = ["simulate_record", "run_record", "base_row", "manifest_features", "FEATURE_SIGNALS",
+__all__ = ["simulate_record", "simulate_records", "run_record", "run_records",
+           "DEFAULT_BATCH_SIZE", "base_row",
+           "manifest_features", "FEATURE_SIGNALS",
            "FORMAT"]
 
 #: Signals of a full-run record whose features go into its manifest row (those it has).
@@ -122,26 +127,9 @@ def _simulated_channels(channels, machine=None):
     return sorted(out)
 
 
-def simulate_record(spec, index):
-    """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
-    docstring). Raises what :func:`cmsim.dynamics.simulate` raises (e.g.
-    :class:`~cmsim.errors.IntegrationDiverged`).
-
-    Parameters
-    ----------
-    spec : DatasetSpec
-        The spec.
-    index : int
-        Record number.
-
-    Returns
-    -------
-    arrays : dict of str to ndarray
-        The channels (float32), or ``t``, ``source`` and every signal of the full run.
-    meta : dict
-        JSON-ready meta of the record.
-    """
-    plan = spec.record(index)
+def _prepared(spec, plan):
+    """``(setup, rig, op, profile)`` of a record: its run checked and built up to the time
+    loop (:func:`cmsim.dynamics.simulation.prepare_run`)."""
     rig = spec.record_rig(plan)
     op = spec.record_operating_point(plan)
     profile = None
@@ -149,13 +137,19 @@ def simulate_record(spec, index):
         profile = SpeedProfile.ramp(op.speed_rpm, plan.params["end_speed_rpm"],
                                     spec.duration_s, start_s=spec.warmup_s)
     channels = spec.channels
+    setup = prepare_run(rig, op, spec.duration_s, mesh=spec.mesh, fs_hz=spec.fs_hz,
+                        substeps=spec.substeps, seed=plan.sim_seed, warmup_s=spec.warmup_s,
+                        faults=plan.faults, profile=profile, losses=spec.losses,
+                        record=None if channels is None else _simulated_channels(channels,
+                                                                                 spec.machine))
+    return setup, rig, op, profile
+
+
+def _record_arrays(spec, plan, rig, op, profile, run, setup_s):
+    """``(arrays, meta)`` of a record from its simulated ``run``: the sensors, the answer key,
+    the meta (module docstring)."""
+    channels = spec.channels
     sensed = [c for c in channels or () if c.startswith("accel_") or c == "tacho"]
-    t0 = time.perf_counter()
-    run = simulate(rig, op, spec.duration_s, mesh=spec.mesh, fs_hz=spec.fs_hz,
-                   substeps=spec.substeps, seed=plan.sim_seed, warmup_s=spec.warmup_s,
-                   faults=plan.faults, profile=profile, losses=spec.losses,
-                   record=None if channels is None else _simulated_channels(channels,
-                                                                            spec.machine))
     t1 = time.perf_counter()
     if spec.machine is not None and (channels is None or spec.machine.channel in channels):
         run = spec.machine.sensor_channel(run, plan.sim_seed, healthy=_machine_reference(
@@ -177,8 +171,7 @@ def simulate_record(spec, index):
                          "base_seed": spec.seed, "seed_policy": spec.seed_policy,
                          "repeat": plan.repeat, "mesh": mesh_key(spec.mesh),
                          "values": {n: plan.params[n] for n, _ in spec.settings}},
-              "timing_s": {"integration": integration, "setup": t1 - t0 - integration,
-                           "sensors": t2 - t1}}
+              "timing_s": {"integration": integration, "setup": setup_s, "sensors": t2 - t1}}
     if channels is None:
         return {"t": run.t, "source": np.asarray(run.source), **run.signals}, \
             {**run.meta, **record}
@@ -205,6 +198,105 @@ def _machine_reference(spec, rig, op, plan, profile, channels):
                     substeps=spec.substeps, seed=plan.sim_seed, warmup_s=spec.warmup_s,
                     losses=spec.losses,
                     record=None if channels is None else list(machine.force_signals))
+
+
+#: Records a dataset integrates together by default: 1, each record alone on the single-run
+#: kernel. Measured on the 2-core build machine (``benchmarks/bench_batch.py``,
+#: docs/benchmarks.md), batches of 8-64 records of ``datasets/gear_faults.toml`` made 0.7-0.95
+#: of its records per hour: the tooth contacts, half of a batch's step, still run record by
+#: record inside the batch, so the vectorised rest cannot pay for the batch's loops. A larger
+#: ``batch_size`` is the batch kernel (:mod:`cmsim.dynamics.batch`), bit for bit the same
+#: records for every size above 1.
+DEFAULT_BATCH_SIZE = 1
+
+
+def simulate_records(spec, plans, batch_size=None):
+    """Simulate records of ``spec`` together; per record, in order, ``(arrays, meta)``
+    (:func:`simulate_record`) or the exception it raised.
+
+    With ``batch_size`` 1 each record runs alone on the single-run kernel
+    (:func:`cmsim.dynamics.simulation.integrate_prepared`, the reference); otherwise those of
+    one kernel layout share one time loop (:func:`cmsim.dynamics.batch.simulate_batch`). A
+    record's arrays do not depend on the records it is simulated with: bit for bit the same
+    in any batch (of any size above 1), and within 1e-9 of each signal's range of the
+    single-run kernel's.
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+    plans : sequence of RecordPlan
+        Its records (:meth:`DatasetSpec.record`).
+    batch_size : int, optional
+        1: each record alone; larger: together (default :data:`DEFAULT_BATCH_SIZE`).
+
+    Returns
+    -------
+    list of tuple or Exception
+    """
+    batch_size = DEFAULT_BATCH_SIZE if batch_size is None else batch_size
+    out = [None] * len(plans)
+    setups, todo = [], []
+    for i, plan in enumerate(plans):
+        t0 = time.perf_counter()
+        try:
+            setup, rig, op, profile = _prepared(spec, plan)
+        except Exception as exc:           # noqa: BLE001 - a failed record, the rest go on
+            out[i] = exc
+            continue
+        setups.append(setup)
+        todo.append((i, plan, rig, op, profile, time.perf_counter() - t0))
+    t0 = time.perf_counter()
+    runs = simulate_batch(setups) if batch_size > 1 else [_alone(s) for s in setups]
+    # what the batch spent besides integrating (filters, signals), shared out
+    around = (time.perf_counter() - t0
+              - sum(r.meta["wall_s"] for r in runs if not isinstance(r, Exception)))
+    around /= max(len(setups), 1)
+    for (i, plan, rig, op, profile, setup_s), run in zip(todo, runs):
+        if isinstance(run, Exception):
+            out[i] = run
+            continue
+        try:
+            out[i] = _record_arrays(spec, plan, rig, op, profile, run, setup_s + around)
+        except Exception as exc:           # noqa: BLE001 - a failed record, the rest go on
+            out[i] = exc
+    return out
+
+
+def _alone(setup):
+    """A record's run on the single-run kernel, or the exception it raised."""
+    try:
+        return integrate_prepared(setup)
+    except Exception as exc:               # noqa: BLE001 - a failed record, the rest go on
+        return exc
+
+
+def simulate_record(spec, index, plan=None):
+    """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
+    docstring), bit for bit as a dataset run makes it by default
+    (:func:`simulate_records` with :data:`DEFAULT_BATCH_SIZE`). Raises what
+    :func:`cmsim.dynamics.simulate` raises (e.g. :class:`~cmsim.errors.IntegrationDiverged`).
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+    index : int
+        Record number.
+    plan : RecordPlan, optional
+        The record's plan, when the caller has drawn it (:meth:`DatasetSpec.record`).
+
+    Returns
+    -------
+    arrays : dict of str to ndarray
+        The channels (float32), or ``t``, ``source`` and every signal of the full run.
+    meta : dict
+        JSON-ready meta of the record.
+    """
+    result = simulate_records(spec, [spec.record(index) if plan is None else plan])[0]
+    if isinstance(result, Exception):
+        raise result
+    return result
 
 
 def manifest_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS, top_n=5):
@@ -239,40 +331,63 @@ def manifest_features(run, signals=FEATURE_SIGNALS, n_harmonics=N_GMF_HARMONICS,
     return out
 
 
-def run_record(spec, index, out_dir):
-    """Worker task: simulate record ``index``, write its file then its sidecar row; return
-    the row (status ``"ok"``, or ``"failed"`` with the error: a failed record does not stop
+def run_records(spec, indices, out_dir, plans=None, batch_size=None):
+    """Worker task: simulate records ``indices`` of ``spec`` together
+    (:func:`simulate_records`), write each one's file then its sidecar row; return the rows
+    in order (status ``"ok"``, or ``"failed"`` with the error: a failed record does not stop
     the others).
+
+    The files are written side by side in threads: each is forced to the disk before its
+    row is written (:func:`cmsim.datasets.manifest.write_row`), and the file system then
+    commits them together instead of once per record.
 
     Parameters
     ----------
     spec : DatasetSpec
         The spec.
-    index : int
-        Record number.
+    indices : sequence of int
+        Record numbers.
     out_dir : str or Path
         The dataset directory.
+    plans : sequence of RecordPlan, optional
+        The records' plans, when the caller has drawn them (:meth:`DatasetSpec.record`).
+    batch_size : int, optional
+        As :func:`simulate_records`.
 
     Returns
     -------
-    dict
+    list of dict
     """
     start = time.perf_counter()
     out = Path(out_dir)
-    plan = spec.record(index)
-    row = base_row(spec, plan)
-    row["record_key"] = spec.record_key(plan)
-    row["pid"] = os.getpid()
-    path = out / row["path"]
-    try:
-        arrays, meta = simulate_record(spec, index)
-    except Exception as exc:               # noqa: BLE001 - a failed record, the rest go on
-        row.update(status="failed", error=" ".join(f"{type(exc).__name__}: {exc}".split()),
-                   wall_s=time.perf_counter() - start)
+    plans = [spec.record(i) for i in indices] if plans is None else list(plans)
+    rows = []
+    for plan in plans:
+        row = base_row(spec, plan)
+        row["record_key"] = spec.record_key(plan)
+        row["pid"] = os.getpid()
+        rows.append(row)
+    results = simulate_records(spec, plans, batch_size)
+    spent = (time.perf_counter() - start) / max(len(plans), 1)
+    if len(rows) == 1:                     # (starting a thread costs more than it saves)
+        return [_write_record(spec, out, rows[0], results[0], spent)]
+    with ThreadPoolExecutor(max_workers=min(len(rows), 16)) as pool:
+        return list(pool.map(lambda rr: _write_record(spec, out, *rr, spent),
+                             zip(rows, results)))
+
+
+def _write_record(spec, out, row, result, spent):
+    """Write one record's file (atomically, synced) then its sidecar row; return the row."""
+    start = time.perf_counter()
+    if isinstance(result, Exception):
+        row.update(status="failed", error=" ".join(f"{type(result).__name__}: {result}".split()),
+                   wall_s=spent)
         if os.environ.get("CMSIM_DEBUG"):
-            traceback.print_exc()
+            traceback.print_exception(result)
         write_row(out, row)
         return row
+    arrays, meta = result
+    path = out / row["path"]
     t_features = time.perf_counter()
     if spec.channels is None:
         signals = {k: v for k, v in arrays.items() if k not in ("t", "source")}
@@ -289,6 +404,25 @@ def run_record(spec, index, out_dir):
     row["bytes"] = path.stat().st_size
     row["sha256"] = file_sha256(path)
     row["save_s"] = time.perf_counter() - t_save
-    row["wall_s"] = time.perf_counter() - start
+    row["wall_s"] = spent + time.perf_counter() - start
     write_row(out, row)
     return row
+
+
+def run_record(spec, index, out_dir):
+    """Worker task of one record: :func:`run_records` of ``[index]``; returns its row.
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec the record belongs to.
+    index : int
+        Its number in the spec.
+    out_dir : str or Path
+        The dataset directory it is written to.
+
+    Returns
+    -------
+    dict
+    """
+    return run_records(spec, [index], out_dir)[0]

@@ -28,6 +28,7 @@ Processes
 from __future__ import annotations
 
 import contextlib
+import numbers
 import shutil
 import sys
 import time
@@ -38,12 +39,13 @@ import numpy as np
 
 from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, SPEC_NAME, consolidate,
-                                     done_indices, open_directory)
+                                     done_indices, open_directory, read_rows)
 from cmsim.datasets.pool import check_start_method, check_workers, run_tasks, scheduler_client
-from cmsim.datasets.records import run_record
+from cmsim.datasets.records import DEFAULT_BATCH_SIZE, run_records
 from cmsim.datasets.spec import DatasetSpec
-from cmsim.dynamics import simulate
-from cmsim.errors import check_type
+from cmsim.dynamics.batch import kernel_layout, simulate_batch
+from cmsim.dynamics.simulation import integrate_prepared, prepare_run
+from cmsim.errors import ParameterError, check_type
 from cmsim.sensors import housing_acceleration
 
 __all__ = ["generate_dataset", "DatasetSummary"]
@@ -115,32 +117,76 @@ class DatasetSummary:
                 "failed": [{"record_id": r, "error": e} for r, e in self.failed]}
 
 
-def _warm_kernels(spec, pending):
-    """Compile/load the kernels here before forking workers: a 3-sample run of the first
-    pending record of each fault label (faulty bearings take their own kernels), and the
+def _batch_key(plan):
+    """What records of one batch share, read from the plan: the kinds of their faults (and
+    the bearing a bearing fault sits in) and whether it is a run-up — what sets the kernels'
+    switches and table sizes (:func:`cmsim.dynamics.batch.kernel_layout` checks the rest)."""
+    return (tuple((type(f).__name__, getattr(f, "bearing", None)) for f in plan.faults),
+            bool(plan.params["runup"]))
+
+
+def _batches(plans, workers, batch_size, batchable):
+    """The pending records' plans in batches: records of one :func:`_batch_key` together, in
+    index order, at most ``batch_size``, in parts of even size (no more than spreads the
+    records over ``workers`` when known); one by one for ``batch_size`` 1 and for a key the
+    batch kernel does not take (``batchable[key]`` False: nothing to share, and an
+    interruption then loses no finished run)."""
+    size = batch_size
+    if workers:
+        size = max(1, min(size, -(-len(plans) // int(workers))))
+    groups = {}
+    for plan in plans:
+        groups.setdefault(_batch_key(plan), []).append(plan)
+    out = []
+    for key, group in groups.items():
+        step = size if batchable.get(key, False) else 1
+        step = -(-len(group) // -(-len(group) // step))        # even parts
+        out += [group[j:j + step] for j in range(0, len(group), step)]
+    return sorted(out, key=lambda part: part[0].index)
+
+
+def _first_runs(spec, plans):
+    """``{batch key: RunSetup or None}``: a 3-sample run of the first record of each
+    :func:`_batch_key` (None where it cannot be built: the record reports why)."""
+    first = {}
+    for plan in plans:
+        first.setdefault(_batch_key(plan), plan)
+    out = {}
+    for key, plan in first.items():
+        try:
+            out[key] = prepare_run(spec.record_rig(plan), spec.record_operating_point(plan),
+                                   3.0 / spec.fs_hz, mesh=spec.mesh, fs_hz=spec.fs_hz,
+                                   substeps=spec.substeps, seed=0, warmup_s=0.0,
+                                   faults=plan.faults, losses=spec.losses)
+        except Exception:                  # noqa: BLE001 - the record reports it
+            out[key] = None
+    return out
+
+
+def _warm_kernels(spec, setups, batch_size):
+    """Compile/load the kernels here before forking workers: the 3-sample runs of
+    :func:`_first_runs` as the workers will run them (alone on the single-run kernel for
+    ``batch_size`` 1, else in a batch; faulty bearings take their own kernels), and the
     housing path's kernel when the records have accelerometers."""
     if any(c.startswith("accel_") for c in spec.channels or ()):
         try:
             housing_acceleration(np.zeros(8), spec.fs_hz, spec.rig.housing)
         except Exception:                  # noqa: BLE001 - the record reports it
             pass
-    seen = set()
-    for i in pending[:200]:
-        plan = spec.record(i)
-        if plan.fault_label in seen:
-            continue
-        seen.add(plan.fault_label)
+    setups = [s for s in setups if s is not None]
+    if batch_size > 1:
+        simulate_batch(setups)
+        return
+    for setup in setups:
         try:
-            simulate(spec.record_rig(plan), spec.record_operating_point(plan),
-                     3.0 / spec.fs_hz, mesh=spec.mesh, fs_hz=spec.fs_hz,
-                     substeps=spec.substeps, seed=0, warmup_s=0.0, faults=plan.faults,
-                     losses=spec.losses)
+            integrate_prepared(setup)
         except Exception:                  # noqa: BLE001 - the record reports it
             pass
 
 
 def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=None,
-                     start_method=None, verify=False, force=False, on_record_done=None):
+                     start_method=None, verify=False, force=False, on_record_done=None,
+                     batch_size=None):
     """Generate every record of ``spec`` that ``out_dir`` does not hold yet.
 
     Parameters
@@ -167,6 +213,13 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
     on_record_done : callable, optional
         ``on_record_done(row)`` after each record (an exception stops the run; the finished
         records are kept).
+    batch_size : int, optional
+        Most records a worker integrates together in one time loop, fewer when that spreads
+        the records over the workers (default
+        :data:`~cmsim.datasets.records.DEFAULT_BATCH_SIZE`, 1: each record alone on the
+        single-run kernel, the reference). A record's arrays are bit for bit the same for
+        every batch size above 1, on any number of workers, resumed or not, and within 1e-9
+        of each signal's range of the single-run kernel's.
 
     Returns
     -------
@@ -185,6 +238,12 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
     """
     check_type("spec", spec, DatasetSpec)
     workers = check_workers(workers)
+    if batch_size is not None:
+        if isinstance(batch_size, bool) or not isinstance(batch_size, numbers.Integral) \
+                or not 1 <= batch_size <= 1024:
+            raise ParameterError(f"batch_size must be a whole number in [1, 1024], got "
+                                 f"{batch_size!r}", param="batch_size")
+        batch_size = int(batch_size)
     method = check_start_method(start_method)
     if progress is None:
         progress = sys.stderr.isatty()
@@ -195,7 +254,7 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
         try:
             return _generate(spec, out, start, workers=workers, client=client,
                              progress=progress, method=method, verify=verify, force=force,
-                             on_record_done=on_record_done)
+                             on_record_done=on_record_done, batch_size=batch_size)
         except BaseException:
             if created:
                 _remove_unfinished(out)
@@ -239,39 +298,50 @@ def _remove_temporary(out):
 
 
 def _generate(spec, out, start, *, workers, client, progress, method, verify, force,
-              on_record_done):
+              on_record_done, batch_size=None):
     """The body of :func:`generate_dataset`, under the directory lock; ``client`` is the
     Dask client (``None``: local processes)."""
     for sub in (RECORDS_DIR, ROWS_DIR):
         (out / sub).mkdir(exist_ok=True)
     _remove_temporary(out)
     kept = open_directory(spec, out, force)
-    done, adopted = done_indices(spec, out, verify)
+    # the manifest is read once: for what is done, then to fold this run's rows into
+    known = read_rows(out)
+    done, adopted = done_indices(spec, out, verify, known)
     adopted += kept
     t_resume = time.perf_counter() - start
     pending = [i for i in range(spec.n_records) if i not in done]
     rows = []
 
-    def record(key, row):
-        rows.append(row)
-        if on_record_done is not None:
-            on_record_done(row)
+    def record_all(key, batch):
+        for row in batch:
+            rows.append(row)
+            if on_record_done is not None:
+                on_record_done(row)
 
     n_workers, t_warm = 0, 0.0
     try:
         if pending:
+            plans = [spec.record(i) for i in pending]      # drawn once, here
+            size = DEFAULT_BATCH_SIZE if batch_size is None else batch_size
+            first = _first_runs(spec, plans)
             if client is None and method == "fork":
                 t_w = time.perf_counter()
-                _warm_kernels(spec, pending)
+                _warm_kernels(spec, first.values(), size)
                 t_warm = time.perf_counter() - t_w
-            tasks = [(spec.record_id(i), (spec, i, str(out))) for i in pending]
-            n_workers = run_tasks(run_record, tasks, record, workers=workers,
+            batchable = {k: s is not None and kernel_layout(s) is not None
+                         for k, s in first.items()}
+            tasks = [(part[0].record_id, (spec, [p.index for p in part], str(out), part, size))
+                     for part in _batches(plans, workers if client is None else None, size,
+                                          batchable)]
+            n_workers = run_tasks(run_records, tasks, record_all, workers=workers,
                                   start_method=method, scheduler=client,
                                   progress=progress, desc=spec.name, unit="rec",
-                                  postfix=lambda k, r: f"{k} {r['status']}")
+                                  postfix=lambda k, r: f"{r[-1]['record_id']} {r[-1]['status']}",
+                                  total=len(pending), units=len)
     finally:
         t_c = time.perf_counter()
-        consolidate(out)
+        consolidate(out, known)
         _remove_temporary(out)             # a worker killed mid-write (Dask retries it)
         t_consolidate = time.perf_counter() - t_c
     timing = {k: 0.0 for k in (*_TIMING_KEYS, "busy")}

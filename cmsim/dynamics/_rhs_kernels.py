@@ -236,6 +236,46 @@ def profile_at(prof, t0, dt, t):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def nominal_rotation_jit(t, P, g):
+    """``(τ, Ω/Ω_ref, (dΩ/dt)/Ω_ref)`` of the nominal rotation at time ``t`` (``t, 1, 0`` at
+    constant speed); with a profile, also its output torque into ``g``."""
+    if P.m_int[MI_PROFILE] == 0:
+        return t, 1.0, 0.0
+    theta, omega_in, alpha_in, torque = profile_at(P.prof, P.m_par[MP_PT0], P.m_par[MP_PDT], t)
+    inv_ref = 1.0 / P.m_par[MP_OMREF]
+    if P.m_int[MI_TDOF] >= 0:
+        g[P.m_int[MI_TDOF]] = -torque
+    return theta * inv_ref, omega_in * inv_ref, alpha_in * inv_ref
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def slip_at_jit(t, P, W):
+    """The balls' and cages' slip at time ``t`` into ``W``; True when the balls move off their
+    nominal offsets (``W.slip_cos``, ``W.slip_sin`` then hold them), False when they keep
+    ``P.b_cos``, ``P.b_sin`` (a cage-only slip, or none)."""
+    if P.jitter.shape[2] > 1 and P.m_int[MI_BALL_SLIP] != 0:
+        slip_offsets_jit(t, P.b_int, P.b_cos, P.b_sin, P.jitter, P.m_par[MP_JDT], W.slip_cos,
+                         W.slip_sin, W.cage_slip)
+        return True
+    if P.jitter.shape[2] > 1:
+        # cages only: the per-ball grid (all zero) is not read
+        cage_slip_jit(t, P.b_int, P.b_cos, P.jitter, P.m_par[MP_JDT], W.cage_slip)
+    return False
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def defect_forces_jit(t, tau, y, n, g, P, W, ball_cos, ball_sin, diag, want_diag):
+    """The change race and ball defects and off-size balls make to the bearing forces (none
+    without them), at time ``t`` and equivalent time ``tau``."""
+    if P.b_def.shape[0] > 0 or P.m_int[MI_FAULTY_BALLS] != 0:
+        if P.track.shape[1] > 1:
+            track_gains_jit(P.track, P.m_par[MP_TDT], t, W.def_gain)
+        faulty_bearing_forces_jit(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin,
+                                  W.cage, W.cage_slip, diag, want_diag, P.b_ang, P.b_off,
+                                  P.b_def, W.def_gain)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     """Equations of motion (module docstring); writes ``dydt[row]`` and optionally ``diag``."""
     minv = P.minv
@@ -244,39 +284,17 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
     g = W.g
     for i in range(n):
         g[i] = fext[i]
-    # nominal rotation: τ = t, Ω/Ω_ref = 1, no acceleration at constant speed
-    tau = t
-    sr = 1.0
-    ar = 0.0
-    if P.m_int[MI_PROFILE] != 0:
-        theta, omega_in, alpha_in, torque = profile_at(P.prof, P.m_par[MP_PT0],
-                                                       P.m_par[MP_PDT], t)
-        inv_ref = 1.0 / P.m_par[MP_OMREF]
-        tau = theta * inv_ref
-        sr = omega_in * inv_ref
-        ar = alpha_in * inv_ref
-        if P.m_int[MI_TDOF] >= 0:
-            g[P.m_int[MI_TDOF]] = -torque
-    if P.jitter.shape[2] > 1 and P.m_int[MI_BALL_SLIP] != 0:
-        slip_offsets_jit(t, P.b_int, P.b_cos, P.b_sin, P.jitter, P.m_par[MP_JDT], W.slip_cos,
-                         W.slip_sin, W.cage_slip)
+    tau, sr, ar = nominal_rotation_jit(t, P, g)
+    if slip_at_jit(t, P, W):
         ball_cos = W.slip_cos
         ball_sin = W.slip_sin
     else:
-        if P.jitter.shape[2] > 1:
-            # cages only: the per-ball grid (all zero) is not read
-            cage_slip_jit(t, P.b_int, P.b_cos, P.jitter, P.m_par[MP_JDT], W.cage_slip)
         ball_cos = P.b_cos
         ball_sin = P.b_sin
     if P.b_int.shape[0] > 0:
         bearing_forces_jit(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos, ball_sin, W.cage,
                            W.cage_slip, diag, want_diag)
-        if P.b_def.shape[0] > 0 or P.m_int[MI_FAULTY_BALLS] != 0:
-            if P.track.shape[1] > 1:
-                track_gains_jit(P.track, P.m_par[MP_TDT], t, W.def_gain)
-            faulty_bearing_forces_jit(tau, y, n, g, P.omega, P.b_int, P.b_par, ball_cos,
-                                      ball_sin, W.cage, W.cage_slip, diag, want_diag, P.b_ang,
-                                      P.b_off, P.b_def, W.def_gain)
+        defect_forces_jit(t, tau, y, n, g, P, W, ball_cos, ball_sin, diag, want_diag)
     if P.m_int[MI_ON] != 0:
         mesh_forces_jit(tau, sr, y, n, g, P, W, diag, want_diag)
     linear_accel_jit(y, g, minv, P.springs, P.spring_ends, dydt, row)

@@ -26,7 +26,7 @@ ANCHOR_RAD = 0.05
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _rotate_small(c0, s0, d):
+def rotate_small_jit(c0, s0, d):
     """cos and sin of (a + d) from those of a, for |d| <= ANCHOR_RAD (Taylor, < 1e-15)."""
     d2 = d * d
     cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0 - d2 * (1.0 / 40320.0))))
@@ -46,4 +46,4 @@ def anchored_cos_sin_jit(anchor, row, angle):
         anchor[row, AN_SIN] = s
         anchor[row, AN_VALID] = 1.0
         return c, s
-    return _rotate_small(anchor[row, AN_COS], anchor[row, AN_SIN], d)
+    return rotate_small_jit(anchor[row, AN_COS], anchor[row, AN_SIN], d)

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import sys
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +57,21 @@ PROFILE_STEP_S = 1e-4
 MAX_ROTATION_DEVIATION_RAD = 0.5
 
 
+def max_displacement_m(model):
+    """The largest displacement of a translational DOF a run of ``model`` may reach before it
+    counts as diverged, m (100 × the largest bearing clearance, at least 1 mm)."""
+    return max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
+
+
+def diverged_at(t, max_disp, substeps):
+    """The :class:`IntegrationDiverged` of a run that diverged at time ``t`` (s)."""
+    return IntegrationDiverged(
+        f"the integration diverged at t = {t:.6g} s (a displacement exceeded {max_disp:g} m, "
+        f"a rotation deviation {MAX_ROTATION_DEVIATION_RAD:g} rad, or a value became "
+        f"non-finite); use a smaller step (substeps > {substeps} or a higher fs_hz) or check "
+        f"the rig parameters")
+
+
 class _Integrator:
     """The fixed-step kernel run in chunks with one scratch state (bit-identical to one call).
 
@@ -77,7 +93,7 @@ class _Integrator:
         self.params = model.kernel_params if self.split is None else self.split.kernel_params
         self.progress = progress
         self.wall = 0.0
-        self.max_disp = max(1e-3, 100 * max(abs(b.clearance_m) for b in model.rig.bearings))
+        self.max_disp = max_displacement_m(model)
         self.mask = model.translational_mask
 
     def chunks(self, y0, t0, h, n_out, substeps, chunk_steps=CHUNK_STEPS):
@@ -108,12 +124,7 @@ class _Integrator:
                                    self.max_disp, MAX_ROTATION_DEVIATION_RAD, self.mask)
             self.wall += time.perf_counter() - start
             if status >= 0:
-                raise IntegrationDiverged(
-                    f"the integration diverged at t = {t0 + (first + status) * substeps * h:.6g}"
-                    f" s (a displacement exceeded {self.max_disp:g} m, a rotation deviation "
-                    f"{MAX_ROTATION_DEVIATION_RAD:g} rad, or a value became non-finite); use a "
-                    f"smaller step (substeps > {substeps} or a higher fs_hz) or check the rig "
-                    f"parameters")
+                raise diverged_at(t0 + (first + status) * substeps * h, self.max_disp, substeps)
             skip = 1 if m0 else 0
             yield m0, states[skip:], diag[skip:]
             y = states[-1].copy()
@@ -233,48 +244,70 @@ def _recorded(model, record):
     return set(record), sorted(q_cols), sorted(d_cols)
 
 
+class _Decimator:
+    """One run's anti-alias decimation, fed the integrator's blocks in order.
+
+    ``feed(i0, states, diag)`` takes a block of fast samples (sample ``i0`` first, as
+    :meth:`_Integrator.chunks` yields them) and filters the recorded columns into the output
+    instants ``n_warm .. n_warm + n_rec − 1``; :attr:`q_out` and :attr:`d_out` hold them
+    (NaN in the columns not recorded). A batch of runs (:mod:`cmsim.dynamics.batch`) feeds
+    one per run from its lane of the batch's blocks.
+    """
+
+    def __init__(self, model, n_warm, n_rec, aa, q_cols=None, d_cols=None):
+        k, hl = aa.factor, aa.half_length
+        n = model.n_dof
+        self.aa, self.k, self.n_rec = aa, k, n_rec
+        self.first = n_warm * k - hl                  # first fast sample the filter reads
+        self.last = (n_warm + n_rec - 1) * k + hl     # last one
+        n_forces = len(model.output_force_names)
+        self.q_out = np.full((n_rec, n), np.nan, order="F")   # signals are read by column
+        self.d_out = np.full((n_rec, n_forces), np.nan, order="F")
+        self.qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
+        self.dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
+        self.m0 = 0                                   # next output sample to fill
+        self.n_tail = 0                               # fast samples not yet consumed
+        # the filtered columns side by side, in one buffer for the run: the tail a block
+        # leaves, then the next block
+        self.width = self.qc.size + self.dc.size
+        self.buf = np.zeros((2 * hl + k + DECIMATION_CHUNK_STEPS + 1, self.width))
+
+    def feed(self, i0, st, dg):
+        """Filter the block ``st``, ``dg`` (fast samples ``i0 ..``) into the outputs."""
+        if i0 + len(st) <= self.first:                # warm-up the filter never reads
+            return
+        lo = max(self.first - i0, 0)
+        n_tail, k, width = self.n_tail, self.k, self.width
+        n_rows = n_tail + len(st) - lo
+        if n_rows > self.buf.shape[0]:
+            self.buf = np.vstack([self.buf[:n_tail], np.zeros((n_rows - n_tail, width))])
+        buf, qc, dc = self.buf, self.qc, self.dc
+        gather_columns_jit(st, dg, lo, qc, dc, buf, n_tail)
+        # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
+        out = self.aa.apply(buf[:n_rows])
+        take = min(len(out), self.n_rec - self.m0)
+        if take > 0:
+            m0 = self.m0
+            self.q_out[m0:m0 + take, qc] = out[:take, :qc.size]
+            self.d_out[m0:m0 + take, dc] = out[:take, qc.size:qc.size + dc.size]
+            self.m0 += take
+        self.n_tail = n_rows - take * k
+        buf[:self.n_tail] = buf[take * k:n_rows].copy()
+
+
 def _integrate_decimated(model, y0, dt_out, n_warm, n_rec, aa, scheme, stats, progress=None,
                          q_cols=None, d_cols=None, split=None):
     """Integrate at ``aa.factor`` steps per output sample in chunks and decimate through
     ``aa``; returns the recorded ``(q, forces, wall_s)`` at the output instants
     ``n_warm .. n_warm + n_rec − 1``. With ``q_cols``/``d_cols`` only those state and force
     columns are filtered (the others are NaN)."""
-    k, hl = aa.factor, aa.half_length
-    n = model.n_dof
-    first = n_warm * k - hl                       # first fast sample the filter reads
-    last = (n_warm + n_rec - 1) * k + hl          # last one
-    n_forces = len(model.output_force_names)
-    q_out = np.full((n_rec, n), np.nan, order="F")       # signals are read column by column
-    d_out = np.full((n_rec, n_forces), np.nan, order="F")
-    qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
-    dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
+    dec = _Decimator(model, n_warm, n_rec, aa, q_cols, d_cols)
     runner = _Integrator(model, scheme, progress, split)
-    m0 = 0                                        # next output sample to fill
-    n_tail = 0                                    # fast samples not yet consumed, at buf[0:]
-    # the filtered columns side by side, in one buffer for the run: the tail a block leaves,
-    # then the next block
-    width = qc.size + dc.size
-    chunk = DECIMATION_CHUNK_STEPS
-    buf = np.zeros((2 * hl + k + chunk + 1, width))
-    for i0, st, dg in runner.chunks(y0, 0.0, dt_out / k, last + 1, 1, chunk):
-        if i0 + len(st) <= first:                 # warm-up the filter never reads
-            continue
-        lo = max(first - i0, 0)
-        n_rows = n_tail + len(st) - lo
-        if n_rows > buf.shape[0]:                 # (not reached: the tail is <= 2·hl rows)
-            buf = np.vstack([buf[:n_tail], np.zeros((n_rows - n_tail, width))])
-        gather_columns_jit(st, dg, lo, qc, dc, buf, n_tail)
-        # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
-        out = aa.apply(buf[:n_rows])
-        take = min(len(out), n_rec - m0)
-        if take > 0:
-            q_out[m0:m0 + take, qc] = out[:take, :qc.size]
-            d_out[m0:m0 + take, dc] = out[:take, qc.size:qc.size + dc.size]
-            m0 += take
-        n_tail = n_rows - take * k
-        buf[:n_tail] = buf[take * k:n_rows].copy()
+    for i0, st, dg in runner.chunks(y0, 0.0, dt_out / aa.factor, dec.last + 1, 1,
+                                    DECIMATION_CHUNK_STEPS):
+        dec.feed(i0, st, dg)
     stats.update(runner.stats())
-    return q_out, d_out, runner.wall
+    return dec.q_out, dec.d_out, runner.wall
 
 
 def kernels_cached():
@@ -439,6 +472,117 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     -------
     Run
     """
+    setup = prepare_run(rig, op, duration_s, mesh=mesh, fs_hz=fs_hz, substeps=substeps,
+                        scheme=scheme, slip=slip, seed=seed, warmup_s=warmup_s,
+                        cage_phases_rad=cage_phases_rad, profile=profile, faults=faults,
+                        loads=loads, friction_table=friction_table,
+                        damping_table=damping_table, losses=losses, record=record)
+    if on_start is not None:
+        on_start(setup.warmup_s + setup.duration_s)
+    compile_s = compile_kernels()       # after on_start: a front end announces the compile
+    return integrate_prepared(setup, progress, compile_s)
+
+
+def integrate_prepared(setup, progress=None, compile_s=0.0):
+    """Integrate a :class:`RunSetup` alone and return its :class:`~cmsim.run.Run`
+    (:func:`simulate`'s time loop; ``progress`` as there, ``compile_s`` for the meta)."""
+    stats = {}
+    try:
+        states, diag, wall, n_warm, aa = _integrate_run(
+            setup.model, setup.y0, setup.dt, setup.warmup_s, setup.fs_hz, setup.n_rec,
+            setup.substeps, setup.scheme, stats, progress, setup.q_cols, setup.d_cols,
+            setup.split)
+    except IntegrationDiverged as exc:
+        raise setup.diverged(exc) from None
+    return finish_run(setup, states, diag, wall, n_warm, aa, stats, compile_s)
+
+
+@dataclass(frozen=True)
+class RunSetup:
+    """A run checked and built, ready to integrate (:func:`prepare_run`): what
+    :func:`simulate` decides before its time loop, and what :func:`finish_run` needs after.
+
+    Attributes
+    ----------
+    rig, op : Rig, OperatingPoint
+        The rig and the operating point (the profile's start speed and torque).
+    model : DynamicModel
+        The run's equations of motion.
+    y0 : ndarray, shape (2n,)
+        Start state ``[q0, 0]``: the quasi-static equilibrium, m and rad.
+    start_method : str
+        How ``q0`` was found (:func:`cmsim.dynamics.quasistatic.initial_state`).
+    fs_hz, dt, warmup_s, duration_s : float
+        Output sample rate (Hz), its interval (s), warm-up and recorded duration (s).
+    n_rec : int
+        Recorded samples.
+    scheme, split, substeps, f_max
+        The integration (:func:`cmsim.dynamics.schemes.choose_scheme`): scheme name, the
+        exponential split or None, steps per output sample, highest mode (Hz).
+    excitation : Excitation
+        The run's fastest excitation.
+    wanted, q_cols, d_cols
+        The recorded signals' names and the state and force columns they need (None: all).
+    kprof, profile
+        The kernel's speed/torque table and the user's speed profile (None at constant
+        speed).
+    seed : int
+        The run's seed.
+    slip : RollingSlip
+        The run's rolling slip.
+    faults : tuple of Fault
+        The run's faults.
+    loss_inputs, loads, friction_table, model_mesh
+        The losses' inputs (or None), the loads and friction table the model was built with.
+    """
+
+    rig: object
+    op: object
+    model: object
+    y0: np.ndarray
+    start_method: str
+    fs_hz: float
+    dt: float
+    warmup_s: float
+    duration_s: float
+    n_rec: int
+    scheme: str
+    split: object
+    substeps: int
+    f_max: float
+    excitation: object
+    wanted: object
+    q_cols: object
+    d_cols: object
+    kprof: object
+    profile: object
+    seed: int
+    slip: object
+    faults: tuple
+    loss_inputs: object
+    loads: object
+    friction_table: object
+
+    def diverged(self, exc):
+        """The :class:`IntegrationDiverged` to raise for ``exc``: as it is, or saying that
+        no static equilibrium was found when the run started from the nominal geometry."""
+        if not self.start_method.endswith("(no equilibrium found)"):
+            return exc
+        op = self.op
+        loads = (f"torque_nm = {op.torque_nm:g} N m" if self.rig.gears is not None
+                 else f"radial_load_n = {op.radial_load_n:g} N")
+        return IntegrationDiverged(f"no static equilibrium at {loads} (the rig may not carry "
+                                   f"it), and the run from the nominal geometry diverged: "
+                                   f"{exc}")
+
+
+def prepare_run(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLING.fs_hz,
+                substeps=SAMPLING.substeps, scheme="auto", slip=None, seed=SAMPLING.seed,
+                warmup_s=SAMPLING.warmup_s, cage_phases_rad="random", profile=None,
+                faults=(), loads=None, friction_table=None, damping_table=None, losses=None,
+                record=None):
+    """Check a run's inputs and build it, up to its time loop (:func:`simulate`'s
+    parameters, which it documents); returns a :class:`RunSetup`."""
     check_choice("scheme", scheme, ("auto",) + tuple(SCHEMES))
     duration_s = RANGES["duration_s"].check("duration_s", duration_s)
     fs_hz = RANGES["fs_hz"].check("fs_hz", fs_hz)
@@ -505,22 +649,25 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
                              f"fs_hz = {fs_hz:g}")
     scheme, split, substeps, f_max = choose_scheme(model, q0, fs_hz, excitation, scheme,
                                                    substeps)
-    stats = {}
-    if on_start is not None:
-        on_start(warmup_s + duration_s)
-    compile_s = compile_kernels()       # after on_start: a front end announces the compile
-    try:
-        states, diag, wall, n_warm, aa = _integrate_run(
-            model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress, q_cols,
-            d_cols, split)
-    except IntegrationDiverged as exc:
-        if not start_method.endswith("(no equilibrium found)"):
-            raise
-        loads = (f"torque_nm = {op.torque_nm:g} N m" if rig.gears is not None
-                 else f"radial_load_n = {op.radial_load_n:g} N")
-        raise IntegrationDiverged(f"no static equilibrium at {loads} (the rig may not carry "
-                                  f"it), and the run from the nominal geometry diverged: "
-                                  f"{exc}") from None
+    return RunSetup(rig, op, model, y0, start_method, fs_hz, dt, warmup_s, duration_s, n_rec,
+                    scheme, split, int(substeps), f_max, excitation, wanted, q_cols, d_cols,
+                    kprof, profile, int(seed), slip, faults, loss_inputs, loads, friction_table)
+
+
+def finish_run(setup, states, diag, wall, n_warm, aa, stats, compile_s=0.0):
+    """The :class:`~cmsim.run.Run` of an integrated :class:`RunSetup`: its named signals
+    and meta from the recorded ``states`` (n_rec, n) and forces ``diag`` (n_rec, n_diag),
+    the integration's wall time ``wall`` (s), warm-up samples ``n_warm``, anti-alias filter
+    ``aa`` (or None), the hybrid solver's ``stats`` and the kernels' ``compile_s``."""
+    rig, op, model, fs_hz, dt, n_rec = (setup.rig, setup.op, setup.model, setup.fs_hz,
+                                        setup.dt, setup.n_rec)
+    scheme, split, substeps, f_max = setup.scheme, setup.split, setup.substeps, setup.f_max
+    excitation, wanted, kprof, profile = (setup.excitation, setup.wanted, setup.kprof,
+                                          setup.profile)
+    seed, slip, faults, loss_inputs = setup.seed, setup.slip, setup.faults, setup.loss_inputs
+    loads, friction_table = setup.loads, setup.friction_table
+    q0 = setup.y0[:model.n_dof]
+    start_method = setup.start_method
     t = (n_warm + np.arange(n_rec)) * dt
     signals = _signals(model, t, states, diag, kprof, wanted)
     if wanted is not None:
@@ -567,6 +714,15 @@ def simulate(rig, op, duration_s=SAMPLING.duration_s, *, mesh=None, fs_hz=SAMPLI
     return run
 
 
+@functools.lru_cache(maxsize=16)
+def decimation(substeps, fs_hz, warmup_s):
+    """``(anti-alias filter, warm-up samples)`` of a run recorded at ``fs_hz`` (Hz) after
+    ``warmup_s`` (s) and integrated at ``substeps`` > 1 steps per sample: the centred filter
+    needs half its length of integration before the first sample (designed once per rate)."""
+    aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
+    return aa, max(int(round(warmup_s * fs_hz)), math.ceil(aa.half_length / substeps))
+
+
 def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stats, progress,
                    q_cols, d_cols, split=None):
     """The run's integration: ``(states, diag, wall_s, n_warm, anti_alias)`` of the recorded
@@ -578,9 +734,7 @@ def _integrate_run(model, y0, dt, warmup_s, fs_hz, n_rec, substeps, scheme, stat
         states, diag, wall = integrate(model, y0, 0.0, dt, n_warm + n_rec, 1, scheme, stats,
                                        report, split)
         return states[n_warm:, :model.n_dof], diag[n_warm:], wall, n_warm, None
-    aa = AntiAliasFilter(int(substeps), fs_hz * substeps)
-    # the centred filter needs half its length of integration before the first sample
-    n_warm = max(int(round(warmup_s * fs_hz)), math.ceil(aa.half_length / substeps))
+    aa, n_warm = decimation(substeps, fs_hz, warmup_s)
     report = None if progress is None else (lambda done, total: progress(
         done * dt / substeps, total * dt / substeps))
     states, diag, wall = _integrate_decimated(model, y0, dt, n_warm, n_rec, aa, scheme, stats,

@@ -183,15 +183,15 @@ def test_killed_run_resumes_without_recomputing(small_one_worker, tmp_path):
 
 def test_failed_record_is_marked_and_the_rest_go_on(tmp_path, monkeypatch):
     import cmsim.datasets.records as gen
-    real = gen.simulate_record
+    real = gen.simulate_records
 
-    def flaky(spec, index):
-        if index == 2:
-            from cmsim.errors import IntegrationDiverged
-            raise IntegrationDiverged("integration diverged at t = 0.01 s (test)")
-        return real(spec, index)
+    def flaky(spec, plans, batch_size=None):
+        from cmsim.errors import IntegrationDiverged
+        return [IntegrationDiverged("integration diverged at t = 0.01 s (test)")
+                if plan.index == 2 else res
+                for plan, res in zip(plans, real(spec, plans, batch_size))]
 
-    monkeypatch.setattr(gen, "simulate_record", flaky)      # forked workers inherit it
+    monkeypatch.setattr(gen, "simulate_records", flaky)     # forked workers inherit it
     s = generate_dataset(DatasetSpec.from_dict(SMALL), tmp_path / "f", workers=2,
                          start_method="fork")
     assert (s.records_written, s.records_failed) == (5, 1)
@@ -200,7 +200,7 @@ def test_failed_record_is_marked_and_the_rest_go_on(tmp_path, monkeypatch):
     row = ds.manifest.iloc[2]
     assert row["status"] == "failed" and "IntegrationDiverged" in row["error"]
     assert len(ds) == 5 and "000002" not in {r.record_id for r in ds}
-    monkeypatch.setattr(gen, "simulate_record", real)
+    monkeypatch.setattr(gen, "simulate_records", real)
     s = generate_dataset(DatasetSpec.from_dict(SMALL), tmp_path / "f", workers=1)
     assert (s.records_written, s.records_skipped) == (0, 6)     # failed ones are not retried
 

@@ -1,0 +1,393 @@
+"""A batch of runs of one rig integrated in lockstep: numba kernels, the record the inner axis.
+
+B runs that share their kernel layout (:func:`cmsim.dynamics.batch.kernel_layout`: the same
+DOFs, bearings, slots, fault and profile switches and table sizes) and differ in their values
+(operating point, clearances, faults, slip, profile) advance together, one step of all B at
+a time. Their states are ``(dim, B)`` arrays, the run index innermost, so the parts of the
+right-hand side that are the same arithmetic on different numbers run as loops over the B
+runs that numba vectorises (SIMD lanes): the linear springs and dampers, the healthy Hertz
+ball sums of every bearing, the Runge-Kutta stage combinations. The parts that branch per
+run — the speed/torque profile, slip, defects and the tooth contacts — call the
+single-run kernels of :mod:`cmsim.dynamics._rhs_kernels` on each run's views (:func:`lane_params`,
+:func:`lane_work`), so their physics is written once.
+
+Independence of the runs (the contract :mod:`cmsim.dynamics.batch` tests): every operation on
+run ``l`` reads only run ``l``'s numbers, in the same order whatever B is and wherever the run
+sits in the batch (no fastmath: no reassociation, no fused multiply-add a vector body would
+use and its scalar remainder not), so a run's samples are bit-identical in any batch. They
+agree with the single-run kernel to rounding (its healthy ball loop is compiled with
+fastmath, which reorders the ball sum).
+
+A run that diverges (a non-finite state, or a displacement or rotation beyond its limit at an
+output sample) is flagged in ``status`` with the sample index and restarted from its start
+state, so the others finish; its samples are not used.
+
+The numba rule of every kernel module of :mod:`cmsim.dynamics` (in full in
+:mod:`cmsim.dynamics._rhs_kernels`): ``@njit(cache=True)``, float64/int64 arrays and
+scalars only, no Python objects, no random numbers, no allocation in the hot path.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from cmsim.dynamics._bearing_kernels import (BI_FAULTY, BI_NB, BI_T, BI_X, BI_Y, BP_C, BP_CAGE,
+                                             BP_DAMP, BP_K, BP_P, BP_PHASE, BP_SENSE)
+from cmsim.dynamics._mesh_kernels import MI_FAULTY_BALLS, MI_ON, mesh_forces_jit
+from cmsim.dynamics._rhs_kernels import (KernelParams, Work, defect_forces_jit,
+                                         nominal_rotation_jit, slip_at_jit)
+from cmsim.dynamics._rotation_kernels import (AN_ANGLE, AN_COS, AN_SIN, AN_VALID, ANCHOR_RAD,
+                                              anchored_cos_sin_jit, rotate_small_jit)
+
+
+class LaneParams(NamedTuple):
+    """The model values the vectorised loops read, the run innermost (SI units)."""
+
+    minv: np.ndarray      # (n, B) inverse masses
+    springs: np.ndarray   # (e, 2, B) stiffness and damping of each spring-damper
+    fext: np.ndarray      # (n, B) constant external load
+    omega: np.ndarray     # (n, B) nominal rotation speeds, rad/s
+    b_par: np.ndarray     # (nb, BP_SIZE, B) bearing parameters
+    b_cos: np.ndarray     # (nb, max_balls, B) cos of each ball's nominal offset
+    b_sin: np.ndarray     # (nb, max_balls, B) sin
+
+
+class BatchBuffers(NamedTuple):
+    """Buffers of :func:`integrate_batch_jit` (the run innermost)."""
+
+    k: np.ndarray         # (s, dim, B) stage slopes
+    y: np.ndarray         # (dim, B) state; the start state on entry to the first chunk
+    yi: np.ndarray        # (dim, B) stage state
+    y0: np.ndarray        # (dim, B) start states (a diverged run restarts from it)
+    diag: np.ndarray      # (n_diag, B) output forces of the current step
+    tau: np.ndarray       # (B,) equivalent time of the nominal rotation, s
+    sr: np.ndarray        # (B,) speed over the reference speed
+    ar: np.ndarray        # (B,) acceleration over the reference speed, 1/s
+    cc: np.ndarray        # (B,) cos, sin of the current bearing's cage angle
+    sc: np.ndarray
+    xr: np.ndarray        # (B,) the inner ring's offset in the cage frame, m
+    yr: np.ndarray
+    fx: np.ndarray        # (B,) the ball sums in the cage frame
+    fy: np.ndarray
+    y1: np.ndarray        # (dim,) one run's state, contiguous
+    g1: np.ndarray        # (n,) its forces
+    d1: np.ndarray        # (n_diag,) its output forces
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def lane_params(S, l):
+    """Run ``l``'s :class:`~cmsim.dynamics._rhs_kernels.KernelParams` from the stacked ``S``
+    (each field with the run first): views, nothing copied."""
+    return KernelParams(S.minv[l], S.springs[l], S.fext[l], S.omega[l], S.b_int[l],
+                        S.b_par[l], S.b_cos[l], S.b_sin[l], S.jitter[l], S.m_int[l],
+                        S.m_par[l], S.geo[l], S.tab_k[l], S.tab_e[l], S.teeth1[l],
+                        S.teeth2[l], S.spring_ends[l], S.hp[l], S.hd1[l], S.hc1[l], S.hd2[l],
+                        S.hc2[l], S.b_def[l], S.b_ang[l], S.b_off[l], S.tk1[l], S.tk2[l],
+                        S.te1[l], S.te2[l], S.ecc[l], S.prof[l], S.mu_tab[l], S.c_tab[l],
+                        S.track[l])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def lane_work(V, l):
+    """Run ``l``'s :class:`~cmsim.dynamics._rhs_kernels.Work` from the stacked ``V`` (the
+    force vector, the cage anchors and the slip arrays with the run last, the rest with the
+    run first)."""
+    return Work(V.g[:, l], V.cage[:, :, l], V.slip_cos[:, :, l], V.slip_sin[:, :, l],
+                V.cage_slip[:, l], V.slots[l], V.hwork[l], V.hdelta[l], V.hrho1[l],
+                V.hrho2[l], V.hchi1[l], V.hchi2[l], V.hout[l], V.hext[l], V.hstat[l], V.psi[l],
+                V.def_gain[l])
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _cage_frames(ib, it, ix, iy, y, b_par, omega, cage_slip, anchor, B):
+    """Pass 1 of bearing ``ib`` (shaft DOF ``it``, DOFs ``ix``, ``iy``) for every run: the cage
+    angle's cos and sin and the inner ring's offset in the cage frame, into ``B``; the sums
+    zeroed.
+
+    Each run's angle turns its own anchor (``anchor`` (nb, AN_SIZE, B), as
+    :func:`~cmsim.dynamics._rotation_kernels.anchored_cos_sin_jit` does): the few runs whose
+    angle left the anchor's range are re-anchored first (exact cos and sin), then every run
+    rotates its anchor by the small difference in one vectorised loop — a re-anchored run by
+    exactly zero, which returns its exact values, so each run gets the single-run kernel's
+    numbers."""
+    rate_a = b_par[ib, BP_CAGE]
+    sense = b_par[ib, BP_SENSE]
+    phase = b_par[ib, BP_PHASE]
+    w = omega[it]
+    q = y[it]
+    slip = cage_slip[ib]
+    ang = B.xr                      # (the angles, until the offsets replace them)
+    for l in range(ang.shape[0]):
+        ang[l] = rate_a[l] * sense[l] * (w[l] * B.tau[l] + q[l]) + phase[l] + slip[l]
+    a0 = anchor[ib, AN_ANGLE]
+    valid = anchor[ib, AN_VALID]
+    for l in range(ang.shape[0]):
+        d = ang[l] - a0[l]
+        if valid[l] == 0.0 or d > ANCHOR_RAD or d < -ANCHOR_RAD:
+            anchored_cos_sin_jit(anchor[:, :, l], ib, ang[l])
+    c0 = anchor[ib, AN_COS]
+    s0 = anchor[ib, AN_SIN]
+    qx = y[ix]
+    qy = y[iy]
+    for l in range(ang.shape[0]):
+        cc, sc = rotate_small_jit(c0[l], s0[l], ang[l] - a0[l])
+        B.cc[l] = cc
+        B.sc[l] = sc
+        B.xr[l] = qx[l] * cc + qy[l] * sc
+        B.yr[l] = qy[l] * cc - qx[l] * sc
+        B.fx[l] = 0.0
+        B.fy[l] = 0.0
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _ball_sums(ib, n_balls, b_par, ball_cos, ball_sin, xr, yr, fx, fy, hertz):
+    """Pass 2: the Fukata ball sums ``fx``, ``fy`` (B,) of bearing ``ib`` (paper 001 eq. 9) for
+    every run, the runs innermost, from the inner ring's offsets ``xr``, ``yr`` (B,) in the
+    cage frame. ``hertz`` (every run's exponent is 1.5): δ·√δ, vectorised; otherwise each run
+    takes its own law (δ·√δ for 1.5, δ^p else), so its sum never depends on the others'.
+
+    Written for the vectoriser: plain arrays (not inlined), each ball's rows taken out of the
+    tables before the loop over the runs (it then checks their overlap once and runs whole
+    vectors; it unrolls by four, so a batch of 32 runs fills its vector body)."""
+    c = b_par[ib, BP_C]
+    p = b_par[ib, BP_P]
+    for i in range(n_balls):
+        bc = ball_cos[ib, i]
+        bs = ball_sin[ib, i]
+        if hertz:
+            for l in range(xr.shape[0]):
+                d = max(xr[l] * bc[l] + yr[l] * bs[l] - c[l], 0.0)
+                f = d * math.sqrt(d)
+                fx[l] += f * bc[l]
+                fy[l] += f * bs[l]
+        else:
+            for l in range(xr.shape[0]):
+                d = max(xr[l] * bc[l] + yr[l] * bs[l] - c[l], 0.0)
+                f = d * math.sqrt(d) if p[l] == 1.5 else d ** p[l]
+                fx[l] += f * bc[l]
+                fy[l] += f * bs[l]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, ball_cos, ball_sin):
+    """The healthy law of every bearing for every run (as
+    :func:`cmsim.dynamics._bearing_kernels.bearing_forces_jit`, which leaves the bearings with
+    an off-size ball, ``BI_FAULTY`` = 2, to the defect kernel)."""
+    for ib in range(S.b_int.shape[1]):
+        if S.b_int[0, ib, BI_FAULTY] == 2:
+            continue
+        ix = S.b_int[0, ib, BI_X]
+        iy = S.b_int[0, ib, BI_Y]
+        _cage_frames(ib, S.b_int[0, ib, BI_T], ix, iy, y, L.b_par, L.omega, V.cage_slip,
+                     V.cage, B)
+        hertz = True
+        for l in range(y.shape[1]):
+            hertz = hertz and L.b_par[ib, BP_P, l] == 1.5
+        _ball_sums(ib, S.b_int[0, ib, BI_NB], L.b_par, ball_cos, ball_sin, B.xr, B.yr, B.fx,
+                   B.fy, hertz)
+        _bearing_out(ib, ix, iy, n, y, g, L.b_par, B, diag, want_diag)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _bearing_out(ib, ix, iy, n, y, g, b_par, B, diag, want_diag):
+    """Pass 3: bearing ``ib``'s ball sums turned back to the housing frame, on its DOFs'
+    forces and, with ``want_diag``, the output forces (plus its viscous damping)."""
+    k = b_par[ib, BP_K]
+    damp = b_par[ib, BP_DAMP]
+    gx = g[ix]
+    gy = g[iy]
+    vx = y[n + ix]
+    vy = y[n + iy]
+    for l in range(gx.shape[0]):
+        fxr = k[l] * B.fx[l]
+        fyr = k[l] * B.fy[l]
+        fx = fxr * B.cc[l] - fyr * B.sc[l]
+        fy = fyr * B.cc[l] + fxr * B.sc[l]
+        gx[l] -= fx
+        gy[l] -= fy
+        if want_diag:
+            diag[2 * ib, l] = fx + damp[l] * vx[l]
+            diag[2 * ib + 1, l] = fy + damp[l] * vy[l]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _springs(y, n, g, ends, springs):
+    """The linear spring-dampers of every run into ``g`` (eq. 1, ``− K q − C v``; ground
+    springs last, as :func:`cmsim.dynamics._rhs_kernels.linear_accel_jit` lays them out);
+    ``springs`` (e, 2, B). Rows out of the arrays before the loops over the runs, as
+    :func:`_ball_sums`."""
+    n_springs = ends.shape[0]
+    n_ground = ends[0, 2]
+    for e in range(n_springs - n_ground):
+        ga = g[ends[e, 0]]
+        gb = g[ends[e, 1]]
+        qa = y[ends[e, 0]]
+        qb = y[ends[e, 1]]
+        va = y[n + ends[e, 0]]
+        vb = y[n + ends[e, 1]]
+        k = springs[e, 0]
+        c = springs[e, 1]
+        for l in range(ga.shape[0]):
+            f = k[l] * (qa[l] - qb[l]) + c[l] * (va[l] - vb[l])
+            gb[l] += f
+            ga[l] -= f
+    for e in range(n_springs - n_ground, n_springs):
+        ga = g[ends[e, 0]]
+        qa = y[ends[e, 0]]
+        va = y[n + ends[e, 0]]
+        k = springs[e, 0]
+        c = springs[e, 1]
+        for l in range(ga.shape[0]):
+            ga[l] -= k[l] * qa[l] + c[l] * va[l]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _accelerations(y, n, g, minv, omega, ar, dydt, row):
+    """Row ``row`` of ``dydt`` (s, dim, B) = ``[v, M⁻¹ g − ω·(dΩ/dt)/Ω_ref]`` for every run
+    (the inertia load of the nominal rotation's acceleration only where it is not zero, as
+    the single-run kernel applies it)."""
+    for i in range(n):
+        out_q = dydt[row, i]
+        out_v = dydt[row, n + i]
+        v = y[n + i]
+        gi = g[i]
+        mi = minv[i]
+        wi = omega[i]
+        for l in range(gi.shape[0]):
+            out_q[l] = v[l]
+            out_v[l] = mi[l] * gi[l] - wi[l] * ar[l] if ar[l] != 0.0 else mi[l] * gi[l]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
+    """The equations of motion of every run at time ``t`` (the single-run contract of
+    :func:`cmsim.dynamics._rhs_kernels.rhs_jit`, with ``y`` (dim, B)); writes ``dydt[row]``
+    (dim, B) and, with ``want_diag``, ``diag`` (n_diag, B)."""
+    n = L.minv.shape[0]
+    n_runs = y.shape[1]
+    g = V.g
+    for i in range(n):
+        gi = g[i]
+        fi = L.fext[i]
+        for l in range(n_runs):
+            gi[l] = fi[l]
+    moved = False
+    for l in range(n_runs):
+        P = lane_params(S, l)
+        W = lane_work(V, l)
+        B.tau[l], B.sr[l], B.ar[l] = nominal_rotation_jit(t, P, W.g)
+        moved = slip_at_jit(t, P, W)          # the same switch for every run of a batch
+    if S.b_int.shape[1] > 0:
+        if moved:
+            _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, V.slip_cos, V.slip_sin)
+        else:
+            _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, L.b_cos, L.b_sin)
+    mesh_on = S.m_int[0, MI_ON] != 0
+    faulty = S.b_def.shape[1] > 0 or S.m_int[0, MI_FAULTY_BALLS] != 0
+    if mesh_on or faulty:
+        # the runs' own contacts through the single-run kernels (the same arithmetic in the
+        # same order), on each run's column of the state and the forces
+        for l in range(n_runs):
+            P = lane_params(S, l)
+            W = lane_work(V, l)
+            yl = y[:, l]
+            gl = g[:, l]
+            dl = diag[:, l]
+            if faulty and moved:
+                defect_forces_jit(t, B.tau[l], yl, n, gl, P, W, W.slip_cos, W.slip_sin, dl,
+                                  want_diag)
+            elif faulty:
+                defect_forces_jit(t, B.tau[l], yl, n, gl, P, W, P.b_cos, P.b_sin, dl,
+                                  want_diag)
+            if mesh_on:
+                mesh_forces_jit(B.tau[l], B.sr[l], yl, n, gl, P, W, dl, want_diag)
+    _springs(y, n, g, S.spring_ends[0], L.springs)
+    _accelerations(y, n, g, L.minv, L.omega, B.ar, dydt, row)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _stage_state(y, k, st, h, rk_a, yi):
+    """``yi = y + h Σ_j a_st,j k_j`` for every run (the terms in the single-run kernel's
+    order)."""
+    for i in range(y.shape[0]):
+        out = yi[i]
+        yr = y[i]
+        for l in range(yr.shape[0]):
+            out[l] = yr[l]
+        for jj in range(st):
+            w = h * rk_a[st, jj]
+            kj = k[jj, i]
+            for l in range(yr.shape[0]):
+                out[l] += w * kj[l]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _step(y, k, h, rk_b):
+    """``y += h Σ_s b_s k_s`` for every run (in the single-run kernel's order)."""
+    for i in range(y.shape[0]):
+        yr = y[i]
+        for l in range(yr.shape[0]):
+            acc = 0.0
+            for st in range(rk_b.shape[0]):
+                acc += rk_b[st] * k[st, i, l]
+            yr[l] += h * acc
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L, V, B, out_y,
+                        out_diag, max_disp, max_rot, trans_mask, status):
+    """Fixed-step explicit Runge-Kutta of a batch of runs, output every ``substeps`` steps.
+
+    The scheme is data (``rk_a``, ``rk_b``, ``rk_c``, as
+    :func:`cmsim.dynamics._rhs_kernels.integrate_jit`). ``S`` holds the runs'
+    :class:`~cmsim.dynamics._rhs_kernels.KernelParams` stacked (run first), ``L`` the
+    :class:`LaneParams`, ``V`` their :class:`~cmsim.dynamics._rhs_kernels.Work` stacked
+    (:func:`lane_work`), ``B`` the :class:`BatchBuffers` (``B.y`` the state to start from).
+    Sample ``m`` of run ``l`` goes to ``out_y[l, m]`` (the state at ``t0 + (m_offset +
+    m)·substeps·h``) and ``out_diag[l, m]`` (its output forces). Chunks started from the
+    last state of the one before with the same ``V`` reproduce one call bit for bit.
+
+    ``status[l]`` (int64, −1 on entry for a run not diverged) becomes the index ``m_offset +
+    m`` of run ``l``'s first output sample that was non-finite or beyond ``max_disp[l]``
+    (translations, ``trans_mask``) or ``max_rot`` (rotations); the run then restarts from
+    ``B.y0`` and its samples mean nothing.
+    """
+    k = B.k
+    y = B.y
+    yi = B.yi
+    diag = B.diag
+    ns = rk_b.shape[0]
+    dim, n_runs = y.shape
+    n = dim // 2
+    for m in range(n_out):
+        for l in range(n_runs):
+            for i in range(dim):
+                out_y[l, m, i] = y[i, l]
+            if status[l] >= 0:
+                continue
+            for i in range(n):
+                limit = max_disp[l] if trans_mask[i] else max_rot
+                if not (math.isfinite(y[i, l]) and math.isfinite(y[n + i, l])
+                        and abs(y[i, l]) <= limit):
+                    status[l] = m_offset + m
+                    for j in range(dim):
+                        y[j, l] = B.y0[j, l]
+                    break
+        for sub in range(substeps):
+            t = t0 + ((m_offset + m) * substeps + sub) * h
+            rhs_batch_jit(t, y, k, 0, S, L, V, B, diag, sub == 0)
+            if sub == 0:
+                for l in range(n_runs):
+                    for i in range(diag.shape[0]):
+                        out_diag[l, m, i] = diag[i, l]
+                if m == n_out - 1:
+                    return
+            for st in range(1, ns):
+                _stage_state(y, k, st, h, rk_a, yi)
+                rhs_batch_jit(t + rk_c[st] * h, yi, k, st, S, L, V, B, diag, False)
+            _step(y, k, h, rk_b)
+
