@@ -6,7 +6,9 @@ Run: ``python benchmarks/validate_real.py [--data DIR] [--workers W] [--out FILE
 ``../shared/datasets``.
 
 * **Calibrated** (``compare --machine``): in a folder with healthy records, a machine is
-  calibrated (:func:`cmsim.machine.calibrate`) on the **first half** of each healthy record
+  calibrated (:func:`cmsim.machine.calibrate` and its signature library,
+  :func:`cmsim.discrepancy.signatures.build_library`) on the **first half** of each healthy
+  record
   and never scored on it; every other record is compared against the machine of the baseline
   at its own documented load (``motor_load_hp``, ``load_percent``, ``radial_load_lbs``), the
   healthy record by its second half; records are also compared across loads (against the
@@ -29,6 +31,7 @@ from pathlib import Path
 from _decisions import spy_on_decisions
 
 from cmsim.discrepancy import compare
+from cmsim.discrepancy.signatures import build_library
 from cmsim.machine import Machine, calibrate
 from cmsim.measured import data_root, read_record
 
@@ -50,9 +53,11 @@ def _half(rec, which):
 
 def calibrate_half(baseline):
     """(baseline path, machine file, calibration wall s): the machine of the first half of a
-    healthy record, written beside the other machine files of this run."""
+    healthy record with its signature library (what ``cmsim calibrate`` writes), written
+    beside the other machine files of this run."""
     t0 = time.perf_counter()
     machine = calibrate([_half(read_record(baseline), "first")])
+    machine = machine.with_library(build_library(machine))
     out = MACHINE_DIR / f"{Path(baseline).parent.name}_{Path(baseline).stem}.toml"
     machine.save(out)
     return str(baseline), str(out), time.perf_counter() - t0
@@ -196,10 +201,13 @@ def main(argv=None):
                 machines[base] = file
                 print(f"calibrated {Path(base).name} (first half) in {wall:.1f} s", flush=True)
             jobs = [(*j, None if j[2] is None else machines[str(j[2])]) for j in jobs]
+            t1 = time.perf_counter()
             for key, c in pool.map(one, jobs):
                 results[key] = c
-                print(key, c["finding"], c["component"], f"{c['wall_s']:.0f} s", flush=True)
-        print(f"total {time.perf_counter() - t0:.0f} s on {a.workers} workers")
+                print(key, c["finding"], c["component"], f"{c['wall_s']:.1f} s", flush=True)
+        t2 = time.perf_counter()
+        print(f"total {t2 - t0:.0f} s on {a.workers} workers: calibrations {t1 - t0:.0f} s, "
+              f"comparisons {t2 - t1:.0f} s ({len(jobs)} records)")
     if a.json and not a.render:
         a.json.write_text(json.dumps(results, indent=1, default=float))
     res = {}

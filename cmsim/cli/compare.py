@@ -61,17 +61,26 @@ def run(args):
     machine = load_file("--machine", args.machine, Machine.load,
                         "a machine file (cmsim calibrate --out)") if args.machine else None
     rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None
+    if machine is not None and rig is not None and rig != machine.rig:
+        # the machine's rig is what its baseline and library were computed on
+        raise CLIError(f"--rig {args.rig}: is not the rig of --machine {args.machine}, which "
+                       "brings its own (the model its baseline and signature library were "
+                       "computed on); leave --rig out", option="--rig")
     channel = args.channel or (machine.channel if machine is not None else None)
+    values = recording_values(args)
     try:
-        record = read_record(args.record, channel=channel, rig=rig, **recording_values(args))
+        record = read_record(args.record, channel=channel, rig=rig, **values)
     except ParameterError as exc:
-        if exc.param != "--channel" or args.channel is not None or machine is None:
+        if exc.param == "rig" and machine is not None and rig is None:
+            # a recording without geometry, read on the machine's own rig
+            record = read_record(args.record, channel=channel, rig=machine.rig, **values)
+        elif exc.param != "--channel" or args.channel is not None or machine is None:
             raise
-        # the channel was the machine's, not the user's: the machine is what does not fit
-        raise CLIError(f"--machine {args.machine}: calibrated on channel {machine.channel!r}, "
-                       f"which the record does not have ({exc}); a machine file belongs to "
-                       "the recordings of the machine it was calibrated on",
-                       option="--machine") from None
+        else:       # the channel was the machine's, not the user's: the machine does not fit
+            raise CLIError(f"--machine {args.machine}: calibrated on channel "
+                           f"{machine.channel!r}, which the record does not have ({exc}); a "
+                           "machine file belongs to the recordings of the machine it was "
+                           "calibrated on", option="--machine") from None
     if args.span is not None:
         record = record.span(*args.span)
     kw = {} if args.budget is None else {"budget": args.budget}

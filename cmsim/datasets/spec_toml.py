@@ -206,6 +206,8 @@ def toml_keywords(data, base_dir=None):
     nz = data.get("nuisances", {})
     sensor = data.get("sensor", {})
     channels = sensor.get("channels")
+    if machine is not None:
+        _check_through_machine(machine, channels, nz)
     sim = data.get("simulation", {})
     return dict(
         variations=settings, sampling=sampling, name=ds.get("name", "dataset"),
@@ -227,6 +229,29 @@ def toml_keywords(data, base_dir=None):
         duration_s=sensor.get("duration_s", SAMPLING.duration_s),
         warmup_s=sensor.get("warmup_s", SAMPLING.warmup_s), mesh=sim.get("mesh"),
         substeps=sim.get("substeps"), losses=sim.get("losses"))
+
+
+#: Nuisances a machine's own path and background replace: a spec through a machine that
+#: draws them would draw a housing and a sensor noise its records never go through.
+MACHINE_OWNS = ("housing_mode_hz", "housing_damping", "sensor_noise_m_s2")
+
+
+def _check_through_machine(machine, channels, nuisances):
+    """Through a machine, a record's channel is the machine's and the path and background
+    are its own: a spec that names another accelerometer, or draws a housing or a sensor
+    noise, is refused naming the key (a stock spec with a ``[machine]`` added kept
+    ``accel_1b1_y`` and its housing nuisances, and evaluate then refused its records)."""
+    for i, c in enumerate(channels or ()):
+        if isinstance(c, str) and c.startswith("accel_"):
+            raise spec_error(f"sensor.channels[{i}]",
+                             f"{c!r} is the model's housing accelerometer; through a [machine] "
+                             f"the record's channel is the machine's ({machine.channel!r}), "
+                             "its path and background the machine's own")
+    for n in MACHINE_OWNS:
+        if n in nuisances:
+            raise spec_error(f"nuisances.{n}",
+                             "through a [machine] the transfer path and the background are "
+                             "the machine's own (calibrated on its baseline); leave it out")
 
 
 def _spec_file(key, name, base_dir):

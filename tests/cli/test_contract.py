@@ -369,6 +369,9 @@ CATALOGUE = [
     R("compare-machine-text", "compare {record} --machine {text}", "--machine"),
     R("compare-machine-other-channel", "compare {record} --machine {machine_other}",
       "--machine", "'a1'"),
+    # issue 48: --rig beside --machine replaced the machine's geometry without a word
+    R("compare-rig-not-the-machines", "compare {record} --machine {machine_other} "
+      "--rig {rig_cwru}", "--rig", "machine"),
     R("compare-span-reversed", "compare {record} --span 1 0.5", "--span"),
     R("calibrate-missing-out", "calibrate {record}", "--out"),
     R("calibrate-record-missing", "calibrate {work}/none.npz --out {work}/m.toml", "BASELINE",
@@ -742,6 +745,8 @@ def files(tmp_path_factory):
             path=TransferPath("F_1b1_y", grid, (0.01,) * len(grid), "g"),
             background=Background(grid, (1e-12,) * len(grid)), unit="g").save(d / "other.toml")
     f["machine_other"] = d / "other.toml"
+    cmsim.rig.preset("cwru_6205").save(d / "rig_cwru.toml")     # not the machine's rig
+    f["rig_cwru"] = d / "rig_cwru.toml"
     mat = d / "mat"                                # a CWRU-layout .mat, no metadata.json
     mat.mkdir()
     from scipy.io import savemat
@@ -1192,3 +1197,23 @@ def test_calibrate_warns_when_its_baseline_departs_from_itself():
     _warn_consistency(args, {"chi2_per_feature": 1.16, "worst_feature": "shape_b2_db",
                              "worst_z": 2.4, "departs": False})
     assert len(said) == 1
+
+
+def test_a_recording_without_geometry_is_read_on_the_machine_s_rig(tmp_path, capsys):
+    """compare --machine of a recording with no geometry (no metadata.json, no --rig) reads
+    it on the machine's rig (issue 48: it was told to give --rig although the machine holds
+    its rig), and the record's unit, stated by --unit, is applied against the machine's."""
+    from cmsim.discrepancy.signatures import build_library
+    from cmsim.discrepancy.synthetic import hidden_effect_record
+    from cmsim.machine import calibrate
+    base = hidden_effect_record(None, 1003, duration_s=2.0, sim_seed=9).record
+    m = calibrate([base], seed=1)
+    m.with_library(build_library(m, causes=[], seed=1)).save(tmp_path / "m.toml")
+    rec = hidden_effect_record(None, 1003, duration_s=2.0, sim_seed=11).record
+    np.savez(tmp_path / "rec.npz", DE=(rec.signal / 9.80665).astype(np.float32))
+    status = main(["compare", str(tmp_path / "rec.npz"), "--machine", str(tmp_path / "m.toml"),
+                   "--fs-hz", "12000", "--speed-rpm", "1797", "--channel", "DE",
+                   "--unit", "g", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert status == 0, out
+    assert out["finding"] == "none", out["discrepancies"][:3]   # the level in g is applied

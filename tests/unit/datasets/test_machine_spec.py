@@ -154,3 +154,17 @@ def test_through_a_machine_with_its_baseline_a_record_is_a_stretch_of_it_plus_th
         assert amp[k - 2:k + 3].max() > 10 * own_amp[k - 2:k + 3].max()   # +20 dB over it
         assert np.abs(amp[120:127] - own_amp[120:127]).max() < 0.1 * own_amp[120:127].max()
     assert kinds == {"healthy", "fault"}
+
+
+@pytest.mark.parametrize("key, table, value", [
+    ("sensor.channels[0]", "sensor", {"channels": ["accel_1b1_y", "tacho"]}),
+    ("nuisances.housing_mode_hz", "nuisances", {"housing_mode_hz": 3000.0}),
+    ("nuisances.sensor_noise_m_s2", "nuisances", {"sensor_noise_m_s2": 0.1})])
+def test_a_machine_spec_refuses_what_the_machine_owns(tmp_path, key, table, value):
+    """A [machine] added to a stock spec: the model's accelerometer channel and the housing
+    and sensor-noise nuisances are the machine's own; the spec is refused naming the key
+    (issue 48; a stock spec kept accel_1b1_y and its housing nuisances)."""
+    data = _spec_dict(tmp_path)
+    data[table] = {**data.get(table, {}), **value}
+    with pytest.raises(ParameterError, match=key.replace("[", r"\[").replace("]", r"\]")):
+        DatasetSpec.from_dict(data, base_dir=tmp_path)
