@@ -12,9 +12,9 @@ import math
 import numbers
 import re
 
-__all__ = ["ParameterError", "RecordWarning", "IntegrationDiverged", "WorkersDied",
-           "check_range", "within",
-           "check_choice", "check_type", "format_range", "format_value"]
+__all__ = ["ParameterError", "RecordWarning", "ModelWarning", "IntegrationDiverged",
+           "WorkersDied", "check_range", "within", "check_choice", "check_type", "format_range",
+           "format_value"]
 
 _LEADING_NAME = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?= (?:must|needs|=|is|has|exceeds)\b)")
 
@@ -46,6 +46,12 @@ class RecordWarning(UserWarning):
     """A measured record is read, but something it states is doubtful (its lines
     contradict its sample rate or speed, weakly): the user should hear it. The command
     line prints each as a warning (with ``--json``, in the object's ``warnings``)."""
+
+
+class ModelWarning(UserWarning):
+    """A model is used beyond what one of its formulas was fitted on (a tooth shape outside
+    Sainsot's fillet-foundation fit): the result stands, and the user should hear it in one
+    line (the command line says it as a warning, never as Python's source-path warning)."""
 
 
 class IntegrationDiverged(RuntimeError):

@@ -25,7 +25,8 @@ from cmsim.cli import (calibrate, compare, dataset, evaluate, export, import_, l
                        mesh_table, modes, report, simulate, spectrum, sweep)
 from cmsim.cli.contract import (CLIError, Parser, check_paths, finite, option_named_in,
                                 options_of, subparsers, user_message)
-from cmsim.errors import IntegrationDiverged, ParameterError, RecordWarning, WorkersDied
+from cmsim.errors import (IntegrationDiverged, ModelWarning, ParameterError, RecordWarning,
+                          WorkersDied)
 
 __all__ = ["main", "build_parser", "COMMANDS"]
 
@@ -162,17 +163,19 @@ def _main(argv):
 
 
 def _run_warned(args):
-    """``args.func(args)`` with every :class:`~cmsim.errors.RecordWarning` the library
-    issues (a measured record read despite a doubt) said through ``args.warn``, once per
-    text; other warnings pass on as they came."""
+    """``args.func(args)`` with every :class:`~cmsim.errors.RecordWarning` (a measured record
+    read despite a doubt) and :class:`~cmsim.errors.ModelWarning` (a formula used beyond its
+    fit) the library issues said through ``args.warn``, once per text; other warnings pass
+    on as they came."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", RecordWarning)
+        warnings.simplefilter("always", ModelWarning)
         try:
             return args.func(args)
         finally:
             said = set()
             for w in caught:
-                if issubclass(w.category, RecordWarning):
+                if issubclass(w.category, (RecordWarning, ModelWarning)):
                     if str(w.message) not in said:
                         said.add(str(w.message))
                         args.warn(str(w.message))

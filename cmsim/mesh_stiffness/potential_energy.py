@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import simpson
 
-from cmsim.errors import ParameterError, check_range, check_type
+from cmsim.errors import ModelWarning, ParameterError, check_range, check_type
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
 from cmsim.rig import GearPair, SpurGear
 
@@ -277,7 +277,8 @@ def sainsot_coefficients(root_half_angle_rad, hf):
                if not SAINSOT_FITTED_RANGES[k][0] <= v <= SAINSOT_FITTED_RANGES[k][1]]
     if outside:
         warnings.warn("Sainsot fillet-foundation formula extrapolated (θf = "
-                      f"{tf:.4f} rad, hf = {hf:.3f}): " + "; ".join(outside), stacklevel=2)
+                      f"{tf:.4f} rad, hf = {hf:.3f}): " + "; ".join(outside), ModelWarning,
+                      stacklevel=2)
     return out
 
 

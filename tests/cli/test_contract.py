@@ -15,6 +15,7 @@ Run ids are ``<command>-<what>``.
 
 import argparse
 import json
+import types
 import math
 import re
 import subprocess
@@ -1217,3 +1218,23 @@ def test_a_recording_without_geometry_is_read_on_the_machine_s_rig(tmp_path, cap
     out = json.loads(capsys.readouterr().out)
     assert status == 0, out
     assert out["finding"] == "none", out["discrepancies"][:3]   # the level in g is applied
+
+
+def test_a_model_warning_is_one_line_of_the_command_not_python_s(capsys, monkeypatch):
+    """A formula used beyond its fit (Sainsot's fillet foundation on an unusual tooth) is
+    said as the command's one-line warning, never as Python's warning with a source path
+    (issue 48: a library UserWarning leaked from calibrate)."""
+    import warnings as w
+
+    from cmsim.errors import ModelWarning
+
+    def func(args):
+        w.warn("Sainsot fillet-foundation formula extrapolated (θf = 0.1 rad)", ModelWarning)
+        w.warn("Sainsot fillet-foundation formula extrapolated (θf = 0.1 rad)", ModelWarning)
+        return {}
+
+    said = []
+    args = types.SimpleNamespace(func=func, warn=said.append)
+    app._run_warned(args)
+    assert said == ["Sainsot fillet-foundation formula extrapolated (θf = 0.1 rad)"]
+    assert "potential_energy.py" not in capsys.readouterr().err
