@@ -84,9 +84,10 @@ BEARING_VARIANTS = (0.0, -5e-6)
 
 #: Parameter ranges of the library where they differ from a cause's fitted bounds: the
 #: noise and background causes scale the machine's own background (below 1.3 times it, the
-#: baseline's spread covers it), a transfer path that moved by less than 8 % is within the
-#: calibration's uncertainty.
-GRIDS = {"noise": (0.13, 10.0), "transfer_path": ((0.3, 0.92), (1.08, 3.0))}
+#: baseline's spread covers it). A two-sided cause (the transfer path's factor) takes as many
+#: values on each side of 1 and 1 itself, the baseline, which the interpolation between the
+#: grid's points then passes through.
+GRIDS = {"noise": (0.13, 10.0), "transfer_path": (0.3, 3.0)}
 
 
 def value_grid(cause, n=N_SIZES):
@@ -112,9 +113,10 @@ def value_grid(cause, n=N_SIZES):
     """
     p = cause.params[0]
     span = GRIDS.get(cause.name, p.bounds)
-    if isinstance(span[0], tuple):
-        half = max(2, n // 2)
-        values = np.concatenate([np.geomspace(*span[0], half), np.geomspace(*span[1], half)])
+    if p.log_scale and span[0] < 1.0 < span[1] and cause.name in GRIDS:
+        half = n // 2 + 1                                          # 1 itself, once
+        values = np.concatenate([np.geomspace(span[0], 1.0, half),
+                                 np.geomspace(1.0, span[1], half)[1:]])
     elif p.log_scale:
         values = np.geomspace(span[0], span[1], n)
     else:

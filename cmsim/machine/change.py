@@ -45,11 +45,12 @@ import numpy as np
 from scipy.ndimage import map_coordinates
 
 from cmsim.errors import ParameterError
+from cmsim.machine.path import smooth_log
 from cmsim.spectra.floor import segment_psd
 from cmsim.spectra.line_detector import detect_lines
 from cmsim.spectra.lines import line_bins
 
-__all__ = ["Change", "apply_change", "pinned_correction", "SHARED_LINE_DB",
+__all__ = ["Change", "apply_change", "pinned_correction", "path_ratio", "SHARED_LINE_DB",
            "BROADBAND_DEAD_ZONE", "warp_speed"]
 
 #: The model's broadband must fall under this share of its healthy power for the baseline's
@@ -212,6 +213,41 @@ def pinned_correction(freq, lines, psd_h, psd_b, floor_b, gain2, pin_hz):
     return np.exp(np.interp(np.log(np.maximum(freq, freq[1])), f_pin, c_pin))
 
 
+#: Smoothing of the path's magnitude before its frequencies are scaled, octave: the
+#: structure's resonances, not the pins' and caps' narrow corrections (a ratio of two scaled
+#: copies of a narrow correction read +16 dB in one band where the modes moved by 8 %).
+PATH_RATIO_OCTAVE = 1.0 / 3.0
+
+#: Most a moved path may change the baseline at any frequency, either way (±20 dB: a mode
+#: moving onto a frequency where the structure had an antiresonance).
+PATH_RATIO_MAX = 10.0
+
+
+def path_ratio(path, freq, factor):
+    """|H(f/a)| / |H(f)| of a path whose frequencies moved by ``factor`` = a, its magnitude
+    smoothed over :data:`PATH_RATIO_OCTAVE` and the ratio held within
+    1/:data:`PATH_RATIO_MAX` and :data:`PATH_RATIO_MAX`.
+
+    Parameters
+    ----------
+    path : TransferPath
+    freq : numpy.ndarray
+        Frequencies, Hz (uniform from 0).
+    factor : float
+        The factor a (> 0).
+
+    Returns
+    -------
+    numpy.ndarray
+    """
+    grid = np.asarray(path.freq_hz)
+    log_gain = np.log(np.asarray(path.gain))
+    if grid.size > 4 and np.allclose(np.diff(grid), grid[1] - grid[0]):
+        log_gain = smooth_log(log_gain, grid, PATH_RATIO_OCTAVE)
+    ratio = np.exp(np.interp(freq / factor, grid, log_gain) - np.interp(freq, grid, log_gain))
+    return np.clip(ratio, 1.0 / PATH_RATIO_MAX, PATH_RATIO_MAX)
+
+
 def apply_change(machine, segments, change, rng):
     """The baseline's segments with a cause's change laid on them (module docstring).
 
@@ -243,7 +279,7 @@ def apply_change(machine, segments, change, rng):
     scale = np.ones(freq.size)
     a = change.frequency_factor
     if a != 1.0:
-        scale *= machine.path.magnitude(freq, a) / machine.path.magnitude(freq)
+        scale *= path_ratio(machine.path, freq, a)
     added = np.zeros((k, n))
     fill = None                 # PSD of the background that fills what the model loses
     psd_b = floor_b = None
