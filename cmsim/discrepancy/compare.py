@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -409,6 +409,8 @@ def _against_machine(record, machine, *, budget, seed, max_segments, causes, wor
     (:func:`cmsim.discrepancy.judge.judge`); ``budget`` bounds only the simulations that
     refine the named cause's size (one here), never which cause is named."""
     del seed                     # the library's runs carry their own seed
+    if machine.components:       # the machine's names where the record has none of its own
+        record = replace(record, components={**machine.components, **record.components})
     res = judge(record, machine, max_segments=max_segments, workers=workers,
                 causes=None if causes is None else [c.name for c in causes],
                 refine=1 if budget >= 1 else 0)
@@ -451,8 +453,8 @@ def _against_machine(record, machine, *, budget, seed, max_segments, causes, wor
         n_features=res["n_features"], inferred=dict(record.inferred),
         record={"channel": record.channel, "model_signal": record.model_signal,
                 "fs_hz": record.fs_hz, "duration_s": duration,
-                "speed_rpm": record.op.speed_rpm, "torque_nm": record.op.torque_nm,
-                "radial_load_n": record.op.radial_load_n, "segment_s": res["segment_s"],
+                "speed_rpm": res["op"].speed_rpm, "torque_nm": res["op"].torque_nm,
+                "radial_load_n": res["op"].radial_load_n, "segment_s": res["segment_s"],
                 "segments": res["segments"], "unit_scale_to_m_s2": record.unit_scale,
                 "machine": machine.name},
         mode="machine", ranges={k: [float(a), float(b)] for k, (a, b) in ranges.items()},

@@ -82,7 +82,8 @@ from cmsim.spectra.misfit import misfit
 __all__ = ["judge", "decide_record", "feature_sigma", "chi2_rows", "detectability",
            "baseline_consistency", "DETECT_FIT_SEGMENTS", "NONE_CHI2_PER_FEATURE", "ALARM_Z", "MIN_EVIDENCE",
            "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE", "RANGE_DELTA_CHI2",
-           "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z", "LOAD_TOLERANCE"]
+           "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z", "LOAD_TOLERANCE", "record_load",
+           "TORQUE_KEYS", "RADIAL_KEYS"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.
 NONE_CHI2_PER_FEATURE = 2.5
@@ -210,6 +211,48 @@ def _columns(names, lib, fit, held):
 #: this share moves the baseline by the model's change between them
 #: (:func:`~cmsim.discrepancy.signatures.operating_shift`).
 LOAD_TOLERANCE = 0.1
+
+
+#: Keys of a recording entry that document its torque (a gear rig's) and its radial load.
+TORQUE_KEYS = ("torque_nm", "load_percent")
+RADIAL_KEYS = ("radial_load_n", "radial_load_lbs")
+
+
+def record_load(record, machine):
+    """(operating point, note): the load a record is read at against its machine — the
+    record's documented torque and radial load, and the machine's own where the record's
+    metadata documents none (reading a file, the model assumes a load it does not know:
+    20 N m on a gear rig; against a machine, the baseline's load is the best guess, and a
+    shift to an assumed load moved a 50-N m gear machine's whole baseline and named a ball
+    defect for its tooth fault). An in-memory record (a run) carries its own load.
+
+    Parameters
+    ----------
+    record : MeasuredRecord
+    machine : cmsim.machine.Machine
+
+    Returns
+    -------
+    (cmsim.rig.OperatingPoint, str)
+        The note says what was taken from the machine ("" when nothing was).
+    """
+    op = record.op
+    if not record.path:
+        return op, ""
+    entry = record.meta.get("recording") or {}
+    taken = []
+    if record.rig is not None and record.rig.gears is not None \
+            and not any(entry.get(k) is not None for k in TORQUE_KEYS):
+        op = replace(op, torque_nm=machine.op.torque_nm)
+        taken.append(f"torque {machine.op.torque_nm:g} N m")
+    if not any(entry.get(k) is not None for k in RADIAL_KEYS) \
+            and op.radial_load_n != machine.op.radial_load_n:
+        op = replace(op, radial_load_n=machine.op.radial_load_n)
+        taken.append(f"radial load {machine.op.radial_load_n:g} N")
+    if not taken:
+        return op, ""
+    return op, ("the record documents no load: read at the machine's ("
+                + ", ".join(taken) + ")")
 
 
 def _at_operating_point(machine, lib, op):
@@ -433,9 +476,9 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
                      "(cmsim calibrate stores it)")
     if record.unit_scale is None and machine.unit_scale is not None:
         notes.append("the record's unit is unknown: its absolute level is not compared")
-    lib, shift_note = _at_operating_point(machine, lib, record.op)
-    if shift_note:
-        notes.append(shift_note)
+    op, load_note = record_load(record, machine)
+    lib, shift_note = _at_operating_point(machine, lib, op)
+    notes.extend(n for n in (load_note, shift_note) if n)
     names, rows = _record_rows(record, machine, lib.segment_s, max_segments)
     fit, held = rows[0::2], rows[1::2]
     cols = _columns(names, lib, fit, held)
@@ -481,7 +524,7 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
                      "on": "held-out segments (odd): chi2 per feature against the baseline, "
                            "and against the baseline with the named cause's change"},
             "segments": int(rows.shape[0]), "segment_s": lib.segment_s, "columns": cnames,
-            "sensor_bearing": sensor, "notes": notes, "library": lib,
+            "sensor_bearing": sensor, "notes": notes, "library": lib, "op": op,
             "fitted_segments": fitted, "simulations": simulations,
             "wall_s": time.perf_counter() - start}
 

@@ -129,3 +129,33 @@ def test_a_baseline_whose_halves_differ_is_said_not_stationary(machine):
     shaky = replace(machine, baseline=Baseline((louder,), machine.fs_hz))
     c = baseline_consistency(shaky)
     assert c["departs"] and c["worst_feature"] == "level_db", c
+
+
+def test_a_file_that_documents_no_load_is_read_at_the_machine_s():
+    """A recording whose metadata states no torque (the reader assumes 20 N m on a gear rig)
+    is read at its machine's load, and says so; a documented load (torque, load_percent,
+    radial load) and an in-memory run's own load stand."""
+    from types import SimpleNamespace
+
+    from cmsim.discrepancy.judge import record_load
+    from cmsim.rig import OperatingPoint
+
+    gears = SimpleNamespace(gears=object())
+    machine = SimpleNamespace(op=OperatingPoint(speed_rpm=1000.0, torque_nm=50.0,
+                                                radial_load_n=120.0))
+    assumed = OperatingPoint(speed_rpm=1000.0, torque_nm=20.0, radial_load_n=0.0)
+
+    def record(entry, path="rec.npz", rig=gears):
+        return SimpleNamespace(op=assumed, path=path, rig=rig, meta={"recording": entry})
+
+    op, note = record_load(record({}), machine)
+    assert (op.torque_nm, op.radial_load_n, op.speed_rpm) == (50.0, 120.0, 1000.0)
+    assert "torque 50 N m" in note and "radial load 120 N" in note
+    op, note = record_load(record({"load_percent": 37.5, "radial_load_n": 0.0}), machine)
+    assert (op.torque_nm, op.radial_load_n) == (20.0, 0.0) and note == ""
+    op, note = record_load(record({"torque_nm": 20.0, "radial_load_lbs": 0.0}), machine)
+    assert op == assumed and note == ""
+    op, note = record_load(record({}, path=""), machine)            # a run: its own load
+    assert op == assumed and note == ""
+    op, _ = record_load(record({}, rig=SimpleNamespace(gears=None)), machine)
+    assert op.torque_nm == 20.0 and op.radial_load_n == 120.0       # no gears: no torque
