@@ -34,14 +34,14 @@ def register(sub):
 def run(args):
     """Generate (or resume) the dataset."""
     from cmsim.datasets import DatasetSpec, generate_dataset
+    from cmsim.datasets.manifest import check_manifest
     from cmsim.datasets.pool import check_scheduler
 
-    # (a resumed directory's manifest is input as well: generate_dataset reads it once,
-    # before any work, and names a corrupt one)
     spec = load_file("SPEC", args.spec, DatasetSpec.load, "a dataset spec TOML file")
     if args.scheduler is not None:
         check_scheduler(args.scheduler)
-    args.notice_compile()
+    check_manifest(args.out)    # a resumed directory's manifest is input (footer only: the
+    args.notice_compile()       # run reads its rows once)
     progress = not args.json and sys.stderr.isatty()
     try:
         summary = generate_dataset(spec, args.out, workers=args.workers,

@@ -35,7 +35,7 @@ from cmsim.errors import ParameterError
 
 __all__ = ["PARQUET_NAME", "RECORDS_DIR", "ROWS_DIR", "SPEC_NAME", "FORMAT_VERSION",
            "file_sha256", "json_default", "write_row", "read_rows", "consolidate",
-           "open_directory", "done_indices", "read_spec"]
+           "open_directory", "done_indices", "read_spec", "check_manifest"]
 
 PARQUET_NAME = "manifest.parquet"
 RECORDS_DIR = "records"
@@ -137,26 +137,57 @@ def read_rows(out_dir, known=None):
     return df.reset_index(drop=True)
 
 
-def _read_parquet(path):
-    """The manifest file as a DataFrame; a corrupt one is a :class:`ParameterError` naming
-    it and the fix (every finished record keeps its row in its own file, so removing the
-    manifest loses nothing: the next run adopts the records)."""
-    import pandas as pd
+def check_manifest(out_dir):
+    """Refuse a directory whose manifest file is corrupt or not a cmsim manifest, reading only
+    its Parquet footer (the rows are read once, by the run): a resumed directory's manifest
+    is input, checked before anything is computed.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The dataset directory (nothing is checked where it holds no manifest).
+
+    Raises
+    ------
+    ParameterError
+        Naming the file and the fix (every finished record keeps its row in its own file,
+        so removing the manifest loses nothing: the next run adopts the records).
+    """
+    path = Path(out_dir) / PARQUET_NAME
+    if path.is_file():
+        _manifest_columns(path, lambda: _schema_names(path))
+
+
+def _schema_names(path):
+    import pyarrow.parquet as pq
+    return pq.read_schema(path).names
+
+
+def _manifest_columns(path, read):
+    """``read()``'s result, its columns checked; a failure is the ParameterError of
+    :func:`check_manifest`."""
     from pyarrow import ArrowException
 
     try:
-        df = pd.read_parquet(path)
+        out = read()
     except READ_ERRORS + (ArrowException,) as exc:
         detail = " ".join(str(exc).split())[:200]
         raise ParameterError(f"{path} is corrupt ({type(exc).__name__}: {detail}); remove "
                              f"it and re-run cmsim dataset on this directory: finished records "
                              f"are recovered from their files", param="out") from None
-    missing = [c for c in ("record_id", "index", "status", "path") if c not in df.columns]
+    columns = out if isinstance(out, list) else list(out.columns)
+    missing = [c for c in ("record_id", "index", "status", "path") if c not in columns]
     if missing:
         raise ParameterError(f"{path} is not a cmsim manifest (no column {missing[0]!r}); "
                              f"remove it and re-run cmsim dataset on this directory: finished "
                              f"records are recovered from their files", param="out")
-    return df
+    return out
+
+
+def _read_parquet(path):
+    """The manifest file as a DataFrame (:func:`check_manifest`'s errors)."""
+    import pandas as pd
+    return _manifest_columns(path, lambda: pd.read_parquet(path))
 
 
 def _read_sidecars(out):
