@@ -74,3 +74,35 @@ def test_a_cause_that_adds_power_is_no_candidate_for_a_quieter_record():
     d = _decide([-3.5, -3.5, 0.0, 0.0, 7.0, 7.0, -12.0])
     assert d["finding"] != "noise"
     assert all(r["name"] != "noise" for r in d["ranked"])
+
+
+@pytest.mark.parametrize("lift, finding", [(4.0, "none"), (7.0, "bearing_outer_race")])
+def test_one_family_standing_clearly_out_of_a_quiet_record_is_a_departure(lift, finding):
+    """The envelope lines lifted by ``lift`` dB on a record otherwise at its baseline, among
+    many quiet features: over all of them the record reads within the spread (χ² per
+    feature under the ``none`` level, no feature at the alarm z), yet a family 7 dB and
+    3 σ over the baseline, which the outer race's prediction reads, is that fault; 4 dB
+    stays ``none``."""
+    from cmsim.discrepancy.judge import ALARM_Z, FAMILY_Z, NONE_CHI2_PER_FEATURE
+
+    quiet = tuple(f"raw_fr_h{k}_db" for k in range(1, 31))
+    names = NAMES[:2] + quiet
+    m = len(names)
+    outer = np.zeros((3, m))
+    outer[:, :2] = np.array([[0.0], [5.0], [20.0]])
+    spread = np.ones(m)
+    spread[:2] = 3.5                                # the family's own spread, dB: σ 1.9
+    lib = SignatureLibrary(
+        names=names, mean=np.zeros(m), spread=spread, realisation=np.zeros(m),
+        entries=(SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                                (3e-5, 3e-4, 3e-3), outer),),
+        segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
+    li = np.arange(m)
+    sigma = feature_sigma(lib, li, list(names), 8)
+    meas = np.zeros(m)
+    meas[:2] = lift
+    d = decide_record(lib, li, list(names), meas, sigma, "1b1")
+    assert d["chi2"] / d["n_eff"] <= NONE_CHI2_PER_FEATURE          # quiet over all
+    assert np.abs(d["z"]).max() < ALARM_Z
+    assert (d["z"][0] >= FAMILY_Z) == (lift == 7.0)
+    assert d["finding"] == finding
