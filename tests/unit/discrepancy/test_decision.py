@@ -106,3 +106,43 @@ def test_one_family_standing_clearly_out_of_a_quiet_record_is_a_departure(lift, 
     assert np.abs(d["z"]).max() < ALARM_Z
     assert (d["z"][0] >= FAMILY_Z) == (lift == 7.0)
     assert d["finding"] == finding
+
+
+@pytest.mark.parametrize("other, finding", [(6.0, "bearing_outer_race"),
+                                            (7.0, "torque_mismatch")])
+def test_a_fault_whose_family_stands_out_wins_a_near_tie_on_the_whole_record(other, finding):
+    """An outer race lifts its envelope lines 12 dB (its family stands out) and a torque
+    mismatch explains the shaft lines and the level the record lifted by ``other`` dB: at
+    6 dB the torque mismatch reads the whole record a little better, within the near tie,
+    and the fault whose family stands out is named; at 7 dB the outer race holds under 0.8
+    of the torque mismatch's evidence, no tie, and the better reading stands."""
+    from cmsim.discrepancy.judge import NEAR_TIE
+
+    names = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "raw_fr_h1_db", "raw_fr_h2_db",
+             "level_db", "raw_bpfi_1b1_db", "raw_bpfi_1b2_db")
+    m = len(names)
+    outer = np.zeros((3, m))
+    outer[:, :2] = np.array([[0.0], [4.0], [16.0]])
+    outer[:, 4] = [0.0, 0.5, 2.0]                          # an impact adds a little power
+    torque = np.zeros((2, m))
+    torque[:, 2:5] = np.array([[0.0], [9.0]])
+    spread = np.ones(m)
+    spread[:2] = 3.0
+    lib = SignatureLibrary(
+        names=names, mean=np.zeros(m), spread=spread, realisation=np.zeros(m),
+        entries=(SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                                (3e-5, 3e-4, 3e-3), outer),
+                 SignatureEntry("torque_mismatch", None, "documented", "torque_factor",
+                                (1.0, 3.0), torque)),
+        segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
+    li = np.arange(m)
+    meas = np.zeros(m)
+    meas[:2], meas[2:5] = 12.0, other
+    d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
+                      "1b1")
+    by = {r["name"]: r for r in d["ranked"]}
+    assert d["ranked"][0]["name"] == "torque_mismatch"          # the better whole reading
+    assert by["bearing_outer_race"]["stands_out"] and not by["torque_mismatch"]["stands_out"]
+    tie = by["bearing_outer_race"]["evidence"] >= NEAR_TIE * by["torque_mismatch"]["evidence"]
+    assert tie == (other == 6.0)
+    assert (d["finding"], d["decided_on"]) == (finding, "whole")
