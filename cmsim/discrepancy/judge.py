@@ -381,10 +381,11 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         # over the baseline: its evidence elsewhere (a broadband that lowers the raw lines
         # over their median, the statistics) any impulsive cause would share
         fam = [names.index(k) for k in r["family"] if path_free(k)]
-        out = [z0[i] for i in fam if z0[i] >= FAMILY_Z and (
+        out = [i for i in fam if z0[i] >= FAMILY_Z and (
             not names[i].endswith("_db") or meas[i] - lib.mean[li][i] >= FAMILY_RISE_DB)]
         r["family_z"] = float(max((z0[i] for i in fam), default=0.0))
         r["stands_out"] = bool(out)
+        r["out"] = out
         r["nameable"] = not r["cause"].rings_structure or bool(out)
 
     # a. the cause whose prediction reads the whole record best, if it explains it (a fault
@@ -408,11 +409,15 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         if cands and explains(cands[0]):
             top, how = cands[0], "whole"
             ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]]
-            out = [r for r in ties if r["cause"].signature is not None and r["stands_out"]]
+            # a fault whose own family stands clearly out where the winner's prediction
+            # leaves it wins a near tie on the whole record against a cause whose family
+            # does not (an outer race that lifted its envelope lines 19 dB tied a torque
+            # mismatch, 137 against 139; a clearance that lifts the cage line itself keeps
+            # it against a ball defect whose family holds that line)
+            left = (meas - top["prediction"]) / sigma
+            out = [r for r in ties if r["cause"].signature is not None and any(
+                left[i] >= FAMILY_Z for i in r["out"])]
             if out and not top["stands_out"]:
-                # a fault whose own family stands clearly out wins a near tie on the whole
-                # record against a cause whose family does not (an outer race that lifted
-                # its envelope lines 19 dB tied a torque mismatch, 137 against 139)
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]
                 top = new
