@@ -35,7 +35,8 @@ sys.path.insert(0, str(ROOT))
 from cmsim.discrepancy import CAUSES, compare                       # noqa: E402
 from cmsim.discrepancy.causes import ModelSetup                     # noqa: E402
 from cmsim.discrepancy.evaluator import path_free                   # noqa: E402
-from cmsim.discrepancy.judge import detectability, judge            # noqa: E402
+from cmsim.discrepancy.judge import judge                            # noqa: E402
+from cmsim.discrepancy.machine_checks import detectability          # noqa: E402
 from cmsim.discrepancy.signatures import build_library, change_of   # noqa: E402
 from cmsim.machine import calibrate, model_force                    # noqa: E402
 from cmsim.machine.change import apply_change                       # noqa: E402

@@ -78,7 +78,7 @@ def read_records(paths, channel, rig_file, span, values=None):
 
 def run(args):
     """Calibrate, build the signature library and write the machine file."""
-    from cmsim.discrepancy.judge import baseline_consistency, detectability
+    from cmsim.discrepancy.machine_checks import baseline_consistency, detectability
     from cmsim.discrepancy.signatures import build_library
     from cmsim.machine import calibrate
     from cmsim.machine.report import write_calibration_report

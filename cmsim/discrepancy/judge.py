@@ -44,9 +44,10 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       calibrated path cannot know), a fault is named on its own signature
       (:func:`~cmsim.discrepancy.ranking.decide`: its evidence on the features it moves, its
       family moved towards the record), provided one feature of its family stands
-      :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB` over the baseline. A cause whose change is impacts ringing the
-      structure (:attr:`~cmsim.discrepancy.causes.Cause.rings_structure`) is judged there
-      with the path profiled out: each feature that depends on the transfer path, and the
+      :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB` over the baseline. A cause whose change
+      is impacts ringing the structure
+      (:attr:`~cmsim.discrepancy.causes.Cause.rings_structure`) is judged there with the
+      path profiled out: each feature that depends on the transfer path, and the
       kurtosis and crest factor, counts for it what it counts for the baseline, neither for
       nor against (the model's impacts through CWRU's baseline path rang 3 kHz lower than
       its outer-race records'; a family that stands out is not vetoed by a statistic the
@@ -75,12 +76,11 @@ from cmsim.discrepancy.signatures import build_library, operating_shift, simulat
 from cmsim.errors import ParameterError
 from cmsim.features import segments
 from cmsim.machine.calibration import feature_rows
-from cmsim.frequencies import rig_frequencies
 from cmsim.run import signal_info
 from cmsim.spectra.misfit import misfit
 
-__all__ = ["judge", "decide_record", "feature_sigma", "chi2_rows", "detectability",
-           "baseline_consistency", "DETECT_FIT_SEGMENTS", "NONE_CHI2_PER_FEATURE", "ALARM_Z", "MIN_EVIDENCE",
+__all__ = ["judge", "decide_record", "feature_sigma", "chi2_rows", "compared_columns",
+           "interpolated", "NONE_CHI2_PER_FEATURE", "ALARM_Z", "MIN_EVIDENCE",
            "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE", "RANGE_DELTA_CHI2",
            "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z", "LOAD_TOLERANCE", "record_load",
            "TORQUE_KEYS", "RADIAL_KEYS"]
@@ -157,8 +157,23 @@ def chi2_rows(meas, pred, sigma, names):
                   np.array([rises(k, True) for k in names], dtype=bool))
 
 
-def _interpolated(values, table, steps):
-    """(values, table) with ``steps`` points between consecutive values (log-linear)."""
+def interpolated(values, table, steps):
+    """(values, table) of a library entry with ``steps`` points between consecutive values
+    (log-linear), as a comparison reads the grid.
+
+    Parameters
+    ----------
+    values : sequence of float
+        The entry's parameter values, increasing.
+    table : numpy.ndarray, shape (len(values), n)
+        Its features at each value.
+    steps : int
+        Points per interval.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+    """
     values = np.asarray(values, dtype=float)
     if values.size < 2:
         return values, table
@@ -187,11 +202,25 @@ def _record_rows(record, machine, seg_s, max_segments):
     return names, rows
 
 
-def _columns(names, lib, fit, held):
-    """Indices (into the library's names) and record columns compared: read by both, finite
-    in the record's fit and held-out means and in the baseline's, one of each set of
-    identical record columns (the two shafts of a 1:1 rig read alike)."""
-    out, seen = [], []
+def compared_columns(names, lib, fit, held):
+    """The features a record and its machine's library are compared on: read by both,
+    finite in the record's fit and held-out rows and in the baseline's mean, one of each set
+    of identical record columns (the two shafts of a 1:1 rig read alike).
+
+    Parameters
+    ----------
+    names : sequence of str
+        The record's feature names (the columns of ``fit`` and ``held``).
+    lib : SignatureLibrary
+    fit, held : numpy.ndarray, shape (segments, len(names))
+        The record's fit and held-out segment rows.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, list of str)
+        Library columns, record columns and the names compared.
+    """
+    li, ri, seen = [], [], []
     for j, k in enumerate(names):
         if k not in lib.names:
             continue
@@ -203,8 +232,9 @@ def _columns(names, lib, fit, held):
         if any(np.array_equal(col, c, equal_nan=True) for c in seen):
             continue
         seen.append(col)
-        out.append((i, j))
-    return out
+        li.append(i)
+        ri.append(j)
+    return (np.array(li, dtype=int), np.array(ri, dtype=int), [lib.names[i] for i in li])
 
 
 #: A record's documented load (torque, radial load) differing from the machine's by more than
@@ -344,7 +374,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         if causes is not None and e.cause not in causes:
             continue
         cause = CAUSES[e.cause]()
-        values, table = _interpolated(e.values, e.features[:, li], INTERPOLATION_STEPS)
+        values, table = interpolated(e.values, e.features[:, li], INTERPOLATION_STEPS)
         ok = np.any(np.isfinite(table), axis=1)
         if direction:
             ok &= (table[:, level] - lib.mean[li][level]) * direction > 0.0
@@ -502,10 +532,7 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     notes.extend(n for n in (load_note, shift_note) if n)
     names, rows = _record_rows(record, machine, lib.segment_s, max_segments)
     fit, held = rows[0::2], rows[1::2]
-    cols = _columns(names, lib, fit, held)
-    li = np.array([i for i, _ in cols], dtype=int)
-    ri = np.array([j for _, j in cols], dtype=int)
-    cnames = [lib.names[i] for i in li]
+    li, ri, cnames = compared_columns(names, lib, fit, held)
     with np.errstate(all="ignore"):
         meas = np.nanmean(fit[:, ri], axis=0)
         meas_held = np.nanmean(held[:, ri], axis=0)
@@ -548,106 +575,3 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
             "sensor_bearing": sensor, "notes": notes, "library": lib, "op": op,
             "fitted_segments": fitted, "simulations": simulations,
             "wall_s": time.perf_counter() - start}
-
-
-#: Fit segments a record's mean is taken over when the library judges its own predictions
-#: (:func:`detectability`): a 10-s record read on 16 half-second segments.
-DETECT_FIT_SEGMENTS = 8
-
-
-def detectability(machine, causes=None):
-    """What this machine's sensor can see: per fault of the library on the sensor's bearing
-    (a bearing defect), a gear, or rig-wide, the smallest size at which the library's own
-    prediction — the baseline with the fault's change at the calibrated path's gain and the
-    documented clearance, read as the mean of :data:`DETECT_FIT_SEGMENTS` fit segments — is
-    named that fault by the comparison's decision (:func:`decide_record`), the grid read
-    between its points as a comparison reads it; None where no size of the grid is.
-
-    A noiseless estimate from the library (the record's own segment noise and a machine's
-    drift are in σ, not in the prediction): the injection benchmark
-    (benchmarks/bench_detectability.py) measures the same on held-out baseline segments.
-
-    Parameters
-    ----------
-    machine : cmsim.machine.Machine
-        With its signature library.
-    causes : sequence of str, optional
-        Default: every fault (a cause with a signature) of the library.
-
-    Returns
-    -------
-    list of dict
-        ``cause``, ``component`` (model key), ``parameter``, ``smallest`` (or None),
-        ``largest_tried``.
-    """
-    lib = machine.library
-    if lib is None:
-        raise ParameterError("the machine holds no signature library: cmsim calibrate builds "
-                             "it", param="machine")
-    li = np.array([i for i, m in enumerate(lib.mean) if math.isfinite(m)], dtype=int)
-    names = [lib.names[i] for i in li]
-    sigma = feature_sigma(lib, li, names, DETECT_FIT_SEGMENTS)
-    sensor = signal_info(machine.model_signal).component
-    out = []
-    for e in lib.entries:
-        cause = CAUSES.get(e.cause)
-        if cause is None or cause.signature is None or e.variant != "documented" \
-                or (causes is not None and e.cause not in causes):
-            continue
-        if cause.kind == "bearing" and e.component != sensor:
-            continue
-        values, table = _interpolated(e.values, e.features[:, li], INTERPOLATION_STEPS)
-        smallest = None
-        for v, row in zip(values, table):
-            if not np.all(np.isfinite(row)):
-                continue
-            d = decide_record(lib, li, names, row, sigma, sensor)
-            if d["finding"] == e.cause and d["top"]["component"] == e.component:
-                smallest = float(v)
-                break
-        out.append({"cause": e.cause, "component": e.component, "parameter": e.parameter,
-                    "smallest": smallest, "largest_tried": float(e.values[-1])})
-    return out
-
-
-def baseline_consistency(machine):
-    """The machine's baseline judged against itself, as a record is judged: the mean of its
-    odd segments against the mean of its even ones, with the comparison's σ
-    (:func:`feature_sigma`) and χ² (:func:`chi2_rows`). A baseline whose halves differ by
-    more than a record may before it departs (χ² per feature over
-    :data:`NONE_CHI2_PER_FEATURE`, or a feature :data:`ALARM_Z` σ off) is not stationary:
-    healthy records of this machine may read as departures.
-
-    Parameters
-    ----------
-    machine : cmsim.machine.Machine
-        With its baseline and signature library.
-
-    Returns
-    -------
-    dict
-        ``chi2_per_feature``, ``worst_feature``, ``worst_z``, ``n_features``, ``departs``.
-    """
-    lib = machine.library
-    segs = machine.baseline.segments(lib.segment_s)
-    rig_freqs = rig_frequencies(machine.rig, machine.op)
-    names, rows = feature_rows(segs, machine.fs_hz, rig_freqs,
-                               list(machine.rig.bearing_names), machine.unit_scale)
-    even, odd = rows[0::2], rows[1::2]
-    cols = _columns(names, lib, even, odd)
-    li = np.array([i for i, _ in cols], dtype=int)
-    ri = np.array([j for _, j in cols], dtype=int)
-    cnames = [lib.names[i] for i in li]
-    with np.errstate(all="ignore"):
-        a, b = np.nanmean(odd[:, ri], axis=0), np.nanmean(even[:, ri], axis=0)
-    sigma = feature_sigma(lib, li, cnames, odd.shape[0])
-    chi = float(chi2_rows(a, b[None, :], sigma, cnames)[0][0])
-    n_eff = float(sum(weight(k) for k in cnames))
-    z = (a - b) / sigma
-    worst = int(np.nanargmax(np.abs(z))) if z.size else None
-    out = {"chi2_per_feature": chi / max(n_eff, 1e-9), "n_features": len(cnames),
-           "worst_feature": None if worst is None else cnames[worst],
-           "worst_z": float("nan") if worst is None else float(z[worst])}
-    out["departs"] = bool(out["chi2_per_feature"] > NONE_CHI2_PER_FEATURE
-                          or (worst is not None and abs(out["worst_z"]) >= ALARM_Z))
-    return out

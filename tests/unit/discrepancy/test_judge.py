@@ -106,7 +106,7 @@ def test_what_the_sensor_can_see_is_read_on_the_library(machine):
     """detectability: each fault of the library on the sensor's bearing (or rig-wide) with
     the smallest size its own prediction is named at — an inner-race spall on this machine is
     seen within the grid."""
-    from cmsim.discrepancy.judge import detectability
+    from cmsim.discrepancy.machine_checks import detectability
     rows = {(d["cause"], d["component"]): d for d in detectability(machine)}
     assert ("bearing_inner_race", "1b1") in rows and ("bearing_inner_race", "1b2") not in rows
     seen = rows[("bearing_inner_race", "1b1")]["smallest"]
@@ -118,7 +118,7 @@ def test_a_baseline_whose_halves_differ_is_said_not_stationary(machine):
     a baseline whose odd segments are 4 times as loud as its even ones (+12 dB) departs."""
     from dataclasses import replace
 
-    from cmsim.discrepancy.judge import baseline_consistency
+    from cmsim.discrepancy.machine_checks import baseline_consistency
     from cmsim.machine.baseline import Baseline
     assert not baseline_consistency(machine)["departs"]
     x = np.array(machine.baseline.records[0], dtype=float)
