@@ -126,26 +126,19 @@ def text(res):
                          "whole record"}.get(res.get("decided_on", ""))
         if how:
             lines.append(f"named because {how}")
-        if res.get("decided_on") == "family":
-            lines.append("leading faults, by their evidence against the machine's baseline on "
-                         "the features their own signature moves (Δχ²):")
-            for c in res["causes"][:5]:
-                lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
-                             f"{c['delta_chi2']:7.1f} on {c['judged_on']} features")
-        else:
-            lines.append("leading causes, by their evidence against the machine's baseline "
-                         "(Δχ² over every feature: the baseline's χ² less the cause's):")
-            for c in res["causes"][:5]:
-                lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
-                             f"{c['delta_chi2']:7.1f}")
-    else:
-        lines.append("leading causes, by their evidence (Δχ²) on the features each moves (a "
-                     "fault is named when its own family stands out, before any cause that "
-                     "reshapes the whole spectrum):")
-        for c in res["causes"][:5]:
-            lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
-                         f"{c['delta_chi2']:7.1f} on {c['judged_on']} features (all: "
-                         f"{c['delta_chi2_all']:.1f})")
+    family = not machine or res.get("decided_on") == "family"     # evidence on own features
+    lines.append(
+        "leading faults, by their evidence against the machine's baseline on the features "
+        "their own signature moves (Δχ²):" if machine and family else
+        "leading causes, by their evidence against the machine's baseline (Δχ² over every "
+        "feature: the baseline's χ² less the cause's):" if machine else
+        "leading causes, by their evidence (Δχ²) on the features each moves (a fault is named "
+        "when its own family stands out, before any cause that reshapes the whole spectrum):")
+    for c in res["causes"][:5]:
+        lines.append(f"  {c['name']:20s} {c['component'] or '-':10s} evidence "
+                     f"{c['delta_chi2']:7.1f}"
+                     + (f" on {c['judged_on']} features" if family else "")
+                     + ("" if machine else f" (all: {c['delta_chi2_all']:.1f})"))
     lines.append("largest departures of the record from "
                  + ("the machine's baseline:" if machine else "the model:"))
     ref = "baseline" if machine else "simulated"
