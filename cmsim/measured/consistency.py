@@ -43,7 +43,8 @@ neighbouring fundamentals predicts (:func:`exclusive_contrast_db`), in steps of 
 The missing-line test goes first because a lower comb predicts the stated lines too. A step
 of 3 is not taken: a gear rig's 3rd shaft harmonic often stands well above the 1st and 2nd.
 
-Line prominence: the largest amplitude within the line's tolerance ± :data:`LINE_WINDOW_BINS`
+Line prominence: the largest amplitude within the line's tolerance ±
+:data:`~cmsim.measured.comb_ratio.LINE_WINDOW_BINS`
 bins over the median of the surrounding ±10 % (at least 25 bins) of a Hann amplitude
 spectrum. The tolerance is the stated speed's own uncertainty (a measured speed is known to
 a fraction of a per cent, a nominal one to a motor's slip,
@@ -65,8 +66,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.measured.comb_ratio import (CLEAR_LINE_DB, LARGEST_FACTOR, LINE_TOLERANCE,
-                                      LINE_WINDOW_BINS, MISSING_MARGIN_DB, REFUSE_LINE_DB,
-                                      STEPS, SUBCOMB_MARGIN_DB, _mean, _steps,
+                                      MISSING_MARGIN_DB, REFUSE_LINE_DB, STEPS, SUBCOMB_MARGIN_DB, _mean, _steps,
                                       exclusive_contrast_db, family_ratio,
                                       line_prominence_db, lowest_fundamental)
 from cmsim.spectra.amplitude import amplitude_spectrum
