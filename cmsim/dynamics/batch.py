@@ -23,9 +23,9 @@ import numpy as np
 from cmsim.dynamics._batch_kernels import BatchBuffers, LaneParams, integrate_batch_jit
 from cmsim.dynamics._rhs_kernels import KernelParams, Work, make_work
 from cmsim.dynamics.integrator import SCHEMES
-from cmsim.dynamics.simulation import (MAX_ROTATION_DEVIATION_RAD, _Decimator, compile_kernels,
-                                       decimation, diverged_at, finish_run,
-                                       integrate_prepared, max_displacement_m)
+from cmsim.dynamics.simulation import compile_kernels, finish_run, integrate_prepared
+from cmsim.dynamics.time_loop import (MAX_ROTATION_DEVIATION_RAD, _Decimator, decimation,
+                                      diverged_at, max_displacement_m)
 from cmsim.errors import IntegrationDiverged
 
 __all__ = ["simulate_batch", "kernel_layout", "BATCH_CHUNK_STEPS"]
