@@ -51,14 +51,19 @@ def _half(rec, which):
     return rec.span(0.0, d / 2) if which == "first" else rec.span(d / 2)
 
 
-def calibrate_half(baseline):
+def calibrate_half(job):
     """(baseline path, machine file, calibration wall s): the machine of the first half of a
     healthy record with its signature library (what ``cmsim calibrate`` writes), written
-    beside the other machine files of this run."""
+    beside the other machine files of this run; with ``reuse``, an earlier run's file of it
+    is read instead (the calibration is deterministic: the judge's rules can be iterated on
+    without 5 minutes of calibrations each time)."""
+    baseline, reuse = job
     t0 = time.perf_counter()
+    out = MACHINE_DIR / f"{Path(baseline).parent.name}_{Path(baseline).stem}.toml"
+    if reuse and out.is_file():
+        return str(baseline), str(out), 0.0
     machine = calibrate([_half(read_record(baseline), "first")])
     machine = machine.with_library(build_library(machine))
-    out = MACHINE_DIR / f"{Path(baseline).parent.name}_{Path(baseline).stem}.toml"
     machine.save(out)
     return str(baseline), str(out), time.perf_counter() - t0
 
@@ -181,6 +186,9 @@ def main(argv=None):
                     default=("machine", "free"), help="the nominal models to run")
     ap.add_argument("--datasets", nargs="+", default=None,
                     help="folder names under --data (default every folder with metadata)")
+    ap.add_argument("--reuse-machines", action="store_true",
+                    help=f"read the machine files an earlier run left in {MACHINE_DIR} "
+                         "instead of calibrating again")
     ap.add_argument("--render", type=Path, default=None,
                     help="only re-render the tables from a --json file of an earlier run")
     a = ap.parse_args(argv)
@@ -197,7 +205,8 @@ def main(argv=None):
         with ProcessPoolExecutor(a.workers) as pool:
             baselines = sorted({str(j[2]) for j in jobs if j[2] is not None})
             machines = {}
-            for base, file, wall in pool.map(calibrate_half, baselines):
+            for base, file, wall in pool.map(calibrate_half,
+                                             [(b, a.reuse_machines) for b in baselines]):
                 machines[base] = file
                 print(f"calibrated {Path(base).name} (first half) in {wall:.1f} s", flush=True)
             jobs = [(*j, None if j[2] is None else machines[str(j[2])]) for j in jobs]

@@ -9,6 +9,8 @@ lifted 4 dB over a record that departs elsewhere is ``unexplained``, one lifted 
 outer race; a noise cause that would make the record quieter is no candidate.
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -146,3 +148,47 @@ def test_a_fault_whose_family_stands_out_wins_a_near_tie_on_the_whole_record(oth
     tie = by["bearing_outer_race"]["evidence"] >= NEAR_TIE * by["torque_mismatch"]["evidence"]
     assert tie == (other == 6.0)
     assert (d["finding"], d["decided_on"]) == (finding, "whole")
+
+
+def _across_loads(monkeypatch, shift):
+    """The closed-form library read at another load, the model's change between the loads
+    being ``shift``."""
+    from types import SimpleNamespace
+
+    import cmsim.discrepancy.judge as judge_module
+    from cmsim.rig import OperatingPoint
+
+    monkeypatch.setattr(judge_module, "operating_shift", lambda machine, lib, op: shift)
+    machine = SimpleNamespace(op=OperatingPoint(speed_rpm=1797.0, torque_nm=0.0,
+                                                radial_load_n=98.0))
+    moved, note = judge_module._at_operating_point(
+        machine, _library(), OperatingPoint(speed_rpm=1797.0, torque_nm=0.0,
+                                           radial_load_n=400.0))
+    assert "within that change's own size" in note
+    return moved
+
+
+def _decide_on(lib, meas):
+    li = np.arange(len(NAMES))
+    sigma = feature_sigma(lib, li, list(NAMES), 8)
+    return decide_record(lib, li, list(NAMES), np.asarray(meas, dtype=float), sigma, "1b1")
+
+
+def test_a_record_across_loads_is_read_within_the_model_s_load_change(monkeypatch):
+    """The model says the other load quiets the broadband 12 dB; the machine's healthy record
+    at that load stays on its baseline (SpectraQuest's does: its sidebands and bands sit where
+    they were at 0 %). Read with the change as exact it departs 12 σ on every band; read
+    within the change's own size it is ``none``. A family the load does not move, lifted
+    20 dB, is still the outer race."""
+    shift = np.zeros(len(NAMES))
+    shift[SHAPE] = -12.0
+    shift[LEVEL] = -3.0
+    moved = _across_loads(monkeypatch, shift)
+    np.testing.assert_allclose(moved.mean, shift)
+    np.testing.assert_allclose(moved.realisation, np.abs(shift))
+    healthy = [0.3, -0.2, 0.02, 0.0, 0.4, -0.3, 0.1]
+    assert _decide_on(moved, healthy)["finding"] == "none"
+    exact = replace(moved, realisation=np.zeros(len(NAMES)))
+    assert _decide_on(exact, healthy)["finding"] != "none"      # the check can fail
+    faulty = [20.0, 20.0, 0.0, 0.0, 0.4, -0.3, 0.1]
+    assert _decide_on(moved, faulty)["finding"] == "bearing_outer_race"
