@@ -97,7 +97,8 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
     factor f of a pair becomes the extra compliance (1/f − 1)/k of its own λ, k the run's
     table stiffness at s, so a pair alone in contact is f times as stiff), and eccentric gears
     (``MI_ECC``: the contact geometry uses each gear's geometric centre, turning about its
-    shaft; moments and contact velocities use the shaft centre).
+    shaft; moments and contact velocities use the shaft centre; the mass on that centre,
+    ``ecc[:, 3]``, loads its shaft with m·Ω² along the offset).
 
     Pass 1 (:func:`_slot_geometry`) stores each slot's geometry in ``W.slots`` (columns
     ``SG_*``); in hybrid mode the interferences of all slots are then solved together
@@ -132,6 +133,15 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
         gy1 += ecc[0, 0] * (sp1 * ecc[0, 1] + cp1 * ecc[0, 2])
         gx2 += ecc[1, 0] * (cp2 * ecc[1, 1] - sp2 * ecc[1, 2])
         gy2 += ecc[1, 0] * (sp2 * ecc[1, 1] + cp2 * ecc[1, 2])
+        # the mass on each offset centre turns about its shaft: m·Ω²·(offset) on the shaft
+        om1 = mp[MP_OM1] * sr + y[n + i1 + 2]
+        om2 = mp[MP_OM2] * sr + y[n + i2 + 2]
+        f1 = ecc[0, 3] * om1 * om1
+        f2 = ecc[1, 3] * om2 * om2
+        g[i1] += f1 * (gx1 - c1x)
+        g[i1 + 1] += f1 * (gy1 - c1y)
+        g[i2] += f2 * (gx2 - c2x)
+        g[i2 + 1] += f2 * (gy2 - c2y)
     phi_t1, length, cos_t1, sin_t1 = _mesh_frame(gx1, gy1, gx2, gy2, rb1, rb2, mp)
     # interference: nominal rolling cancels exactly (rb1·Ω1 = rb2·Ω2)
     delta_inv = (rb1 * (y[i1 + 2] + mp[MP_PSI10] - phi_t1)

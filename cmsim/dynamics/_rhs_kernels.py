@@ -74,8 +74,8 @@ class KernelParams(NamedTuple):
     b_off : (nb, max_balls) extra overlap of each ball (off-size balls), m.
     tk1, tk2 : (Z, m) per-tooth factor on the pair stiffness on the mesh table's grid
         ((1, 1) when ``MI_TEETH`` is off); te1, te2 : the same for extra separation, m.
-    ecc : (2, 2) eccentricity (amplitude m, phase rad − the gear's reference phase) of each
-        gear's geometric centre.
+    ecc : (2, 4) eccentricity of each gear's geometric centre: amplitude m, cos and sin of
+        its phase rad − the gear's reference phase, and the mass on that centre, kg.
     prof : (n_t, PR_SIZE) input speed and output torque profile (``PR_*``; (1, PR_SIZE)
         when ``MI_PROFILE`` is off).
     mu_tab : (m,) mesh friction coefficient against the pair's position on the mesh table's
@@ -145,7 +145,7 @@ class KernelParams(NamedTuple):
 def no_faults(nb, max_balls):
     """Neutral fault fields ``(b_def, b_off, tk1, tk2, te1, te2, ecc)`` of :class:`KernelParams`."""
     return (np.zeros((0, DF_SIZE)), np.zeros((nb, max_balls)), np.ones((1, 1)),
-            np.ones((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 2)))
+            np.ones((1, 1)), np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 4)))
 
 
 def no_profile():

@@ -440,15 +440,15 @@ def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
     else:
         tk1 = tk2 = np.ones((1, 1))
         te1 = te2 = np.zeros((1, 1))
-    ecc_in = np.asarray(fa.eccentricity, dtype=float).reshape(2, 2)
-    ecc = np.zeros((2, 3))
+    ecc_in = np.asarray(fa.eccentricity, dtype=float).reshape(2, 3)
+    ecc = np.zeros((2, 4))
     if rig.gears is not None and np.any(ecc_in[:, 0] != 0.0):
         m_int[MI_ECC] = 1
         # the kernel turns the offset with the gear's involute origin ψ = θ + ψ0
         refs = (rm.mesh["psi10"], rm.mesh["psi20"])
         for gear in range(2):
             ecc[gear] = (ecc_in[gear, 0], math.cos(ecc_in[gear, 1] - refs[gear]),
-                         math.sin(ecc_in[gear, 1] - refs[gear]))
+                         math.sin(ecc_in[gear, 1] - refs[gear]), ecc_in[gear, 2])
     return b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc)
 
 

@@ -64,8 +64,8 @@ class FaultArrays(NamedTuple):
         ones when healthy; shape (0, 0) on a rig without gears.
     tooth_sep1, tooth_sep2 : ndarray, shape (Z1, n_s), (Z2, n_s)
         Additional unloaded separation, m; zeros when healthy.
-    eccentricity : ndarray, shape (2, 2)
-        (amplitude m, phase rad) of gear 1 and gear 2.
+    eccentricity : ndarray, shape (2, 3)
+        (amplitude m, phase rad, mass on the offset centre kg) of gear 1 and gear 2.
     tooth_grid_m : ndarray, shape (2,)
         (s0, ds) of the tooth tables' grid, m: the run's mesh table grid when one is given
         (then equal to its ``position_m[0]`` and spacing), else a grid of
@@ -246,7 +246,7 @@ def compile_faults(rig, faults, mesh_table=None, *, op=None):
     else:
         fac = {1: np.ones((0, 0)), 2: np.ones((0, 0))}
         sep = {1: np.zeros((0, 0)), 2: np.zeros((0, 0))}
-    ecc = np.zeros((2, 2))
+    ecc = np.zeros((2, 3))
     pair = rig.gears
 
     for f in faults:
@@ -259,7 +259,8 @@ def compile_faults(rig, faults, mesh_table=None, *, op=None):
         elif isinstance(f, OffSizeBall):
             ball_offset[check_bearing(rig, f.bearing), f.ball] += f.diameter_excess_m
         elif isinstance(f, Eccentricity):
-            ecc[f.gear - 1] = (f.amplitude_m, f.phase_rad)
+            g = pair.driving if f.gear == 1 else pair.driven
+            ecc[f.gear - 1] = (f.amplitude_m, f.phase_rad, f.mass_share * g.mass_kg)
         elif isinstance(f, ToothCrack):
             fac[f.gear][f.tooth] *= crack_stiffness_factor(pair, f.gear, f.depth_m,
                                                            f.angle_rad, s, method=f.method)

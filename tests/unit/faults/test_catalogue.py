@@ -99,6 +99,7 @@ def test_toml_round_trip(tmp_path):
     ("wear:bearing=1b1,clearance_growth_m=1e-3", "clearance_growth_m"),
     ("eccentricity:gear=3,amplitude_m=1e-5", "gear"),
     ("eccentricity:gear=1,amplitude_m=0", "amplitude_m"),
+    ("eccentricity:gear=1,amplitude_m=1e-5,mass_share=1.5", "mass_share"),
     ("tooth_crack:gear=1,depth_mm=5", "depth_m"),                      # tip past centreline
     ("tooth_crack:gear=1,depth_mm=1,tooth=28", "tooth"),
     ("tooth_crack:gear=1,depth_mm=1,angle_deg=0", "angle_rad"),
@@ -273,7 +274,8 @@ def test_tooth_tables_where_geometry_puts_them(rig, table):
     np.testing.assert_allclose(sep[s > lam_b + table.spacing_m], BREAKAGE_SEPARATION_M,
                                rtol=1e-12)
     assert np.all(sep[s < lam_b - table.spacing_m] == 0.0)
-    np.testing.assert_allclose(fa.eccentricity, [[0, 0], [2e-5, 0.5]])
+    # (amplitude, phase, the mass on the offset centre: the whole gear's by default)
+    np.testing.assert_allclose(fa.eccentricity, [[0, 0, 0], [2e-5, 0.5, g2.mass_kg]])
 
 
 def test_tip_relief_linear_on_every_tooth(rig, table):

@@ -308,6 +308,33 @@ def test_eccentricity_te_at_shaft_rate_and_gmf_sidebands():
     assert sb[0] < sb[1] / 3.0 and all(b > a for a, b in zip(sb[1:], sb[2:])), sb
 
 
+def test_an_eccentric_gear_s_mass_loads_its_shaft_with_m_e_omega_squared():
+    """The body of an eccentric gear turns about its shaft with its mass centre on the offset
+    centre: its shaft's bearings carry m·e·Ω² more at the shaft rate, a force rotating with
+    the gear (the x and y lines equal, a quarter turn apart), on top of what the contact
+    geometry's own change makes (``mass_share=0``). Quasi-static: the shaft rate is far
+    below the rig's modes, so the bearings take the whole of it."""
+    rig = cmsim.Rig.paper_2016()
+    fr, _, _ = _gear_freqs()
+    e = 1e-4
+    expected = rig.gears.driving.mass_kg * e * (2 * math.pi * fr) ** 2       # 0.88 N
+
+    def shaft_line(share):
+        run = gear_run(f"eccentricity:gear=1,amplitude_m={e},mass_share={share}")
+        t = np.arange(run["F_1b1_x"].size) / run.fs_hz
+        turn = np.exp(-2j * math.pi * fr * t)
+        return [2 * np.mean((run[f"F_1b1_{a}"] + run[f"F_1b2_{a}"]) * turn) for a in "xy"]
+
+    whole, toothing = shaft_line(1.0), shaft_line(0.0)
+    added = [w - b for w, b in zip(whole, toothing)]
+    assert abs(added[0]) == pytest.approx(expected, rel=0.02)
+    assert abs(added[1]) == pytest.approx(expected, rel=0.02)
+    quarter = abs(np.angle(added[1] / added[0]))
+    assert quarter == pytest.approx(math.pi / 2, abs=0.05)
+    half = shaft_line(0.5)
+    assert abs(half[0] - toothing[0]) == pytest.approx(0.5 * expected, rel=0.03)
+
+
 TOOTH_FAULTS = {
     "tooth_crack": [f"tooth_crack:gear=1,depth_m={d}" for d in (1.0e-3, 1.75e-3, 2.5e-3)],
     "tooth_spall": [f"tooth_spall:gear=1,width_m={w},depth_m={d}"
