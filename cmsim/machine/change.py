@@ -333,6 +333,21 @@ def apply_change(machine, segments, change, rng):
                                          machine.background.psd) / floor_b, 0.0, 1.0)
         scale *= np.sqrt(ratio)
         fill = floor_b * (1.0 - share) * (1.0 - ratio)
+        # a shaft-order line the cause makes (an eccentric gear's rotating mass) adds its
+        # power to the baseline's line there through the machine's gain at that order, as a
+        # rotating force does: its phase against the machine's own residual unbalance is
+        # unknown (added in time, a fixed phase took 5 dB off the 1× line it lifts)
+        made = []
+        for order, g in machine.shaft_gain.items():
+            b = line_bins(freq, order * change.shaft_hz)
+            if b is None or not g > 0 or any(
+                    ln.bins.start < b.stop and b.start < ln.bins.stop for ln in lines):
+                continue                       # (a line the healthy model has: above)
+            p_add = float(psd_c[b].sum()) - float(psd_h[b].sum())
+            p_b = float(psd_b[b].sum())
+            if p_add >= 9.0 * float(psd_h[b].sum()) and p_b > 0.0:
+                scale[b] *= math.sqrt((p_b + (g * change.path_gain) ** 2 * p_add) / p_b)
+                made.append(b)
         # the rest of the change: the forces' difference without those lines, through the
         # path: the lines the cause makes whole, its broadband with as much power as the
         # model's broadband grew (a change that only moves the phase of what was there adds
@@ -345,10 +360,10 @@ def apply_change(machine, segments, change, rng):
         spec = np.fft.rfft(d)
         f_long = np.fft.rfftfreq(d.size, 1.0 / fs)
         notch = np.ones(f_long.size)        # raised-cosine edges a bin wide: a brick-wall
-        for ln in lines:                     # notch rings in time, and a segment reads the
-            lo, hi = freq[ln.bins.start] - 0.5 * df, freq[ln.bins.stop - 1] + 0.5 * df
-            edge_w = np.clip(np.maximum(lo - f_long, f_long - hi) / df, 0.0, 1.0)  # ringing
-            notch = np.minimum(notch, 0.5 - 0.5 * np.cos(np.pi * edge_w))        # by its edge
+        for bins in [ln.bins for ln in lines] + made:    # notch rings in time, and a
+            lo, hi = freq[bins.start] - 0.5 * df, freq[bins.stop - 1] + 0.5 * df  # segment
+            edge_w = np.clip(np.maximum(lo - f_long, f_long - hi) / df, 0.0, 1.0)  # reads
+            notch = np.minimum(notch, 0.5 - 0.5 * np.cos(np.pi * edge_w))  # its edge ringing
         spec = spec * notch
         d = np.fft.irfft(spec, d.size)
         _, psd_d = segment_psd(list(d[span].reshape(k, n)), fs)
@@ -357,12 +372,6 @@ def apply_change(machine, segments, change, rng):
         for ln in new_lines:                # a line the cause makes is added whole
             grow[ln.bins] = 1.0
         pin = np.sqrt(gain2) / machine.path.magnitude(freq, a)
-        for order, g in machine.shaft_gain.items():    # a shaft-order line the cause makes
-            b = line_bins(freq, order * change.shaft_hz)   # (an eccentric gear's rotating
-            if b is None or not g > 0:                     # force) reaches the sensor as a
-                continue                                   # rotating force does
-            if float(psd_c[b].sum()) >= 10.0 * float(psd_h[b].sum()):
-                pin[b] = g * change.path_gain / machine.path.magnitude(freq[b], a)
         d = np.fft.irfft(spec * np.interp(f_long, freq, grow * pin), d.size)
         added += machine.path.apply(d, fs, a)[span].reshape(k, n)
     for order, amp, _ in change.rotating:
