@@ -41,7 +41,7 @@ from cmsim.discrepancy.angle_domain import GEAR_ONLY, draw_machine, write_machin
 from cmsim.discrepancy.compare import DEFAULT_BUDGET
 from cmsim.discrepancy.signatures import build_library
 from cmsim.discrepancy.synthetic import GEAR_EFFECTS, HIDDEN_EFFECTS, hidden_effect_record
-from cmsim.machine import calibrate
+from cmsim.machine import Machine, calibrate
 from cmsim.measured import read_record
 
 SEVERITY_FACTOR = 2.0
@@ -103,18 +103,24 @@ def one(job):
 def machine_jobs(job):
     """One machine (its healthy baseline calibrated and its signature library built once),
     then every effect of ``effects`` on it: the rows of the report."""
-    effects, s, budget, generator, _ = job
+    effects, s, budget, generator, cache = job
     rows = []
     machine = calibration_s = None
+    kept = (None if cache is None else
+            Path(cache) / f"{generator}_{_machine_key(effects[0], s, generator)[0]}_{s}.toml")
     with tempfile.TemporaryDirectory() as tmp:
         for eff in effects:
             record, baseline, value, component = (_model_case(eff, s) if generator == "model"
                                                   else _angle_case(eff, s, tmp))
+            if machine is None and kept is not None and kept.is_file():
+                machine = Machine.load(kept)
             if machine is None:
                 t0 = time.perf_counter()
                 machine = calibrate([baseline], seed=s)
                 machine = machine.with_library(build_library(machine, seed=s))
                 calibration_s = time.perf_counter() - t0
+                if kept is not None:
+                    machine.save(kept)
             c, wall, decided = _compare(record, machine, budget, s)
             rows.append(_row(eff, s, c, wall, decided, value, component, generator,
                              calibration_s))
@@ -141,6 +147,10 @@ def main(argv=None):
     ap.add_argument("--clean-seeds", type=int, default=None,
                     help="seeds of the records with no hidden effect (default --seeds)")
     ap.add_argument("--json", default=None)
+    ap.add_argument("--machine-cache", type=Path, default=None,
+                    help="keep each calibrated machine (with its library) in this folder and "
+                         "read it back on a later run: the judge's rules can be iterated on "
+                         "without the calibrations (a machine depends only on its seed)")
     a = ap.parse_args(argv)
     budget = a.budget or DEFAULT_BUDGET
     catalogue = list(HIDDEN_EFFECTS) if a.generator == "model" else list(ANGLE_EFFECTS)
@@ -154,7 +164,10 @@ def main(argv=None):
         groups = defaultdict(list)
         for e, s, *_ in jobs:
             groups[_machine_key(e, s, a.generator)].append(e)
-        jobs = [(effs, key[1], budget, a.generator, True) for key, effs in groups.items()]
+        if a.machine_cache is not None:
+            a.machine_cache.mkdir(parents=True, exist_ok=True)
+        jobs = [(effs, key[1], budget, a.generator, a.machine_cache)
+                for key, effs in groups.items()]
         run = machine_jobs
     rows = []
     t_all = time.perf_counter()
