@@ -40,13 +40,7 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       the model makes the way the machine does. Faults within :data:`NEAR_TIE` of the best
       one's evidence are told apart by their evidence on their own signatures. A fault is a
       candidate here where its family stands out (below), or where its prediction reads the
-      whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`). A
-      nuisance (a speed fluctuation, a load, the background) that reads the record best
-      yields to a fault that reads its own family better than the nuisance does and lifts
-      a feature of it :data:`FAMILY_RISE_DB` over the nuisance's prediction where the
-      record stands :data:`FAMILY_Z` σ over the nuisance's: a time warp cannot lift the 1×
-      line an eccentric gear's mass lifts, a load cannot lift an outer race's envelope
-      lines.
+      whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`).
    b. *A family that stands out.* Where no cause reads the whole record (a real machine
       rings a spall's impacts at a resonance its healthy baseline never showed, which the
       calibrated path cannot know), a fault is named on its own signature
@@ -470,21 +464,6 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]
                 top = new
-            # a nuisance (a speed fluctuation, the background, a load) cannot leave a
-            # fault's own family standing out where that fault predicts it: a fault that
-            # reads its family better than the winner and lifts a feature of it
-            # FAMILY_RISE_DB over the winner's, where the record stands FAMILY_Z σ over the
-            # winner's, is named however far behind on the whole record (a speed fluctuation is a time warp: it read the
-            # sidebands of an eccentric gear and left its shaft-rate envelope line, 23 dB
-            # and 5 σ over its prediction, which the eccentricity lifts 10 dB)
-            if top["cause"].signature is None and not top["stands_out"]:
-                over = [r for r in cands if r["cause"].signature is not None
-                        and r["evidence"] >= MIN_EVIDENCE and _lifts_what_is_left(
-                            r, top, meas, sigma, names)]
-                if over:
-                    new = max(over, key=lambda r: r["evidence"])
-                    ties = [r for r in [top] + ties if r is not new]
-                    top = new
             if top["cause"].signature is not None:
                 # faults the whole record cannot tell apart are told apart by their own
                 # signatures (a broken tooth's once-per-revolution impacts light a bearing's
@@ -514,29 +493,6 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
                                    key=lambda r: (r["cause"].signature is None,
                                                   -r["delta_chi2"])),
             "decided_on": how, "chi2": chi0, "n_eff": n_eff, "z": z0}
-
-
-def _lifts_what_is_left(r, top, meas, sigma, names):
-    """Whether the fault row ``r`` reads its own family better than the winner ``top``
-    does, and predicts a feature of it :data:`FAMILY_RISE_DB` (a log statistic:
-    :data:`FAMILY_Z` σ) over the winner's prediction where the record stands
-    :data:`FAMILY_Z` σ or more over the winner's. Every feature of the family counts, a raw
-    line's too: the record and the baseline share their path, and the fault's change reaches
-    a line through the path's calibrated gain there. (One feature alone named a tooth fault
-    for a speed fluctuation: a sideband of the other shaft its prediction lifted, where it
-    left the sidebands the fluctuation read 15 dB short.)"""
-    fam = [names.index(k) for k in r["family"]]
-    if not fam:
-        return False
-    _, per = chi2_rows(meas, np.vstack([r["prediction"], top["prediction"]]), sigma, names)
-    if np.nansum(per[0][fam]) >= np.nansum(per[1][fam]):
-        return False
-    for i in fam:
-        rise = r["prediction"][i] - top["prediction"][i]
-        needed = FAMILY_RISE_DB if names[i].endswith("_db") else FAMILY_Z * sigma[i]
-        if (meas[i] - top["prediction"][i]) >= FAMILY_Z * sigma[i] and rise >= needed:
-            return True
-    return False
 
 
 def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,

@@ -110,18 +110,14 @@ def test_one_family_standing_clearly_out_of_a_quiet_record_is_a_departure(lift, 
     assert d["finding"] == finding
 
 
-@pytest.mark.parametrize("other, lift, finding", [(6.0, 12.0, "bearing_outer_race"),
-                                                  (7.0, 12.0, "bearing_outer_race"),
-                                                  (7.0, 5.0, "torque_mismatch")])
-def test_a_fault_whose_family_stands_out_wins_over_a_nuisance_on_the_whole_record(
-        other, lift, finding):
-    """An outer race lifts its envelope lines ``lift`` dB and a torque mismatch explains the
-    shaft lines and the level the record lifted by ``other`` dB. The torque mismatch reads
-    the whole record better each time. At 6 dB it is a near tie, and the fault whose
-    family stands out is named; at 7 dB, no tie, the outer race is named still: a load
-    cannot lift envelope lines that stand out over its prediction where the outer race
-    predicts them. Lines lifted 5 dB (under 6 dB) do not stand out, and the better reading
-    stands."""
+@pytest.mark.parametrize("other, finding", [(6.0, "bearing_outer_race"),
+                                            (7.0, "torque_mismatch")])
+def test_a_fault_whose_family_stands_out_wins_a_near_tie_on_the_whole_record(other, finding):
+    """An outer race lifts its envelope lines 12 dB (its family stands out) and a torque
+    mismatch explains the shaft lines and the level the record lifted by ``other`` dB: at
+    6 dB the torque mismatch reads the whole record a little better, within the near tie,
+    and the fault whose family stands out is named; at 7 dB the outer race holds under 0.8
+    of the torque mismatch's evidence, no tie, and the better reading stands."""
     from cmsim.discrepancy.judge import NEAR_TIE
 
     names = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "raw_fr_h1_db", "raw_fr_h2_db",
@@ -143,13 +139,12 @@ def test_a_fault_whose_family_stands_out_wins_over_a_nuisance_on_the_whole_recor
         segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
     li = np.arange(m)
     meas = np.zeros(m)
-    meas[:2], meas[2:5] = lift, other
+    meas[:2], meas[2:5] = 12.0, other
     d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
                       "1b1")
     by = {r["name"]: r for r in d["ranked"]}
     assert d["ranked"][0]["name"] == "torque_mismatch"          # the better whole reading
-    assert by["bearing_outer_race"]["stands_out"] == (lift == 12.0)
-    assert not by["torque_mismatch"]["stands_out"]
+    assert by["bearing_outer_race"]["stands_out"] and not by["torque_mismatch"]["stands_out"]
     tie = by["bearing_outer_race"]["evidence"] >= NEAR_TIE * by["torque_mismatch"]["evidence"]
     assert tie == (other == 6.0)
     assert (d["finding"], d["decided_on"]) == (finding, "whole")
@@ -197,51 +192,3 @@ def test_a_record_across_loads_is_read_within_the_model_s_load_change(monkeypatc
     assert _decide_on(exact, healthy)["finding"] != "none"      # the check can fail
     faulty = [20.0, 20.0, 0.0, 0.0, 0.4, -0.3, 0.1]
     assert _decide_on(moved, faulty)["finding"] == "bearing_outer_race"
-
-
-GEAR_NAMES = ("sb1_fr1_k1_db", "sb1_fr1_k2_db", "env_fr_h1_db", "raw_fr_h1_db",
-              "shape_b0_db", "shape_b1_db", "shape_b2_db", "shape_b3_db")
-
-
-def _gear_decide(meas, ecc_sidebands=9.0):
-    """A gear machine's closed-form library: a speed fluctuation (a time warp) lifts the
-    mesh's shaft-rate sidebands 10 dB at its largest and smears the mesh into the bands
-    beside it (8 dB); an eccentricity lifts the sidebands 9 dB and, its gear's mass turning
-    off-centre, the 1× line 12 dB (the sidebands ``ecc_sidebands``)."""
-    m = len(GEAR_NAMES)
-    fluct = np.zeros((3, m))
-    fluct[:, :2] = np.array([[0.5], [4.0], [10.0]])
-    fluct[:, 4:] = np.array([[0.4], [3.2], [8.0]])
-    ecc = np.zeros((3, m))
-    ecc[:, :2] = np.array([[0.01], [0.1], [1.0]]) * ecc_sidebands
-    ecc[:, 3] = [0.5, 4.0, 12.0]
-    lib = SignatureLibrary(
-        names=GEAR_NAMES, mean=np.zeros(m), spread=np.ones(m), realisation=np.zeros(m),
-        entries=(SignatureEntry("speed_fluctuation", None, "documented",
-                                "relative_amplitude", (0.001, 0.01, 0.1), fluct),
-                 SignatureEntry("eccentricity", "1G1", "documented", "amplitude_m",
-                                (2e-6, 2e-5, 1.5e-4), ecc)),
-        segment_s=0.5, segments=8, speed_rpm=1500.0, torque_nm=50.0, radial_load_n=0.0)
-    li = np.arange(m)
-    sigma = feature_sigma(lib, li, list(GEAR_NAMES), 8)
-    return decide_record(lib, li, list(GEAR_NAMES), np.asarray(meas, dtype=float), sigma,
-                         "1b1")
-
-
-def test_a_time_warp_that_leaves_its_gear_s_1x_line_is_not_the_answer():
-    """Sidebands 10 dB up with the bands beside the mesh 8 dB up are the speed fluctuation.
-    With the 1× line 10 dB up besides, the speed fluctuation still reads the whole record
-    best (the bands are its alone), but a time warp cannot lift a line: the eccentricity,
-    which reads its own family (sidebands, 1×) better and lifts the 1× 12 dB where the record
-    stands 11 σ over the time warp's, is named. Where the eccentricity reads its family worse
-    than the warp (its sidebands unmoved, where the record's stand 10 dB up), the warp
-    stands, whatever line it lifts."""
-    d = _gear_decide([10.0, 10.0, 0.0, 0.0, 8.0, 8.0, 8.0, 8.0])
-    assert d["finding"] == "speed_fluctuation"
-    d = _gear_decide([10.0, 10.0, 0.0, 10.0, 8.0, 8.0, 8.0, 8.0])
-    assert d["ranked"][0]["name"] == "speed_fluctuation"        # whole record: the warp
-    assert d["finding"] == "eccentricity" and d["top"]["component"] == "1G1"
-    assert any(r["name"] == "speed_fluctuation" for r in d["ties"])
-    d = _gear_decide([10.0, 10.0, 0.0, 10.0, 8.0, 8.0, 8.0, 8.0], ecc_sidebands=0.0)
-    assert d["ranked"][0]["name"] == "speed_fluctuation"
-    assert d["finding"] == "speed_fluctuation"
