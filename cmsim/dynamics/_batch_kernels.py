@@ -6,11 +6,12 @@ DOFs, bearings, slots, fault and profile switches and table sizes) and differ in
 a time. Their states are ``(dim, B)`` arrays, the run index innermost, so the parts of the
 right-hand side that are the same arithmetic on different numbers run as loops over the B
 runs that numba vectorises (SIMD lanes): the linear springs and dampers, the healthy Hertz
-ball sums of every bearing, the tooth contacts from their tables
-(:mod:`cmsim.dynamics._batch_mesh_kernels`), the Runge-Kutta stage combinations. The parts
-that branch per run — the speed/torque profile, slip, bearing defects and the on-line
-hybrid contact solve — call the single-run kernels of :mod:`cmsim.dynamics._rhs_kernels` on
-each run's views (:func:`lane_params`, :func:`lane_work`), so their physics is written once.
+ball sums of every bearing, the Runge-Kutta stage combinations. The tooth contacts from
+their tables (:mod:`cmsim.dynamics._batch_mesh_kernels`), the slip and the speed profile
+run in passes over the runs as well, branch-free where the single-run kernel branches. The
+parts that branch per run in depth — bearing defects and the on-line hybrid contact solve
+— call the single-run kernels of :mod:`cmsim.dynamics._rhs_kernels` on each run's views
+(:func:`lane_params`, :func:`lane_work`), so their physics is written once.
 
 Independence of the runs (the contract :mod:`cmsim.dynamics.batch` tests): every operation on
 run ``l`` reads only run ``l``'s numbers, in the same order whatever B is and wherever the run

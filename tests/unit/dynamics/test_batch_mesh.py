@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import cmsim
-from cmsim.dynamics._batch_mesh_kernels import R_LEN, R_SIZE, mesh_forces_batch_jit
-from cmsim.dynamics._mesh_kernels import MI_SLOTS, SG_SIZE, mesh_forces_jit
+from cmsim.dynamics._batch_mesh_kernels import BS_SIZE, R_LEN, R_SIZE, mesh_forces_batch_jit
+from cmsim.dynamics._mesh_kernels import MI_SLOTS, mesh_forces_jit
 from cmsim.dynamics._rhs_kernels import KernelParams, make_work
 from cmsim.dynamics.batch import _batch_arrays, kernel_layout
 from cmsim.dynamics.simulation import prepare_run
@@ -66,7 +66,7 @@ def _batched(setups, ys, taus, srs, want_diag):
     n = ys[0][0].size // 2
     n_diag = len(setups[0].model.output_force_names)
     r = np.zeros((R_SIZE, n_runs))
-    sg = np.zeros((int(S.m_int[0, MI_SLOTS]), SG_SIZE, n_runs))
+    sg = np.zeros((int(S.m_int[0, MI_SLOTS]), BS_SIZE, n_runs))
     out = []
     for y, tau, sr in zip(ys, taus, srs):
         g = np.zeros((n, n_runs))
@@ -135,7 +135,7 @@ def test_corner_contacts_and_zone_changes_are_exercised():
     ys, taus, srs = _states(setups)
     geo = setups[0].model.kernel_params.geo
     r = np.zeros((R_SIZE, len(setups)))
-    sg = np.zeros((int(S.m_int[0, MI_SLOTS]), SG_SIZE, len(setups)))
+    sg = np.zeros((int(S.m_int[0, MI_SLOTS]), BS_SIZE, len(setups)))
     n = ys[0][0].size // 2
     kinds = set()
     for y, tau, sr in zip(ys, taus, srs):
