@@ -39,11 +39,12 @@ from cmsim.dynamics.profiles import SpeedProfile
 from cmsim.faults import fault_frequencies
 from cmsim.features import N_GMF_HARMONICS, run_features
 from cmsim.frequencies import rig_frequencies
+from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
 __all__ = ["simulate_record", "simulate_records", "run_record", "run_records",
-           "DEFAULT_BATCH_SIZE", "base_row",
+           "BATCH_SIZE", "BATCH_FROM_RECORDS", "default_batch_size", "base_row",
            "manifest_features", "FEATURE_SIGNALS",
            "FORMAT"]
 
@@ -200,14 +201,40 @@ def _machine_reference(spec, rig, op, plan, profile, channels):
                     record=None if channels is None else list(machine.force_signals))
 
 
-#: Records a dataset integrates together by default: 1, each record alone on the single-run
-#: kernel. Measured on the 2-core build machine (``benchmarks/bench_batch.py``,
-#: docs/benchmarks.md), batches of 8-64 records of ``datasets/gear_faults.toml`` made 0.7-0.95
-#: of its records per hour: the tooth contacts, half of a batch's step, still run record by
-#: record inside the batch, so the vectorised rest cannot pay for the batch's loops. A larger
-#: ``batch_size`` is the batch kernel (:mod:`cmsim.dynamics.batch`), bit for bit the same
-#: records for every size above 1.
-DEFAULT_BATCH_SIZE = 1
+#: Records a dataset integrates together by default (:func:`default_batch_size`): B runs in
+#: one time loop, the record the inner array axis (:mod:`cmsim.dynamics.batch`). Measured on
+#: the 2-core build machine (``benchmarks/bench_batch.py``, docs/benchmarks.md): a step of the
+#: paper rig costs 0.64 of one record's alone at 32 records and 0.60 at 64 (8: 1.1), and the
+#: batch's arrays stay under 0.5 GiB per worker at 64.
+BATCH_SIZE = 64
+#: Fewest records a spec has for them to be batched by default: below, batches would be
+#: too small to pay (at 8 records a step costs more than alone), so each record runs alone
+#: on the single-run kernel, the reference.
+BATCH_FROM_RECORDS = 64
+
+
+def default_batch_size(spec):
+    """Records of ``spec`` integrated together when no batch size is given:
+    :data:`BATCH_SIZE` for a spec of at least :data:`BATCH_FROM_RECORDS` records whose tooth
+    contact is not the on-line hybrid solve (the batch kernel runs that record by record),
+    else 1 (each record alone on the single-run kernel).
+
+    Decided from the spec alone — not from how many records are pending or on which worker —
+    so a record's arrays are the same bits in a fresh run, a resume or
+    :func:`simulate_record`: every batch size above 1 gives the same bits (a batch of one
+    included), and 1 agrees with them within 1e-9 of each signal's range.
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+
+    Returns
+    -------
+    int
+    """
+    hybrid = spec.mesh == "hybrid" or isinstance(spec.mesh, HybridMeshModel)
+    return BATCH_SIZE if spec.n_records >= BATCH_FROM_RECORDS and not hybrid else 1
 
 
 def simulate_records(spec, plans, batch_size=None):
@@ -228,13 +255,13 @@ def simulate_records(spec, plans, batch_size=None):
     plans : sequence of RecordPlan
         Its records (:meth:`DatasetSpec.record`).
     batch_size : int, optional
-        1: each record alone; larger: together (default :data:`DEFAULT_BATCH_SIZE`).
+        1: each record alone; larger: together (default :func:`default_batch_size`).
 
     Returns
     -------
     list of tuple or Exception
     """
-    batch_size = DEFAULT_BATCH_SIZE if batch_size is None else batch_size
+    batch_size = default_batch_size(spec) if batch_size is None else batch_size
     out = [None] * len(plans)
     setups, todo = [], []
     for i, plan in enumerate(plans):
@@ -247,7 +274,8 @@ def simulate_records(spec, plans, batch_size=None):
         setups.append(setup)
         todo.append((i, plan, rig, op, profile, time.perf_counter() - t0))
     t0 = time.perf_counter()
-    runs = simulate_batch(setups) if batch_size > 1 else [_alone(s) for s in setups]
+    runs = (simulate_batch(setups, batch_size) if batch_size > 1
+            else [_alone(s) for s in setups])
     # what the batch spent besides integrating (filters, signals), shared out
     around = (time.perf_counter() - t0
               - sum(r.meta["wall_s"] for r in runs if not isinstance(r, Exception)))
@@ -274,7 +302,7 @@ def _alone(setup):
 def simulate_record(spec, index, plan=None):
     """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
     docstring), bit for bit as a dataset run makes it by default
-    (:func:`simulate_records` with :data:`DEFAULT_BATCH_SIZE`). Raises what
+    (:func:`simulate_records` with :func:`default_batch_size`). Raises what
     :func:`cmsim.dynamics.simulate` raises (e.g. :class:`~cmsim.errors.IntegrationDiverged`).
 
     Parameters
