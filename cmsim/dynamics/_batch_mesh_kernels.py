@@ -127,18 +127,26 @@ def _centres(y, n, i1, i2, tau, sr, mp, r):
         trig[l] = 0.0
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _turn_origins(r, l, psi_anchor):
+    """cos and sin of run ``l``'s involute origins ψ1, ψ2 through its anchors (``psi_anchor``
+    (B, 2, AN_SIZE)), kept in ``r`` (``R_TRIG`` 1) and returned ``(cp1, sp1, cp2, sp2)``."""
+    cp1, sp1 = anchored_cos_sin_jit(psi_anchor[l], 0, r[R_PSI1, l])
+    cp2, sp2 = anchored_cos_sin_jit(psi_anchor[l], 1, r[R_PSI2, l])
+    r[R_TRIG, l] = 1.0
+    r[R_CP1, l] = cp1
+    r[R_SP1, l] = sp1
+    r[R_CP2, l] = cp2
+    r[R_SP2, l] = sp2
+    return cp1, sp1, cp2, sp2
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _eccentric_centres(r, ecc, psi_anchor):
     """The geometric centres of eccentric gears (``MI_ECC``), run by run: the involute
     origins turned through each run's anchors (``psi_anchor`` (B, 2, AN_SIZE))."""
     for l in range(r.shape[1]):
-        cp1, sp1 = anchored_cos_sin_jit(psi_anchor[l], 0, r[R_PSI1, l])
-        cp2, sp2 = anchored_cos_sin_jit(psi_anchor[l], 1, r[R_PSI2, l])
-        r[R_TRIG, l] = 1.0
-        r[R_CP1, l] = cp1
-        r[R_SP1, l] = sp1
-        r[R_CP2, l] = cp2
-        r[R_SP2, l] = sp2
+        cp1, sp1, cp2, sp2 = _turn_origins(r, l, psi_anchor)
         e = ecc[l]
         r[R_GX1, l] += e[0, 0] * (cp1 * e[0, 1] - sp1 * e[0, 2])
         r[R_GY1, l] += e[0, 0] * (sp1 * e[0, 1] + cp1 * e[0, 2])
@@ -316,13 +324,7 @@ def _corner_slots(z1, z2, r, sg, geo_runs, teeth1, teeth2, psi_anchor):
             if sj[BS_CORNER, l] == 0.0:
                 continue
             if r[R_TRIG, l] == 0.0:
-                cp1, sp1 = anchored_cos_sin_jit(psi_anchor[l], 0, r[R_PSI1, l])
-                cp2, sp2 = anchored_cos_sin_jit(psi_anchor[l], 1, r[R_PSI2, l])
-                r[R_TRIG, l] = 1.0
-                r[R_CP1, l] = cp1
-                r[R_SP1, l] = sp1
-                r[R_CP2, l] = cp2
-                r[R_SP2, l] = sp2
+                _turn_origins(r, l, psi_anchor)
             cp1 = r[R_CP1, l]
             sp1 = r[R_SP1, l]
             cp2 = r[R_CP2, l]
