@@ -44,7 +44,8 @@ from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
 __all__ = ["simulate_record", "simulate_records", "run_record", "run_records",
-           "BATCH_SIZE", "BATCH_FROM_RECORDS", "default_batch_size", "base_row",
+           "BATCH_SIZE", "BATCH_SAMPLES", "BATCH_MIN", "BATCH_FROM_RECORDS",
+           "default_batch_size", "base_row",
            "manifest_features", "FEATURE_SIGNALS",
            "FORMAT"]
 
@@ -201,23 +202,30 @@ def _machine_reference(spec, rig, op, plan, profile, channels):
                     record=None if channels is None else list(machine.force_signals))
 
 
-#: Records a dataset integrates together by default (:func:`default_batch_size`): B runs in
-#: one time loop, the record the inner array axis (:mod:`cmsim.dynamics.batch`). Measured on
-#: the 2-core build machine (``benchmarks/bench_batch.py``, docs/benchmarks.md): a step of the
-#: paper rig costs 0.64 of one record's alone at 32 records and 0.60 at 64 (8: 1.1), and the
-#: batch's arrays stay under 0.5 GiB per worker at 64.
+#: Most records a dataset integrates together by default (:func:`default_batch_size`): B runs
+#: in one time loop, the record the inner array axis (:mod:`cmsim.dynamics.batch`). Measured
+#: on the 2-core build machine (docs/benchmarks.md): a record of the paper rig costs, in CPU,
+#: 0.77 of its cost alone in a batch of 32 and 0.69-0.74 in one of 64 (8: 1.14-1.19).
 BATCH_SIZE = 64
-#: Fewest records a spec has for them to be batched by default: below, batches would be
-#: too small to pay (at 8 records a step costs more than alone), so each record runs alone
-#: on the single-run kernel, the reference.
+#: Samples (duration × sample rate) a default batch holds at most: a batch's arrays grow
+#: with it (64 one-second records at 25.6 kHz peaked at 0.87 GiB in one process, 229 MiB
+#: before the batch), so 48 such records, and fewer of longer or faster ones, keep a worker
+#: under 1 GiB.
+BATCH_SAMPLES = 48 * 25_600
+#: Smallest batch that pays (a batch of 16 costs 0.87-0.88 of its records alone, one of 8
+#: more than alone): a spec whose records would batch fewer keeps each record alone.
+BATCH_MIN = 16
+#: Fewest records a spec has for them to be batched by default (fewer make batches too
+#: small to pay once spread over the workers and fault types).
 BATCH_FROM_RECORDS = 64
 
 
 def default_batch_size(spec):
-    """Records of ``spec`` integrated together when no batch size is given:
-    :data:`BATCH_SIZE` for a spec of at least :data:`BATCH_FROM_RECORDS` records whose tooth
-    contact is not the on-line hybrid solve (the batch kernel runs that record by record),
-    else 1 (each record alone on the single-run kernel).
+    """Records of ``spec`` integrated together when no batch size is given: up to
+    :data:`BATCH_SIZE`, as many as :data:`BATCH_SAMPLES` allows, for a spec of at least
+    :data:`BATCH_FROM_RECORDS` records whose tooth contact is not the on-line hybrid solve
+    (the batch kernel runs that record by record); 1 (each record alone on the single-run
+    kernel) otherwise, and where fewer than :data:`BATCH_MIN` would fit.
 
     Decided from the spec alone — not from how many records are pending or on which worker —
     so a record's arrays are the same bits in a fresh run, a resume or
@@ -234,7 +242,10 @@ def default_batch_size(spec):
     int
     """
     hybrid = spec.mesh == "hybrid" or isinstance(spec.mesh, HybridMeshModel)
-    return BATCH_SIZE if spec.n_records >= BATCH_FROM_RECORDS and not hybrid else 1
+    if spec.n_records < BATCH_FROM_RECORDS or hybrid:
+        return 1
+    size = min(BATCH_SIZE, int(BATCH_SAMPLES // (spec.duration_s * spec.fs_hz)))
+    return size if size >= BATCH_MIN else 1
 
 
 def simulate_records(spec, plans, batch_size=None):

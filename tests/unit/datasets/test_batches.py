@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from cmsim.datasets import DatasetSpec, generate_dataset, load
-from cmsim.datasets.records import (BATCH_FROM_RECORDS, BATCH_SIZE, default_batch_size,
-                                    simulate_record, simulate_records)
+from cmsim.datasets.records import (BATCH_FROM_RECORDS, BATCH_MIN, BATCH_SAMPLES, BATCH_SIZE,
+                                    default_batch_size, simulate_record, simulate_records)
 from cmsim.errors import ParameterError
 
 SPEC = {
@@ -101,6 +101,11 @@ def test_a_large_spec_batches_by_default_and_its_records_keep_their_bits():
     assert default_batch_size(spec) == BATCH_SIZE > 1
     hybrid = DatasetSpec.from_dict({**raw, "simulation": {"mesh": "hybrid"}})
     assert default_batch_size(hybrid) == 1               # the on-line solve: run by run
+    fs = SPEC["sensor"]["fs_hz"]
+    for duration, size in ((BATCH_SAMPLES / fs / 20, 20), (BATCH_SAMPLES / fs / 10, 1)):
+        longer = DatasetSpec.from_dict({**raw, "sensor": {**SPEC["sensor"],
+                                                          "duration_s": duration}})
+        assert default_batch_size(longer) == (size if size >= BATCH_MIN else 1)
     plans = [spec.record(i) for i in range(5)]
     together = simulate_records(spec, plans)             # the default: one batch of 5
     for i in (0, 3):
