@@ -45,15 +45,15 @@ import math
 
 from numba import njit
 
-from cmsim.dynamics._mesh_kernels import (MI_CTAB, MI_ECC, MI_G1, MI_G2, MI_MUTAB, MI_SLOTS,
-                                          MI_TEETH, MP_A0, MP_BETA, MP_COST0, MP_DIAGB,
+from cmsim.dynamics._mesh_kernels import (MI_CTAB, MI_ECC, MI_G1, MI_G2, MI_MUTAB, MI_TEETH,
+                                          MP_A0, MP_BETA, MP_COST0, MP_DIAGB,
                                           MP_DTHR, MP_KOSTER, MP_MU, MP_OM1, MP_OM2, MP_PB,
                                           MP_PHIT0, MP_PSI10, MP_PSI20, MP_SINT0, MP_SLO,
                                           MP_TAB0, MP_TABD, MP_V0, MP_ZAFTER, MP_ZBEFORE,
                                           SG_ELASTIC, SG_GAP, SG_KPAIR, SG_NX, SG_NY, SG_ON,
                                           SG_PX, SG_PY, SG_REQ, SG_S, SG_SIZE)
 from cmsim.dynamics._rotation_kernels import anchored_cos_sin_jit
-from cmsim.mesh_stiffness._kernels import mesh_line_jit, pair_contact_jit, table_lookup2_jit
+from cmsim.mesh_stiffness._kernels import mesh_line_jit, pair_contact_jit
 
 # rows of the per-run scratch ``r``: shaft centres, geometric centres, involute origins, the
 # line of action (angle, length, cos, sin; R_OK 0 where its angle needs atan2), interference
@@ -337,7 +337,7 @@ def _corner_slots(z1, z2, r, sg, geo_runs, teeth1, teeth2, psi_anchor):
             s1n = sp1 * t1[k1, 0] - cp1 * t1[k1, 1]
             c2n = cp2 * t2[k2, 0] - sp2 * t2[k2, 1]
             s2n = sp2 * t2[k2, 0] + cp2 * t2[k2, 1]
-            delta, nx, ny, px, py, s_eq, chi1, chi2 = pair_contact_jit(
+            delta, nx, ny, px, py, _s_eq, chi1, chi2 = pair_contact_jit(
                 sj[SG_S, l], r[R_DINV, l], c1n, s1n, c2n, s2n, r[R_GX1, l], r[R_GY1, l],
                 r[R_GX2, l], r[R_GY2, l], r[R_COS, l], r[R_SIN, l], r[R_LEN, l], geo_runs[l])
             sj[SG_NX, l] = nx

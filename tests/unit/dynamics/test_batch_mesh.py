@@ -15,7 +15,7 @@ import pytest
 import cmsim
 from cmsim.dynamics._batch_mesh_kernels import BS_SIZE, R_LEN, R_SIZE, mesh_forces_batch_jit
 from cmsim.dynamics._mesh_kernels import MI_SLOTS, mesh_forces_jit
-from cmsim.dynamics._rhs_kernels import KernelParams, make_work
+from cmsim.dynamics._rhs_kernels import make_work
 from cmsim.dynamics.batch import _batch_arrays, kernel_layout
 from cmsim.dynamics.simulation import prepare_run
 from cmsim.faults import Eccentricity, ToothCrack, ToothSpall
