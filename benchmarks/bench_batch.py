@@ -15,9 +15,11 @@ machine load (the machine is shared: the ratios carry, the absolute figures do n
    hour if 2 workers did nothing but that integration, one record at a time;
 3. ``generate_dataset(spec, batch_size=B, workers=2)`` for each batch size B in a fresh
    process (start-up, imports, kernel loading and the manifest included): wall time,
-   records per hour, its ratio to the bound, and the peak resident memory of the largest
-   worker (``getrusage``); B = 1 is each record alone on the single-run kernel (the
-   reference), B > 1 the batch kernel (``cmsim.dynamics.batch``);
+   records per hour, its ratio to the bound, the CPU per record of the process and its
+   workers with the bound's ratio to it (what the wall ratio is on 2 idle cores: on a
+   shared machine the wall figures carry the other processes' load), and the peak resident
+   memory of the largest worker (``getrusage``); B = 1 is each record alone on the
+   single-run kernel (the reference), B > 1 the batch kernel (``cmsim.dynamics.batch``);
 4. with ``--command``: ``cmsim dataset SPEC --workers 2`` itself on the spec as shipped (its
    own record count, its default batch size), as a user runs it, against the bound.
 
@@ -56,8 +58,10 @@ raw = read_toml(sys.argv[1])
 raw["dataset"]["records"] = int(sys.argv[3])
 spec = DatasetSpec.from_dict(raw, base_dir=__import__("pathlib").Path(sys.argv[1]).parent)
 s = generate_dataset(spec, sys.argv[2], workers=2, batch_size=int(sys.argv[4]))
+me, kids = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
 print(json.dumps({"wall_s": time.perf_counter() - t0, "failed": s.records_failed,
-                  "worker_rss_kb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss}))
+                  "cpu_s": me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime,
+                  "worker_rss_kb": kids.ru_maxrss}))
 """
 
 
@@ -87,7 +91,8 @@ def bound_run(args, tmp):
 
 
 def generate_run(spec_path, records, batch, tmp):
-    """One dataset run in a fresh process: ``(wall s, peak RSS of the largest worker MiB)``."""
+    """One dataset run in a fresh process: ``(wall s, peak RSS of the largest worker MiB,
+    CPU s of the process and its workers)``."""
     out = tempfile.mkdtemp(dir=tmp)
     done = subprocess.run([sys.executable, "-c", GENERATE, str(spec_path), str(Path(out) / "ds"),
                            str(records), str(batch)], capture_output=True, text=True, env=ENV)
@@ -95,7 +100,7 @@ def generate_run(spec_path, records, batch, tmp):
         raise SystemExit(f"generate_dataset failed: {done.stderr[-2000:]}")
     res = json.loads(done.stdout.strip().splitlines()[-1])
     assert res["failed"] == 0
-    return res["wall_s"], res["worker_rss_kb"] / 1024.0
+    return res["wall_s"], res["worker_rss_kb"] / 1024.0, res["cpu_s"]
 
 
 def command_run(spec_path, tmp):
@@ -137,12 +142,14 @@ def main(argv=None):
         rig_args, spec = spec_rig_args(args.spec, tmp)
         bound_run(rig_args, tmp)                           # warm: kernels from the cache
         generate_run(args.spec, 4, 2, tmp)
-        bounds, walls, rss, commands = [], {b: [] for b in sizes}, {}, []
+        bounds, walls, cpus, rss, commands = [], {b: [] for b in sizes}, {b: [] for b in sizes}, \
+            {}, []
         for _ in range(args.rounds):                       # interleaved rounds
             bounds.append(bound_run(rig_args, tmp))
             for b in sizes:
-                w, m = generate_run(args.spec, args.records, b, tmp)
+                w, m, c = generate_run(args.spec, args.records, b, tmp)
                 walls[b].append(w)
+                cpus[b].append(c)
                 rss[b] = max(rss.get(b, 0.0), m)
             if args.command:
                 commands.append(command_run(args.spec, tmp))
@@ -154,15 +161,22 @@ def main(argv=None):
               f"records/hour on 2 workers")
         print(f"\ngenerate_dataset, {args.records} records of {spec.name}, 2 workers, fresh "
               f"process (median of {args.rounds} rounds, interleaved):")
-        print(f"  {'batch':>5} {'wall s':>8} {'records/h':>10} {'ratio':>6} {'worker MiB':>11}")
+        print("  (CPU: the process and its workers, per record; the CPU ratio is the bound over "
+              "it, what the wall ratio is on 2 idle cores)")
+        print(f"  {'batch':>5} {'wall s':>8} {'records/h':>10} {'ratio':>6} {'CPU ms/rec':>11} "
+              f"{'CPU ratio':>9} {'worker MiB':>11}")
         rows = []
         for b in sizes:
             w = float(np.median(walls[b]))
+            cpu_rec = float(np.median(cpus[b])) / args.records
             rate = 3600.0 * args.records / w
             rows.append({"batch": b, "wall_s": w, "walls_s": walls[b], "records_per_hour": rate,
-                         "ratio_to_bound": rate / per_hour_bound, "worker_rss_mib": rss[b]})
+                         "ratio_to_bound": rate / per_hour_bound, "worker_rss_mib": rss[b],
+                         "cpu_per_record_s": cpu_rec, "cpus_s": cpus[b],
+                         "cpu_ratio_to_bound": bound / cpu_rec,
+                         "cpu_records_per_hour": 2 * 3600.0 / cpu_rec})
             print(f"  {b:>5} {w:8.1f} {rate:10.0f} {rate / per_hour_bound:6.2f} "
-                  f"{rss[b]:11.0f}")
+                  f"{cpu_rec * 1e3:11.1f} {bound / cpu_rec:9.2f} {rss[b]:11.0f}")
         res.update(bound_wall_s=bound, bounds_s=bounds, bound_per_hour=per_hour_bound,
                    rows=rows)
         if commands:
@@ -190,7 +204,10 @@ def plot(res, path):
     rows = res["rows"]
     b = [r["batch"] for r in rows]
     ax.plot(b, [r["records_per_hour"] for r in rows], "-o", color="C0",
-            label="generate_dataset, 2 workers (1 = each record alone)")
+            label="generate_dataset, 2 workers, wall (1 = each record alone)")
+    if all("cpu_records_per_hour" in r for r in rows):
+        ax.plot(b, [r["cpu_records_per_hour"] for r in rows], "--s", color="C1",
+                label="the same in CPU: records per hour on 2 idle cores")
     ax.axhline(res["bound_per_hour"], color="C3", ls="--",
                label="one-record bound (integration alone, 2 workers)")
     if "command" in res:

@@ -39,11 +39,13 @@ from cmsim.dynamics.profiles import SpeedProfile
 from cmsim.faults import fault_frequencies
 from cmsim.features import N_GMF_HARMONICS, run_features
 from cmsim.frequencies import rig_frequencies
+from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
 __all__ = ["simulate_record", "simulate_records", "run_record", "run_records",
-           "DEFAULT_BATCH_SIZE", "base_row",
+           "BATCH_SIZE", "BATCH_SAMPLES", "BATCH_MIN", "BATCH_FROM_RECORDS",
+           "default_batch_size", "base_row",
            "manifest_features", "FEATURE_SIGNALS",
            "FORMAT"]
 
@@ -200,14 +202,50 @@ def _machine_reference(spec, rig, op, plan, profile, channels):
                     record=None if channels is None else list(machine.force_signals))
 
 
-#: Records a dataset integrates together by default: 1, each record alone on the single-run
-#: kernel. Measured on the 2-core build machine (``benchmarks/bench_batch.py``,
-#: docs/benchmarks.md), batches of 8-64 records of ``datasets/gear_faults.toml`` made 0.7-0.95
-#: of its records per hour: the tooth contacts, half of a batch's step, still run record by
-#: record inside the batch, so the vectorised rest cannot pay for the batch's loops. A larger
-#: ``batch_size`` is the batch kernel (:mod:`cmsim.dynamics.batch`), bit for bit the same
-#: records for every size above 1.
-DEFAULT_BATCH_SIZE = 1
+#: Most records a dataset integrates together by default (:func:`default_batch_size`): B runs
+#: in one time loop, the record the inner array axis (:mod:`cmsim.dynamics.batch`). Measured
+#: on the 2-core build machine (docs/benchmarks.md): a record of the paper rig costs, in CPU,
+#: 0.77 of its cost alone in a batch of 32 and 0.69-0.74 in one of 64 (8: 1.14-1.19).
+BATCH_SIZE = 64
+#: Samples (duration × sample rate) a default batch holds at most: a batch's arrays grow
+#: with it (64 one-second records at 25.6 kHz peaked at 0.87 GiB in one process, 229 MiB
+#: before the batch), so 48 such records, and fewer of longer or faster ones, keep a worker
+#: under 1 GiB.
+BATCH_SAMPLES = 48 * 25_600
+#: Smallest batch that pays (a batch of 16 costs 0.87-0.88 of its records alone, one of 8
+#: more than alone): a spec whose records would batch fewer keeps each record alone.
+BATCH_MIN = 16
+#: Fewest records a spec has for them to be batched by default (fewer make batches too
+#: small to pay once spread over the workers and fault types).
+BATCH_FROM_RECORDS = 64
+
+
+def default_batch_size(spec):
+    """Records of ``spec`` integrated together when no batch size is given: up to
+    :data:`BATCH_SIZE`, as many as :data:`BATCH_SAMPLES` allows, for a spec of at least
+    :data:`BATCH_FROM_RECORDS` records whose tooth contact is not the on-line hybrid solve
+    (the batch kernel runs that record by record); 1 (each record alone on the single-run
+    kernel) otherwise, and where fewer than :data:`BATCH_MIN` would fit.
+
+    Decided from the spec alone — not from how many records are pending or on which worker —
+    so a record's arrays are the same bits in a fresh run, a resume or
+    :func:`simulate_record`: every batch size above 1 gives the same bits (a batch of one
+    included), and 1 agrees with them within 1e-9 of each signal's range.
+
+    Parameters
+    ----------
+    spec : DatasetSpec
+        The spec.
+
+    Returns
+    -------
+    int
+    """
+    hybrid = spec.mesh == "hybrid" or isinstance(spec.mesh, HybridMeshModel)
+    if spec.n_records < BATCH_FROM_RECORDS or hybrid:
+        return 1
+    size = min(BATCH_SIZE, int(BATCH_SAMPLES // (spec.duration_s * spec.fs_hz)))
+    return size if size >= BATCH_MIN else 1
 
 
 def simulate_records(spec, plans, batch_size=None):
@@ -228,13 +266,13 @@ def simulate_records(spec, plans, batch_size=None):
     plans : sequence of RecordPlan
         Its records (:meth:`DatasetSpec.record`).
     batch_size : int, optional
-        1: each record alone; larger: together (default :data:`DEFAULT_BATCH_SIZE`).
+        1: each record alone; larger: together (default :func:`default_batch_size`).
 
     Returns
     -------
     list of tuple or Exception
     """
-    batch_size = DEFAULT_BATCH_SIZE if batch_size is None else batch_size
+    batch_size = default_batch_size(spec) if batch_size is None else batch_size
     out = [None] * len(plans)
     setups, todo = [], []
     for i, plan in enumerate(plans):
@@ -247,7 +285,8 @@ def simulate_records(spec, plans, batch_size=None):
         setups.append(setup)
         todo.append((i, plan, rig, op, profile, time.perf_counter() - t0))
     t0 = time.perf_counter()
-    runs = simulate_batch(setups) if batch_size > 1 else [_alone(s) for s in setups]
+    runs = (simulate_batch(setups, batch_size) if batch_size > 1
+            else [_alone(s) for s in setups])
     # what the batch spent besides integrating (filters, signals), shared out
     around = (time.perf_counter() - t0
               - sum(r.meta["wall_s"] for r in runs if not isinstance(r, Exception)))
@@ -274,7 +313,7 @@ def _alone(setup):
 def simulate_record(spec, index, plan=None):
     """Simulate record ``index`` of ``spec``: ``(arrays, meta)``, what its file holds (module
     docstring), bit for bit as a dataset run makes it by default
-    (:func:`simulate_records` with :data:`DEFAULT_BATCH_SIZE`). Raises what
+    (:func:`simulate_records` with :func:`default_batch_size`). Raises what
     :func:`cmsim.dynamics.simulate` raises (e.g. :class:`~cmsim.errors.IntegrationDiverged`).
 
     Parameters

@@ -41,7 +41,7 @@ from cmsim.datasets.lock import DirectoryLock
 from cmsim.datasets.manifest import (PARQUET_NAME, RECORDS_DIR, ROWS_DIR, SPEC_NAME, consolidate,
                                      done_indices, open_directory, read_rows)
 from cmsim.datasets.pool import check_start_method, check_workers, run_tasks, scheduler_client
-from cmsim.datasets.records import DEFAULT_BATCH_SIZE, run_records
+from cmsim.datasets.records import default_batch_size, run_records
 from cmsim.datasets.spec import DatasetSpec
 from cmsim.dynamics.batch import kernel_layout, simulate_batch
 from cmsim.dynamics.simulation import integrate_prepared, prepare_run
@@ -216,10 +216,12 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
     batch_size : int, optional
         Most records a worker integrates together in one time loop, fewer when that spreads
         the records over the workers (default
-        :data:`~cmsim.datasets.records.DEFAULT_BATCH_SIZE`, 1: each record alone on the
-        single-run kernel, the reference). A record's arrays are bit for bit the same for
-        every batch size above 1, on any number of workers, resumed or not, and within 1e-9
-        of each signal's range of the single-run kernel's.
+        :func:`~cmsim.datasets.records.default_batch_size`: 48 one-second 25.6-kHz records
+        for a spec of 64 records or more, else 1; 1 is each record alone on the single-run
+        kernel, the reference). A
+        record's arrays are bit for bit the same for every batch size above 1, on any number
+        of workers, resumed or not, and within 1e-9 of each signal's range of the single-run
+        kernel's.
 
     Returns
     -------
@@ -323,7 +325,7 @@ def _generate(spec, out, start, *, workers, client, progress, method, verify, fo
     try:
         if pending:
             plans = [spec.record(i) for i in pending]      # drawn once, here
-            size = DEFAULT_BATCH_SIZE if batch_size is None else batch_size
+            size = default_batch_size(spec) if batch_size is None else batch_size
             first = _first_runs(spec, plans)
             if client is None and method == "fork":
                 t_w = time.perf_counter()

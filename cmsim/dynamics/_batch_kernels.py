@@ -6,10 +6,12 @@ DOFs, bearings, slots, fault and profile switches and table sizes) and differ in
 a time. Their states are ``(dim, B)`` arrays, the run index innermost, so the parts of the
 right-hand side that are the same arithmetic on different numbers run as loops over the B
 runs that numba vectorises (SIMD lanes): the linear springs and dampers, the healthy Hertz
-ball sums of every bearing, the Runge-Kutta stage combinations. The parts that branch per
-run — the speed/torque profile, slip, defects and the tooth contacts — call the
-single-run kernels of :mod:`cmsim.dynamics._rhs_kernels` on each run's views (:func:`lane_params`,
-:func:`lane_work`), so their physics is written once.
+ball sums of every bearing, the Runge-Kutta stage combinations. The tooth contacts from
+their tables (:mod:`cmsim.dynamics._batch_mesh_kernels`), the slip and the speed profile
+run in passes over the runs as well, branch-free where the single-run kernel branches. The
+parts that branch per run in depth — bearing defects and the on-line hybrid contact solve
+— call the single-run kernels of :mod:`cmsim.dynamics._rhs_kernels` on each run's views
+(:func:`lane_params`, :func:`lane_work`), so their physics is written once.
 
 Independence of the runs (the contract :mod:`cmsim.dynamics.batch` tests): every operation on
 run ``l`` reads only run ``l``'s numbers, in the same order whatever B is and wherever the run
@@ -37,9 +39,11 @@ from numba import njit
 
 from cmsim.dynamics._bearing_kernels import (BI_FAULTY, BI_NB, BI_T, BI_X, BI_Y, BP_C, BP_CAGE,
                                              BP_DAMP, BP_K, BP_P, BP_PHASE, BP_SENSE)
-from cmsim.dynamics._mesh_kernels import MI_FAULTY_BALLS, MI_ON, mesh_forces_jit
-from cmsim.dynamics._rhs_kernels import (KernelParams, Work, defect_forces_jit,
-                                         nominal_rotation_jit, slip_at_jit)
+from cmsim.dynamics._batch_mesh_kernels import _clamped_lookup, mesh_forces_batch_jit
+from cmsim.dynamics._mesh_kernels import (MI_BALL_SLIP, MI_FAULTY_BALLS, MI_MODE, MI_ON,
+                                          MI_PROFILE, MI_TDOF, MODE_TABLE, MP_JDT, MP_OMREF,
+                                          MP_PDT, MP_PT0, mesh_forces_jit)
+from cmsim.dynamics._rhs_kernels import KernelParams, Work, defect_forces_jit, profile_at
 from cmsim.dynamics._rotation_kernels import (AN_ANGLE, AN_COS, AN_SIN, AN_VALID, ANCHOR_RAD,
                                               anchored_cos_sin_jit, rotate_small_jit)
 
@@ -54,6 +58,8 @@ class LaneParams(NamedTuple):
     b_par: np.ndarray     # (nb, BP_SIZE, B) bearing parameters
     b_cos: np.ndarray     # (nb, max_balls, B) cos of each ball's nominal offset
     b_sin: np.ndarray     # (nb, max_balls, B) sin
+    m_par: np.ndarray     # (MP_SIZE, B) mesh parameters
+    geo: np.ndarray       # (GEO_SIZE, B) tooth geometry
 
 
 class BatchBuffers(NamedTuple):
@@ -76,6 +82,8 @@ class BatchBuffers(NamedTuple):
     y1: np.ndarray        # (dim,) one run's state, contiguous
     g1: np.ndarray        # (n,) its forces
     d1: np.ndarray        # (n_diag,) its output forces
+    mesh: np.ndarray      # (R_SIZE, B) the tooth contacts' per-run values
+    slots: np.ndarray     # (slots, SG_SIZE, B) their per-slot geometry
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -262,6 +270,62 @@ def _accelerations(y, n, g, minv, omega, ar, dydt, row):
             out_v[l] = mi[l] * gi[l] - wi[l] * ar[l] if ar[l] != 0.0 else mi[l] * gi[l]
 
 
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _constant_speed(t, tau, sr, ar):
+    """``τ = t``, ``Ω/Ω_ref = 1``, no acceleration for every run (no speed profile)."""
+    for l in range(tau.shape[0]):
+        tau[l] = t
+        sr[l] = 1.0
+        ar[l] = 0.0
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _profiles(t, prof, mp, tdof, g, tau, sr, ar):
+    """Every run's nominal rotation ``τ``, ``Ω/Ω_ref``, ``(dΩ/dt)/Ω_ref`` at time ``t`` from
+    its speed and torque profile ``prof`` (B, n_t, PR_SIZE), and its output torque into row
+    ``tdof`` of ``g`` (n, B) unless ``tdof`` < 0 (as
+    :func:`cmsim.dynamics._rhs_kernels.nominal_rotation_jit` run by run)."""
+    for l in range(tau.shape[0]):
+        theta, omega_in, alpha_in, torque = profile_at(prof[l], mp[MP_PT0, l], mp[MP_PDT, l],
+                                                       t)
+        inv_ref = 1.0 / mp[MP_OMREF, l]
+        if tdof >= 0:
+            g[tdof, l] = -torque
+        tau[l] = theta * inv_ref
+        sr[l] = omega_in * inv_ref
+        ar[l] = alpha_in * inv_ref
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _slip_batch(t, b_int, jitter, rows, ng, jdt, b_cos, b_sin, slip_cos, slip_sin, cage_slip,
+                balls):
+    """Every run's cage slip angles ``cage_slip`` (nb, B) at time ``t`` and, with ``balls``,
+    its balls' offsets with slip ``slip_cos``, ``slip_sin`` (nb, max_balls, B) (as
+    :func:`cmsim.dynamics._bearing_kernels.slip_offsets_jit` and ``cage_slip_jit`` run by
+    run). ``jitter`` is the runs' slip grids flat ((B, nb, rows, ng) run first, rows =
+    max_balls + 1, the cage last), ``jdt`` (B,) their spacing."""
+    nb = b_int.shape[0]
+    for ib in range(nb):
+        cs = cage_slip[ib]
+        for l in range(cs.shape[0]):
+            cs[l] = _clamped_lookup(jitter, ((l * nb + ib) * rows + rows - 1) * ng, ng,
+                                    t / jdt[l])
+        if not balls:
+            continue
+        for i in range(b_int[ib, BI_NB]):
+            bc = b_cos[ib, i]
+            bs = b_sin[ib, i]
+            oc = slip_cos[ib, i]
+            os_ = slip_sin[ib, i]
+            for l in range(cs.shape[0]):
+                j = _clamped_lookup(jitter, ((l * nb + ib) * rows + i) * ng, ng, t / jdt[l])
+                j2 = j * j
+                cj = 1.0 - j2 * (0.5 - j2 * (1.0 / 24.0))
+                sj = j * (1.0 - j2 * (1.0 / 6.0 - j2 * (1.0 / 120.0)))
+                oc[l] = bc[l] * cj - bs[l] * sj
+                os_[l] = bs[l] * cj + bc[l] * sj
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
     """The equations of motion of every run at time ``t`` (the single-run contract of
@@ -275,22 +339,29 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
         fi = L.fext[i]
         for l in range(n_runs):
             gi[l] = fi[l]
-    moved = False
-    for l in range(n_runs):
-        P = lane_params(S, l)
-        W = lane_work(V, l)
-        B.tau[l], B.sr[l], B.ar[l] = nominal_rotation_jit(t, P, W.g)
-        moved = slip_at_jit(t, P, W)          # the same switch for every run of a batch
+    if S.m_int[0, MI_PROFILE] != 0:
+        _profiles(t, S.prof, L.m_par, S.m_int[0, MI_TDOF], g, B.tau, B.sr, B.ar)
+    else:
+        _constant_speed(t, B.tau, B.sr, B.ar)
+    # the same switches for every run of a batch (as slip_at_jit)
+    slip = S.jitter.shape[3] > 1
+    moved = slip and S.m_int[0, MI_BALL_SLIP] != 0
+    if slip:
+        _slip_batch(t, S.b_int[0], S.jitter.reshape(-1), S.jitter.shape[2], S.jitter.shape[3],
+                    L.m_par[MP_JDT], L.b_cos, L.b_sin, V.slip_cos, V.slip_sin, V.cage_slip,
+                    moved)
     if S.b_int.shape[1] > 0:
         if moved:
             _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, V.slip_cos, V.slip_sin)
         else:
             _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, L.b_cos, L.b_sin)
     mesh_on = S.m_int[0, MI_ON] != 0
+    table = S.m_int[0, MI_MODE] == MODE_TABLE
     faulty = S.b_def.shape[1] > 0 or S.m_int[0, MI_FAULTY_BALLS] != 0
-    if mesh_on or faulty:
-        # the runs' own contacts through the single-run kernels (the same arithmetic in the
-        # same order), on each run's column of the state and the forces
+    if faulty or (mesh_on and not table):
+        # what branches per run through the single-run kernels (the same arithmetic in the
+        # same order), on each run's column of the state and the forces: bearing defects,
+        # the hybrid contact solve
         for l in range(n_runs):
             P = lane_params(S, l)
             W = lane_work(V, l)
@@ -303,8 +374,12 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
             elif faulty:
                 defect_forces_jit(t, B.tau[l], yl, n, gl, P, W, P.b_cos, P.b_sin, dl,
                                   want_diag)
-            if mesh_on:
+            if mesh_on and not table:
                 mesh_forces_jit(B.tau[l], B.sr[l], yl, n, gl, P, W, dl, want_diag)
+    if mesh_on and table:
+        # the tooth contacts of every run in passes over the runs (the same numbers)
+        mesh_forces_batch_jit(y, n, g, S, L.m_par, L.geo, B.tau, B.sr, V.psi, B.mesh,
+                              B.slots, diag, want_diag)
     _springs(y, n, g, S.spring_ends[0], L.springs)
     _accelerations(y, n, g, L.minv, L.omega, B.ar, dydt, row)
 

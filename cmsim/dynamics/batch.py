@@ -21,6 +21,8 @@ import time
 import numpy as np
 
 from cmsim.dynamics._batch_kernels import BatchBuffers, LaneParams, integrate_batch_jit
+from cmsim.dynamics._batch_mesh_kernels import BS_SIZE, R_SIZE
+from cmsim.dynamics._mesh_kernels import MI_SLOTS
 from cmsim.dynamics._rhs_kernels import KernelParams, Work, make_work
 from cmsim.dynamics.integrator import SCHEMES
 from cmsim.dynamics.simulation import compile_kernels, finish_run, integrate_prepared
@@ -101,7 +103,8 @@ def _integrate_batch(setups, chunk_steps=BATCH_CHUNK_STEPS):
     B = BatchBuffers(np.zeros((tab.b.shape[0], dim, n_runs)), y0.copy(), np.empty_like(y0),
                      y0, np.zeros((n_diag, n_runs)),
                      *(np.zeros(n_runs) for _ in range(9)), np.zeros(dim),
-                     np.zeros(dim // 2), np.zeros(n_diag))
+                     np.zeros(dim // 2), np.zeros(n_diag), np.zeros((R_SIZE, n_runs)),
+                     np.zeros((max(int(S.m_int[0, MI_SLOTS]), 1), BS_SIZE, n_runs)))
     max_disp = np.array([max_displacement_m(m) for m in models])
     status = np.full(n_runs, -1, dtype=np.int64)
     h = 1.0 / (first.fs_hz * first.substeps)

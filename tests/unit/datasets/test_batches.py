@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from cmsim.datasets import DatasetSpec, generate_dataset, load
-from cmsim.datasets.records import DEFAULT_BATCH_SIZE, simulate_record
+from cmsim.datasets.records import (BATCH_FROM_RECORDS, BATCH_MIN, BATCH_SAMPLES, BATCH_SIZE,
+                                    default_batch_size, simulate_record, simulate_records)
 from cmsim.errors import ParameterError
 
 SPEC = {
@@ -57,7 +58,7 @@ def test_a_record_is_the_same_in_any_batch_and_on_any_worker(made):
 
 def test_batches_agree_with_the_single_run_kernel(made):
     spec, _, out = made
-    assert DEFAULT_BATCH_SIZE == 1                       # by default: the reference path
+    assert default_batch_size(spec) == 1                 # 8 records: the reference path
     one, batched = out["b1w2"], out["b4w2"]
     for rid in one:
         for c in one[rid]:
@@ -89,3 +90,30 @@ def test_a_bad_batch_size_is_refused(bad, tmp_path):
     with pytest.raises(ParameterError, match="batch_size"):
         generate_dataset(DatasetSpec.from_dict(SPEC), tmp_path / "x", batch_size=bad)
     assert not (tmp_path / "x").exists()
+
+
+def test_a_large_spec_batches_by_default_and_its_records_keep_their_bits():
+    """From BATCH_FROM_RECORDS records on, a spec's records take the batch kernel by
+    default, decided by the spec alone: a record made alone (simulate_record, a batch of
+    one) is the record made among others, bit for bit."""
+    raw = {**SPEC, "dataset": {**SPEC["dataset"], "records": BATCH_FROM_RECORDS}}
+    spec = DatasetSpec.from_dict(raw)
+    assert default_batch_size(spec) == BATCH_SIZE > 1
+    hybrid = DatasetSpec.from_dict({**raw, "simulation": {"mesh": "hybrid"}})
+    assert default_batch_size(hybrid) == 1               # the on-line solve: run by run
+    fs = SPEC["sensor"]["fs_hz"]
+    for duration, size in ((BATCH_SAMPLES / fs / 20, 20), (BATCH_SAMPLES / fs / 10, 1)):
+        longer = DatasetSpec.from_dict({**raw, "sensor": {**SPEC["sensor"],
+                                                          "duration_s": duration}})
+        assert default_batch_size(longer) == (size if size >= BATCH_MIN else 1)
+    plans = [spec.record(i) for i in range(5)]
+    together = simulate_records(spec, plans)             # the default: one batch of 5
+    for i in (0, 3):
+        alone, _ = simulate_record(spec, i)
+        for c in alone:
+            np.testing.assert_array_equal(alone[c], together[i][0][c], err_msg=f"{i} {c}")
+    reference = simulate_records(spec, plans[3:4], batch_size=1)[0][0]
+    for c in reference:
+        ref = reference[c].astype(float)
+        tol = max(np.ptp(ref), np.max(np.abs(ref))) * 2.0 ** -22
+        assert np.max(np.abs(together[3][0][c] - ref)) <= tol, c
