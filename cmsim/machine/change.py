@@ -248,6 +248,12 @@ def path_ratio(path, freq, factor):
     return np.clip(ratio, 1.0 / PATH_RATIO_MAX, PATH_RATIO_MAX)
 
 
+def _add_power(scale, bins, p_base, p_add):
+    """Scale the spectrum's ``bins``, holding ``p_base`` of power, so that ``p_add`` adds to
+    it: a line at an unknown phase against the baseline's own adds its power."""
+    scale[bins] *= math.sqrt((p_base + p_add) / p_base)
+
+
 def apply_change(machine, segments, change, rng):
     """The baseline's segments with a cause's change laid on them (module docstring).
 
@@ -346,7 +352,7 @@ def apply_change(machine, segments, change, rng):
             p_add = float(psd_c[b].sum()) - float(psd_h[b].sum())
             p_b = float(psd_b[b].sum())
             if p_add >= 9.0 * float(psd_h[b].sum()) and p_b > 0.0:
-                scale[b] *= math.sqrt((p_b + (g * change.path_gain) ** 2 * p_add) / p_b)
+                _add_power(scale, b, p_b, (g * change.path_gain) ** 2 * p_add)
                 made.append(b)
         # the rest of the change: the forces' difference without those lines, through the
         # path: the lines the cause makes whole, its broadband with as much power as the
@@ -379,9 +385,9 @@ def apply_change(machine, segments, change, rng):
         if b is None:
             continue
         p_b = float(psd_b[b].sum())
-        p_add = (machine.rotating_gain(order, change.shaft_hz) * amp) ** 2 / 2.0 / df
         if p_b > 0.0:
-            scale[b] *= math.sqrt((p_b + p_add) / p_b)
+            _add_power(scale, b, p_b,
+                       (machine.rotating_gain(order, change.shaft_hz) * amp) ** 2 / 2.0 / df)
     y = np.fft.irfft(np.fft.rfft(x, axis=1) * scale, n, axis=1) + added
     if fill is not None and np.any(fill > 0.0):
         white = np.fft.rfft(rng.standard_normal((k, n)), axis=1)
