@@ -117,6 +117,8 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
     # physical involute origins of the reference pair (tooth 0 on both gears)
     psi1 = mp[MP_OM1] * t + y[i1 + 2] + mp[MP_PSI10]
     psi2 = mp[MP_PSI20] - (mp[MP_OM2] * t + y[i2 + 2])
+    w1 = mp[MP_OM1] * sr + y[n + i1 + 2]
+    w2 = -(mp[MP_OM2] * sr + y[n + i2 + 2])
     trig_done = False
     cp1 = sp1 = cp2 = sp2 = 0.0
     # geometric centres (the shaft centres unless a gear is eccentric)
@@ -134,10 +136,8 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
         gx2 += ecc[1, 0] * (cp2 * ecc[1, 1] - sp2 * ecc[1, 2])
         gy2 += ecc[1, 0] * (sp2 * ecc[1, 1] + cp2 * ecc[1, 2])
         # the mass on each offset centre turns about its shaft: m·Ω²·(offset) on the shaft
-        om1 = mp[MP_OM1] * sr + y[n + i1 + 2]
-        om2 = mp[MP_OM2] * sr + y[n + i2 + 2]
-        f1 = ecc[0, 3] * om1 * om1
-        f2 = ecc[1, 3] * om2 * om2
+        f1 = ecc[0, 3] * w1 * w1
+        f2 = ecc[1, 3] * w2 * w2
         g[i1] += f1 * (gx1 - c1x)
         g[i1 + 1] += f1 * (gy1 - c1y)
         g[i2] += f2 * (gx2 - c2x)
@@ -152,8 +152,6 @@ def mesh_forces_jit(t, sr, y, n, g, P, W, diag, want_diag):
                    gx2, gy2, cos_t1, sin_t1, length)
     if m_int[MI_MODE] == MODE_HYBRID:
         _hybrid_slot_forces(P, W)
-    w1 = mp[MP_OM1] * sr + y[n + i1 + 2]
-    w2 = -(mp[MP_OM2] * sr + y[n + i2 + 2])
     _apply_pair_forces(y, n, g, P, W, diag, want_diag, c1x, c1y, c2x, c2y, w1, w2)
 
 
