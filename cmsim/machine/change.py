@@ -366,10 +366,14 @@ def apply_change(machine, segments, change, rng):
         spec = np.fft.rfft(d)
         f_long = np.fft.rfftfreq(d.size, 1.0 / fs)
         notch = np.ones(f_long.size)        # raised-cosine edges a bin wide: a brick-wall
-        for bins in [ln.bins for ln in lines] + made:    # notch rings in time, and a
-            lo, hi = freq[bins.start] - 0.5 * df, freq[bins.stop - 1] + 0.5 * df  # segment
-            edge_w = np.clip(np.maximum(lo - f_long, f_long - hi) / df, 0.0, 1.0)  # reads
-            notch = np.minimum(notch, 0.5 - 0.5 * np.cos(np.pi * edge_w))  # its edge ringing
+        df_long = f_long[1] - f_long[0]     # notch rings in time, and a segment reads its
+        for bins in [ln.bins for ln in lines] + made:                    # edge ringing
+            lo, hi = freq[bins.start] - 0.5 * df, freq[bins.stop - 1] + 0.5 * df
+            # the edges reach a bin beyond the line: the notch is 1 farther out
+            near = slice(max(int((lo - df) / df_long), 0),
+                         min(int((hi + df) / df_long) + 2, f_long.size))
+            edge_w = np.clip(np.maximum(lo - f_long[near], f_long[near] - hi) / df, 0.0, 1.0)
+            notch[near] = np.minimum(notch[near], 0.5 - 0.5 * np.cos(np.pi * edge_w))
         spec = spec * notch
         d = np.fft.irfft(spec, d.size)
         _, psd_d = segment_psd(list(d[span].reshape(k, n)), fs)
