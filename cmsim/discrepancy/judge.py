@@ -40,7 +40,12 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       the model makes the way the machine does. Faults within :data:`NEAR_TIE` of the best
       one's evidence are told apart by their evidence on their own signatures. A fault is a
       candidate here where its family stands out (below), or where its prediction reads the
-      whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`).
+      whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`). A reshaping
+      cause that reads best yields to a fault whose own change holds it
+      (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`: an eccentric gear's run-out modulates
+      the mesh as a speed fluctuation does) where that fault's family stands out over the
+      reshaping cause's prediction on a feature it does not raise (the once-per-revolution
+      line an eccentric gear's mass lifts and a speed fluctuation lowers).
    b. *A family that stands out.* Where no cause reads the whole record (a real machine
       rings a spall's impacts at a resonance its healthy baseline never showed, which the
       calibrated path cannot know), a fault is named on its own signature
@@ -464,7 +469,11 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]
                 top = new
-            if top["cause"].signature is not None:
+            absorbed = _absorbed_by(top, rows_out, lib.mean[li], meas, sigma, names)
+            if absorbed is not None:
+                ties = [top]
+                top = absorbed
+            elif top["cause"].signature is not None:
                 # faults the whole record cannot tell apart are told apart by their own
                 # signatures (a broken tooth's once-per-revolution impacts light a bearing's
                 # envelope lines too; its sidebands are its own)
@@ -493,6 +502,27 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
                                    key=lambda r: (r["cause"].signature is None,
                                                   -r["delta_chi2"])),
             "decided_on": how, "chi2": chi0, "n_eff": n_eff, "z": z0}
+
+
+def _absorbed_by(top, rows, base, meas, sigma, names):
+    """The fault whose own change holds the reshaping cause ``top``'s
+    (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`) and whose family stands out where
+    ``top``'s prediction leaves the record — :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB`
+    over it, on a feature ``top`` does not raise — the best-reading such fault; else None."""
+    if top["cause"].signature is not None:
+        return None
+    left = (meas - top["prediction"]) / sigma
+    raised = top["prediction"] - base
+    found = []
+    for r in rows:
+        if top["name"] not in r["cause"].absorbs:
+            continue
+        fam = [names.index(k) for k in r["family"]]
+        if any(left[i] >= FAMILY_Z and raised[i] <= 0.0 and (
+                not names[i].endswith("_db") or meas[i] - top["prediction"][i]
+                >= FAMILY_RISE_DB) for i in fam):
+            found.append(r)
+    return min(found, key=lambda r: r["chi2"], default=None)
 
 
 def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,

@@ -192,3 +192,48 @@ def test_a_record_across_loads_is_read_within_the_model_s_load_change(monkeypatc
     assert _decide_on(exact, healthy)["finding"] != "none"      # the check can fail
     faulty = [20.0, 20.0, 0.0, 0.0, 0.4, -0.3, 0.1]
     assert _decide_on(moved, faulty)["finding"] == "bearing_outer_race"
+
+
+GEAR_NAMES = ("sb1_fr1_k1_db", "sb1_fr1_k2_db", "sb1_fr1_k3_db", "raw_fr_h1_db",
+              "env_fr_h1_db", "shape_b0_db", "shape_b1_db")
+SB, ONCE = [0, 1, 2], [3, 4]
+
+
+def _gear_library():
+    """A speed fluctuation lifts every shaft-rate sideband of the mesh and lowers the 1×
+    lines a little; an eccentricity lifts its 1× lines and hardly the sidebands."""
+    m = len(GEAR_NAMES)
+    fluct = np.zeros((3, m))
+    fluct[:, SB] = np.array([[0.5], [5.0], [15.0]])
+    fluct[:, ONCE] = np.array([[0.0], [-0.5], [-1.5]])
+    ecc = np.zeros((3, m))
+    ecc[:, SB] = np.array([[0.0], [0.3], [1.0]])
+    ecc[:, ONCE] = np.array([[0.5], [3.0], [8.0]])
+    return SignatureLibrary(
+        names=GEAR_NAMES, mean=np.zeros(m), spread=np.ones(m), realisation=np.zeros(m),
+        entries=(SignatureEntry("speed_fluctuation", None, "documented", "relative_amplitude",
+                                (1e-3, 1e-2, 1e-1), fluct),
+                 SignatureEntry("eccentricity", "1G1", "documented", "amplitude_m",
+                                (2e-6, 2e-5, 1.5e-4), ecc)),
+        segment_s=0.5, segments=8, speed_rpm=1500.0, torque_nm=20.0, radial_load_n=0.0)
+
+
+@pytest.mark.parametrize("once, finding", [(0.0, "speed_fluctuation"),
+                                           (-1.5, "speed_fluctuation"),
+                                           (4.0, "speed_fluctuation"),
+                                           (12.0, "eccentricity")])
+def test_a_mesh_modulation_with_a_risen_once_per_rev_line_is_an_eccentric_gear(once, finding):
+    """The sidebands risen 15 dB, as the speed fluctuation makes them and the eccentricity
+    does not; the 1× lines as the fluctuation leaves them (0, −1.5 dB), within the 6 dB a
+    family must stand out by (4 dB), or 12 dB over them, which a speed fluctuation cannot
+    make: an eccentric gear's mass turning off-centre while its run-out modulates the
+    mesh (EccentricityCause.absorbs)."""
+    lib = _gear_library()
+    li = np.arange(len(GEAR_NAMES))
+    meas = np.array([15.0, 15.0, 15.0, once, once, 0.0, 0.0])
+    sigma = feature_sigma(lib, li, list(GEAR_NAMES), 8)
+    d = decide_record(lib, li, list(GEAR_NAMES), meas, sigma, "1b1")
+    assert d["finding"] == finding, [(r["name"], r["chi2"]) for r in d["ranked"]]
+    if finding == "eccentricity":
+        assert d["top"]["component"] == "1G1"
+        assert [r["name"] for r in d["ties"]] == ["speed_fluctuation"]
