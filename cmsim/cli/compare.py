@@ -111,8 +111,9 @@ def text(res):
         lines.append("not judged without a calibrated machine (they depend on the transfer "
                      "path): " + ", ".join(res["not_judged"]))
     for t in res["near_ties"]:
-        lines.append(f"near tie: {t['name']} on {t['component']} (evidence "
-                     f"{t['delta_chi2']:.0f})")
+        lines.append(f"near tie: {t['name']}"
+                     + (f" on {t['component']}" if t["component"] else "")
+                     + f" (evidence {t['delta_chi2']:.0f})")
     if res["departures"]:
         lines.append("departs from the model in: " + ", ".join(res["departures"]))
     g = res["gain"]
@@ -122,6 +123,8 @@ def text(res):
                  f"{g['before']:.3g} -> {g['after']:.3g} (relative gain {g['relative']:.2f})")
     if machine:
         how = {"whole": "its prediction reads the whole record best",
+               "beside": "what it changes holds the change that reads the whole record best "
+                         "(the near tie), and its own family stands out over that change",
                "family": "its own family stands out over the baseline and no cause reads the "
                          "whole record"}.get(res.get("decided_on", ""))
         if how:

@@ -45,7 +45,8 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`: an eccentric gear's run-out modulates
       the mesh as a speed fluctuation does) where that fault's family stands out over the
       reshaping cause's prediction on a feature it does not raise (the once-per-revolution
-      line an eccentric gear's mass lifts and a speed fluctuation lowers).
+      line an eccentric gear's mass lifts and a speed fluctuation lowers); its size is read
+      with its change laid beside the reshaping cause's.
    b. *A family that stands out.* Where no cause reads the whole record (a real machine
       rings a spall's impacts at a resonance its healthy baseline never showed, which the
       calibrated path cannot know), a fault is named on its own signature
@@ -374,7 +375,8 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         ``finding``, ``top`` (its row or None), ``ties``, ``ranked`` (each cause's best on
         the whole record), ``by_signature`` (each cause's best on its own signature, the
         path profiled out for a structure-ringing fault), ``decided_on`` (``"whole"``,
-        ``"family"`` or ``""``), ``chi2`` (χ²₀), ``n_eff``, ``z`` (departures).
+        ``"beside"`` (a fault whose change holds the whole record's best reading), ``"family"``
+        or ``""``), ``chi2`` (χ²₀), ``n_eff``, ``z`` (departures).
     """
     base = lib.mean[li][None, :]
     chi0_arr, per0 = chi2_rows(meas, base, sigma, names)
@@ -387,7 +389,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
     direction = 0.0
     if level is not None and abs(z0[level]) >= LEVEL_DIRECTION_Z:
         direction = math.copysign(1.0, z0[level])
-    ranked, by_signature = {}, {}
+    ranked, by_signature, tables = {}, {}, {}
     for e in lib.entries:
         if causes is not None and e.cause not in causes:
             continue
@@ -398,6 +400,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             ok &= (table[:, level] - lib.mean[li][level]) * direction > 0.0
         if not np.any(ok):
             continue
+        tables.setdefault((e.cause, e.component), []).append((e, values[ok], table[ok]))
         chi, per_full = chi2_rows(meas, table, sigma, names)
         per_prof = per_full
         if cause.rings_structure and np.any(path_dep):
@@ -469,10 +472,10 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]
                 top = new
-            absorbed = _absorbed_by(top, rows_out, lib.mean[li], meas, sigma, names)
+            absorbed = _absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, names,
+                                    sensor_bearing)
             if absorbed is not None:
-                ties = [top]
-                top = absorbed
+                ties, top, how = [top], absorbed, "beside"
             elif top["cause"].signature is not None:
                 # faults the whole record cannot tell apart are told apart by their own
                 # signatures (a broken tooth's once-per-revolution impacts light a bearing's
@@ -504,25 +507,51 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             "decided_on": how, "chi2": chi0, "n_eff": n_eff, "z": z0}
 
 
-def _absorbed_by(top, rows, base, meas, sigma, names):
+def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
     """The fault whose own change holds the reshaping cause ``top``'s
     (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`) and whose family stands out where
     ``top``'s prediction leaves the record — :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB`
-    over it, on a feature ``top`` does not raise — the best-reading such fault; else None."""
+    over it, on a feature ``top`` does not raise; else None. Of such faults on several
+    components, the one on the sensor's shaft (the shaft-order lines that stand out are
+    its). Its prediction is ``top``'s with the fault's own change on the features of its
+    family ``top`` does not raise (its size read there), and the row says what it was read
+    beside (``"beside"``)."""
     if top["cause"].signature is not None:
         return None
-    left = (meas - top["prediction"]) / sigma
-    raised = top["prediction"] - base
+    pred = top["prediction"]
+    left = (meas - pred) / sigma
+    raised = pred - base
     found = []
     for r in rows:
         if top["name"] not in r["cause"].absorbs:
             continue
         fam = [names.index(k) for k in r["family"]]
-        if any(left[i] >= FAMILY_Z and raised[i] <= 0.0 and (
-                not names[i].endswith("_db") or meas[i] - top["prediction"][i]
-                >= FAMILY_RISE_DB) for i in fam):
-            found.append(r)
-    return min(found, key=lambda r: r["chi2"], default=None)
+        out = [i for i in fam if left[i] >= FAMILY_Z and raised[i] <= 0.0 and (
+            not names[i].endswith("_db") or meas[i] - pred[i] >= FAMILY_RISE_DB)]
+        if out:
+            found.append((r["component"] is None or r["component"][0] != sensor_bearing[0],
+                          r["chi2"], r, out))
+    if not found:
+        return None
+    _, _, r, out = min(found, key=lambda f: f[:2])
+    # the fault's change on its family where the reshaping cause does not raise it, the
+    # reshaping cause's elsewhere (its size read there)
+    own = np.array([k in r["family"] and raised[i] <= 0.0 for i, k in enumerate(names)])
+    best = None
+    for e, values, table in tables[(r["name"], r["component"])]:
+        both = pred[None, :] + np.where(own, table - base[None, :], 0.0)
+        chi = chi2_rows(meas, both, sigma, names)[1][:, own].sum(axis=1)
+        k = int(np.argmin(chi))
+        if best is None or chi[k] < best["score"]:
+            within = values[chi <= chi[k] + RANGE_DELTA_CHI2]
+            best = {**r, "variant": e.variant, "value": float(values[k]),
+                    "range": (float(within.min()), float(within.max())),
+                    "chi2": float(chi2_rows(meas, both[k:k + 1], sigma, names)[0][0]),
+                    "score": float(chi[k]), "prediction": both[k],
+                    "out": out, "stands_out": True,
+                    "beside": {"name": top["name"], "parameter": top["parameter"],
+                               "value": top["value"]}}
+    return best
 
 
 def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
@@ -584,8 +613,15 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     sensor = signal_info(machine.model_signal).component
     d = decide_record(lib, li, cnames, meas, sigma, sensor, causes)
     top, z0, n_eff, chi0 = d["top"], d["z"], d["n_eff"], d["chi2"]
+    if top is not None and "beside" in top:
+        b = top["beside"]
+        notes.append(f"named beside a {b['name'].replace('_', ' ')} ({b['parameter']} about "
+                     f"{b['value']:.3g}) that reads the rest of the record's change: its own "
+                     "change is read on the features of its family that one does not raise, "
+                     "where it stands out over it ("
+                     + ", ".join(cnames[i] for i in top["out"]) + "); read its size as a trend")
     fitted, simulations = None, 0
-    if top is not None and refine > 0 and top["name"] in CAUSES:
+    if top is not None and refine > 0 and top["name"] in CAUSES and "beside" not in top:
         got = simulate_entry(machine, lib, CAUSES[top["name"]](), top["component"],
                              top["variant"], top["value"])
         simulations = 1
