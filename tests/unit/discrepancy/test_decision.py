@@ -235,5 +235,7 @@ def test_a_mesh_modulation_with_a_risen_once_per_rev_line_is_an_eccentric_gear(o
     d = decide_record(lib, li, list(GEAR_NAMES), meas, sigma, "1b1")
     assert d["finding"] == finding, [(r["name"], r["chi2"]) for r in d["ranked"]]
     if finding == "eccentricity":
-        assert d["top"]["component"] == "1G1"
+        assert (d["top"]["component"], d["decided_on"]) == ("1G1", "beside")
         assert [r["name"] for r in d["ties"]] == ["speed_fluctuation"]
+        # its size read where its family stands out: the largest, whose 1x lines rise 8 dB
+        assert d["top"]["value"] == pytest.approx(1.5e-4)
