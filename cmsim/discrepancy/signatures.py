@@ -58,7 +58,6 @@ from cmsim.run import signal_info
 __all__ = ["build_library", "value_grid", "predicted_rows", "change_of",
            "simulate_entry", "operating_shift",
            "N_SIZES", "LIBRARY_SEGMENTS", "REALISATIONS", "BEARING_VARIANTS", "GRIDS",
-           "GRID_DENSITY",
            "PATH_GAINS"]
 
 #: Values of each cause's parameter in the library (log-spaced over its bounds).
@@ -90,18 +89,10 @@ BEARING_VARIANTS = (0.0, -5e-6)
 #: grid's points then passes through.
 GRIDS = {"noise": (0.13, 10.0), "transfer_path": (0.3, 3.0)}
 
-#: Causes whose features change too steeply between the grid's points for the interpolation
-#: in log size to follow, with the factor on their number of values: the tooth friction's
-#: film ratio λ crosses 1 between roughnesses a factor 2 apart (on the model's gear
-#: machines the friction records at 1 and 2 µm read `unexplained` between the points 1.4 and
-#: 2.7 µm of 8; with 16 the 1-µm one is named).
-GRID_DENSITY = {"friction": 2}
-
 
 def value_grid(cause, n=N_SIZES):
-    """(parameter name, values) of a cause's entries: ``n`` values (times its
-    :data:`GRID_DENSITY`) log-spaced over the bounds of its first parameter (or
-    :data:`GRIDS`; a two-sided range split in two halves).
+    """(parameter name, values) of a cause's entries: ``n`` values log-spaced over the bounds
+    of its first parameter (or :data:`GRIDS`; a two-sided range split in two halves).
 
     Parameters
     ----------
@@ -119,11 +110,8 @@ def value_grid(cause, n=N_SIZES):
     >>> name, v = value_grid(CAUSES["bearing_inner_race"](), 3)
     >>> name, [round(x * 1e3, 2) for x in v]
     ('size_m', [0.03, 0.3, 3.0])
-    >>> len(value_grid(CAUSES["friction"](), 3)[1])
-    6
     """
     p = cause.params[0]
-    n *= GRID_DENSITY.get(cause.name, 1)
     span = GRIDS.get(cause.name, p.bounds)
     if p.log_scale and span[0] < 1.0 < span[1] and cause.name in GRIDS:
         half = n // 2 + 1                                          # 1 itself, once
