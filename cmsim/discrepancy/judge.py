@@ -528,7 +528,7 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
         fam = [names.index(k) for k in r["family"]]
         out = [i for i in fam if left[i] >= FAMILY_Z and raised[i] <= 0.0 and (
             not names[i].endswith("_db") or meas[i] - pred[i] >= FAMILY_RISE_DB)]
-        if out:
+        if out:     # a component's name starts with its shaft's number ("1G1", "1b1")
             found.append((r["component"] is None or r["component"][0] != sensor_bearing[0],
                           r["chi2"], r, out))
     if not found:
