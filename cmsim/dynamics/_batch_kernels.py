@@ -414,7 +414,7 @@ def _step(y, k, h, rk_b):
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L, V, B, out_y,
-                        out_diag, max_disp, max_rot, trans_mask, status):
+                        out_diag, y_cols, d_cols, max_disp, max_rot, trans_mask, status):
     """Fixed-step explicit Runge-Kutta of a batch of runs, output every ``substeps`` steps.
 
     The scheme is data (``rk_a``, ``rk_b``, ``rk_c``, as
@@ -423,8 +423,11 @@ def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L
     :class:`LaneParams`, ``V`` their :class:`~cmsim.dynamics._rhs_kernels.Work` stacked
     (:func:`lane_work`), ``B`` the :class:`BatchBuffers` (``B.y`` the state to start from).
     Sample ``m`` of run ``l`` goes to ``out_y[l, m]`` (the state at ``t0 + (m_offset +
-    m)·substeps·h``) and ``out_diag[l, m]`` (its output forces). Chunks started from the
-    last state of the one before with the same ``V`` reproduce one call bit for bit.
+    m)·substeps·h``: its columns ``y_cols``, int64) and ``out_diag[l, m]`` (its output forces:
+    columns ``d_cols``); only the columns a caller reads are copied (a record's filter reads
+    a few of them, and copying a whole state per sample was 5 % of a step). Chunks started
+    from the last state of the one before (``B.y``) with the same ``V`` reproduce one call
+    bit for bit.
 
     ``status[l]`` (int64, −1 on entry for a run not diverged) becomes the index ``m_offset +
     m`` of run ``l``'s first output sample that was non-finite or beyond ``max_disp[l]``
@@ -440,8 +443,8 @@ def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L
     n = dim // 2
     for m in range(n_out):
         for l in range(n_runs):
-            for i in range(dim):
-                out_y[l, m, i] = y[i, l]
+            for c in range(y_cols.shape[0]):
+                out_y[l, m, c] = y[y_cols[c], l]
             if status[l] >= 0:
                 continue
             for i in range(n):
@@ -457,8 +460,8 @@ def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L
             rhs_batch_jit(t, y, k, 0, S, L, V, B, diag, sub == 0)
             if sub == 0:
                 for l in range(n_runs):
-                    for i in range(diag.shape[0]):
-                        out_diag[l, m, i] = diag[i, l]
+                    for c in range(d_cols.shape[0]):
+                        out_diag[l, m, c] = diag[d_cols[c], l]
                 if m == n_out - 1:
                     return
             for st in range(1, ns):

@@ -378,7 +378,10 @@ def _slot_loads(z1, z2, mp, sg, teeth_on, m_t, tk1, te1, tk2, te2, m_tab, tab_k,
         el_out = sj[SG_ELASTIC]
         gap_out = sj[SG_GAP]
         kp_out = sj[SG_KPAIR]
+        on = sj[SG_ON]
         for l in range(x0.shape[0]):
+            if on[l] == 0.0:              # out of the zone: nothing reads its loads
+                continue
             u = (s_r[l] - x0[l]) / dx[l]
             delta = delta_r[l]
             f_teeth = 1.0
@@ -462,6 +465,11 @@ def _slot_forces(y, n, i1, i2, g, r, mp, sg, ctab_on, mutab_on, diag, want_diag)
         mu_r = sj[BS_MU]
         d_out = diag[d0 + j]
         for l in range(on.shape[0]):
+            if on[l] == 0.0:
+                # out of the zone: no force (the single-run kernel's zero), forces untouched
+                if want_diag:
+                    d_out[l] = 0.0
+                continue
             nx = nx_r[l]
             ny = ny_r[l]
             rx1 = px_r[l] - c1x[l]
@@ -479,7 +487,6 @@ def _slot_forces(y, n, i1, i2, g, r, mp, sg, ctab_on, mutab_on, diag, want_diag)
             x = req_r[l] / (2.0 * gap)
             fk = koster[l] * x * math.sqrt(x) * approach
             fn = fe if elastic > 0.0 else (fk if approach > 0.0 else 0.0)
-            fn = fn if on[l] != 0.0 else 0.0
             if want_diag:
                 d_out[l] = fn
             slide = dvx * ny - dvy * nx

@@ -88,17 +88,32 @@ def _batch_arrays(models):
     return S, L, V
 
 
+def _block_columns(size, cols):
+    """The columns (int64, sorted) the runs' filters read, of ``size``: each run's ``cols``
+    (None: all of them)."""
+    if any(c is None for c in cols):
+        return np.arange(size, dtype=np.int64)
+    return np.unique(np.concatenate([np.asarray(c, dtype=np.int64) for c in cols]
+                                    + [np.zeros(0, dtype=np.int64)]))
+
+
 def _integrate_batch(setups, chunk_steps=BATCH_CHUNK_STEPS):
     """Integrate runs of one kernel layout together; per run ``(q, forces, wall share, n_warm,
     anti-alias filter, stats)`` or the :class:`IntegrationDiverged` it raises."""
     first = setups[0]
     models = [s.model for s in setups]
     aa, n_warm = decimation(first.substeps, first.fs_hz, first.warmup_s)
-    decs = [_Decimator(s.model, n_warm, s.n_rec, aa, s.q_cols, s.d_cols) for s in setups]
-    tab = SCHEMES[first.scheme]
-    S, L, V = _batch_arrays(models)
     n_runs, dim = len(setups), first.y0.size
     n_diag = len(first.model.output_force_names)
+    # the blocks hold the columns the runs' filters read (all runs', in order)
+    y_cols = _block_columns(dim // 2, [s.q_cols for s in setups])
+    d_cols = _block_columns(n_diag, [s.d_cols for s in setups])
+    decs = [_Decimator(s.model, n_warm, s.n_rec, aa, s.q_cols, s.d_cols,
+                       *(None if c is None else np.searchsorted(cols, c)
+                         for c, cols in ((s.q_cols, y_cols), (s.d_cols, d_cols))))
+            for s in setups]
+    tab = SCHEMES[first.scheme]
+    S, L, V = _batch_arrays(models)
     y0 = _stack([s.y0 for s in setups], axis=-1)
     B = BatchBuffers(np.zeros((tab.b.shape[0], dim, n_runs)), y0.copy(), np.empty_like(y0),
                      y0, np.zeros((n_diag, n_runs)),
@@ -110,8 +125,8 @@ def _integrate_batch(setups, chunk_steps=BATCH_CHUNK_STEPS):
     h = 1.0 / (first.fs_hz * first.substeps)
     n_out = decs[0].last + 1
     rows = min(chunk_steps + 1, n_out)
-    out_y = np.empty((n_runs, rows, dim))
-    out_d = np.empty((n_runs, rows, n_diag))
+    out_y = np.empty((n_runs, rows, y_cols.size))
+    out_d = np.empty((n_runs, rows, d_cols.size))
     mask = first.model.translational_mask
     m0, wall = 0, 0.0
     while m0 < n_out:
@@ -120,7 +135,8 @@ def _integrate_batch(setups, chunk_steps=BATCH_CHUNK_STEPS):
         start_at = m0 - 1 if m0 else 0
         t = time.perf_counter()
         integrate_batch_jit(0.0, h, count, 1, start_at, tab.a, tab.b, tab.c, S, L, V, B,
-                            out_y, out_d, max_disp, MAX_ROTATION_DEVIATION_RAD, mask, status)
+                            out_y, out_d, y_cols, d_cols, max_disp, MAX_ROTATION_DEVIATION_RAD,
+                            mask, status)
         wall += time.perf_counter() - t
         skip = 1 if m0 else 0
         for l, dec in enumerate(decs):

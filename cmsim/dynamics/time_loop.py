@@ -175,10 +175,13 @@ class _Decimator:
     :meth:`_Integrator.chunks` yields them) and filters the recorded columns into the output
     instants ``n_warm .. n_warm + n_rec − 1``; :attr:`q_out` and :attr:`d_out` hold them
     (NaN in the columns not recorded). A batch of runs (:mod:`cmsim.dynamics.batch`) feeds
-    one per run from its lane of the batch's blocks.
+    one per run from its lane of the batch's blocks, which hold only the recorded columns:
+    ``block_q``, ``block_d`` say where in a block's states and forces the recorded ones
+    are (default: the blocks hold every column).
     """
 
-    def __init__(self, model, n_warm, n_rec, aa, q_cols=None, d_cols=None):
+    def __init__(self, model, n_warm, n_rec, aa, q_cols=None, d_cols=None, block_q=None,
+                 block_d=None):
         k, hl = aa.factor, aa.half_length
         n = model.n_dof
         self.aa, self.k, self.n_rec = aa, k, n_rec
@@ -189,6 +192,8 @@ class _Decimator:
         self.d_out = np.full((n_rec, n_forces), np.nan, order="F")
         self.qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
         self.dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
+        self.bq = self.qc if block_q is None else np.asarray(block_q, dtype=int)
+        self.bd = self.dc if block_d is None else np.asarray(block_d, dtype=int)
         self.m0 = 0                                   # next output sample to fill
         self.n_tail = 0                               # fast samples not yet consumed
         # the filtered columns side by side, in one buffer for the run: the tail a block
@@ -206,7 +211,7 @@ class _Decimator:
         if n_rows > self.buf.shape[0]:
             self.buf = np.vstack([self.buf[:n_tail], np.zeros((n_rows - n_tail, width))])
         buf, qc, dc = self.buf, self.qc, self.dc
-        gather_columns_jit(st, dg, lo, qc, dc, buf, n_tail)
+        gather_columns_jit(st, dg, lo, self.bq, self.bd, buf, n_tail)
         # output m sits at fast index (n_warm + m)·k; its window starts at that − hl
         out = self.aa.apply(buf[:n_rows])
         take = min(len(out), self.n_rec - self.m0)
