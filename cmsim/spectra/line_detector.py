@@ -111,8 +111,11 @@ def detect_lines(freq, psd, *, min_db=LINE_MIN_DB, half_width_hz=FLOOR_HALF_WIDT
     med = median_floor(freq, psd, half_width_hz)
     ratio = psd / med
     thr = 10.0 ** (min_db / 10.0)
-    peaks = [i for i in range(2, psd.size - 2) if ratio[i] > thr and freq[i] >= lowest_hz
-             and psd[i] >= psd[i - 1] and psd[i] >= psd[i + 1]]
+    inner = slice(2, max(psd.size - 2, 2))
+    is_peak = ((ratio[inner] > thr) & (freq[inner] >= lowest_hz)
+               & (psd[inner] >= psd[1:-3][:psd[inner].size])
+               & (psd[inner] >= psd[3:][:psd[inner].size]))
+    peaks = (np.flatnonzero(is_peak) + 2).tolist()
     owner = np.full(psd.size, -1)        # the line each bin belongs to
     spans = []
     for i in sorted(peaks, key=lambda j: -psd[j]):
@@ -126,8 +129,9 @@ def detect_lines(freq, psd, *, min_db=LINE_MIN_DB, half_width_hz=FLOOR_HALF_WIDT
     floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
                                    mode="valid"), 1e-300)
     kept = []
+    above = np.maximum(psd - floor, 0.0)
     for i, bins in spans:
-        excess = float(np.sum(np.maximum(psd[bins] - floor[bins], 0.0))) * df
+        excess = float(np.sum(above[bins])) * df
         if excess > 0:
             kept.append(DetectedLine(float(freq[i]), math.sqrt(2.0 * excess), bins))
     kept.sort(key=lambda ln: -ln.amplitude)
