@@ -17,11 +17,10 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    calibrated: far departures rise). A record whose χ²₀ per feature stays within
    :data:`NONE_CHI2_PER_FEATURE` and no feature of which departs by :data:`ALARM_Z` σ is
    ``none``: within the machine's own spread. A record documented at another load than the
-   machine's (by more than :data:`LOAD_TOLERANCE`) is read against the baseline moved by the
-   model's change between the two loads, every prediction with it
-   (:func:`~cmsim.discrepancy.signatures.operating_shift`), and each feature's σ widened by
-   that change's own size (:data:`OPERATING_SHIFT_UNCERTAINTY`): how a gearbox answers its
-   load is the model's guess, not the machine's measurement.
+   machine's is read against the baseline moved by the model's change between the two
+   loads, every prediction with it, and each feature's σ widened by that change's own size
+   (:mod:`cmsim.discrepancy.operating_point`): how a gearbox answers its load is the
+   model's guess, not the machine's measurement.
 3. **Matching.** Every entry of the library (a cause on a component, a nuisance variant, a
    grid of sizes) is compared with the record the same way; between two sizes of the grid the
    features are interpolated (:data:`INTERPOLATION_STEPS`, linear in log size), so the size is
@@ -73,14 +72,14 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import replace
 
 import numpy as np
 
 from cmsim.discrepancy.causes import CAUSES, STATISTICS
 from cmsim.discrepancy.evaluator import feature_floor, path_free, rises, weight
+from cmsim.discrepancy.operating_point import at_operating_point, record_load
 from cmsim.discrepancy.ranking import _consistent, decide
-from cmsim.discrepancy.signatures import build_library, operating_shift, simulate_entry
+from cmsim.discrepancy.signatures import build_library, simulate_entry
 from cmsim.errors import ParameterError
 from cmsim.features import segments
 from cmsim.machine.calibration import feature_rows
@@ -88,11 +87,9 @@ from cmsim.run import signal_info
 from cmsim.spectra.misfit import misfit
 
 __all__ = ["judge", "decide_record", "feature_sigma", "chi2_rows", "compared_columns",
-           "interpolated", "NONE_CHI2_PER_FEATURE", "ALARM_Z", "MIN_EVIDENCE",
+           "interpolated", "standing_out", "NONE_CHI2_PER_FEATURE", "ALARM_Z", "MIN_EVIDENCE",
            "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE", "RANGE_DELTA_CHI2",
-           "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z", "LOAD_TOLERANCE",
-           "OPERATING_SHIFT_UNCERTAINTY", "record_load",
-           "TORQUE_KEYS", "RADIAL_KEYS"]
+           "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.
 NONE_CHI2_PER_FEATURE = 2.5
@@ -246,87 +243,6 @@ def compared_columns(names, lib, fit, held):
     return (np.array(li, dtype=int), np.array(ri, dtype=int), [lib.names[i] for i in li])
 
 
-#: A record's documented load (torque, radial load) differing from the machine's by more than
-#: this share moves the baseline by the model's change between them
-#: (:func:`~cmsim.discrepancy.signatures.operating_shift`).
-LOAD_TOLERANCE = 0.1
-
-
-#: The model's change of a feature between the machine's load and a record's is read to
-#: within this share of itself (added in quadrature to the model's realisation spread). A
-#: gearbox's own load response is not the model's: SpectraQuest's healthy record at 50 %
-#: load sits on its 0 % baseline where the model moves the mesh sidebands 19 dB and the
-#: broadband 11 dB, so a shift taken as exact named a tooth fault on a healthy record; the
-#: CWRU records across loads (0 → 1 hp) move their defect families far beyond their shift.
-OPERATING_SHIFT_UNCERTAINTY = 1.0
-
-
-#: Keys of a recording entry that document its torque (a gear rig's) and its radial load.
-TORQUE_KEYS = ("torque_nm", "load_percent")
-RADIAL_KEYS = ("radial_load_n", "radial_load_lbs")
-
-
-def record_load(record, machine):
-    """(operating point, note): the load a record is read at against its machine — the
-    record's documented torque and radial load, and the machine's own where the record's
-    metadata documents none (reading a file, the model assumes a load it does not know:
-    20 N m on a gear rig; against a machine, the baseline's load is the best guess, and a
-    shift to an assumed load moved a 50-N m gear machine's whole baseline and named a ball
-    defect for its tooth fault). An in-memory record (a run) carries its own load.
-
-    Parameters
-    ----------
-    record : MeasuredRecord
-    machine : cmsim.machine.Machine
-
-    Returns
-    -------
-    (cmsim.rig.OperatingPoint, str)
-        The note says what was taken from the machine ("" when nothing was).
-    """
-    op = record.op
-    if not record.path:
-        return op, ""
-    entry = record.meta.get("recording") or {}
-    taken = []
-    if record.rig is not None and record.rig.gears is not None \
-            and not any(entry.get(k) is not None for k in TORQUE_KEYS):
-        op = replace(op, torque_nm=machine.op.torque_nm)
-        taken.append(f"torque {machine.op.torque_nm:g} N m")
-    if not any(entry.get(k) is not None for k in RADIAL_KEYS) \
-            and op.radial_load_n != machine.op.radial_load_n:
-        op = replace(op, radial_load_n=machine.op.radial_load_n)
-        taken.append(f"radial load {machine.op.radial_load_n:g} N")
-    if not taken:
-        return op, ""
-    return op, ("the record documents no load: read at the machine's ("
-                + ", ".join(taken) + ")")
-
-
-def _at_operating_point(machine, lib, op):
-    """(library, note): the library with every reference and prediction moved by the model's
-    change from the machine's documented load to the record's, where they differ by more than
-    :data:`LOAD_TOLERANCE` (the baseline at 0 % load, a record at 50 %); else as it is."""
-    def differs(a, b):
-        return abs(a - b) > LOAD_TOLERANCE * max(abs(a), abs(b), 1e-9)
-
-    if not (differs(op.torque_nm, machine.op.torque_nm)
-            or differs(op.radial_load_n, machine.op.radial_load_n)):
-        return lib, ""
-    shift = operating_shift(machine, lib, op)
-    if shift is None:
-        return lib, ("the record's documented load differs from the machine's, and the model "
-                     "at it diverged: read against the baseline as it is")
-    shift = np.nan_to_num(shift)
-    realisation = np.hypot(np.nan_to_num(lib.realisation), OPERATING_SHIFT_UNCERTAINTY * shift)
-    moved = replace(lib, mean=lib.mean + shift, realisation=realisation, entries=tuple(
-        replace(e, features=e.features + shift[None, :]) for e in lib.entries))
-    return moved, (f"the record's documented load (torque {op.torque_nm:g} N m, radial load "
-                   f"{op.radial_load_n:g} N) is not the machine's ({machine.op.torque_nm:g} N m,"
-                   f" {machine.op.radial_load_n:g} N): the baseline is read moved by the "
-                   "model's change between them, each feature within that change's own size")
-
-
 def feature_sigma(lib, li, names, n_fit):
     """σ of each compared feature (module docstring, step 2).
 
@@ -349,6 +265,28 @@ def feature_sigma(lib, li, names, n_fit):
     return np.sqrt(np.nan_to_num(lib.spread[li]) ** 2 * (1.0 / max(n_fit, 1)
                                                         + 1.0 / lib.segments)
                    + np.nan_to_num(lib.realisation[li]) ** 2 + floor ** 2)
+
+
+def standing_out(features, meas, reference, sigma, names):
+    """The ``features`` (column indices) on which the record stands out over a reference
+    (the baseline, or a cause's prediction): :data:`FAMILY_Z` of their σ upwards and, for a
+    level in dB, :data:`FAMILY_RISE_DB` over it.
+
+    Parameters
+    ----------
+    features : sequence of int
+        Columns to look at.
+    meas, reference, sigma : numpy.ndarray
+        The record's features, the reference's and their σ.
+    names : sequence of str
+        Feature names (a ``_db`` name is a level in dB).
+
+    Returns
+    -------
+    list of int
+    """
+    return [i for i in features if (meas[i] - reference[i]) / sigma[i] >= FAMILY_Z and (
+        not names[i].endswith("_db") or meas[i] - reference[i] >= FAMILY_RISE_DB)]
 
 
 def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
@@ -432,8 +370,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         # over the baseline: its evidence elsewhere (a broadband that lowers the raw lines
         # over their median, the statistics) any impulsive cause would share
         fam = [names.index(k) for k in r["family"] if path_free(k)]
-        out = [i for i in fam if z0[i] >= FAMILY_Z and (
-            not names[i].endswith("_db") or meas[i] - lib.mean[li][i] >= FAMILY_RISE_DB)]
+        out = standing_out(fam, meas, lib.mean[li], sigma, names)
         r["family_z"] = float(max((z0[i] for i in fam), default=0.0))
         r["stands_out"] = bool(out)
         r["out"] = out
@@ -519,15 +456,13 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
     if top["cause"].signature is not None:
         return None
     pred = top["prediction"]
-    left = (meas - pred) / sigma
     raised = pred - base
     found = []
     for r in rows:
         if top["name"] not in r["cause"].absorbs:
             continue
-        fam = [names.index(k) for k in r["family"]]
-        out = [i for i in fam if left[i] >= FAMILY_Z and raised[i] <= 0.0 and (
-            not names[i].endswith("_db") or meas[i] - pred[i] >= FAMILY_RISE_DB)]
+        out = [i for i in standing_out([names.index(k) for k in r["family"]], meas, pred,
+                                       sigma, names) if raised[i] <= 0.0]
         if out:     # a component's name starts with its shaft's number ("1G1", "1b1")
             found.append((r["component"] is None or r["component"][0] != sensor_bearing[0],
                           r["chi2"], r, out))
@@ -600,7 +535,7 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     if record.unit_scale is None and machine.unit_scale is not None:
         notes.append("the record's unit is unknown: its absolute level is not compared")
     op, load_note = record_load(record, machine)
-    lib, shift_note = _at_operating_point(machine, lib, op)
+    lib, shift_note = at_operating_point(machine, lib, op)
     notes.extend(n for n in (load_note, shift_note) if n)
     names, rows = _record_rows(record, machine, lib.segment_s, max_segments)
     fit, held = rows[0::2], rows[1::2]

@@ -155,13 +155,13 @@ def _across_loads(monkeypatch, shift):
     being ``shift``."""
     from types import SimpleNamespace
 
-    import cmsim.discrepancy.judge as judge_module
+    import cmsim.discrepancy.operating_point as operating_point
     from cmsim.rig import OperatingPoint
 
-    monkeypatch.setattr(judge_module, "operating_shift", lambda machine, lib, op: shift)
+    monkeypatch.setattr(operating_point, "operating_shift", lambda machine, lib, op: shift)
     machine = SimpleNamespace(op=OperatingPoint(speed_rpm=1797.0, torque_nm=0.0,
                                                 radial_load_n=98.0))
-    moved, note = judge_module._at_operating_point(
+    moved, note = operating_point.at_operating_point(
         machine, _library(), OperatingPoint(speed_rpm=1797.0, torque_nm=0.0,
                                            radial_load_n=400.0))
     assert "within that change's own size" in note

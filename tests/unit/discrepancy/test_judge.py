@@ -137,7 +137,7 @@ def test_a_file_that_documents_no_load_is_read_at_the_machine_s():
     radial load) and an in-memory run's own load stand."""
     from types import SimpleNamespace
 
-    from cmsim.discrepancy.judge import record_load
+    from cmsim.discrepancy.operating_point import record_load
     from cmsim.rig import OperatingPoint
 
     gears = SimpleNamespace(gears=object())
