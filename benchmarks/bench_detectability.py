@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 from cmsim.discrepancy import CAUSES, compare                       # noqa: E402
 from cmsim.discrepancy.causes import ModelSetup                     # noqa: E402
 from cmsim.discrepancy.evaluator import path_free                   # noqa: E402
-from cmsim.discrepancy.judge import FAMILY_Z, judge                  # noqa: E402
+from cmsim.discrepancy.judge import judge, standing_out             # noqa: E402
 from cmsim.discrepancy.machine_checks import detectability          # noqa: E402
 from cmsim.discrepancy.signatures import build_library, change_of   # noqa: E402
 from cmsim.machine import calibrate, model_force                    # noqa: E402
@@ -103,16 +103,17 @@ def inject(machine, held, cause, component, value, seed):
 
 def family_rise(res, cause, component):
     """(largest rise in dB over the baseline of the cause's path-free family features,
-    largest rise of those that also stand :data:`~cmsim.discrepancy.judge.FAMILY_Z` of their
-    σ over it): a rise within a noisy feature's own spread (a shaft-rate envelope line whose
-    σ is 4.5-9 dB) is no rise of the family."""
+    largest rise of those that stand out over it as the judge reads a family: 3 σ and 6 dB,
+    :func:`~cmsim.discrepancy.judge.standing_out`): a rise within a noisy feature's own
+    spread is no rise of the family."""
     fam = set(CAUSES[cause]().family([d["feature"] for d in res["discrepancies"]], component))
     mine = [d for d in res["discrepancies"]
             if d["feature"] in fam and path_free(d["feature"]) and d["feature"].endswith("_db")]
-    rise = max((d["measured"] - d["simulated"] for d in mine), default=0.0)
-    out = max((d["measured"] - d["simulated"] for d in mine if d["z"] >= FAMILY_Z),
-              default=0.0)
-    return rise, out
+    meas, ref, sigma = (np.array([d[k] for d in mine], dtype=float)
+                        for k in ("measured", "simulated", "sigma"))
+    rise = meas - ref
+    out = standing_out(range(len(mine)), meas, ref, sigma, [d["feature"] for d in mine])
+    return float(max(rise, default=0.0)), float(max(rise[out], default=0.0))
 
 
 def _job(args):
