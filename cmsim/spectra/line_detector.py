@@ -111,11 +111,10 @@ def detect_lines(freq, psd, *, min_db=LINE_MIN_DB, half_width_hz=FLOOR_HALF_WIDT
     med = median_floor(freq, psd, half_width_hz)
     ratio = psd / med
     thr = 10.0 ** (min_db / 10.0)
-    inner = slice(2, max(psd.size - 2, 2))
-    is_peak = ((ratio[inner] > thr) & (freq[inner] >= lowest_hz)
-               & (psd[inner] >= psd[1:-3][:psd[inner].size])
-               & (psd[inner] >= psd[3:][:psd[inner].size]))
-    peaks = (np.flatnonzero(is_peak) + 2).tolist()
+    n = psd.size                         # local maxima standing out, bins 2 to n - 3
+    mid = psd[2:n - 2]
+    peaks = (np.flatnonzero((ratio[2:n - 2] > thr) & (freq[2:n - 2] >= lowest_hz)
+                            & (mid >= psd[1:n - 3]) & (mid >= psd[3:n - 1])) + 2).tolist()
     owner = np.full(psd.size, -1)        # the line each bin belongs to
     spans = []
     for i in sorted(peaks, key=lambda j: -psd[j]):
