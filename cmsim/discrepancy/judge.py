@@ -405,6 +405,13 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             left = (meas - top["prediction"]) / sigma
             out = [r for r in ties if r["cause"].signature is not None and any(
                 left[i] >= FAMILY_Z for i in r["out"])]
+            if not out and top["cause"].signature is not None:
+                # nor is a fault named on the whole record with none of its own family
+                # risen, however far ahead, where another fault's family stands out over
+                # its prediction (a gear machine's outer race: the envelope lines 25 dB
+                # up, read best as a tooth fault whose sidebands stayed where they were)
+                out = [r for r in cands[1:] if r["cause"].signature is not None
+                       and standing_out(r["out"], meas, top["prediction"], sigma, names)]
             if out and not top["stands_out"]:
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]

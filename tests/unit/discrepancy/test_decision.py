@@ -239,3 +239,49 @@ def test_a_mesh_modulation_with_a_risen_once_per_rev_line_is_an_eccentric_gear(o
         assert [r["name"] for r in d["ties"]] == ["speed_fluctuation"]
         # its size read where its family stands out: the largest, whose 1x lines rise 8 dB
         assert d["top"]["value"] == pytest.approx(1.5e-4)
+
+
+@pytest.mark.parametrize("lift, finding", [(3.0, "tooth_fault"), (12.0, "bearing_outer_race")])
+def test_a_fault_with_none_of_its_family_risen_yields_to_one_whose_family_stands_out(
+        lift, finding):
+    """A gear machine's outer race (the angle generator's): its impacts ring a band the mesh
+    does not reach, so the band the envelope is read in moves there and the spectrum's shape
+    with it — which a tooth fault's impacts make too, and read best over the whole record,
+    though none of its sidebands rose. Its envelope lines stand ``lift`` dB over the
+    baseline, which the tooth fault's prediction leaves: 12 dB (3 σ and 6 dB over that
+    prediction) is the outer race, however far behind on the whole record; 3 dB stays the
+    tooth fault's reading."""
+    from cmsim.discrepancy.judge import NEAR_TIE
+
+    quiet = tuple(f"raw_fr_h{k}_db" for k in range(1, 61))
+    names = (("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "sb1_fr1_k1_db", "sb1_fr1_k2_db")
+             + tuple(f"shape_b{k}_db" for k in range(10)) + quiet)
+    m = len(names)
+    tooth = np.zeros((3, m))
+    tooth[:, 2:4] = np.array([[0.0], [0.3], [1.0]])       # its sidebands hardly move
+    tooth[:, 4:14] = np.array([[0.0], [2.0], [8.0]])      # its impacts reshape the spectrum
+    outer = np.zeros((3, m))
+    outer[:, :2] = np.array([[0.0], [8.0], [24.0]])
+    outer[:, 4:14] = np.array([[0.0], [0.2], [1.0]])
+    spread = np.ones(m)
+    spread[:2] = 3.0
+    lib = SignatureLibrary(
+        names=names, mean=np.zeros(m), spread=spread, realisation=np.zeros(m),
+        entries=(SignatureEntry("tooth_fault", "1G1", "documented", "lost_height_m",
+                                (1e-4, 5e-4, 3e-3), tooth),
+                 SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                                (3e-5, 3e-4, 3e-3), outer)),
+        segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
+    li = np.arange(m)
+    meas = np.zeros(m)
+    meas[:2], meas[4:14] = lift, 8.0
+    d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
+                      "1b1")
+    by = {r["name"]: r for r in d["ranked"]}
+    assert d["ranked"][0]["name"] == "tooth_fault"               # the better whole reading
+    assert not by["tooth_fault"]["stands_out"]
+    assert by["bearing_outer_race"]["stands_out"] == (lift == 12.0)
+    assert by["bearing_outer_race"]["evidence"] < NEAR_TIE * by["tooth_fault"]["evidence"]
+    assert (d["finding"], d["decided_on"]) == (finding, "whole")
+    if finding == "bearing_outer_race":
+        assert [r["name"] for r in d["ties"]][:1] == ["tooth_fault"]
