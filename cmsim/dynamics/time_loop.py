@@ -168,13 +168,31 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
     return states, diag, runner.wall
 
 
+class RecordedColumns:
+    """A table of ``n_rows`` samples by ``n_cols`` columns of which only ``cols`` are held
+    (the rest were never filtered): ``x[rows, j]`` reads column j, NaN where it is not
+    held. A batch's records keep their recorded columns only (3 of a gear rig's 38 states
+    for an accelerometer and the DTE), not a full-width array each."""
+
+    def __init__(self, n_rows, n_cols, cols):
+        self.shape = (int(n_rows), int(n_cols))
+        self._where = {int(c): k for k, c in enumerate(cols)}
+        self.data = np.full((self.shape[0], len(self._where)), np.nan, order="F")
+
+    def __getitem__(self, key):
+        rows, j = key
+        k = self._where.get(int(j))
+        col = self.data[:, k] if k is not None else np.full(self.shape[0], np.nan)
+        return col[rows]
+
+
 class _Decimator:
     """One run's anti-alias decimation, fed the integrator's blocks in order.
 
     ``feed(i0, states, diag)`` takes a block of fast samples (sample ``i0`` first, as
     :meth:`_Integrator.chunks` yields them) and filters the recorded columns into the output
     instants ``n_warm .. n_warm + n_rec − 1``; :attr:`q_out` and :attr:`d_out` hold them
-    (NaN in the columns not recorded). A batch of runs (:mod:`cmsim.dynamics.batch`) feeds
+    (:class:`RecordedColumns`: NaN in the columns not recorded). A batch of runs (:mod:`cmsim.dynamics.batch`) feeds
     one per run from its lane of the batch's blocks, which hold only the recorded columns:
     ``block_q``, ``block_d`` say where in a block's states and forces the recorded ones
     are (default: the blocks hold every column).
@@ -188,10 +206,10 @@ class _Decimator:
         self.first = n_warm * k - hl                  # first fast sample the filter reads
         self.last = (n_warm + n_rec - 1) * k + hl     # last one
         n_forces = len(model.output_force_names)
-        self.q_out = np.full((n_rec, n), np.nan, order="F")   # signals are read by column
-        self.d_out = np.full((n_rec, n_forces), np.nan, order="F")
         self.qc = np.arange(n) if q_cols is None else np.asarray(q_cols, dtype=int)
         self.dc = np.arange(n_forces) if d_cols is None else np.asarray(d_cols, dtype=int)
+        self.q_out = RecordedColumns(n_rec, n, self.qc)
+        self.d_out = RecordedColumns(n_rec, n_forces, self.dc)
         self.bq = self.qc if block_q is None else np.asarray(block_q, dtype=int)
         self.bd = self.dc if block_d is None else np.asarray(block_d, dtype=int)
         self.m0 = 0                                   # next output sample to fill
@@ -217,8 +235,8 @@ class _Decimator:
         take = min(len(out), self.n_rec - self.m0)
         if take > 0:
             m0 = self.m0
-            self.q_out[m0:m0 + take, qc] = out[:take, :qc.size]
-            self.d_out[m0:m0 + take, dc] = out[:take, qc.size:qc.size + dc.size]
+            self.q_out.data[m0:m0 + take] = out[:take, :qc.size]
+            self.d_out.data[m0:m0 + take] = out[:take, qc.size:qc.size + dc.size]
             self.m0 += take
         self.n_tail = n_rows - take * k
         buf[:self.n_tail] = buf[take * k:n_rows].copy()
