@@ -34,7 +34,7 @@ from cmsim._io import atomic_savez
 from cmsim.datasets.manifest import RECORDS_DIR, file_sha256, json_default, write_row
 from cmsim.datasets.spec import mesh_key
 from cmsim.dynamics.batch import simulate_batch
-from cmsim.dynamics.simulation import integrate_prepared, prepare_run, simulate
+from cmsim.dynamics.simulation import integrate_prepared, prepare_run
 from cmsim.dynamics.profiles import SpeedProfile
 from cmsim.faults import fault_frequencies
 from cmsim.features import N_GMF_HARMONICS, run_features
@@ -147,15 +147,15 @@ def _prepared(spec, plan):
     return setup, rig, op, profile
 
 
-def _record_arrays(spec, plan, rig, op, profile, run, setup_s):
+def _record_arrays(spec, plan, rig, op, profile, run, setup_s, reference=None):
     """``(arrays, meta)`` of a record from its simulated ``run``: the sensors, the answer key,
-    the meta (module docstring)."""
+    the meta (module docstring); ``reference`` is the healthy run its change through the
+    machine is read against (:func:`_machine_references`)."""
     channels = spec.channels
     sensed = [c for c in channels or () if c.startswith("accel_") or c == "tacho"]
     t1 = time.perf_counter()
-    if spec.machine is not None and (channels is None or spec.machine.channel in channels):
-        run = spec.machine.sensor_channel(run, plan.sim_seed, healthy=_machine_reference(
-            spec, rig, op, plan, profile, channels))
+    if _through_machine(spec):
+        run = spec.machine.sensor_channel(run, plan.sim_seed, healthy=reference)
     if sensed:
         bearings, directions = _accelerometers(sensed)
         run = add_sensors(run, path=rig.housing, noise_rms=plan.params["sensor_noise_m_s2"],
@@ -186,20 +186,50 @@ def _record_arrays(spec, plan, rig, op, profile, run, setup_s):
     return {c: np.asarray(run[c], dtype=np.float32) for c in channels}, meta
 
 
-def _machine_reference(spec, rig, op, plan, profile, channels):
+def _through_machine(spec):
+    """Whether the spec's records are read through its machine (its channel recorded)."""
+    return spec.machine is not None and (spec.channels is None
+                                         or spec.machine.channel in spec.channels)
+
+
+def _reference_setup(spec, rig, op, plan, profile):
     """The healthy run a record's change through a machine is read against
-    (:meth:`cmsim.machine.Machine.sensor_channel`): the same model run — seed, duration,
-    warm-up, tooth contact — on the machine's rig at its operating point without the
-    record's faults; None when the record is that run (no fault, the machine's rig and
+    (:meth:`cmsim.machine.Machine.sensor_channel`), prepared: the same model run — seed,
+    duration, warm-up, tooth contact — on the machine's rig at its operating point without
+    the record's faults; None when the record is that run (no fault, the machine's rig and
     operating point, no run-up), or the machine has no baseline to lay a change on (a
     version-1 machine file)."""
     machine = spec.machine
     if not machine.needs_reference(op, plan.faults, profile, rig):
         return None
-    return simulate(machine.rig, machine.op, spec.duration_s, mesh=spec.mesh, fs_hz=spec.fs_hz,
-                    substeps=spec.substeps, seed=plan.sim_seed, warmup_s=spec.warmup_s,
-                    losses=spec.losses,
-                    record=None if channels is None else list(machine.force_signals))
+    return prepare_run(machine.rig, machine.op, spec.duration_s, mesh=spec.mesh,
+                       fs_hz=spec.fs_hz, substeps=spec.substeps, seed=plan.sim_seed,
+                       warmup_s=spec.warmup_s, losses=spec.losses,
+                       record=None if spec.channels is None else list(machine.force_signals))
+
+
+def _machine_references(spec, todo, batch_size):
+    """Per record of ``todo`` (``(i, plan, rig, op, profile, setup_s)``), its healthy
+    reference run (:func:`_reference_setup`; None where it needs none), or the exception
+    that stopped it: each alone on the single-run kernel for ``batch_size`` 1, else those of
+    a batch together (a reference's bits, as a record's, do not depend on its companions)."""
+    if not _through_machine(spec):
+        return [None] * len(todo)
+    out, setups, where = [None] * len(todo), [], []
+    for k, (_, plan, rig, op, profile, _) in enumerate(todo):
+        try:
+            setup = _reference_setup(spec, rig, op, plan, profile)
+        except Exception as exc:           # noqa: BLE001 - a failed record, the rest go on
+            out[k] = exc
+            continue
+        if setup is not None:
+            setups.append(setup)
+            where.append(k)
+    runs = (simulate_batch(setups, batch_size) if batch_size > 1
+            else [_alone(s) for s in setups])
+    for k, run in zip(where, runs):
+        out[k] = run
+    return out
 
 
 #: Most records a dataset integrates together by default (:func:`default_batch_size`): B runs
@@ -208,10 +238,11 @@ def _machine_reference(spec, rig, op, plan, profile, channels):
 #: 0.77 of its cost alone in a batch of 32 and 0.69-0.74 in one of 64 (8: 1.14-1.19).
 BATCH_SIZE = 64
 #: Samples (duration × sample rate) a default batch holds at most: a batch's arrays grow
-#: with it (64 one-second records at 25.6 kHz peaked at 0.87 GiB in one process, 229 MiB
-#: before the batch), so 48 such records, and fewer of longer or faster ones, keep a worker
-#: under 1 GiB.
-BATCH_SAMPLES = 48 * 25_600
+#: with it (64 one-second records at 25.6 kHz of the paper rig peaked at 0.53 GiB in one
+#: process, 0.30 before the batch, each record keeping only the columns its channels read:
+#: 0.87 when every record kept every state), so 64 such records, and fewer of longer or
+#: faster ones, keep a worker well under 1 GiB.
+BATCH_SAMPLES = 64 * 25_600
 #: Smallest batch that pays (a batch of 16 costs 0.87-0.88 of its records alone, one of 8
 #: more than alone): a spec whose records would batch fewer keeps each record alone.
 BATCH_MIN = 16
@@ -254,10 +285,10 @@ def simulate_records(spec, plans, batch_size=None):
 
     With ``batch_size`` 1 each record runs alone on the single-run kernel
     (:func:`cmsim.dynamics.simulation.integrate_prepared`, the reference); otherwise those of
-    one kernel layout share one time loop (:func:`cmsim.dynamics.batch.simulate_batch`). A
-    record's arrays do not depend on the records it is simulated with: bit for bit the same
-    in any batch (of any size above 1), and within 1e-9 of each signal's range of the
-    single-run kernel's.
+    one kernel layout share one time loop (:func:`cmsim.dynamics.batch.simulate_batch`), and
+    so do the healthy reference runs of a spec read through a machine. A record's arrays do
+    not depend on the records it is simulated with: bit for bit the same in any batch (of any
+    size above 1), and within 1e-9 of each signal's range of the single-run kernel's.
 
     Parameters
     ----------
@@ -291,12 +322,13 @@ def simulate_records(spec, plans, batch_size=None):
     around = (time.perf_counter() - t0
               - sum(r.meta["wall_s"] for r in runs if not isinstance(r, Exception)))
     around /= max(len(setups), 1)
-    for (i, plan, rig, op, profile, setup_s), run in zip(todo, runs):
-        if isinstance(run, Exception):
-            out[i] = run
+    references = _machine_references(spec, todo, batch_size)
+    for (i, plan, rig, op, profile, setup_s), run, ref in zip(todo, runs, references):
+        if isinstance(run, Exception) or isinstance(ref, Exception):
+            out[i] = run if isinstance(run, Exception) else ref
             continue
         try:
-            out[i] = _record_arrays(spec, plan, rig, op, profile, run, setup_s + around)
+            out[i] = _record_arrays(spec, plan, rig, op, profile, run, setup_s + around, ref)
         except Exception as exc:           # noqa: BLE001 - a failed record, the rest go on
             out[i] = exc
     return out

@@ -216,7 +216,7 @@ def generate_dataset(spec, out_dir, *, workers=None, scheduler=None, progress=No
     batch_size : int, optional
         Most records a worker integrates together in one time loop, fewer when that spreads
         the records over the workers (default
-        :func:`~cmsim.datasets.records.default_batch_size`: 48 one-second 25.6-kHz records
+        :func:`~cmsim.datasets.records.default_batch_size`: 64 one-second 25.6-kHz records
         for a spec of 64 records or more, else 1; 1 is each record alone on the single-run
         kernel, the reference). A
         record's arrays are bit for bit the same for every batch size above 1, on any number

@@ -168,3 +168,43 @@ def test_a_machine_spec_refuses_what_the_machine_owns(tmp_path, key, table, valu
     data[table] = {**data.get(table, {}), **value}
     with pytest.raises(ParameterError, match=key.replace("[", r"\[").replace("]", r"\]")):
         DatasetSpec.from_dict(data, base_dir=tmp_path)
+
+
+def test_a_machine_spec_s_references_run_in_batches_and_keep_the_records_bits(
+        tmp_path, monkeypatch):
+    """Issue 49: the healthy reference runs a machine spec's faulty records are read against
+    are integrated together, as the records are; a record is then the same bits in batches
+    of 2 and 3, and within a float32 unit of the single-run kernel's (batch size 1, every
+    run alone)."""
+    from cmsim.datasets import records
+    from cmsim.datasets.records import simulate_records
+    from cmsim.machine.baseline import Baseline
+
+    rng = np.random.default_rng(8)
+    t = np.arange(int(2 * FS)) / FS
+    own = 0.05 * rng.standard_normal(t.size) + 0.2 * np.cos(2 * np.pi * 123.0 * t)
+    data = _spec_dict(tmp_path)
+    dataclasses.replace(_machine(), baseline=Baseline((own,), FS)).save(tmp_path / "m.toml")
+    data["dataset"]["records"] = 6
+    data["sensor"] = {"duration_s": 0.1, "warmup_s": 0.02}
+    spec = DatasetSpec.from_dict(data, base_dir=tmp_path)
+    plans = [spec.record(i) for i in range(6)]
+    faulty = sum(p.fault is not None for p in plans)
+    assert 2 <= faulty < 6          # healthy records at the machine's point need none
+    batched = []
+    real = records.simulate_batch
+    monkeypatch.setattr(records, "simulate_batch",
+                        lambda setups, size=None: batched.append(len(setups)) or real(
+                            setups, size))
+    by_size = {b: simulate_records(spec, plans, batch_size=b) for b in (2, 3)}
+    assert batched == [6, faulty, 6, faulty]          # the records, then their references
+    monkeypatch.setattr(records, "simulate_batch", real)
+    alone = simulate_records(spec, plans, batch_size=1)
+    for k in range(6):
+        a, b, c = (by_size[2][k][0], by_size[3][k][0], alone[k][0])
+        for ch in a:
+            np.testing.assert_array_equal(a[ch], b[ch], err_msg=ch)
+            ref = np.asarray(c[ch], dtype=float)
+            # float32 channels: one unit in the last place of the signal's range at most
+            tol = max(np.ptp(ref), np.max(np.abs(ref))) * 2.0 ** -22
+            assert np.max(np.abs(np.asarray(a[ch], dtype=float) - ref)) <= tol, ch
