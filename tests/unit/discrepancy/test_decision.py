@@ -39,6 +39,15 @@ def _library():
         segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
 
 
+def _baseline_at_zero(names, spread, *entries):
+    """A library whose baseline reads 0 on every feature, with the given spread and
+    entries (one record's segments: 8)."""
+    m = len(names)
+    return SignatureLibrary(names=names, mean=np.zeros(m), spread=spread,
+                            realisation=np.zeros(m), entries=entries, segment_s=0.5,
+                            segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
+
+
 def _decide(meas):
     lib = _library()
     li = np.arange(len(NAMES))
@@ -94,11 +103,10 @@ def test_one_family_standing_clearly_out_of_a_quiet_record_is_a_departure(lift, 
     outer[:, :2] = np.array([[0.0], [5.0], [20.0]])
     spread = np.ones(m)
     spread[:2] = 3.5                                # the family's own spread, dB: σ 1.9
-    lib = SignatureLibrary(
-        names=names, mean=np.zeros(m), spread=spread, realisation=np.zeros(m),
-        entries=(SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
-                                (3e-5, 3e-4, 3e-3), outer),),
-        segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
+    lib = _baseline_at_zero(
+        names, spread,
+        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), outer))
     li = np.arange(m)
     sigma = feature_sigma(lib, li, list(names), 8)
     meas = np.zeros(m)
@@ -130,13 +138,12 @@ def test_a_fault_whose_family_stands_out_wins_a_near_tie_on_the_whole_record(oth
     torque[:, 2:5] = np.array([[0.0], [9.0]])
     spread = np.ones(m)
     spread[:2] = 3.0
-    lib = SignatureLibrary(
-        names=names, mean=np.zeros(m), spread=spread, realisation=np.zeros(m),
-        entries=(SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
-                                (3e-5, 3e-4, 3e-3), outer),
-                 SignatureEntry("torque_mismatch", None, "documented", "torque_factor",
-                                (1.0, 3.0), torque)),
-        segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
+    lib = _baseline_at_zero(
+        names, spread,
+        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), outer),
+        SignatureEntry("torque_mismatch", None, "documented", "torque_factor",
+                       (1.0, 3.0), torque))
     li = np.arange(m)
     meas = np.zeros(m)
     meas[:2], meas[2:5] = 12.0, other
@@ -265,13 +272,12 @@ def test_a_fault_with_none_of_its_family_risen_yields_to_one_whose_family_stands
     outer[:, 4:14] = np.array([[0.0], [0.2], [1.0]])
     spread = np.ones(m)
     spread[:2] = 3.0
-    lib = SignatureLibrary(
-        names=names, mean=np.zeros(m), spread=spread, realisation=np.zeros(m),
-        entries=(SignatureEntry("tooth_fault", "1G1", "documented", "lost_height_m",
-                                (1e-4, 5e-4, 3e-3), tooth),
-                 SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
-                                (3e-5, 3e-4, 3e-3), outer)),
-        segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
+    lib = _baseline_at_zero(
+        names, spread,
+        SignatureEntry("tooth_fault", "1G1", "documented", "lost_height_m",
+                       (1e-4, 5e-4, 3e-3), tooth),
+        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), outer))
     li = np.arange(m)
     meas = np.zeros(m)
     meas[:2], meas[4:14] = lift, 8.0
