@@ -9,10 +9,7 @@ relative to the model's own healthy run with the same seeds (same cage phases, s
   :func:`~cmsim.spectra.line_detector.detect_lines` on the healthy force's spectrum) are
   changed on the baseline's own bins there. What the model *adds* to a line is added through
   the calibrated path's gain, in power, to the baseline's level there (a defect's comb on a
-  ball-pass line) — as far as the baseline allows the model's healthy line: where that line
-  through the path would stand over all the baseline has there, the path's gain is an
-  extrapolation and the model's rise is taken as a ratio on the baseline's level; what it
-  *takes away* is taken from the baseline's own line in proportion
+  ball-pass line); what it *takes away* is taken from the baseline's own line in proportion
   (the ratio of the model's line with the cause to without it: the path cancels) where the
   baseline shows that line, as far as the model's line makes it (its power through the
   path over the baseline line's), and nothing where it does not show it (a preload cannot
@@ -322,15 +319,7 @@ def apply_change(machine, segments, change, rng):
                 continue
             g2 = float(np.mean(gain2[b]))
             if p_c >= p_h:                  # what the model adds, added through the path
-                add = g2 * (p_c - p_h)
-                if g2 * p_h > p_b:
-                    # as far as the baseline allows the model's healthy line: one that
-                    # would stand over the baseline's whole power there says the path's
-                    # gain is an extrapolation, and the model's rise is read as a ratio on
-                    # the baseline's level (a 0.4-dB chance rise of a healthy line 57 dB
-                    # over a gear machine's baseline laid a 47-dB line on it)
-                    add *= p_b / (g2 * p_h)
-                target = p_b + add
+                target = p_b + g2 * (p_c - p_h)
             elif p_b - f_b >= (10.0 ** (SHARED_LINE_DB / 10.0) - 1.0) * f_b:
                 # the baseline's line, in proportion — as far as the model makes it (a
                 # baseline's shaft line is its unbalance, not a weak model line there)
