@@ -318,11 +318,12 @@ def simulate_records(spec, plans, batch_size=None):
     t0 = time.perf_counter()
     runs = (simulate_batch(setups, batch_size) if batch_size > 1
             else [_alone(s) for s in setups])
-    # what the batch spent besides integrating (filters, signals), shared out
+    references = _machine_references(spec, todo, batch_size)
+    # what the batch spent besides integrating its records (filters, signals, the healthy
+    # references of a machine spec), shared out
     around = (time.perf_counter() - t0
               - sum(r.meta["wall_s"] for r in runs if not isinstance(r, Exception)))
     around /= max(len(setups), 1)
-    references = _machine_references(spec, todo, batch_size)
     for (i, plan, rig, op, profile, setup_s), run, ref in zip(todo, runs, references):
         if isinstance(run, Exception) or isinstance(ref, Exception):
             out[i] = run if isinstance(run, Exception) else ref

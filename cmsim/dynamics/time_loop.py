@@ -171,8 +171,8 @@ def integrate(model, y0, t0, dt_out, n_out, substeps=1, scheme="ode3", stats=Non
 class RecordedColumns:
     """A table of ``n_rows`` samples by ``n_cols`` columns of which only ``cols`` are held
     (the rest were never filtered): ``x[rows, j]`` reads column j, NaN where it is not
-    held. A batch's records keep their recorded columns only (3 of a gear rig's 38 states
-    for an accelerometer and the DTE), not a full-width array each."""
+    held. A record keeps its recorded columns only (3 of the gear rig's 19 displacements
+    for an accelerometer and the DTE), not a full-width array."""
 
     def __init__(self, n_rows, n_cols, cols):
         self.shape = (int(n_rows), int(n_cols))
@@ -192,8 +192,9 @@ class _Decimator:
     ``feed(i0, states, diag)`` takes a block of fast samples (sample ``i0`` first, as
     :meth:`_Integrator.chunks` yields them) and filters the recorded columns into the output
     instants ``n_warm .. n_warm + n_rec − 1``; :attr:`q_out` and :attr:`d_out` hold them
-    (:class:`RecordedColumns`: NaN in the columns not recorded). A batch of runs (:mod:`cmsim.dynamics.batch`) feeds
-    one per run from its lane of the batch's blocks, which hold only the recorded columns:
+    (:class:`RecordedColumns`: NaN in the columns not recorded). A batch of runs
+    (:mod:`cmsim.dynamics.batch`) feeds one per run from its lane of the batch's blocks,
+    which hold only the recorded columns:
     ``block_q``, ``block_d`` say where in a block's states and forces the recorded ones
     are (default: the blocks hold every column).
     """
