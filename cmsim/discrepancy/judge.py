@@ -402,16 +402,13 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             # does not (an outer race that lifted its envelope lines 19 dB tied a torque
             # mismatch, 137 against 139; a clearance that lifts the cage line itself keeps
             # it against a ball defect whose family holds that line)
-            left = (meas - top["prediction"]) / sigma
-            out = [r for r in ties if r["cause"].signature is not None and any(
-                left[i] >= FAMILY_Z for i in r["out"])]
-            if not out and top["cause"].signature is not None:
-                # nor is a fault named on the whole record with none of its own family
-                # risen, however far ahead, where another fault's family stands out over
-                # its prediction (a gear machine's outer race: the envelope lines 25 dB
-                # up, read best as a tooth fault whose sidebands stayed where they were)
-                out = [r for r in cands[1:] if r["cause"].signature is not None
-                       and standing_out(r["out"], meas, top["prediction"], sigma, names)]
+            # nor, however far ahead, is a fault named on the whole record with none of its
+            # own family risen, where another fault's family stands out over its prediction
+            # (a gear machine's outer race: the envelope lines 25 dB up, read best as a
+            # tooth fault whose sidebands stayed where they were)
+            rivals = ties if top["cause"].signature is None else cands[1:]
+            out = [r for r in rivals if r["cause"].signature is not None
+                   and standing_out(r["out"], meas, top["prediction"], sigma, names)]
             if out and not top["stands_out"]:
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]
