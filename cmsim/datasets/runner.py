@@ -46,6 +46,7 @@ from cmsim.datasets.spec import DatasetSpec
 from cmsim.dynamics.batch import kernel_layout, simulate_batch
 from cmsim.dynamics.simulation import integrate_prepared, prepare_run
 from cmsim.errors import ParameterError, check_type
+from cmsim.faults.compile import TOOTH_TABLE_FAULTS
 from cmsim.sensors import housing_acceleration
 
 __all__ = ["generate_dataset", "DatasetSummary"]
@@ -119,10 +120,14 @@ class DatasetSummary:
 
 def _batch_key(plan):
     """What records of one batch share, read from the plan: the kinds of their faults (and
-    the bearing a bearing fault sits in) and whether it is a run-up — what sets the kernels'
-    switches and table sizes (:func:`cmsim.dynamics.batch.kernel_layout` checks the rest)."""
-    return (tuple((type(f).__name__, getattr(f, "bearing", None)) for f in plan.faults),
-            bool(plan.params["runup"]))
+    the bearing a bearing fault sits in; every fault of the per-tooth tables one kind) and
+    whether it is a run-up — what sets the kernels' switches and table sizes
+    (:func:`cmsim.dynamics.batch.kernel_layout` checks the rest)."""
+    kinds = sorted((type(f).__name__, getattr(f, "bearing", None) or "")
+                   for f in plan.faults if not isinstance(f, TOOTH_TABLE_FAULTS))
+    if any(isinstance(f, TOOTH_TABLE_FAULTS) for f in plan.faults):
+        kinds.append(("tooth tables", ""))
+    return tuple(kinds), bool(plan.params["runup"])
 
 
 def _batches(plans, workers, batch_size, batchable):

@@ -73,6 +73,7 @@ class BatchBuffers(NamedTuple):
     tau: np.ndarray       # (B,) equivalent time of the nominal rotation, s
     sr: np.ndarray        # (B,) speed over the reference speed
     ar: np.ndarray        # (B,) acceleration over the reference speed, 1/s
+    ang: np.ndarray       # (B,) the current bearing's cage angle, rad
     cc: np.ndarray        # (B,) cos, sin of the current bearing's cage angle
     sc: np.ndarray
     xr: np.ndarray        # (B,) the inner ring's offset in the cage frame, m
@@ -111,26 +112,27 @@ def lane_work(V, l):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _cage_frames(ib, it, ix, iy, y, b_par, omega, cage_slip, anchor, B):
+def _cage_frames(ib, it, ix, iy, y, b_par, omega, cage_slip, anchor, tau, ang, cc, sc, xr, yr,
+                 fx, fy):
     """Pass 1 of bearing ``ib`` (shaft DOF ``it``, DOFs ``ix``, ``iy``) for every run: the cage
-    angle's cos and sin and the inner ring's offset in the cage frame, into ``B``; the sums
-    zeroed.
+    angle ``ang``, its cos ``cc`` and sin ``sc`` and the inner ring's offset ``xr``, ``yr``
+    in the cage frame (all (B,)); the sums ``fx``, ``fy`` zeroed.
 
     Each run's angle turns its own anchor (``anchor`` (nb, AN_SIZE, B), as
     :func:`~cmsim.dynamics._rotation_kernels.anchored_cos_sin_jit` does): the few runs whose
     angle left the anchor's range are re-anchored first (exact cos and sin), then every run
     rotates its anchor by the small difference in one vectorised loop — a re-anchored run by
     exactly zero, which returns its exact values, so each run gets the single-run kernel's
-    numbers."""
+    numbers. The arrays are passed one by one (a call that unpacks a tuple of 19 arrays
+    costs more than a bearing's ball sums at one run), and each loop writes few of them."""
     rate_a = b_par[ib, BP_CAGE]
     sense = b_par[ib, BP_SENSE]
     phase = b_par[ib, BP_PHASE]
     w = omega[it]
     q = y[it]
     slip = cage_slip[ib]
-    ang = B.xr                      # (the angles, until the offsets replace them)
     for l in range(ang.shape[0]):
-        ang[l] = rate_a[l] * sense[l] * (w[l] * B.tau[l] + q[l]) + phase[l] + slip[l]
+        ang[l] = rate_a[l] * sense[l] * (w[l] * tau[l] + q[l]) + phase[l] + slip[l]
     a0 = anchor[ib, AN_ANGLE]
     valid = anchor[ib, AN_VALID]
     for l in range(ang.shape[0]):
@@ -139,16 +141,18 @@ def _cage_frames(ib, it, ix, iy, y, b_par, omega, cage_slip, anchor, B):
             anchored_cos_sin_jit(anchor[:, :, l], ib, ang[l])
     c0 = anchor[ib, AN_COS]
     s0 = anchor[ib, AN_SIN]
+    for l in range(ang.shape[0]):
+        c, s = rotate_small_jit(c0[l], s0[l], ang[l] - a0[l])
+        cc[l] = c
+        sc[l] = s
     qx = y[ix]
     qy = y[iy]
     for l in range(ang.shape[0]):
-        cc, sc = rotate_small_jit(c0[l], s0[l], ang[l] - a0[l])
-        B.cc[l] = cc
-        B.sc[l] = sc
-        B.xr[l] = qx[l] * cc + qy[l] * sc
-        B.yr[l] = qy[l] * cc - qx[l] * sc
-        B.fx[l] = 0.0
-        B.fy[l] = 0.0
+        xr[l] = qx[l] * cc[l] + qy[l] * sc[l]
+        yr[l] = qy[l] * cc[l] - qx[l] * sc[l]
+    for l in range(ang.shape[0]):
+        fx[l] = 0.0
+        fy[l] = 0.0
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -191,17 +195,18 @@ def _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, ball_cos, ball_sin):
         ix = S.b_int[0, ib, BI_X]
         iy = S.b_int[0, ib, BI_Y]
         _cage_frames(ib, S.b_int[0, ib, BI_T], ix, iy, y, L.b_par, L.omega, V.cage_slip,
-                     V.cage, B)
+                     V.cage, B.tau, B.ang, B.cc, B.sc, B.xr, B.yr, B.fx, B.fy)
         hertz = True
         for l in range(y.shape[1]):
             hertz = hertz and L.b_par[ib, BP_P, l] == 1.5
         _ball_sums(ib, S.b_int[0, ib, BI_NB], L.b_par, ball_cos, ball_sin, B.xr, B.yr, B.fx,
                    B.fy, hertz)
-        _bearing_out(ib, ix, iy, n, y, g, L.b_par, B, diag, want_diag)
+        _bearing_out(ib, ix, iy, n, y, g, L.b_par, B.cc, B.sc, B.fx, B.fy, diag,
+                     want_diag)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _bearing_out(ib, ix, iy, n, y, g, b_par, B, diag, want_diag):
+def _bearing_out(ib, ix, iy, n, y, g, b_par, cc, sc, sum_x, sum_y, diag, want_diag):
     """Pass 3: bearing ``ib``'s ball sums turned back to the housing frame, on its DOFs'
     forces and, with ``want_diag``, the output forces (plus its viscous damping)."""
     k = b_par[ib, BP_K]
@@ -211,15 +216,24 @@ def _bearing_out(ib, ix, iy, n, y, g, b_par, B, diag, want_diag):
     vx = y[n + ix]
     vy = y[n + iy]
     for l in range(gx.shape[0]):
-        fxr = k[l] * B.fx[l]
-        fyr = k[l] * B.fy[l]
-        fx = fxr * B.cc[l] - fyr * B.sc[l]
-        fy = fyr * B.cc[l] + fxr * B.sc[l]
+        fxr = k[l] * sum_x[l]
+        fyr = k[l] * sum_y[l]
+        fx = fxr * cc[l] - fyr * sc[l]
+        fy = fyr * cc[l] + fxr * sc[l]
         gx[l] -= fx
         gy[l] -= fy
         if want_diag:
             diag[2 * ib, l] = fx + damp[l] * vx[l]
             diag[2 * ib + 1, l] = fy + damp[l] * vy[l]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _copy_flat(src, dst):
+    """``dst[...] = src`` for two C-contiguous arrays of one shape, as one loop."""
+    a = src.reshape(-1)
+    b = dst.reshape(-1)
+    for j in range(a.shape[0]):
+        b[j] = a[j]
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -258,15 +272,13 @@ def _accelerations(y, n, g, minv, omega, ar, dydt, row):
     """Row ``row`` of ``dydt`` (s, dim, B) = ``[v, M⁻¹ g − ω·(dΩ/dt)/Ω_ref]`` for every run
     (the inertia load of the nominal rotation's acceleration only where it is not zero, as
     the single-run kernel applies it)."""
+    _copy_flat(y[n:], dydt[row, :n])
     for i in range(n):
-        out_q = dydt[row, i]
         out_v = dydt[row, n + i]
-        v = y[n + i]
         gi = g[i]
         mi = minv[i]
         wi = omega[i]
         for l in range(gi.shape[0]):
-            out_q[l] = v[l]
             out_v[l] = mi[l] * gi[l] - wi[l] * ar[l] if ar[l] != 0.0 else mi[l] * gi[l]
 
 
@@ -334,11 +346,7 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
     n = L.minv.shape[0]
     n_runs = y.shape[1]
     g = V.g
-    for i in range(n):
-        gi = g[i]
-        fi = L.fext[i]
-        for l in range(n_runs):
-            gi[l] = fi[l]
+    _copy_flat(L.fext, g)
     if S.m_int[0, MI_PROFILE] != 0:
         _profiles(t, S.prof, L.m_par, S.m_int[0, MI_TDOF], g, B.tau, B.sr, B.ar)
     else:
@@ -387,29 +395,39 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _stage_state(y, k, st, h, rk_a, yi):
     """``yi = y + h Σ_j a_st,j k_j`` for every run (the terms in the single-run kernel's
-    order)."""
-    for i in range(y.shape[0]):
-        out = yi[i]
-        yr = y[i]
-        for l in range(yr.shape[0]):
-            out[l] = yr[l]
-        for jj in range(st):
-            w = h * rk_a[st, jj]
-            kj = k[jj, i]
-            for l in range(yr.shape[0]):
-                out[l] += w * kj[l]
+    order; a zero weight adds nothing, as there). The arrays flat (C-contiguous (dim, B)
+    views): one loop per term over every state of every run, not one per state."""
+    out = yi.reshape(-1)
+    yf = y.reshape(-1)
+    for j in range(out.shape[0]):
+        out[j] = yf[j]
+    for jj in range(st):
+        if rk_a[st, jj] == 0.0:
+            continue
+        w = h * rk_a[st, jj]
+        kj = k[jj].reshape(-1)
+        for j in range(out.shape[0]):
+            out[j] += w * kj[j]
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _step(y, k, h, rk_b):
-    """``y += h Σ_s b_s k_s`` for every run (in the single-run kernel's order)."""
-    for i in range(y.shape[0]):
-        yr = y[i]
-        for l in range(yr.shape[0]):
-            acc = 0.0
-            for st in range(rk_b.shape[0]):
-                acc += rk_b[st] * k[st, i, l]
-            yr[l] += h * acc
+def _step(y, k, h, rk_b, acc):
+    """``y += h Σ_s b_s k_s`` for every run (in the single-run kernel's order: the sum from
+    zero, then one add), the sum built in ``acc`` (dim, B) one stage at a time over every
+    state of every run (flat), so each loop vectorises."""
+    a = acc.reshape(-1)
+    yf = y.reshape(-1)
+    for j in range(a.shape[0]):
+        a[j] = 0.0
+    for st in range(rk_b.shape[0]):
+        if rk_b[st] == 0.0:
+            continue
+        b = rk_b[st]
+        ks = k[st].reshape(-1)
+        for j in range(a.shape[0]):
+            a[j] += b * ks[j]
+    for j in range(a.shape[0]):
+        yf[j] += h * a[j]
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -467,5 +485,5 @@ def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L
             for st in range(1, ns):
                 _stage_state(y, k, st, h, rk_a, yi)
                 rhs_batch_jit(t + rk_c[st] * h, yi, k, st, S, L, V, B, diag, False)
-            _step(y, k, h, rk_b)
+            _step(y, k, h, rk_b, yi)
 

@@ -450,7 +450,8 @@ def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, X, P, 
                 for i in range(dim):
                     acc = y[i]
                     for jj in range(st):
-                        acc += h * rk_a[st, jj] * k[jj, i]
+                        if rk_a[st, jj] != 0.0:          # (a zero weight adds nothing)
+                            acc += h * rk_a[st, jj] * k[jj, i]
                     yi[i] = acc
                 if n_ex > 0:
                     _propagate_jit(X, st, yi)
@@ -460,7 +461,8 @@ def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, X, P, 
             for i in range(dim):
                 acc = 0.0
                 for st in range(ns):
-                    acc += rk_b[st] * k[st, i]
+                    if rk_b[st] != 0.0:
+                        acc += rk_b[st] * k[st, i]
                 y[i] += h * acc
             if n_ex > 0:
                 _propagate_jit(X, ns, y)

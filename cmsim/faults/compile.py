@@ -38,11 +38,16 @@ from cmsim.mesh_stiffness.potential_energy import _path_length
 
 __all__ = ["FaultArrays", "CheckedFaults", "compile_faults", "rig_with_faults",
            "slip_from_faults", "operating_modulation", "fault_frequencies", "check_faults",
-           "DEFECT_COLUMNS", "DEFAULT_GRID_POINTS"]
+           "DEFECT_COLUMNS", "DEFAULT_GRID_POINTS", "TOOTH_TABLE_FAULTS"]
 
 #: Columns of ``FaultArrays.bearing_defects``.
 DEFECT_COLUMNS = ("bearing", "kind", "centre_rad", "half_width_rad", "depth_m", "entry_rad",
                   "exit_rad", "ball", "axis_offset", "wander_s", "track_rad")
+
+#: The faults :func:`compile_faults` writes into the per-tooth tables (``tooth_factor*``,
+#: ``tooth_sep*``): runs with any of them have the same kernel layout, whichever tooth of
+#: which gear they change.
+TOOTH_TABLE_FAULTS = (ToothCrack, ToothSpall, ToothBreakage, ProfileError)
 
 #: Grid points of the tooth tables when no mesh table is given (as
 #: :meth:`~cmsim.mesh_stiffness.table.MeshStiffnessTable.potential_energy`).
