@@ -80,6 +80,7 @@ class BatchBuffers(NamedTuple):
     yr: np.ndarray
     fx: np.ndarray        # (B,) the ball sums in the cage frame
     fy: np.ndarray
+    ok: np.ndarray        # (B,) 1 where a run's state is finite and within its limits
     y1: np.ndarray        # (dim,) one run's state, contiguous
     g1: np.ndarray        # (n,) its forces
     d1: np.ndarray        # (n_diag,) its output forces
@@ -431,6 +432,27 @@ def _step(y, k, h, rk_b, acc):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
+def _check_states(y, n, max_disp, max_rot, trans_mask, ok):
+    """``ok[l]`` 1 where run ``l``'s state is finite and within its limits (translations,
+    ``trans_mask``, within ``max_disp[l]``; rotations within ``max_rot``), 0 elsewhere: one
+    loop over the runs per DOF, no branch in it."""
+    for l in range(ok.shape[0]):
+        ok[l] = 1.0
+    for i in range(n):
+        q = y[i]
+        v = y[n + i]
+        if trans_mask[i]:
+            for l in range(ok.shape[0]):
+                good = ((abs(q[l]) <= max_disp[l]) & (abs(q[l]) < math.inf)
+                        & (abs(v[l]) < math.inf))
+                ok[l] = ok[l] if good else 0.0
+        else:
+            for l in range(ok.shape[0]):
+                good = (abs(q[l]) <= max_rot) & (abs(q[l]) < math.inf) & (abs(v[l]) < math.inf)
+                ok[l] = ok[l] if good else 0.0
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
 def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L, V, B, out_y,
                         out_diag, y_cols, d_cols, max_disp, max_rot, trans_mask, status):
     """Fixed-step explicit Runge-Kutta of a batch of runs, output every ``substeps`` steps.
@@ -460,19 +482,14 @@ def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L
     dim, n_runs = y.shape
     n = dim // 2
     for m in range(n_out):
+        _check_states(y, n, max_disp, max_rot, trans_mask, B.ok)
         for l in range(n_runs):
             for c in range(y_cols.shape[0]):
                 out_y[l, m, c] = y[y_cols[c], l]
-            if status[l] >= 0:
-                continue
-            for i in range(n):
-                limit = max_disp[l] if trans_mask[i] else max_rot
-                if not (math.isfinite(y[i, l]) and math.isfinite(y[n + i, l])
-                        and abs(y[i, l]) <= limit):
-                    status[l] = m_offset + m
-                    for j in range(dim):
-                        y[j, l] = B.y0[j, l]
-                    break
+            if status[l] < 0 and B.ok[l] == 0.0:
+                status[l] = m_offset + m
+                for j in range(dim):
+                    y[j, l] = B.y0[j, l]
         for sub in range(substeps):
             t = t0 + ((m_offset + m) * substeps + sub) * h
             rhs_batch_jit(t, y, k, 0, S, L, V, B, diag, sub == 0)

@@ -117,7 +117,7 @@ def _integrate_batch(setups, chunk_steps=BATCH_CHUNK_STEPS):
     y0 = _stack([s.y0 for s in setups], axis=-1)
     B = BatchBuffers(np.zeros((tab.b.shape[0], dim, n_runs)), y0.copy(), np.empty_like(y0),
                      y0, np.zeros((n_diag, n_runs)),
-                     *(np.zeros(n_runs) for _ in range(10)), np.zeros(dim),
+                     *(np.zeros(n_runs) for _ in range(11)), np.zeros(dim),
                      np.zeros(dim // 2), np.zeros(n_diag), np.zeros((R_SIZE, n_runs)),
                      np.zeros((max(int(S.m_int[0, MI_SLOTS]), 1), BS_SIZE, n_runs)))
     max_disp = np.array([max_displacement_m(m) for m in models])
