@@ -133,9 +133,9 @@ def _batch_key(plan):
 def _batches(plans, workers, batch_size, batchable):
     """The pending records' plans in batches: records of one :func:`_batch_key` together, in
     index order, at most ``batch_size``, in parts of even size (no more than spreads the
-    records over ``workers`` when known); one by one for ``batch_size`` 1 and for a key the
-    batch kernel does not take (``batchable[key]`` False: nothing to share, and an
-    interruption then loses no finished run)."""
+    records over ``workers`` when known), the largest batches first; one by one for
+    ``batch_size`` 1 and for a key the batch kernel does not take (``batchable[key]`` False:
+    nothing to share, and an interruption then loses no finished run)."""
     size = batch_size
     if workers:
         size = max(1, min(size, -(-len(plans) // int(workers))))
@@ -147,7 +147,10 @@ def _batches(plans, workers, batch_size, batchable):
         step = size if batchable.get(key, False) else 1
         step = -(-len(group) // -(-len(group) // step))        # even parts
         out += [group[j:j + step] for j in range(0, len(group), step)]
-    return sorted(out, key=lambda part: part[0].index)
+    # the largest first, so the workers, each taking the next when it is free, finish
+    # together (in index order, batches of 62 and of 39 records could leave one worker
+    # with some 60 records more than the other)
+    return sorted(out, key=lambda part: (-len(part), part[0].index))
 
 
 def _first_runs(spec, plans):
