@@ -3,7 +3,8 @@ its worker or a resume; a batch of one is the single-run kernel, the reference.
 
 Test tier: behaviour contracts (no physics): 8 records of 0.03 s of a gear spec with faults,
 slip and a speed wobble, generated with batch sizes 1, 3 and 4 on 1 and 2 workers and
-resumed; a record that diverges in a batch fails alone.
+resumed; a record that diverges in a batch fails alone; the runner's batches (the tooth
+faults' records together, the largest first) from 60 plans, with no integration.
 """
 
 import numpy as np
@@ -117,3 +118,48 @@ def test_a_large_spec_batches_by_default_and_its_records_keep_their_bits():
         ref = reference[c].astype(float)
         tol = max(np.ptp(ref), np.max(np.abs(ref))) * 2.0 ** -22
         assert np.max(np.abs(together[3][0][c] - ref)) <= tol, c
+
+
+def test_tooth_table_faults_share_a_batch_and_the_largest_batches_go_first():
+    """A crack, a spall and a breakage write the same per-tooth tables: their records share
+    a batch key (and the kernel layout the key stands for), a healthy or an eccentric record
+    does not; the runner hands the batches out largest first."""
+    from cmsim.datasets.records import _prepared
+    from cmsim.datasets.runner import _batch_key, _batches
+    from cmsim.dynamics.batch import kernel_layout
+    from cmsim.faults import Eccentricity
+    from cmsim.faults.compile import TOOTH_TABLE_FAULTS
+
+    spec = DatasetSpec.from_dict({**SPEC, "dataset": {"name": "kinds", "records": 60, "seed": 5},
+                                  "faults": {"healthy_share": 0.2, "types": [
+                                      {"type": "tooth_crack", "gear": [1, 2],
+                                       "depth_m": {"min": 0.5e-3, "max": 2.0e-3}},
+                                      {"type": "tooth_spall", "gear": [1, 2],
+                                       "width_m": {"min": 0.5e-3, "max": 2.0e-3},
+                                       "depth_m": 20.0e-6},
+                                      {"type": "tooth_breakage", "gear": [1, 2],
+                                       "lost_height_m": {"min": 0.5e-3, "max": 2.0e-3}},
+                                      {"type": "eccentricity", "gear": [1, 2],
+                                       "amplitude_m": {"min": 5.0e-6, "max": 50.0e-6}}]}})
+    plans = [spec.record(i) for i in range(spec.n_records)]
+
+    def first(kind):
+        return next(p for p in plans if any(type(f).__name__ == kind for f in p.faults))
+
+    tooth = [first(k) for k in ("ToothCrack", "ToothSpall", "ToothBreakage")]
+    healthy = next(p for p in plans
+                   if not any(isinstance(f, TOOTH_TABLE_FAULTS + (Eccentricity,))
+                              for f in p.faults))
+    keys = {_batch_key(p) for p in tooth}
+    assert len(keys) == 1
+    assert _batch_key(healthy) not in keys and _batch_key(first("Eccentricity")) not in keys
+    layouts = {kernel_layout(_prepared(spec, p)[0]) for p in tooth}
+    assert len(layouts) == 1 and None not in layouts
+
+    batches = _batches(plans, 2, 16, {_batch_key(p): True for p in plans})
+    sizes = [len(b) for b in batches]
+    assert sizes == sorted(sizes, reverse=True) and sizes[0] > sizes[-1]
+    assert sorted(p.index for b in batches for p in b) == list(range(spec.n_records))
+    for b in batches:
+        assert len({_batch_key(p) for p in b}) == 1
+        assert [p.index for p in b] == sorted(p.index for p in b)
