@@ -273,9 +273,11 @@ def bench_stages(spec, n, tmp):
     records.run_records(spec, [0], out, batch_size=1)  # warm: kernels, caches
     clock = StageClock()
     # (a stage's function that this version of cmsim does not have is left out)
-    originals = [(_resolve(owner), attr, clock.wrap(_resolve(owner), attr, stage))
-                 for stage, owner, attr in STAGES
-                 if _resolve(owner) is not None and hasattr(_resolve(owner), attr)]
+    originals = []
+    for stage, owner, attr in STAGES:
+        obj = _resolve(owner)
+        if obj is not None and hasattr(obj, attr):
+            originals.append((obj, attr, clock.wrap(obj, attr, stage)))
     try:
         t0, w0 = cpu(), time.perf_counter()
         # in one batch, as the command integrates a spec of its size (a batch of n: its

@@ -435,21 +435,18 @@ def _step(y, k, h, rk_b, acc):
 def _check_states(y, n, max_disp, max_rot, trans_mask, ok):
     """``ok[l]`` 1 where run ``l``'s state is finite and within its limits (translations,
     ``trans_mask``, within ``max_disp[l]``; rotations within ``max_rot``), 0 elsewhere: one
-    loop over the runs per DOF, no branch in it."""
+    loop over the runs per DOF, no branch in it. The limits are finite, so a displacement
+    within its limit is finite too."""
     for l in range(ok.shape[0]):
         ok[l] = 1.0
     for i in range(n):
         q = y[i]
         v = y[n + i]
-        if trans_mask[i]:
-            for l in range(ok.shape[0]):
-                good = ((abs(q[l]) <= max_disp[l]) & (abs(q[l]) < math.inf)
-                        & (abs(v[l]) < math.inf))
-                ok[l] = ok[l] if good else 0.0
-        else:
-            for l in range(ok.shape[0]):
-                good = (abs(q[l]) <= max_rot) & (abs(q[l]) < math.inf) & (abs(v[l]) < math.inf)
-                ok[l] = ok[l] if good else 0.0
+        trans = trans_mask[i]
+        for l in range(ok.shape[0]):
+            limit = max_disp[l] if trans else max_rot
+            good = (abs(q[l]) <= limit) & (abs(v[l]) < math.inf)
+            ok[l] = ok[l] if good else 0.0
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
