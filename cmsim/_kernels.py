@@ -13,8 +13,9 @@ are never stored whole).
   increasing. Each phase t reads its taps as one row (zero where the filter has none) and
   the signal padded with zeros; like the zero taps ``resample_poly`` pads its own filter
   with, the products these add are ±0.0 and change nothing (a running sum of them is never
-  −0.0). The sums of one phase run eight outputs at a time, so their adds do not wait for
-  each other.
+  −0.0). Each tap adds its products to a whole block of one phase's outputs (the taps
+  outside, the outputs inside: a contiguous loop the vectoriser takes), each output's sum
+  still in the order above.
 * Each biquad is the direct form II transposed of :func:`scipy.signal.sosfilt` written with
   the same operations in the same order, and the modes are summed in the order
   ``((0 + y₁) + y₂) + …`` of adding one ``sosfilt`` output after another.
@@ -38,53 +39,24 @@ HOUSING_BLOCK = 512
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _interpolate_block(x, taps, j0, j1, xk):
-    """``xk[t, j − j0] = Σ_d x[j + d]·taps[t, d]`` (d increasing) for j in [j0, j1): fast
-    sample j·k + t, ``x`` being the signal padded as :func:`housing_path_jit` says. Indices
-    are unsigned (no negative-index test on every load)."""
+    """``xk[t, j − j0] = Σ_d x[j + d]·taps[t, d]`` (d increasing, from 0.0) for j in [j0, j1):
+    fast sample j·k + t, ``x`` being the signal padded as :func:`housing_path_jit` says.
+
+    The taps run in the outer loop and the block's outputs in the inner one: each tap adds
+    its products to the whole block, a contiguous run the vectoriser takes whole (one product
+    per output per tap, in the order of the sums above, so the same numbers)."""
     n_phases, n_taps = taps.shape
-    one = np.uint64(1)
+    m = j1 - j0
     for t in range(n_phases):
         g = taps[t]
         row = xk[t]
-        j = j0
-        while j + 8 <= j1:
-            a0 = 0.0
-            a1 = 0.0
-            a2 = 0.0
-            a3 = 0.0
-            a4 = 0.0
-            a5 = 0.0
-            a6 = 0.0
-            a7 = 0.0
-            i = np.uint64(j)
-            for d in range(n_taps):
-                gd = g[np.uint64(d)]
-                a0 += x[i] * gd
-                a1 += x[i + one] * gd
-                a2 += x[i + np.uint64(2)] * gd
-                a3 += x[i + np.uint64(3)] * gd
-                a4 += x[i + np.uint64(4)] * gd
-                a5 += x[i + np.uint64(5)] * gd
-                a6 += x[i + np.uint64(6)] * gd
-                a7 += x[i + np.uint64(7)] * gd
-                i += one
-            r = j - j0
-            row[r] = a0
-            row[r + 1] = a1
-            row[r + 2] = a2
-            row[r + 3] = a3
-            row[r + 4] = a4
-            row[r + 5] = a5
-            row[r + 6] = a6
-            row[r + 7] = a7
-            j += 8
-        for j in range(j, j1):
-            acc = 0.0
-            i = np.uint64(j)
-            for d in range(n_taps):
-                acc += x[i] * g[np.uint64(d)]
-                i += one
-            row[j - j0] = acc
+        for r in range(m):
+            row[r] = 0.0
+        for d in range(n_taps):
+            gd = g[d]
+            src = x[j0 + d: j0 + d + m]
+            for r in range(m):
+                row[r] += src[r] * gd
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
