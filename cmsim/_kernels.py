@@ -29,7 +29,6 @@ the hot path.
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 #: Input samples per block of :func:`housing_path_jit` (scratch ``xk`` of k rows of this

@@ -237,8 +237,8 @@ def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_
 
 @functools.lru_cache(maxsize=8)
 def _simpson_weights(n):
-    """Weights of the composite Simpson rule on ``n`` (odd) equal intervals of [0, 1]:
-    ∫₀ᵈ f(u) du = d · Σ wᵢ f(d tᵢ) (1, 4, 2, 4, …, 4, 1, over 3(n − 1); read-only)."""
+    """Weights of the composite Simpson rule on ``n`` (odd) equally spaced nodes tᵢ of [0, 1]:
+    ∫₀ᵈ f(u) du ≈ d · Σ wᵢ f(d tᵢ) (1, 4, 2, 4, …, 4, 1, over 3(n − 1); read-only)."""
     w = np.full(n, 2.0)
     w[1::2] = 4.0
     w[0] = w[-1] = 1.0
