@@ -58,6 +58,21 @@ def test_uniform_cantilever_matches_closed_form(alpha1):
         assert np.allclose(kb, d ** 3 / (3 * E * inertia), rtol=1e-6)
 
 
+@pytest.mark.parametrize("n_nodes", [3, 11, 1001])
+def test_simpson_rule_is_exact_on_a_cubic_bending_integrand(n_nodes):
+    # h(u) = (a + b u)^(-1/3): 1/I is linear in u, so the bending integrand is a cubic,
+    # which the composite Simpson rule integrates exactly on any odd number of nodes
+    a, b, alpha1, e = 1.0 / 2e-3 ** 3, 4.0e10 / 1e-3, 0.25, 1.2e-3
+    d = np.array([1e-3, 4e-3])
+    kb = cantilever_compliance(lambda u: (a + b * u) ** (-1.0 / 3.0), d, e, alpha1, E, NU, B,
+                               n_nodes=n_nodes)[0]
+    c, s = math.cos(alpha1), math.sin(alpha1)
+    p = c * d - e * s                        # the moment arm is p − c u
+    m0 = p * p * d - p * c * d ** 2 + c * c * d ** 3 / 3          # ∫₀ᵈ (p − c u)² du
+    m1 = p * p * d ** 2 / 2 - 2 * p * c * d ** 3 / 3 + c * c * d ** 4 / 4   # ∫₀ᵈ u (…)² du
+    assert np.allclose(kb, 1.5 / (E * B) * (a * m0 + b * m1), rtol=1e-12, atol=0.0)
+
+
 def test_tapered_cantilever_converges():
     # h(u) = h0 (1 − u/(2L)): a coarse and a fine Simpson rule agree
     L = 5e-3
