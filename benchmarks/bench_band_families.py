@@ -2,16 +2,19 @@
 "envelope families per band"): how many of the angle-domain generator's bearing defects would
 stand out, and how many of its healthy records would not.
 
-Run: ``python benchmarks/bench_band_families.py [--seeds N] [--json OUT]`` (about 15 s for
-8 seeds on one core: no calibration, no model run).
+Run: ``python benchmarks/bench_band_families.py [--generator angle|model] [--seeds N]
+[--json OUT]`` (angle: about 15 s for 8 seeds on one core, no calibration and no model run;
+model: cmsim's own records and another healthy realisation as the baseline, as
+``bench_compare.py --generator model --machine`` makes them, a few minutes).
 
 For each machine of :mod:`cmsim.discrepancy.angle_domain` (the same machines and records as
 ``bench_compare.py --generator angle``: bearing machines on even seeds, gear machines on odd
-ones) its healthy baseline and its outer-race, inner-race, ball and healthy records are cut
-into half-second segments. Every segment is demodulated in each band of the fixed bank
+ones), or of cmsim's model (``--generator model``: a bearing and a gear machine per seed),
+its healthy baseline and its outer-race, inner-race, ball and healthy records are cut into
+half-second segments. Every segment is demodulated in each band of the fixed bank
 (:func:`cmsim.features.envelope.band_bank`, Hann envelope spectrum of
-:func:`~cmsim.features.envelope.demodulated_spectrum`), and the drive-end bearing's lines
-(BPFO, BPFI, 2·BSF and their second harmonics, :func:`~cmsim.features.envelope.envelope_lines`,
+:func:`~cmsim.features.envelope.demodulated_spectrum`), and the lines of the defect's bearing
+(every bearing's on a healthy record: BPFO, BPFI, 2·BSF and their second harmonics, :func:`~cmsim.features.envelope.envelope_lines`,
 the 2 % line rule) are read over the envelope spectrum's median between half the shaft rate
 and 4 × BPFI, dB — the record's ``env_*`` features, in every band instead of the band rule's
 one.
@@ -33,7 +36,7 @@ import math
 import tempfile
 
 import numpy as np
-from bench_compare import _angle_case
+from bench_compare import _angle_case, _model_case
 
 from cmsim.discrepancy.evaluator import feature_floor
 from cmsim.discrepancy.judge import FLOOR_SHARE, standing_out
@@ -56,10 +59,10 @@ def _db(a, ref):
     return 20.0 * math.log10(max(a, 1e-30) / ref) if math.isfinite(a) else math.nan
 
 
-def band_lines(record):
-    """(segments, bands, lines) levels in dB of the drive-end bearing's family lines."""
+def band_lines(record, bearing):
+    """(segments, bands, lines) levels in dB of one bearing's family lines."""
     freqs = record.model_frequencies()
-    bf = freqs.bearing(next(iter(freqs.bearing_names)))
+    bf = freqs.bearing(bearing)
     fs = record.fs_hz
     x = np.asarray(record.signal, dtype=float)
     rows = []
@@ -76,9 +79,10 @@ def band_lines(record):
     return np.array(rows)
 
 
-def compare(base, rec):
-    """Per family: whether it stands out in any band, and its largest rise (dB)."""
-    fb, fr = band_lines(base), band_lines(rec)
+def compare(base, rec, bearing):
+    """Per family of ``bearing``: whether it stands out in any band, and its largest rise
+    (dB)."""
+    fb, fr = band_lines(base, bearing), band_lines(rec, bearing)
     mean_b, mean_r = np.nanmean(fb, axis=0).ravel(), np.nanmean(fr, axis=0).ravel()
     spread = np.nanstd(fb, axis=0, ddof=1).ravel()
     names = [f"env_{k}_db" for _ in range(fb.shape[1]) for k in KEYS]
@@ -96,26 +100,45 @@ def compare(base, rec):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--seeds", type=int, default=8)
+    ap.add_argument("--generator", choices=("angle", "model"), default="angle")
+    ap.add_argument("--seeds", type=int, default=None,
+                    help="machines (default 8 angle, 3 model, as bench_compare.py reads them)")
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
+    seeds = a.seeds or (8 if a.generator == "angle" else 3)
     rows = []
-    for s in range(a.seeds):
+    for s in range(seeds):
         kind = "gear" if s % 2 else "bearing"
-        for eff in (*TRUE_FAMILY, "none_gear" if kind == "gear" else "none"):
+        effects = ((*TRUE_FAMILY, "none_gear" if kind == "gear" else "none")
+                   if a.generator == "angle" else (*TRUE_FAMILY, "none", "none_gear"))
+        for eff in effects:
             with tempfile.TemporaryDirectory() as tmp:
-                rec, base, sev, _ = _angle_case(eff, s, tmp)
-            r = compare(base, rec)
+                rec, base, sev, comp = (_angle_case(eff, s, tmp) if a.generator == "angle"
+                                        else _model_case(eff, s))
+            if a.generator == "model":
+                kind = "gear" if eff == "none_gear" else "bearing"
+            names = list(rec.model_frequencies().bearing_names)
+            # a defect's own bearing (the angle generator's sits on the first); a healthy
+            # record alarms where any bearing's family stands out
+            keys = {"drive_end": "1b1", "fan_end": "1b2"}        # the model's locations
+            read = (names if eff.startswith("none") else
+                    [keys.get(comp, comp) if keys.get(comp, comp) in names else names[0]])
+            per = [compare(base, rec, b) for b in read]
+            r = {f: {"stands_out": any(p[f]["stands_out"] for p in per),
+                     "max_rise_db": max(p[f]["max_rise_db"] for p in per)} for f in FAMILIES}
             top = max(r, key=lambda f: r[f]["max_rise_db"])
             rows.append({"seed": s, "machine": kind, "effect": eff, "severity": sev,
                          "families": r, "largest": top})
-            print(f"seed {s} {kind:7s} {eff:20s} severity {sev:.2f}  stands out: "
+            size = "-" if sev is None else f"{sev:.3g}"
+            print(f"seed {s} {kind:7s} {eff:20s} size {size} on {read[0] if len(read) == 1 else 'every bearing'}  stands out: "
                   f"{[f for f in r if r[f]['stands_out']]}  largest rise (dB): "
                   + ", ".join(f"{f} {r[f]['max_rise_db']:.1f}" for f in r), flush=True)
     print("\nmachine  defect               true family stands out   true family rises most")
     for kind in ("bearing", "gear"):
         for eff, fam in TRUE_FAMILY.items():
             rs = [r for r in rows if r["machine"] == kind and r["effect"] == eff]
+            if not rs:
+                continue
             print(f"{kind:8s} {eff:20s} {sum(r['families'][fam]['stands_out'] for r in rs):6d} "
                   f"of {len(rs):<14d} {sum(r['largest'] == fam for r in rs):6d} of {len(rs)}")
     clean = [r for r in rows if r["effect"].startswith("none")]
