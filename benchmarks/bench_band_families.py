@@ -23,9 +23,11 @@ A family **stands out** where one of its lines, in one band, rises over the base
 the same band by the judge's rule (:func:`cmsim.discrepancy.judge.standing_out`:
 :data:`~cmsim.discrepancy.judge.FAMILY_Z` σ and :data:`~cmsim.discrepancy.judge.FAMILY_RISE_DB`
 dB; σ² the baseline's segment-to-segment spread² over both means' segments plus the judge's
-floor²). The report gives, per record, the families that stand out and each family's largest
-rise, then the counts: the true family standing out, the true family rising most, and healthy
-records in which any family stands out (false alarms). The answer key is read only to score.
+floor², and with ``--realisations N`` the spread² of the baseline's mean and N other healthy
+records' of the same machine, as the library's realisation spread). The report gives, per
+record, the families that stand out and each family's largest rise, then the counts: the
+true family standing out, the true family rising most, and healthy records in which any
+family stands out (false alarms). The answer key is read only to score.
 """
 
 from __future__ import annotations
@@ -34,16 +36,20 @@ import argparse
 import json
 import math
 import tempfile
+from pathlib import Path
 
 import numpy as np
-from bench_compare import _angle_case, _model_case
+from bench_compare import SEED0, _angle_case, _model_case
 
+from cmsim.discrepancy.angle_domain import draw_machine, write_machine
 from cmsim.discrepancy.evaluator import feature_floor
 from cmsim.discrepancy.judge import FLOOR_SHARE, standing_out
+from cmsim.discrepancy.synthetic import hidden_effect_record
 from cmsim.features.envelope import (band_bank, demodulated_spectrum, envelope_lines,
                                      line_amplitudes)
 from cmsim.features.lines import SLIP_TOLERANCE
 from cmsim.features.relative import segments
+from cmsim.measured import read_record
 
 #: Lines of each family read (``envelope_lines`` names).
 FAMILIES = {"bpfo": ("bpfo_1", "bpfo_2"), "bpfi": ("bpfi_1", "bpfi_2"),
@@ -79,15 +85,34 @@ def band_lines(record, bearing):
     return np.array(rows)
 
 
-def compare(base, rec, bearing):
+def other_healthy(generator, s, kind, j):
+    """Healthy record ``j`` (0, 1, …) of machine ``s`` other than its baseline and the
+    records compared: another run of the same machine, what the realisation spread is read
+    from."""
+    if generator == "angle":
+        with tempfile.TemporaryDirectory() as tmp:
+            write_machine(tmp, draw_machine(SEED0 + s, kind),
+                          [("baseline", None, 0.0, 1), ("other", None, 0.0, 10 + j)])
+            return read_record(Path(tmp) / "other.npz")
+    return hidden_effect_record(None, SEED0 + s, rig_kind=kind,
+                                sim_seed=SEED0 + s + 500_000 + 1_000 * j).record
+
+
+def compare(base, rec, bearing, others=()):
     """Per family of ``bearing``: whether it stands out in any band, and its largest rise
-    (dB)."""
+    (dB); with ``others`` (other healthy records of the machine) the spread of the
+    baseline's and their means joins σ, as the library's realisation spread does."""
     fb, fr = band_lines(base, bearing), band_lines(rec, bearing)
     mean_b, mean_r = np.nanmean(fb, axis=0).ravel(), np.nanmean(fr, axis=0).ravel()
     spread = np.nanstd(fb, axis=0, ddof=1).ravel()
     names = [f"env_{k}_db" for _ in range(fb.shape[1]) for k in KEYS]
     floor = np.array([FLOOR_SHARE * feature_floor(n) for n in names])
-    sigma = np.sqrt(spread ** 2 * (1.0 / fr.shape[0] + 1.0 / fb.shape[0]) + floor ** 2)
+    realisation = np.zeros_like(mean_b)
+    if others:
+        means = [mean_b] + [np.nanmean(band_lines(o, bearing), axis=0).ravel() for o in others]
+        realisation = np.nanstd(np.vstack(means), axis=0, ddof=1)
+    sigma = np.sqrt(spread ** 2 * (1.0 / fr.shape[0] + 1.0 / fb.shape[0]) + realisation ** 2
+                    + floor ** 2)
     out = set(standing_out(range(len(names)), mean_r, mean_b, sigma, names))
     result = {}
     for fam, ks in FAMILIES.items():
@@ -103,8 +128,12 @@ def main(argv=None):
     ap.add_argument("--generator", choices=("angle", "model"), default="angle")
     ap.add_argument("--seeds", type=int, default=None,
                     help="machines (default 8 angle, 3 model, as bench_compare.py reads them)")
+    ap.add_argument("--realisations", type=int, default=0,
+                    help="other healthy records per machine whose spread joins σ (default 0: "
+                         "the baseline's segments alone)")
     ap.add_argument("--json", default=None)
     a = ap.parse_args(argv)
+    kept = {}
     seeds = a.seeds or (8 if a.generator == "angle" else 3)
     rows = []
     for s in range(seeds):
@@ -123,7 +152,10 @@ def main(argv=None):
             keys = {"drive_end": "1b1", "fan_end": "1b2"}        # the model's locations
             read = (names if eff.startswith("none") else
                     [keys.get(comp, comp) if keys.get(comp, comp) in names else names[0]])
-            per = [compare(base, rec, b) for b in read]
+            if (s, kind) not in kept:
+                kept[(s, kind)] = [other_healthy(a.generator, s, kind, j)
+                                   for j in range(a.realisations)]
+            per = [compare(base, rec, b, kept[(s, kind)]) for b in read]
             r = {f: {"stands_out": any(p[f]["stands_out"] for p in per),
                      "max_rise_db": max(p[f]["max_rise_db"] for p in per)} for f in FAMILIES}
             top = max(r, key=lambda f: r[f]["max_rise_db"])
