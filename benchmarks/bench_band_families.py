@@ -11,20 +11,20 @@ For each machine of :mod:`cmsim.discrepancy.angle_domain` (the same machines and
 ``bench_compare.py --generator angle``: bearing machines on even seeds, gear machines on odd
 ones), or of cmsim's model (``--generator model``: a bearing and a gear machine per seed),
 its healthy baseline and its outer-race, inner-race, ball and healthy records are cut into
-half-second segments. Every segment is demodulated in each band of the fixed bank
-(:func:`cmsim.features.envelope.band_bank`, Hann envelope spectrum of
-:func:`~cmsim.features.envelope.demodulated_spectrum`), and the lines of the defect's bearing
-(every bearing's on a healthy record: BPFO, BPFI, 2·BSF and their second harmonics, :func:`~cmsim.features.envelope.envelope_lines`,
-the 2 % line rule) are read over the envelope spectrum's median between half the shaft rate
-and 4 × BPFI, dB — the record's ``env_*`` features, in every band instead of the band rule's
-one.
+half-second segments. Every segment's envelope columns
+(:func:`cmsim.features.relative.envelope_features`, the record's ``env_*`` features: the
+lines of BPFO, BPFI, 2·BSF and their second harmonics over the envelope spectrum's median,
+dB) are read in each band of the fixed bank (:func:`cmsim.features.envelope.band_bank`)
+instead of the band rule's one, for the defect's bearing (every bearing on a healthy
+record).
 
 A family **stands out** where one of its lines, in one band, rises over the baseline's mean in
 the same band by the judge's rule (:func:`cmsim.discrepancy.judge.standing_out`:
 :data:`~cmsim.discrepancy.judge.FAMILY_Z` σ and :data:`~cmsim.discrepancy.judge.FAMILY_RISE_DB`
-dB; σ² the baseline's segment-to-segment spread² over both means' segments plus the judge's
-floor², and with ``--realisations N`` the spread² of the baseline's mean and N other healthy
-records' of the same machine, as the library's realisation spread). The report gives, per
+dB; σ of :func:`~cmsim.discrepancy.judge.sigma_of`: the baseline's segment-to-segment
+spread over both means' segments and the judge's floor, and with ``--realisations N`` the
+spread of the baseline's mean and N other healthy records' of the same machine, as the
+library's realisation spread). The report gives, per
 record, the families that stand out and each family's largest rise, then the counts: the
 true family standing out, the true family rising most, and healthy records in which any
 family stands out (false alarms). The answer key is read only to score.
@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import tempfile
 from pathlib import Path
 
@@ -42,13 +41,10 @@ import numpy as np
 from bench_compare import SEED0, _angle_case, _model_case
 
 from cmsim.discrepancy.angle_domain import draw_machine, write_machine
-from cmsim.discrepancy.evaluator import feature_floor
-from cmsim.discrepancy.judge import FLOOR_SHARE, standing_out
+from cmsim.discrepancy.judge import sigma_of, standing_out
 from cmsim.discrepancy.synthetic import hidden_effect_record
-from cmsim.features.envelope import (band_bank, demodulated_spectrum, envelope_lines,
-                                     line_amplitudes)
-from cmsim.features.lines import SLIP_TOLERANCE
-from cmsim.features.relative import segments
+from cmsim.features.envelope import band_bank
+from cmsim.features.relative import envelope_features, segments
 from cmsim.measured import read_record
 
 #: Lines of each family read (``envelope_lines`` names).
@@ -61,14 +57,11 @@ SEG_S = 0.5
 MAX_SEGMENTS = 16
 
 
-def _db(a, ref):
-    return 20.0 * math.log10(max(a, 1e-30) / ref) if math.isfinite(a) else math.nan
-
-
 def band_lines(record, bearing):
-    """(segments, bands, lines) levels in dB of one bearing's family lines."""
+    """(segments, bands, lines) levels in dB of one bearing's family lines: the record's
+    ``env_*`` columns (:func:`cmsim.features.relative.envelope_features`) in every band."""
     freqs = record.model_frequencies()
-    bf = freqs.bearing(bearing)
+    bf = {bearing: freqs.bearing(bearing)}
     fs = record.fs_hz
     x = np.asarray(record.signal, dtype=float)
     rows = []
@@ -76,13 +69,16 @@ def band_lines(record, bearing):
         seg = x[a:b] - x[a:b].mean()
         per_band = []
         for band in band_bank(fs):
-            (ef, ea), _ = demodulated_spectrum(seg, fs, [bf], band_hz=band)
-            sel = (ef >= 0.5 * freqs.fr1_hz) & (ef <= 4.0 * bf.bpfi_hz)
-            floor = float(np.median(ea[sel]))
-            amp = line_amplitudes(ef, ea, envelope_lines(bf), SLIP_TOLERANCE)
-            per_band.append([_db(amp[k], floor) for k in KEYS])
+            f = envelope_features(seg, fs, freqs.fr1_hz, bf, band)
+            per_band.append([f[_column(k, bearing)] for k in KEYS])
         rows.append(per_band)
     return np.array(rows)
+
+
+def _column(key, bearing):
+    """The ``env_*`` column of line ``key`` (``bpfo_1`` …) of ``bearing``."""
+    fam, h = key.split("_")
+    return f"env_{fam}_{bearing}_h{h}_db"
 
 
 def other_healthy(generator, s, kind, j):
@@ -105,14 +101,12 @@ def compare(base, rec, bearing, others=()):
     fb, fr = band_lines(base, bearing), band_lines(rec, bearing)
     mean_b, mean_r = np.nanmean(fb, axis=0).ravel(), np.nanmean(fr, axis=0).ravel()
     spread = np.nanstd(fb, axis=0, ddof=1).ravel()
-    names = [f"env_{k}_db" for _ in range(fb.shape[1]) for k in KEYS]
-    floor = np.array([FLOOR_SHARE * feature_floor(n) for n in names])
+    names = [_column(k, bearing) for _ in range(fb.shape[1]) for k in KEYS]
     realisation = np.zeros_like(mean_b)
     if others:
         means = [mean_b] + [np.nanmean(band_lines(o, bearing), axis=0).ravel() for o in others]
         realisation = np.nanstd(np.vstack(means), axis=0, ddof=1)
-    sigma = np.sqrt(spread ** 2 * (1.0 / fr.shape[0] + 1.0 / fb.shape[0]) + realisation ** 2
-                    + floor ** 2)
+    sigma = sigma_of(spread, realisation, names, fr.shape[0], fb.shape[0])
     out = set(standing_out(range(len(names)), mean_r, mean_b, sigma, names))
     result = {}
     for fam, ks in FAMILIES.items():

@@ -86,7 +86,7 @@ from cmsim.machine.calibration import feature_rows
 from cmsim.run import signal_info
 from cmsim.spectra.misfit import misfit
 
-__all__ = ["judge", "decide_record", "feature_sigma", "chi2_rows", "compared_columns",
+__all__ = ["judge", "decide_record", "feature_sigma", "sigma_of", "chi2_rows", "compared_columns",
            "interpolated", "standing_out", "NONE_CHI2_PER_FEATURE", "ALARM_Z", "MIN_EVIDENCE",
            "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE", "RANGE_DELTA_CHI2",
            "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z"]
@@ -261,10 +261,30 @@ def feature_sigma(lib, li, names, n_fit):
     -------
     numpy.ndarray
     """
+    return sigma_of(lib.spread[li], lib.realisation[li], names, n_fit, lib.segments)
+
+
+def sigma_of(spread, realisation, names, n_fit, n_baseline):
+    """σ of features against a baseline (module docstring, step 2), from the baseline's
+    segment-to-segment ``spread``, the ``realisation`` spread (run to run) and the judge's
+    floor: spread²·(1/n_fit + 1/n_baseline) + realisation² + floor² (NaN spreads count 0).
+
+    Parameters
+    ----------
+    spread, realisation : numpy.ndarray
+        Per feature.
+    names : sequence of str
+        Their names (the floor is the feature kind's).
+    n_fit, n_baseline : int
+        Segments the record's and the baseline's means are taken over.
+
+    Returns
+    -------
+    numpy.ndarray
+    """
     floor = np.array([FLOOR_SHARE * feature_floor(k) for k in names])
-    return np.sqrt(np.nan_to_num(lib.spread[li]) ** 2 * (1.0 / max(n_fit, 1)
-                                                        + 1.0 / lib.segments)
-                   + np.nan_to_num(lib.realisation[li]) ** 2 + floor ** 2)
+    return np.sqrt(np.nan_to_num(spread) ** 2 * (1.0 / max(n_fit, 1) + 1.0 / n_baseline)
+                   + np.nan_to_num(realisation) ** 2 + floor ** 2)
 
 
 def standing_out(features, meas, reference, sigma, names):

@@ -24,9 +24,8 @@ from cmsim.features.sidebands import sideband_energies
 from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
-__all__ = ["relative_features", "segment_features", "segments", "N_SHAPE_BANDS",
-           "shape_band_edges",
-           "N_RELATIVE_GMF_HARMONICS"]
+__all__ = ["relative_features", "envelope_features", "segment_features", "segments",
+           "N_SHAPE_BANDS", "shape_band_edges", "N_RELATIVE_GMF_HARMONICS"]
 
 #: Bands of the spectral-shape columns (3 log-spaced up to 0.05·fs, then linear to fs/2).
 N_SHAPE_BANDS = 12
@@ -137,23 +136,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
         out[f"raw_bpfo_{b}_band_db"] = _db_power(band_excess(freq, amp, bf.bpfo_hz, floor,
                                                              tol))
     if bfs:
-        (ef, ea), _ = demodulated_spectrum(x, fs, bfs.values())
-        top_e = max(bf.bpfi_hz for bf in bfs.values())
-        esel = (ef >= 0.5 * fr) & (ef <= 4.0 * top_e)
-        efloor = float(np.median(ea[esel])) if np.any(esel) else 1.0
-        out["env_fr_h1_db"] = _db(line_amplitude(ef, ea, fr, tol), efloor)
-        for b, bf in bfs.items():
-            a = line_amplitudes(ef, ea, envelope_lines(bf), tol)
-            for fam, key in (("bpfo", "bpfo"), ("bpfi", "bpfi"), ("bsf2", "bsf2")):
-                for h in (1, 2):
-                    out[f"env_{fam}_{b}_h{h}_db"] = _db(a[f"{key}_{h}"], efloor)
-            out[f"env_ftf_{b}_db"] = _db(a["ftf"], efloor)
-            out[f"env_bpfi_{b}_sb_db"] = _db(_mean(a["bpfi_m1"], a["bpfi_p1"]), efloor)
-            sb = [line_amplitude(ef, ea, h * bf.bpfo_hz + s * bf.shaft_hz, tol)
-                  for h in (1, 2) for s in (-1, 1)]
-            out[f"env_bpfo_{b}_sb_db"] = _db(_mean(*sb), efloor)
-            out[f"env_bpfo_{b}_band_db"] = _db_power(band_excess(ef, ea, bf.bpfo_hz, efloor,
-                                                                 tol))
+        out.update(envelope_features(x, fs, fr, bfs))
     if freqs.gmf_hz is not None:
         n_gmf = N_RELATIVE_GMF_HARMONICS
         g = gmf_levels(amplitude_spectrum(x, fs), freqs.gmf_hz, n_gmf, EXACT_TOLERANCE)
@@ -164,6 +147,49 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
         tk = tsa_residual_kurtosis(x, fs, freqs.fr1_hz)
         out["tsa_residual_kurtosis_log"] = math.log(tk) if math.isfinite(tk) and tk > 0 \
             else math.nan
+    return out
+
+
+def envelope_features(x, fs_hz, shaft_hz, bearings, band_hz=None):
+    """The envelope columns of :func:`relative_features` (``env_*``): the lines of each
+    bearing's families over the envelope spectrum's median between half the shaft rate and
+    4 × the highest BPFI, dB.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Segment, mean removed.
+    fs_hz : float
+        Sample rate, Hz.
+    shaft_hz : float
+        Input shaft rate, Hz.
+    bearings : dict of str to cmsim.frequencies.BearingFrequencies
+        The bearings read, by name (at least one).
+    band_hz : tuple of float, optional
+        Demodulation band (lo, hi), Hz; default the band rule's
+        (:func:`~cmsim.features.envelope.demodulated_spectrum`).
+
+    Returns
+    -------
+    dict of str to float
+    """
+    fr, tol, out = shaft_hz, SLIP_TOLERANCE, {}
+    (ef, ea), _ = demodulated_spectrum(x, fs_hz, bearings.values(), band_hz)
+    top_e = max(bf.bpfi_hz for bf in bearings.values())
+    esel = (ef >= 0.5 * fr) & (ef <= 4.0 * top_e)
+    efloor = float(np.median(ea[esel])) if np.any(esel) else 1.0
+    out["env_fr_h1_db"] = _db(line_amplitude(ef, ea, fr, tol), efloor)
+    for b, bf in bearings.items():
+        a = line_amplitudes(ef, ea, envelope_lines(bf), tol)
+        for fam in ("bpfo", "bpfi", "bsf2"):
+            for h in (1, 2):
+                out[f"env_{fam}_{b}_h{h}_db"] = _db(a[f"{fam}_{h}"], efloor)
+        out[f"env_ftf_{b}_db"] = _db(a["ftf"], efloor)
+        out[f"env_bpfi_{b}_sb_db"] = _db(_mean(a["bpfi_m1"], a["bpfi_p1"]), efloor)
+        sb = [line_amplitude(ef, ea, h * bf.bpfo_hz + s * bf.shaft_hz, tol)
+              for h in (1, 2) for s in (-1, 1)]
+        out[f"env_bpfo_{b}_sb_db"] = _db(_mean(*sb), efloor)
+        out[f"env_bpfo_{b}_band_db"] = _db_power(band_excess(ef, ea, bf.bpfo_hz, efloor, tol))
     return out
 
 
