@@ -12,7 +12,7 @@ For each machine of :mod:`cmsim.discrepancy.angle_domain` (the same machines and
 ones), or of cmsim's model (``--generator model``: a bearing and a gear machine per seed),
 its healthy baseline and its outer-race, inner-race, ball and healthy records are cut into
 half-second segments. Every segment's envelope columns
-(:func:`cmsim.features.relative.envelope_features`, the record's ``env_*`` features: the
+(:func:`cmsim.features.relative.envelope_columns`, the record's ``env_*`` features: the
 lines of BPFO, BPFI, 2·BSF and their second harmonics over the envelope spectrum's median,
 dB) are read in each band of the fixed bank (:func:`cmsim.features.envelope.band_bank`)
 instead of the band rule's one, for the defect's bearing (every bearing on a healthy
@@ -44,7 +44,7 @@ from cmsim.discrepancy.angle_domain import draw_machine, write_machine
 from cmsim.discrepancy.judge import sigma_of, standing_out
 from cmsim.discrepancy.synthetic import hidden_effect_record
 from cmsim.features.envelope import band_bank
-from cmsim.features.relative import envelope_features, segments
+from cmsim.features.relative import envelope_columns, segments
 from cmsim.measured import read_record
 
 #: Lines of each family read (``envelope_lines`` names).
@@ -59,7 +59,7 @@ MAX_SEGMENTS = 16
 
 def band_lines(record, bearing):
     """(segments, bands, lines) levels in dB of one bearing's family lines: the record's
-    ``env_*`` columns (:func:`cmsim.features.relative.envelope_features`) in every band."""
+    ``env_*`` columns (:func:`cmsim.features.relative.envelope_columns`) in every band."""
     freqs = record.model_frequencies()
     bf = {bearing: freqs.bearing(bearing)}
     fs = record.fs_hz
@@ -69,7 +69,7 @@ def band_lines(record, bearing):
         seg = x[a:b] - x[a:b].mean()
         per_band = []
         for band in band_bank(fs):
-            f = envelope_features(seg, fs, freqs.fr1_hz, bf, band)
+            f = envelope_columns(seg, fs, freqs.fr1_hz, bf, band)
             per_band.append([f[_column(k, bearing)] for k in KEYS])
         rows.append(per_band)
     return np.array(rows)

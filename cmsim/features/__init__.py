@@ -31,13 +31,13 @@ from cmsim.features.envelope import (FAULT_FAMILIES, EnvelopeLine, band_bank_fea
 from cmsim.features.lines import (EXACT_TOLERANCE, LINE_HALF_WIDTH_BINS, SLIP_TOLERANCE,
                                   demodulation_band, highest_fault_hz, line_amplitude,
                                   line_window)
-from cmsim.features.relative import (N_SHAPE_BANDS, envelope_features, relative_features,
+from cmsim.features.relative import (N_SHAPE_BANDS, envelope_columns, relative_features,
                                      segment_features, segments)
 from cmsim.features.sidebands import (MAX_SIDEBAND_ORDER, N_SIDEBAND_HARMONICS,
                                       SIDEBAND_HALF_WIDTH)
 
 __all__ = ["FeatureRow", "LabelledLine", "extract_features", "run_features", "gmf_levels",
-           "statistics", "relative_features", "envelope_features", "segment_features",
+           "statistics", "relative_features", "envelope_columns", "segment_features",
            "segments",
            "line_amplitude", "line_window", "demodulation_band", "highest_fault_hz",
            "EnvelopeLine", "envelope_lines", "line_ratios", "family_scores",

@@ -24,7 +24,7 @@ from cmsim.features.sidebands import sideband_energies
 from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
-__all__ = ["relative_features", "envelope_features", "segment_features", "segments",
+__all__ = ["relative_features", "envelope_columns", "segment_features", "segments",
            "N_SHAPE_BANDS", "shape_band_edges", "N_RELATIVE_GMF_HARMONICS"]
 
 #: Bands of the spectral-shape columns (3 log-spaced up to 0.05·fs, then linear to fs/2).
@@ -136,7 +136,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
         out[f"raw_bpfo_{b}_band_db"] = _db_power(band_excess(freq, amp, bf.bpfo_hz, floor,
                                                              tol))
     if bfs:
-        out.update(envelope_features(x, fs, fr, bfs))
+        out.update(envelope_columns(x, fs, fr, bfs))
     if freqs.gmf_hz is not None:
         n_gmf = N_RELATIVE_GMF_HARMONICS
         g = gmf_levels(amplitude_spectrum(x, fs), freqs.gmf_hz, n_gmf, EXACT_TOLERANCE)
@@ -150,7 +150,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
     return out
 
 
-def envelope_features(x, fs_hz, shaft_hz, bearings, band_hz=None):
+def envelope_columns(x, fs_hz, shaft_hz, bearings, band_hz=None):
     """The envelope columns of :func:`relative_features` (``env_*``): the lines of each
     bearing's families over the envelope spectrum's median between half the shaft rate and
     4 × the highest BPFI, dB.
