@@ -11,14 +11,12 @@ For each machine of :mod:`cmsim.discrepancy.angle_domain` (the same machines and
 ``bench_compare.py --generator angle``: bearing machines on even seeds, gear machines on odd
 ones), or of cmsim's model (``--generator model``: a bearing and a gear machine per seed),
 its healthy baseline and its outer-race, inner-race, ball and healthy records are cut into
-half-second segments. Every segment's envelope columns
-(:func:`cmsim.features.relative.envelope_columns`, the record's ``env_*`` features: the
-lines of BPFO, BPFI, 2·BSF and their second harmonics over the envelope spectrum's median,
-dB) are read in each band of the fixed bank (:func:`cmsim.features.envelope.band_bank`)
-instead of the band rule's one, for the defect's bearing (every bearing on a healthy
-record).
+half-second segments. Every segment's band columns
+(:func:`cmsim.features.band_family_columns`, what the judge reads: the lines of BPFO, BPFI
+and 2·BSF over the envelope spectrum's median, dB, in each band of the fixed bank) are read
+for the defect's bearing (every bearing on a healthy record).
 
-A family **stands out** where one of its lines, in one band, rises over the baseline's mean in
+A family **stands out** where its line, in one band, rises over the baseline's mean in
 the same band by the judge's rule (:func:`cmsim.discrepancy.judge.standing_out`:
 :data:`~cmsim.discrepancy.judge.FAMILY_Z` σ and :data:`~cmsim.discrepancy.judge.FAMILY_RISE_DB`
 dB; σ of :func:`~cmsim.discrepancy.judge.sigma_of`: the baseline's segment-to-segment
@@ -43,13 +41,11 @@ from bench_compare import SEED0, _angle_case, _model_case
 from cmsim.discrepancy.angle_domain import draw_machine, write_machine
 from cmsim.discrepancy.judge import sigma_of, standing_out
 from cmsim.discrepancy.synthetic import hidden_effect_record
-from cmsim.features.envelope import band_bank
-from cmsim.features.relative import envelope_columns, segments
+from cmsim.features import N_ENVELOPE_BANDS, band_family_columns, segments
 from cmsim.measured import read_record
 
 #: Lines of each family read (``envelope_lines`` names).
-FAMILIES = {"bpfo": ("bpfo_1", "bpfo_2"), "bpfi": ("bpfi_1", "bpfi_2"),
-            "bsf2": ("bsf2_1", "bsf2_2")}
+FAMILIES = {"bpfo": ("bpfo_1",), "bpfi": ("bpfi_1",), "bsf2": ("bsf2_1",)}
 TRUE_FAMILY = {"bearing_outer_race": "bpfo", "bearing_inner_race": "bpfi",
                "bearing_ball": "bsf2"}
 KEYS = [k for ks in FAMILIES.values() for k in ks]
@@ -58,27 +54,24 @@ MAX_SEGMENTS = 16
 
 
 def band_lines(record, bearing):
-    """(segments, bands, lines) levels in dB of one bearing's family lines: the record's
-    ``env_*`` columns (:func:`cmsim.features.relative.envelope_columns`) in every band."""
+    """(segments, bands, lines) levels in dB of one bearing's family lines in every band
+    (:func:`cmsim.features.band_family_columns`, what the judge reads)."""
     freqs = record.model_frequencies()
     bf = {bearing: freqs.bearing(bearing)}
     fs = record.fs_hz
     x = np.asarray(record.signal, dtype=float)
     rows = []
     for a, b in segments(x.size, fs, SEG_S, MAX_SEGMENTS):
-        seg = x[a:b] - x[a:b].mean()
-        per_band = []
-        for band in band_bank(fs):
-            f = envelope_columns(seg, fs, freqs.fr1_hz, bf, band)
-            per_band.append([f[_column(k, bearing)] for k in KEYS])
-        rows.append(per_band)
+        f = band_family_columns(x[a:b] - x[a:b].mean(), fs, freqs.fr1_hz, bf)
+        rows.append([[f[_column(k, bearing, j)] for k in KEYS]
+                     for j in range(N_ENVELOPE_BANDS)])
     return np.array(rows)
 
 
-def _column(key, bearing):
-    """The ``env_*`` column of line ``key`` (``bpfo_1`` …) of ``bearing``."""
+def _column(key, bearing, band=None):
+    """The ``env_*`` column of line ``key`` (``bpfo_1`` …) of ``bearing`` (in ``band``)."""
     fam, h = key.split("_")
-    return f"env_{fam}_{bearing}_h{h}_db"
+    return f"env_{fam}_{bearing}_h{h}" + ("" if band is None else f"_bb{band}") + "_db"
 
 
 def other_healthy(generator, s, kind, j):
@@ -113,7 +106,7 @@ def compare(ref, rec, bearing):
     fr = band_lines(rec, bearing)
     mean_b, mean_r = np.nanmean(fb, axis=0).ravel(), np.nanmean(fr, axis=0).ravel()
     spread = np.nanstd(fb, axis=0, ddof=1).ravel()
-    names = [_column(k, bearing) for _ in range(fb.shape[1]) for k in KEYS]
+    names = [_column(k, bearing, j) for j in range(fb.shape[1]) for k in KEYS]
     sigma = sigma_of(spread, realisation, names, fr.shape[0], fb.shape[0])
     out = set(standing_out(range(len(names)), mean_r, mean_b, sigma, names))
     result = {}

@@ -4,8 +4,13 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
 1. **Features.** The record is cut into the machine's segments (at most ``max_segments``,
    spread over it); the even ones are the **fit** set, the odd ones the **held-out** set.
    Features are those of the library (:func:`~cmsim.machine.calibration.feature_rows`:
-   :func:`cmsim.features.relative_features` at the record's own speed, and ``level_db`` in
-   m/s² when both the record's unit and the machine's are known — each through its own unit).
+   :func:`cmsim.features.relative_features` at the record's own speed, each bearing's
+   defect families in every band of the fixed bank,
+   :func:`cmsim.features.band_family_columns`, and ``level_db`` in m/s² when both the
+   record's unit and the machine's are known — each through its own unit). The band-by-band
+   families weigh nothing in the χ² (:func:`~cmsim.discrepancy.evaluator.weight`): they
+   tell where a family stands out over the baseline (step 4), whichever band its impacts
+   ring in.
 2. **Departure.** Each feature of the record (its mean over the fit segments) is compared
    with the machine's baseline (:class:`~cmsim.machine.library.SignatureLibrary`, the mean
    over its segments): z = (record − baseline) / σ, σ² the baseline's segment-to-segment
@@ -79,7 +84,7 @@ from cmsim.discrepancy.causes import CAUSES, STATISTICS
 from cmsim.discrepancy.evaluator import feature_floor, path_free, rises, weight
 from cmsim.discrepancy.operating_point import at_operating_point, record_load
 from cmsim.discrepancy.ranking import _consistent, decide
-from cmsim.discrepancy.signatures import build_library, simulate_entry
+from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
 from cmsim.errors import ParameterError
 from cmsim.features import segments
 from cmsim.machine.calibration import feature_rows
@@ -204,7 +209,7 @@ def _record_rows(record, machine, seg_s, max_segments):
     scale = record.unit_scale if machine.unit_scale is not None else None
     names, rows = feature_rows([x[a:b] for a, b in spans], record.fs_hz,
                                record.model_frequencies(), list(machine.rig.bearing_names),
-                               scale)
+                               scale, bands=BAND_FAMILIES)
     return names, rows
 
 

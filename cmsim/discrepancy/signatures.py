@@ -55,13 +55,17 @@ from cmsim.machine.change import Change, apply_change
 from cmsim.machine.library import SignatureEntry, SignatureLibrary
 from cmsim.run import signal_info
 
-__all__ = ["build_library", "value_grid", "predicted_rows", "change_of",
+__all__ = ["BAND_FAMILIES", "build_library", "value_grid", "predicted_rows", "change_of",
            "simulate_entry", "operating_shift",
            "N_SIZES", "LIBRARY_SEGMENTS", "REALISATIONS", "BEARING_VARIANTS", "GRIDS",
            "PATH_GAINS"]
 
 #: Values of each cause's parameter in the library (log-spaced over its bounds).
 N_SIZES = 8
+
+#: A machine's library and the records judged against it read each bearing's defect
+#: families in every band of the fixed bank too (:func:`cmsim.features.band_family_columns`).
+BAND_FAMILIES = True
 
 #: Baseline segments each prediction is averaged over (spread over the baseline).
 LIBRARY_SEGMENTS = 8
@@ -213,7 +217,7 @@ class _Library:
         segments, with ``signals``)."""
         y = apply_change(self.machine, self.segs, change, np.random.default_rng(rng_key))
         names, rows = feature_rows(y, self.fs, self.freqs, self.bearings,
-                                   self.machine.unit_scale)
+                                   self.machine.unit_scale, bands=BAND_FAMILIES)
         return (names, _nanmean(rows), y) if signals else (names, _nanmean(rows))
 
     def entry(self, job):
@@ -250,7 +254,7 @@ class _Library:
         k, n = self.segs.shape
         twin = self.machine.sensor_signal(c[0], c[1], k * n, seed)
         got, rows = feature_rows(twin.reshape(k, n), self.fs, self.freqs, self.bearings,
-                                 self.machine.unit_scale)
+                                 self.machine.unit_scale, bands=BAND_FAMILIES)
         return names, laid, _nanmean(rows) if got == names else None
 
 
@@ -326,10 +330,10 @@ def build_library(machine, *, causes=None, n_sizes=N_SIZES, n_segments=LIBRARY_S
     lib = _Library(machine, segs, int(seed))
     nominal = ModelSetup(rig=machine.rig, op=machine.op, machine=machine)
     names, base_rows = feature_rows(segs, machine.fs_hz, lib.freqs, lib.bearings,
-                                    machine.unit_scale)
+                                    machine.unit_scale, bands=BAND_FAMILIES)
     all_rows = machine.baseline.segments(machine.segment_s)
     _, spread_rows = feature_rows(all_rows, machine.fs_hz, lib.freqs, lib.bearings,
-                                  machine.unit_scale)
+                                  machine.unit_scale, bands=BAND_FAMILIES)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         spread = np.nanstd(spread_rows, axis=0, ddof=1)

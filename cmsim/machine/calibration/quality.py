@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.features import relative_features
+from cmsim.features import band_family_columns, relative_features
 
 __all__ = ["WOBBLE_MIN_SNR", "feature_rows"]
 
@@ -34,9 +34,12 @@ def _misfit(names, twin_rows, rows, spread):
     return z, z_model
 
 
-def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
+def feature_rows(segs, fs_hz, freqs, bearings, unit_scale, bands=False):
     """Features of each segment: :func:`cmsim.features.relative_features`, plus ``level_db``
-    (dB re 1 m/s²) when the unit is known; ``(names, array (n_segments, n_features))``.
+    (dB re 1 m/s²) when the unit is known, and with ``bands`` each bearing's defect families
+    in every band of the fixed bank (:func:`cmsim.features.band_family_columns`: what a
+    record is judged on against its machine's baseline); ``(names, array (n_segments,
+    n_features))``.
 
     Parameters
     ----------
@@ -50,10 +53,15 @@ def feature_rows(segs, fs_hz, freqs, bearings, unit_scale):
         Bearings whose families are read.
     unit_scale : float or None
         Sensor unit → m/s² (None: no ``level_db``).
+    bands : bool
+        Add the band-by-band families.
     """
     rows = []
+    bfs = {b: freqs.bearing(b) for b in bearings}
     for x in segs:
         f = relative_features(x, fs_hz, freqs, bearings)
+        if bands and bfs:
+            f.update(band_family_columns(x - np.mean(x), fs_hz, freqs.fr1_hz, bfs))
         if unit_scale is not None:
             f["level_db"] = 20.0 * math.log10(max(float(np.std(x)) * unit_scale, 1e-30))
         rows.append(f)

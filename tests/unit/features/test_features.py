@@ -178,3 +178,49 @@ def test_sideband_energies_read_an_amplitude_modulation_and_ignore_a_small_wobbl
         assert clean[f"sb23_fr1_k{k}_db"] < expected - 30, k
         assert wobbly[f"sb1_fr1_k{k}_db"] == pytest.approx(expected, abs=1.5), k
 
+
+
+def test_band_families_stand_out_in_the_band_where_the_impacts_ring():
+    """Impacts at the ball pass ringing an 8-kHz resonance, under white noise of their RMS and
+    a 1.5-kHz noise band three times louder: the BPFO family stands out in the bank's bands
+    holding 8 kHz and in no other, no other family does there, and the noise alone lifts no
+    line anywhere."""
+    from scipy.signal import butter, sosfilt
+
+    from cmsim.discrepancy.evaluator import weight
+    from cmsim.features import N_ENVELOPE_BANDS, band_column, band_family_columns
+    from cmsim.features.envelope import band_bank
+
+    brg, f, fs = _ball_pass_rig()
+    n = int(0.5 * fs)
+    rng = np.random.default_rng(3)
+    wn = 2 * np.pi * 8000.0
+    th = np.arange(int(0.02 * fs)) / fs
+    ring = np.exp(-0.01 * wn * th) * np.sin(wn * th)
+    hits = np.zeros(n)
+    hits[np.round(np.arange(0.0, n / fs, 1.0 / brg.bpfo_hz) * fs).astype(int)] = 1.0
+    impacts = np.convolve(hits, ring)[:n]
+    hum = sosfilt(butter(4, (1200.0, 1800.0), "bandpass", fs=fs, output="sos"),
+                  rng.standard_normal(n))
+    noise = 3.0 * np.std(impacts) / np.std(hum) * hum + np.std(impacts) * rng.standard_normal(n)
+    bf = {"DE": brg}
+    spall = band_family_columns(impacts + noise, fs, f.fr1_hz, bf)
+    healthy = band_family_columns(noise, fs, f.fr1_hz, bf)
+    bands = band_bank(fs)
+    assert len(bands) == N_ENVELOPE_BANDS
+    assert len(spall) == N_ENVELOPE_BANDS * 3 and all(band_column(k) for k in spall)
+    ringing = [j for j, (lo, hi) in enumerate(bands) if lo < 8000.0 < hi]
+    assert ringing == [4, 5]
+    for j in range(N_ENVELOPE_BANDS):
+        bpfo = spall[f"env_bpfo_DE_h1_bb{j}_db"]
+        if j in ringing:
+            assert bpfo > 25.0, (j, bpfo)
+            for fam in ("bpfi", "bsf2"):
+                assert spall[f"env_{fam}_DE_h1_bb{j}_db"] < bpfo - 15.0, (j, fam)
+        else:
+            assert bpfo < 12.0, (j, bpfo)
+    assert max(healthy.values()) < 12.0
+    # they stand out against a baseline; the chi2 does not weigh them (where a structure
+    # rings is not what a calibrated path knows)
+    assert all(weight(k) == 0.0 for k in spall) and weight("env_bpfo_DE_h1_db") == 1.0
+    assert not band_column("sb1_fr1_k3_db") and not band_column("env_bpfo_DE_band_db")
