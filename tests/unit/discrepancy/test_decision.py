@@ -118,6 +118,39 @@ def test_one_family_standing_clearly_out_of_a_quiet_record_is_a_departure(lift, 
     assert d["finding"] == finding
 
 
+@pytest.mark.parametrize("lift, finding", [(4.0, "none"), (8.0, "unexplained")])
+def test_a_family_standing_out_in_one_band_alone_is_a_departure(lift, finding):
+    """A spall's family read band by band (weightless in the χ²) lifted by ``lift`` dB in one
+    band, the record otherwise at its baseline: χ² per feature 0, no feature at the alarm z.
+    8 dB and 4 σ over the baseline is outside its spread, so the record is not ``none``; no
+    cause's prediction reads it (the lifted column weighs nothing), so it is
+    ``unexplained``, departing there. 4 dB stays ``none``."""
+    from cmsim.discrepancy.judge import ALARM_Z, FAMILY_Z, NONE_CHI2_PER_FEATURE
+    from cmsim.discrepancy.evaluator import weight
+
+    band = "env_bpfo_1b1_h1_bb4_db"
+    names = (band,) + tuple(f"raw_fr_h{k}_db" for k in range(1, 11))
+    assert weight(band) == 0.0
+    m = len(names)
+    outer = np.zeros((3, m))
+    outer[:, 0] = [0.0, 5.0, 20.0]
+    spread = np.ones(m)
+    spread[0] = 3.5
+    lib = _baseline_at_zero(
+        names, spread,
+        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), outer))
+    li = np.arange(m)
+    sigma = feature_sigma(lib, li, list(names), 8)
+    meas = np.zeros(m)
+    meas[0] = lift
+    d = decide_record(lib, li, list(names), meas, sigma, "1b1")
+    assert d["chi2"] / d["n_eff"] <= NONE_CHI2_PER_FEATURE and np.abs(d["z"]).max() < ALARM_Z
+    assert (d["z"][0] >= FAMILY_Z) == (lift == 8.0)
+    assert d["finding"] == finding
+    assert int(np.argmax(np.abs(d["z"]))) == 0                  # where it departs
+
+
 @pytest.mark.parametrize("other, finding", [(6.0, "bearing_outer_race"),
                                             (7.0, "torque_mismatch")])
 def test_a_fault_whose_family_stands_out_wins_a_near_tie_on_the_whole_record(other, finding):
