@@ -23,7 +23,7 @@ import numpy as np
 from cmsim.datasets.pool import check_workers, process_pool
 from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO, STATISTICS
 from cmsim.errors import IntegrationDiverged, ParameterError
-from cmsim.features import N_SHAPE_BANDS, band_column, relative_features
+from cmsim.features import N_ENVELOPE_BANDS, N_SHAPE_BANDS, band_column, relative_features
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine import Background, model_force, rotating_force, static_load
 from cmsim.run import signal_info
@@ -221,17 +221,29 @@ def simulate_setup(setup, fs_hz, duration_s, model_signal, seed, noise_ref_rms=N
                   bearing=signal_info(model_signal).component)
 
 
-def weight(name):
+def weight(name, signature=False):
     """Weight of a feature in the χ²: the spectral-shape bands share one family's weight of 4;
     a family's fundamental read band by band (:func:`~cmsim.features.band_family_columns`)
-    weighs nothing there — whether it stands out over the baseline in a band is evidence
-    (:func:`cmsim.discrepancy.judge.standing_out`), but its prediction in each band depends on
-    where the structure rings, which a path calibrated on a healthy baseline does not know
-    (counted at 1/6 each on the cached machines of 2026-11-30, cmsim's own records read 37 of
-    45 against 41: a tooth fault, a friction and an eccentricity went to bearing faults)."""
+    weighs nothing in the χ² of the whole record — whether it stands out over the baseline in
+    a band is evidence (:func:`cmsim.discrepancy.judge.standing_out`), but its prediction in
+    each band depends on where the structure rings, which a path calibrated on a healthy
+    baseline does not know (counted at 1/6 each on the cached machines of 2026-11-30, cmsim's
+    own records read 37 of 45 against 41: a tooth fault, a friction and an eccentricity went
+    to bearing faults). In a fault's own ``signature`` (the evidence that tells one fault
+    from another once the whole record is read) its six bands weigh one line, 1/6 each.
+
+    Parameters
+    ----------
+    name : str
+        Column name.
+    signature : bool
+        Weighed within a fault's own signature.
+    """
     if name.startswith("shape_"):
         return 4.0 / N_SHAPE_BANDS
-    return 0.0 if band_column(name) else 1.0
+    if band_column(name):
+        return 1.0 / N_ENVELOPE_BANDS if signature else 0.0
+    return 1.0
 
 
 def chi2(meas, sim, sigma, names, calibrated=False):

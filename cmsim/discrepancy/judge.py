@@ -146,7 +146,7 @@ RANGE_DELTA_CHI2 = 4.0
 LEVEL_DIRECTION_Z = 3.0
 
 
-def chi2_rows(meas, pred, sigma, names):
+def chi2_rows(meas, pred, sigma, names, signature=False):
     """Robust χ² of predicted feature rows against measured features: THE misfit
     (:func:`cmsim.spectra.misfit.misfit`), each feature weighted by
     :func:`~cmsim.discrepancy.evaluator.weight`, calibrated (every feature but the statistics
@@ -160,13 +160,16 @@ def chi2_rows(meas, pred, sigma, names):
         Predicted features, a row each.
     names : sequence of str
         Feature names (their weights and rules).
+    signature : bool
+        Weigh them as a fault's own signature does (the families read band by band count).
 
     Returns
     -------
     (numpy.ndarray of shape (r,), numpy.ndarray of shape (r, m))
         χ² of each row and each feature's share of it.
     """
-    return misfit(meas, pred, sigma, np.array([weight(k) for k in names]),
+    w = np.array([weight(k, signature) for k in names])
+    return misfit(meas, pred, sigma, w,
                   np.array([rises(k, True) for k in names], dtype=bool))
 
 
@@ -345,6 +348,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
     """
     base = lib.mean[li][None, :]
     chi0_arr, per0 = chi2_rows(meas, base, sigma, names)
+    per0s = chi2_rows(meas, base, sigma, names, signature=True)[1]
     chi0 = float(chi0_arr[0])
     n_eff = float(sum(weight(k) for k in names))
     z0 = (meas - lib.mean[li]) / sigma
@@ -367,20 +371,22 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             continue
         tables.setdefault((e.cause, e.component), []).append((e, values[ok], table[ok]))
         chi, per_full = chi2_rows(meas, table, sigma, names)
-        per_prof = per_full
+        per_sig = chi2_rows(meas, table, sigma, names, signature=True)[1]
+        per_prof = per_sig
         if cause.rings_structure and np.any(path_dep):
-            per_prof = np.where(path_dep, per0[0], per_full)
+            per_prof = np.where(path_dep, per0s[0], per_sig)
         judged = cause.judged_on(names, e.component)
         sel = np.array([k in judged for k in names], dtype=bool)
-        for store, per, score in (
-                (ranked, per_full, np.where(ok, chi, np.inf)),
-                (by_signature, per_prof, np.where(ok, per_prof[:, sel].sum(axis=1), np.inf))):
+        for store, per, p0, score in (
+                (ranked, per_full, per0, np.where(ok, chi, np.inf)),
+                (by_signature, per_prof, per0s,
+                 np.where(ok, per_prof[:, sel].sum(axis=1), np.inf))):
             b = int(np.argmin(score))
             key = (e.cause, e.component)
             if key in store and score[b] >= store[key]["score"]:
                 continue
             within = values[score <= score[b] + RANGE_DELTA_CHI2]
-            delta = per0[0] - per[b]
+            delta = p0[0] - per[b]
             store[key] = {"name": e.cause, "cause": cause, "component": e.component,
                           "variant": e.variant, "parameter": e.parameter,
                           "value": float(values[b]),

@@ -223,4 +223,7 @@ def test_band_families_stand_out_in_the_band_where_the_impacts_ring():
     # they stand out against a baseline; the chi2 does not weigh them (where a structure
     # rings is not what a calibrated path knows)
     assert all(weight(k) == 0.0 for k in spall) and weight("env_bpfo_DE_h1_db") == 1.0
+    # within a fault's own signature one line's six bands weigh one line
+    assert sum(weight(f"env_bpfo_DE_h1_bb{j}_db", signature=True)
+               for j in range(N_ENVELOPE_BANDS)) == pytest.approx(1.0)
     assert not band_column("sb1_fr1_k3_db") and not band_column("env_bpfo_DE_band_db")
