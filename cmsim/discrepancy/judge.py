@@ -146,7 +146,7 @@ RANGE_DELTA_CHI2 = 4.0
 LEVEL_DIRECTION_Z = 3.0
 
 
-def chi2_rows(meas, pred, sigma, names, signature=False):
+def chi2_rows(meas, pred, sigma, names):
     """Robust χ² of predicted feature rows against measured features: THE misfit
     (:func:`cmsim.spectra.misfit.misfit`), each feature weighted by
     :func:`~cmsim.discrepancy.evaluator.weight`, calibrated (every feature but the statistics
@@ -160,16 +160,13 @@ def chi2_rows(meas, pred, sigma, names, signature=False):
         Predicted features, a row each.
     names : sequence of str
         Feature names (their weights and rules).
-    signature : bool
-        Weigh them as a fault's own signature does (the families read band by band count).
 
     Returns
     -------
     (numpy.ndarray of shape (r,), numpy.ndarray of shape (r, m))
         χ² of each row and each feature's share of it.
     """
-    w = np.array([weight(k, signature) for k in names])
-    return misfit(meas, pred, sigma, w,
+    return misfit(meas, pred, sigma, np.array([weight(k) for k in names]),
                   np.array([rises(k, True) for k in names], dtype=bool))
 
 
@@ -347,9 +344,14 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         or ``""``), ``chi2`` (χ²₀), ``n_eff``, ``z`` (departures).
     """
     base = lib.mean[li][None, :]
-    chi0_arr, per0 = chi2_rows(meas, base, sigma, names)
-    per0s = chi2_rows(meas, base, sigma, names, signature=True)[1]
-    chi0 = float(chi0_arr[0])
+    # each feature's robust loss is read once and weighed twice: as the whole record's χ²
+    # weighs it, and as a fault's own signature does (chi2_rows's misfit, its shares)
+    w = np.array([weight(k) for k in names])
+    w_sig = np.array([weight(k, signature=True) for k in names])
+    rising = np.array([rises(k, True) for k in names], dtype=bool)
+    loss0 = misfit(meas, base, sigma, 1.0, rising)[1]
+    per0, per0s = w * loss0, w_sig * loss0
+    chi0 = float(per0.sum(axis=1)[0])
     n_eff = float(sum(weight(k) for k in names))
     z0 = (meas - lib.mean[li]) / sigma
 
@@ -370,8 +372,9 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         if not np.any(ok):
             continue
         tables.setdefault((e.cause, e.component), []).append((e, values[ok], table[ok]))
-        chi, per_full = chi2_rows(meas, table, sigma, names)
-        per_sig = chi2_rows(meas, table, sigma, names, signature=True)[1]
+        loss = misfit(meas, table, sigma, 1.0, rising)[1]
+        per_full, per_sig = w * loss, w_sig * loss
+        chi = per_full.sum(axis=1)
         per_prof = per_sig
         if cause.rings_structure and np.any(path_dep):
             per_prof = np.where(path_dep, per0s[0], per_sig)

@@ -161,7 +161,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
     return out
 
 
-def envelope_columns(x, fs_hz, shaft_hz, bearings, band_hz=None):
+def envelope_columns(x, fs_hz, shaft_hz, bearings):
     """The envelope columns of :func:`relative_features` (``env_*``): the lines of each
     bearing's families over the envelope spectrum's median between half the shaft rate and
     4 × the highest BPFI, dB.
@@ -176,16 +176,13 @@ def envelope_columns(x, fs_hz, shaft_hz, bearings, band_hz=None):
         Input shaft rate, Hz.
     bearings : dict of str to cmsim.frequencies.BearingFrequencies
         The bearings read, by name (at least one).
-    band_hz : tuple of float, optional
-        Demodulation band (lo, hi), Hz; default the band rule's
-        (:func:`~cmsim.features.envelope.demodulated_spectrum`).
 
     Returns
     -------
     dict of str to float
     """
     fr, tol, out = shaft_hz, SLIP_TOLERANCE, {}
-    (ef, ea), _ = demodulated_spectrum(x, fs_hz, bearings.values(), band_hz)
+    (ef, ea), _ = demodulated_spectrum(x, fs_hz, bearings.values())
     efloor = _envelope_floor(ef, ea, fr, bearings)
     out["env_fr_h1_db"] = _db(line_amplitude(ef, ea, fr, tol), efloor)
     for b, bf in bearings.items():
@@ -239,17 +236,15 @@ def band_family_columns(x, fs_hz, shaft_hz, bearings):
     -------
     dict of str to float
     """
-    lines = {b: {ln.name[:-2]: ln.frequency_hz for ln in envelope_lines(bf)
-                 if ln.name in _BAND_LINES} for b, bf in bearings.items()}
+    lines = {b: [ln for ln in envelope_lines(bf) if ln.name in _BAND_LINES]
+             for b, bf in bearings.items()}
     out = {}
     for j, band in enumerate(band_bank(fs_hz)):
         (ef, ea), _ = demodulated_spectrum(x, fs_hz, bearings.values(), band)
         floor = _envelope_floor(ef, ea, shaft_hz, bearings)
-        for b, fams in lines.items():
-            for fam, f in fams.items():
-                out[f"env_{fam}_{b}_h1_bb{j}_db"] = _db(
-                    line_amplitude(ef, ea, f, SLIP_TOLERANCE) if 0.0 < f < ef[-1] else math.nan,
-                    floor)
+        for b, bl in lines.items():
+            for name, a in line_amplitudes(ef, ea, bl, SLIP_TOLERANCE).items():
+                out[f"env_{name[:-2]}_{b}_h1_bb{j}_db"] = _db(a, floor)
     return out
 
 

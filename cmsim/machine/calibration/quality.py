@@ -57,10 +57,10 @@ def feature_rows(segs, fs_hz, freqs, bearings, unit_scale, bands=False):
         Add the band-by-band families.
     """
     rows = []
-    bfs = {b: freqs.bearing(b) for b in bearings}
+    bfs = {b: freqs.bearing(b) for b in bearings} if bands else {}
     for x in segs:
         f = relative_features(x, fs_hz, freqs, bearings)
-        if bands and bfs:
+        if bfs:
             f.update(band_family_columns(x - np.mean(x), fs_hz, freqs.fr1_hz, bfs))
         if unit_scale is not None:
             f["level_db"] = 20.0 * math.log10(max(float(np.std(x)) * unit_scale, 1e-30))
