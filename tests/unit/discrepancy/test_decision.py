@@ -48,6 +48,27 @@ def _baseline_at_zero(names, spread, *entries):
                             segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0)
 
 
+def _outer_race_family_lifted(family, quiet, lift):
+    """decide_record on a record whose outer-race ``family`` columns (spread 3.5 dB: σ 1.9)
+    are lifted by ``lift`` dB over a baseline at 0, its ``quiet`` columns (spread 1) at it;
+    the library's outer race lifts the family 0, 5 and 20 dB over its three sizes."""
+    names = tuple(family) + tuple(quiet)
+    m, k = len(names), len(family)
+    outer = np.zeros((3, m))
+    outer[:, :k] = np.array([[0.0], [5.0], [20.0]])
+    spread = np.ones(m)
+    spread[:k] = 3.5
+    lib = _baseline_at_zero(
+        names, spread,
+        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), outer))
+    li = np.arange(m)
+    meas = np.zeros(m)
+    meas[:k] = lift
+    return decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
+                         "1b1")
+
+
 def _decide(meas):
     lib = _library()
     li = np.arange(len(NAMES))
@@ -97,21 +118,7 @@ def test_one_family_standing_clearly_out_of_a_quiet_record_is_a_departure(lift, 
     from cmsim.discrepancy.judge import ALARM_Z, FAMILY_Z, NONE_CHI2_PER_FEATURE
 
     quiet = tuple(f"raw_fr_h{k}_db" for k in range(1, 31))
-    names = NAMES[:2] + quiet
-    m = len(names)
-    outer = np.zeros((3, m))
-    outer[:, :2] = np.array([[0.0], [5.0], [20.0]])
-    spread = np.ones(m)
-    spread[:2] = 3.5                                # the family's own spread, dB: σ 1.9
-    lib = _baseline_at_zero(
-        names, spread,
-        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
-                       (3e-5, 3e-4, 3e-3), outer))
-    li = np.arange(m)
-    sigma = feature_sigma(lib, li, list(names), 8)
-    meas = np.zeros(m)
-    meas[:2] = lift
-    d = decide_record(lib, li, list(names), meas, sigma, "1b1")
+    d = _outer_race_family_lifted(NAMES[:2], quiet, lift)
     assert d["chi2"] / d["n_eff"] <= NONE_CHI2_PER_FEATURE          # quiet over all
     assert np.abs(d["z"]).max() < ALARM_Z
     assert (d["z"][0] >= FAMILY_Z) == (lift == 7.0)
@@ -129,22 +136,9 @@ def test_a_family_standing_out_in_one_band_alone_is_a_departure(lift, finding):
     from cmsim.discrepancy.evaluator import weight
 
     band = "env_bpfo_1b1_h1_bb4_db"
-    names = (band,) + tuple(f"raw_fr_h{k}_db" for k in range(1, 11))
     assert weight(band) == 0.0
-    m = len(names)
-    outer = np.zeros((3, m))
-    outer[:, 0] = [0.0, 5.0, 20.0]
-    spread = np.ones(m)
-    spread[0] = 3.5
-    lib = _baseline_at_zero(
-        names, spread,
-        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
-                       (3e-5, 3e-4, 3e-3), outer))
-    li = np.arange(m)
-    sigma = feature_sigma(lib, li, list(names), 8)
-    meas = np.zeros(m)
-    meas[0] = lift
-    d = decide_record(lib, li, list(names), meas, sigma, "1b1")
+    d = _outer_race_family_lifted((band,), tuple(f"raw_fr_h{k}_db" for k in range(1, 11)),
+                                  lift)
     assert d["chi2"] / d["n_eff"] <= NONE_CHI2_PER_FEATURE and np.abs(d["z"]).max() < ALARM_Z
     assert (d["z"][0] >= FAMILY_Z) == (lift == 8.0)
     assert d["finding"] == finding
