@@ -78,6 +78,14 @@ class ModelSetup:
         sensor noise (:mod:`cmsim.machine`).
     frequency_factor : float
         Scale of the machine path's frequencies (1: as calibrated).
+    structure : str
+        Where the machine's structural response that ``frequency_factor`` moves is read:
+        ``"path"``, its calibrated path; ``"floor"``, its baseline's broadband floor
+        (:class:`cmsim.machine.change.Change`).
+    lines_follow_path : bool
+        Whether the baseline's lines move with the machine's path when its frequencies
+        scale (``frequency_factor``): True, they reach the sensor through the structure;
+        False, by another way (the mains picked up by the cable, a line drawn at the sensor).
     background_gain : float
         Factor on the machine's background (1: as calibrated).
     white_noise : float
@@ -104,6 +112,8 @@ class ModelSetup:
     white_noise: float = 0.0
     shaft_forces: tuple = ()
     background_level: float = 1.0
+    structure: str = "path"
+    lines_follow_path: bool = True
 
     def with_faults(self, *faults):
         """Same setup with ``faults`` added."""
@@ -114,12 +124,14 @@ class ModelSetup:
         forces laid on the force after the dynamics)."""
         return repr(replace(self, housing=None, noise_ratio=0.0, machine=None,
                             frequency_factor=1.0, background_gain=1.0, white_noise=0.0,
-                            shaft_forces=(), background_level=1.0))
+                            shaft_forces=(), background_level=1.0, structure="path",
+                            lines_follow_path=True))
 
     def chain_key(self):
         """What the sensor signal depends on besides the dynamics."""
         return (self.housing, self.noise_ratio, self.frequency_factor, self.background_gain,
-                self.white_noise, self.shaft_forces, self.background_level)
+                self.white_noise, self.shaft_forces, self.background_level, self.structure,
+                self.lines_follow_path)
 
 
 @dataclass(frozen=True)
@@ -220,6 +232,10 @@ class Cause:
     #: record, on features it does not raise, this fault is named
     #: (:mod:`cmsim.discrepancy.judge`).
     absorbs: typing.ClassVar[tuple] = ()
+    #: It moves the structure's frequencies (a sensor remounted, a housing changed): against
+    #: a machine, whether the baseline's lines move with it is a nuisance profiled
+    #: (:attr:`ModelSetup.lines_follow_path`; :mod:`cmsim.discrepancy.signatures`).
+    moves_path: typing.ClassVar[bool] = False
 
     def judged_on(self, names, component):
         """The features of ``names`` this cause is judged on (its :attr:`signature`).
@@ -570,6 +586,7 @@ class TransferPathCause(Cause):
     bounds = (0.3, 3.0)
     probes = ()
     post_dynamics = True
+    moves_path = True
 
     def apply(self, setup, value, component):
         if setup.machine is not None:

@@ -27,7 +27,10 @@ relative to the model's own healthy run with the same seeds (same cage phases, s
   read on a warped time, τ(t) = t + a/(2π f)·sin(2π f t + φ), so its instantaneous speed is
   (1 + a·cos(2π f t + φ)) times its own (a ratio: the path cancels);
 * a **transfer path** whose frequencies moved by a factor refilters the baseline by the ratio
-  of the path's magnitudes, |H(f/a)| / |H(f)| (the structure shapes all the sensor sees);
+  of the structure's responses, |H(f/a)| / |H(f)| (the structure shapes all the sensor sees),
+  H the calibrated path or, read another way, the root of the baseline's own broadband floor
+  (its resonances are where the baseline's broadband peaks); its lines moved with it or held
+  where they reach the sensor another way;
 * **more noise**: white noise, RMS relative to the background's coloured noise; a **louder
   background**: the background's noise and lines (random phases) added so that its power
   grows by the factor squared.
@@ -51,7 +54,8 @@ from cmsim.spectra.line_detector import detect_lines
 from cmsim.spectra.lines import line_bins
 
 __all__ = ["Change", "apply_change", "pinned_correction", "path_ratio", "SHARED_LINE_DB",
-           "BROADBAND_DEAD_ZONE", "warp_speed"]
+           "BROADBAND_DEAD_ZONE", "warp_speed", "STRUCTURES", "PATH_RATIO_OCTAVE",
+           "FLOOR_RATIO_OCTAVE", "PATH_RATIO_MAX"]
 
 #: The model's broadband must fall under this share of its healthy power for the baseline's
 #: broadband to fall with it: the running floors of 8 half-second segments scatter by ~7 %,
@@ -84,6 +88,16 @@ class Change:
         Rate of the input shaft, Hz (a speed fluctuation's frequency).
     frequency_factor : float
         Scale of the path's frequencies (1: as calibrated).
+    structure : str
+        Where the structure's response that ``frequency_factor`` moves is read (one of
+        :data:`STRUCTURES`): ``"path"``, the calibrated transfer path; ``"floor"``, the
+        baseline's broadband floor (what a broadband excitation makes through the structure:
+        its resonances are where the floor peaks; the path's gain is pinned to the model's
+        lines and divided by the model force's own shape, which a record not made by the
+        model does not share).
+    lines_follow_path : bool
+        Whether the baseline's lines move with the path (:func:`path_ratio`); False, they
+        reach the sensor another way and keep their level.
     white_noise : float
         White noise added, RMS relative to the background's coloured noise RMS.
     background_gain : float
@@ -110,6 +124,8 @@ class Change:
     speed_fluctuation: float = 0.0
     pin_hz: tuple = ()
     path_gain: float = 1.0
+    structure: str = "path"
+    lines_follow_path: bool = True
 
     def __post_init__(self):
         if (self.force is None) != (self.healthy is None):
@@ -122,6 +138,9 @@ class Change:
             raise ParameterError("a change's frequency factor must be > 0, its noise and "
                                  "speed fluctuation >= 0 and its background gain >= 1",
                                  param="change")
+        if self.structure not in STRUCTURES:
+            raise ParameterError(f"a change's structure must be one of {STRUCTURES}, got "
+                                 f"{self.structure!r}", param="structure")
 
 
 def warp_speed(x, fs_hz, amplitude, frequency_hz, phase_rad):
@@ -213,38 +232,60 @@ def pinned_correction(freq, lines, psd_h, psd_b, floor_b, gain2, pin_hz):
     return np.exp(np.interp(np.log(np.maximum(freq, freq[1])), f_pin, c_pin))
 
 
-#: Smoothing of the path's magnitude before its frequencies are scaled, octave: the
-#: structure's resonances, not the pins' and caps' narrow corrections (a ratio of two scaled
-#: copies of a narrow correction read +16 dB in one band where the modes moved by 8 %).
+#: Smoothing of the calibrated path's magnitude before its frequencies are scaled, octave:
+#: the structure's resonances, not the pins' and caps' narrow corrections (a ratio of two
+#: scaled copies of a narrow correction read +16 dB in one band where the modes moved by 8 %).
 PATH_RATIO_OCTAVE = 1.0 / 3.0
+
+#: Smoothing of the baseline's floor before its frequencies are scaled, octave: the
+#: calibration's own smoothing of a path's shape
+#: (:data:`~cmsim.machine.calibration.path_reading.PATH_SMOOTHING_OCTAVE`; the floor is a
+#: running median already, with no pins). The angle-domain generator's moved housing modes
+#: (±17-37 %) are read within 1-2 dB in every band from 150 Hz to 3.5 kHz at 1/12 octave; at
+#: 1/3 they lose up to 8 dB at the modes' peaks.
+FLOOR_RATIO_OCTAVE = 1.0 / 12.0
 
 #: Most a moved path may change the baseline at any frequency, either way (±20 dB: a mode
 #: moving onto a frequency where the structure had an antiresonance).
 PATH_RATIO_MAX = 10.0
 
+#: Where the structure's response that moves is read (:attr:`Change.structure`).
+STRUCTURES = ("path", "floor")
 
-def path_ratio(path, freq, factor):
-    """|H(f/a)| / |H(f)| of a path whose frequencies moved by ``factor`` = a, its magnitude
-    smoothed over :data:`PATH_RATIO_OCTAVE` and the ratio held within
-    1/:data:`PATH_RATIO_MAX` and :data:`PATH_RATIO_MAX`.
+
+def path_ratio(freq, grid, power, factor, octave):
+    """|H(f/a)| / |H(f)| of a structure whose frequencies moved by ``factor`` = a, |H|² being
+    ``power`` on ``grid`` (smoothed over ``octave`` where the grid is uniform), the ratio
+    held within 1/:data:`PATH_RATIO_MAX` and :data:`PATH_RATIO_MAX`.
 
     Parameters
     ----------
-    path : TransferPath
     freq : numpy.ndarray
-        Frequencies, Hz (uniform from 0).
+        Frequencies the ratio is read at, Hz.
+    grid, power : numpy.ndarray
+        The structure's power response |H|² and its frequencies, Hz (increasing).
     factor : float
         The factor a (> 0).
+    octave : float
+        Smoothing, octave.
 
     Returns
     -------
     numpy.ndarray
+
+    Examples
+    --------
+    >>> f = np.arange(0.0, 5000.0, 2.0)
+    >>> mode = 1.0 / ((1 - (f / 1000.0) ** 2) ** 2 + (0.1 * f / 1000.0) ** 2)
+    >>> r = path_ratio(f, f, mode, 1.2, FLOOR_RATIO_OCTAVE)
+    >>> bool(r[600] > 3.0 and r[500] < 0.5)     # the peak moved from 1000 Hz to 1200 Hz
+    True
     """
-    grid = np.asarray(path.freq_hz)
-    log_gain = np.log(np.asarray(path.gain))
+    grid = np.asarray(grid, dtype=float)
+    log_p = np.log(np.maximum(np.asarray(power, dtype=float), 1e-300))
     if grid.size > 4 and np.allclose(np.diff(grid), grid[1] - grid[0]):
-        log_gain = smooth_log(log_gain, grid, PATH_RATIO_OCTAVE)
-    ratio = np.exp(np.interp(freq / factor, grid, log_gain) - np.interp(freq, grid, log_gain))
+        log_p = smooth_log(log_p, grid, octave)
+    ratio = np.exp(0.5 * (np.interp(freq / factor, grid, log_p) - np.interp(freq, grid, log_p)))
     return np.clip(ratio, 1.0 / PATH_RATIO_MAX, PATH_RATIO_MAX)
 
 
@@ -284,17 +325,25 @@ def apply_change(machine, segments, change, rng):
     df = freq[1] - freq[0]
     scale = np.ones(freq.size)
     a = change.frequency_factor
-    if a != 1.0:
-        scale *= path_ratio(machine.path, freq, a)
     added = np.zeros((k, n))
     fill = None                 # PSD of the background that fills what the model loses
     psd_b = floor_b = None
-    if change.force is not None or change.rotating:
+    if change.force is not None or change.rotating or a != 1.0:
         _, psd_b = segment_psd(list(x), fs)
         found, floor_b = detect_lines(freq, psd_b)
         base_lines = np.zeros(freq.size, dtype=bool)
         for ln in found:
             base_lines[ln.bins] = True
+    if a != 1.0:
+        if change.structure == "floor":
+            moved = path_ratio(freq, freq, floor_b, a, FLOOR_RATIO_OCTAVE)
+        else:
+            moved = path_ratio(freq, machine.path.freq_hz, np.asarray(machine.path.gain) ** 2,
+                               a, PATH_RATIO_OCTAVE)
+        if not change.lines_follow_path:    # every line the baseline has, however many
+            for ln in detect_lines(freq, psd_b, max_lines=freq.size)[0]:
+                moved[ln.bins] = 1.0
+        scale *= moved
     if change.force is not None:
         e = int(change.edge)
         span = slice(e, e + k * n)
