@@ -22,12 +22,12 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    calibrated: far departures rise). A record whose χ²₀ per feature stays within
    :data:`NONE_CHI2_PER_FEATURE` and no feature of which departs by :data:`ALARM_Z` σ is
    ``none``: within the machine's own spread, unless a structure-ringing fault's family
-   stands out over the baseline (step 4), in whatever band. A record documented at another
-   load than the
-   machine's is read against the baseline moved by the model's change between the two
-   loads, every prediction with it, and each feature's σ widened by that change's own size
-   (:mod:`cmsim.discrepancy.operating_point`): how a gearbox answers its load is the
-   model's guess, not the machine's measurement.
+   stands out over the baseline (step 4), in whatever band, or a band of the spectrum's
+   shape moved as far from it, either way (:func:`shape_moved`). A record documented at
+   another load than the machine's is read against the baseline moved by the model's change
+   between the two loads, every prediction with it, and each feature's σ widened by that
+   change's own size (:mod:`cmsim.discrepancy.operating_point`): how a gearbox answers its
+   load is the model's guess, not the machine's measurement.
 3. **Matching.** Every entry of the library (a cause on a component, a nuisance variant, a
    grid of sizes) is compared with the record the same way; between two sizes of the grid the
    features are interpolated (:data:`INTERPOLATION_STEPS`, linear in log size), so the size is
@@ -94,8 +94,8 @@ from cmsim.run import signal_info
 from cmsim.spectra.misfit import misfit
 
 __all__ = ["judge", "decide_record", "feature_sigma", "sigma_of", "chi2_rows", "compared_columns",
-           "interpolated", "standing_out", "NONE_CHI2_PER_FEATURE", "ALARM_Z", "MIN_EVIDENCE",
-           "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE", "RANGE_DELTA_CHI2",
+           "interpolated", "standing_out", "shape_moved", "NONE_CHI2_PER_FEATURE", "ALARM_Z",
+           "MIN_EVIDENCE", "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE", "RANGE_DELTA_CHI2",
            "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.
@@ -316,6 +316,16 @@ def standing_out(features, meas, reference, sigma, names):
         not names[i].endswith("_db") or meas[i] - reference[i] >= FAMILY_RISE_DB)]
 
 
+def shape_moved(meas, reference, sigma, names):
+    """The columns of the spectrum's shape bands (``shape_*``) on which the record moved
+    away from a reference either way by :func:`standing_out`'s gate (:data:`FAMILY_Z` σ
+    and :data:`FAMILY_RISE_DB`): a band halving its power departs as one doubling it does.
+    The arguments are :func:`standing_out`'s, every column looked at."""
+    return [i for i, k in enumerate(names) if k.startswith("shape_")
+            and abs(meas[i] - reference[i]) >= FAMILY_Z * sigma[i]
+            and abs(meas[i] - reference[i]) >= FAMILY_RISE_DB]
+
+
 def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
     """Steps 2-4 of the module docstring on a record's mean features.
 
@@ -431,7 +441,10 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         # a spall's family standing out over the baseline in some band is outside the
         # baseline's spread, however quiet the rest (the angle generator's gear machines:
         # an outer race 7.8 dB and 3.3 sigma up in the two top bands alone read none)
-        any(r["stands_out"] and r["cause"].rings_structure for r in by_signature.values()))
+        any(r["stands_out"] and r["cause"].rings_structure for r in by_signature.values())) or (
+        # a band of the spectrum's shape that moved as far, either way, too: they share one
+        # family's weight, so resonances moved by 20 % (bands 5-8 sigma, 6-7 dB) read none
+        bool(shape_moved(meas, lib.mean[li], sigma, names)))
     finding, top, ties, how = "none", None, [], ""
     if departs:
         if cands and explains(cands[0]):

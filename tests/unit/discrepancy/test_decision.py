@@ -145,6 +145,33 @@ def test_a_family_standing_out_in_one_band_alone_is_a_departure(lift, finding):
     assert int(np.argmax(np.abs(d["z"]))) == 0                  # where it departs
 
 
+@pytest.mark.parametrize("moved, finding", [(4.0, "none"), (7.0, "transfer_path"),
+                                            (-7.0, "transfer_path")])
+def test_a_band_of_the_shape_moved_either_way_is_a_departure(moved, finding):
+    """Two bands of the spectrum's shape moved by ``moved`` dB the opposite ways (a resonance
+    moving from one band to the next; spread 1 dB, so 7 dB is 6 σ) and twenty raw lines at
+    the baseline: χ² per feature within the spread and no feature at the alarm z. 7 dB
+    either way departs, and the library's moved path that makes it is named; 4 dB, under
+    the 6 dB of a band that stands out, stays ``none``."""
+    from cmsim.discrepancy.judge import ALARM_Z, NONE_CHI2_PER_FEATURE
+
+    names = ("shape_b4_db", "shape_b5_db") + tuple(f"raw_fr_h{k}_db" for k in range(1, 21))
+    m = len(names)
+    path = np.zeros((3, m))
+    path[:, :2] = np.array([[-7.0, 7.0], [0.0, 0.0], [7.0, -7.0]])
+    lib = _baseline_at_zero(names, np.ones(m), SignatureEntry(
+        "transfer_path", None, "documented", "frequency_factor", (0.8, 1.0, 1.25), path))
+    li = np.arange(m)
+    meas = np.zeros(m)
+    meas[:2] = [moved, -moved]
+    d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
+                      "1b1")
+    assert d["chi2"] / d["n_eff"] <= NONE_CHI2_PER_FEATURE and np.abs(d["z"]).max() < ALARM_Z
+    assert d["finding"] == finding
+    if finding != "none":
+        assert d["top"]["value"] == pytest.approx(1.25 if moved > 0 else 0.8, rel=0.05)
+
+
 @pytest.mark.parametrize("other, finding", [(6.0, "bearing_outer_race"),
                                             (7.0, "torque_mismatch")])
 def test_a_fault_whose_family_stands_out_wins_a_near_tie_on_the_whole_record(other, finding):
