@@ -7,6 +7,7 @@ the baseline's own line in proportion (the path cancels); noise, rotating forces
 fluctuation add what their closed forms say; a change with nothing in it is no change.
 """
 
+import itertools
 import math
 
 import numpy as np
@@ -162,7 +163,7 @@ def _resonant(rng, f0, line_hz, line_amp):
 def _bands_db(segs, edges):
     freq, psd = segment_psd(list(segs), FS)
     return np.array([10 * np.log10(psd[(freq >= lo) & (freq < hi)].sum())
-                     for lo, hi in zip(edges[:-1], edges[1:])])
+                     for lo, hi in itertools.pairwise(edges)])
 
 
 def test_a_moved_structure_read_from_the_baseline_s_floor_moves_its_resonance(machine):
