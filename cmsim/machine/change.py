@@ -55,7 +55,7 @@ from cmsim.spectra.lines import line_bins
 
 __all__ = ["Change", "apply_change", "pinned_correction", "path_ratio", "SHARED_LINE_DB",
            "BROADBAND_DEAD_ZONE", "warp_speed", "STRUCTURES", "PATH_RATIO_OCTAVE",
-           "FLOOR_RATIO_OCTAVE", "PATH_RATIO_MAX"]
+           "FLOOR_RATIO_OCTAVE", "PATH_RATIO_MAX", "MESH_REGION_ORDERS", "shaft_locked"]
 
 #: The model's broadband must fall under this share of its healthy power for the baseline's
 #: broadband to fall with it: the running floors of 8 half-second segments scatter by ~7 %,
@@ -289,6 +289,39 @@ def path_ratio(freq, grid, power, factor, octave):
     return np.clip(ratio, 1.0 / PATH_RATIO_MAX, PATH_RATIO_MAX)
 
 
+#: Orders of the faster shaft on each side of a mesh harmonic that a gear's modulation
+#: (its sidebands) and the speed's wobble (their smear) fill: on the angle-domain generator's
+#: gear machines the floor stands 20-45 dB over its level an octave away within ±3 orders.
+MESH_REGION_ORDERS = 4.0
+
+
+def shaft_locked(freq, psd, change):
+    """The bins of a baseline's spectrum that are locked to the shafts, not its broadband:
+    every line it has (:func:`~cmsim.spectra.line_detector.detect_lines`, however many) and,
+    on a gear rig, each mesh harmonic (``change.pin_hz``) with :data:`MESH_REGION_ORDERS`
+    orders of the faster shaft on each side (its sidebands, smeared by the speed's wobble,
+    which the floor's running median reads as broadband).
+
+    Parameters
+    ----------
+    freq, psd : numpy.ndarray
+        The baseline's PSD and its frequencies, Hz.
+    change : Change
+        Its mesh harmonics and shaft rates.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+    """
+    out = np.zeros(freq.size, dtype=bool)
+    for ln in detect_lines(freq, psd, max_lines=freq.size)[0]:
+        out[ln.bins] = True
+    reach = MESH_REGION_ORDERS * max(change.shaft_hz, change.input_hz)
+    for f in change.pin_hz:
+        out |= np.abs(freq - f) <= reach
+    return out
+
+
 def _add_power(scale, bins, p_base, p_add):
     """Scale the spectrum's ``bins``, holding ``p_base`` of power, so that ``p_add`` adds to
     it: a line at an unknown phase against the baseline's own adds its power."""
@@ -335,14 +368,15 @@ def apply_change(machine, segments, change, rng):
         for ln in found:
             base_lines[ln.bins] = True
     if a != 1.0:
-        if change.structure == "floor":
-            moved = path_ratio(freq, freq, floor_b, a, FLOOR_RATIO_OCTAVE)
+        locked = shaft_locked(freq, psd_b, change)
+        if change.structure == "floor":     # the structure read where the floor is broadband
+            broadband = np.exp(np.interp(freq, freq[~locked], np.log(floor_b[~locked])))
+            moved = path_ratio(freq, freq, broadband, a, FLOOR_RATIO_OCTAVE)
         else:
             moved = path_ratio(freq, machine.path.freq_hz, np.asarray(machine.path.gain) ** 2,
                                a, PATH_RATIO_OCTAVE)
-        if not change.lines_follow_path:    # every line the baseline has, however many
-            for ln in detect_lines(freq, psd_b, max_lines=freq.size)[0]:
-                moved[ln.bins] = 1.0
+        if not change.lines_follow_path:
+            moved[locked] = 1.0
         scale *= moved
     if change.force is not None:
         e = int(change.edge)
