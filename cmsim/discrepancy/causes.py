@@ -233,8 +233,9 @@ class Cause:
     #: (:mod:`cmsim.discrepancy.judge`).
     absorbs: typing.ClassVar[tuple] = ()
     #: It moves the structure's frequencies (a sensor remounted, a housing changed): against
-    #: a machine, whether the baseline's lines move with it is a nuisance profiled
-    #: (:attr:`ModelSetup.lines_follow_path`; :mod:`cmsim.discrepancy.signatures`).
+    #: a machine, where the structure's response is read and whether the baseline's lines
+    #: move with it are a nuisance profiled (:attr:`ModelSetup.structure`,
+    #: :attr:`ModelSetup.lines_follow_path`; :mod:`cmsim.discrepancy.signatures`).
     moves_path: typing.ClassVar[bool] = False
 
     def judged_on(self, names, component):

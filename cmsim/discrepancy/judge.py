@@ -95,7 +95,8 @@ from cmsim.spectra.misfit import misfit
 
 __all__ = ["judge", "decide_record", "feature_sigma", "sigma_of", "chi2_rows", "compared_columns",
            "interpolated", "standing_out", "shape_moved", "NONE_CHI2_PER_FEATURE", "ALARM_Z",
-           "MIN_EVIDENCE", "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE", "RANGE_DELTA_CHI2",
+           "MIN_EVIDENCE", "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE",
+           "RANGE_DELTA_CHI2",
            "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.

@@ -368,7 +368,8 @@ def apply_change(machine, segments, change, rng):
         for ln in found:
             base_lines[ln.bins] = True
     if a != 1.0:
-        locked = shaft_locked(freq, psd_b, change)
+        locked = (shaft_locked(freq, psd_b, change)
+                  if change.structure == "floor" or not change.lines_follow_path else None)
         if change.structure == "floor":     # the structure read where the floor is broadband
             broadband = np.exp(np.interp(freq, freq[~locked], np.log(floor_b[~locked])))
             moved = path_ratio(freq, freq, broadband, a, FLOOR_RATIO_OCTAVE)
