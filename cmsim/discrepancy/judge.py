@@ -321,7 +321,18 @@ def shape_moved(meas, reference, sigma, names):
     """The columns of the spectrum's shape bands (``shape_*``) on which the record moved
     away from a reference either way by :func:`standing_out`'s gate (:data:`FAMILY_Z` σ
     and :data:`FAMILY_RISE_DB`): a band halving its power departs as one doubling it does.
-    The arguments are :func:`standing_out`'s, every column looked at."""
+
+    Parameters
+    ----------
+    meas, reference, sigma : numpy.ndarray
+        The record's features, the reference's and their σ.
+    names : sequence of str
+        Feature names.
+
+    Returns
+    -------
+    list of int
+    """
     return [i for i, k in enumerate(names) if k.startswith("shape_")
             and abs(meas[i] - reference[i]) >= FAMILY_Z * sigma[i]
             and abs(meas[i] - reference[i]) >= FAMILY_RISE_DB]
