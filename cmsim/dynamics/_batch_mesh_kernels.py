@@ -284,40 +284,51 @@ def _involute_slots(z1, z2, r, mp, geo, sg):
     g3 = geo[3]
     for j in range(sg.shape[0]):
         sj = sg[j]
-        on = sj[SG_ON]
-        s_out = sj[SG_S]
-        nx_out = sj[SG_NX]
-        ny_out = sj[SG_NY]
-        px_out = sj[SG_PX]
-        py_out = sj[SG_PY]
+        # loops that write one to three arrays each: LLVM vectorises a loop only where it
+        # can check at run time that its writes alias none of its reads, and gives up on
+        # the twelve outputs of one loop
         k1_out = sj[BS_K1]
         k2_out = sj[BS_K2]
+        if j > 0:
+            for l in range(k1.shape[0]):
+                k1[l] = k1[l] - 1.0 if k1[l] > 0.0 else z1 - 1.0
+            for l in range(k2.shape[0]):
+                k2[l] = k2[l] - 1.0 if k2[l] > 0.0 else z2 - 1.0
+        for l in range(k1.shape[0]):
+            k1_out[l] = k1[l]
+        for l in range(k2.shape[0]):
+            k2_out[l] = k2[l]
+        s_out = sj[SG_S]
+        for l in range(s_out.shape[0]):
+            s_out[l] = sref[l] - (m0[l] - j) * pb[l]
+        on = sj[SG_ON]
         corner = sj[BS_CORNER]
+        for l in range(on.shape[0]):
+            s = s_out[l]
+            inside = not (s < lo[l] or s > hi[l])
+            on[l] = 1.0 if inside else 0.0
+            corner[l] = 1.0 if inside and (s < length[l] - g3[l] or s > g2[l]) else 0.0
+        nx_out = sj[SG_NX]
+        ny_out = sj[SG_NY]
         delta_out = sj[BS_DELTA]
+        for l in range(nx_out.shape[0]):
+            nx_out[l] = -sin_t[l]
+        for l in range(ny_out.shape[0]):
+            ny_out[l] = cos_t[l]
+        for l in range(delta_out.shape[0]):
+            delta_out[l] = dinv[l]
         chi1_out = sj[BS_CHI1]
         chi2_out = sj[BS_CHI2]
-        for l in range(k1.shape[0]):
-            if j > 0:
-                k1[l] = k1[l] - 1.0 if k1[l] > 0.0 else z1 - 1.0
-                k2[l] = k2[l] - 1.0 if k2[l] > 0.0 else z2 - 1.0
-            k1_out[l] = k1[l]
-            k2_out[l] = k2[l]
-            s = sref[l] - (m0[l] - j) * pb[l]
-            inside = not (s < lo[l] or s > hi[l])
-            ln = length[l]
-            corner[l] = 1.0 if inside and (s < ln - g3[l] or s > g2[l]) else 0.0
-            sc = s - 0.5 * dinv[l]
-            nx = -sin_t[l]
-            ny = cos_t[l]
-            on[l] = 1.0 if inside else 0.0
-            s_out[l] = s
-            nx_out[l] = nx
-            ny_out[l] = ny
-            px_out[l] = gx1[l] + rb1[l] * cos_t[l] + sc * nx
-            py_out[l] = gy1[l] + rb1[l] * sin_t[l] + sc * ny
-            delta_out[l] = dinv[l]
+        for l in range(chi1_out.shape[0]):
+            sc = s_out[l] - 0.5 * dinv[l]
             chi1_out[l] = sc
-            chi2_out[l] = ln - sc
+            chi2_out[l] = length[l] - sc
+        px_out = sj[SG_PX]
+        py_out = sj[SG_PY]
+        for l in range(px_out.shape[0]):
+            sc = s_out[l] - 0.5 * dinv[l]
+            px_out[l] = gx1[l] + rb1[l] * cos_t[l] + sc * (-sin_t[l])
+            py_out[l] = gy1[l] + rb1[l] * sin_t[l] + sc * cos_t[l]
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
