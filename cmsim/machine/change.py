@@ -296,7 +296,8 @@ MESH_REGION_ORDERS = 4.0
 
 
 def shaft_locked(freq, psd, change):
-    """The bins of a baseline's spectrum that are locked to the shafts, not its broadband:
+    """The bins of a baseline's spectrum that are locked to the shafts, not its broadband
+    (a moved path keeps their locked power and moves only the broadband under them):
     every line it has (:func:`~cmsim.spectra.line_detector.detect_lines`, however many) and,
     on a gear rig, each mesh harmonic (``change.pin_hz``) with :data:`MESH_REGION_ORDERS`
     orders of the faster shaft on each side (its sidebands, smeared by the speed's wobble,
@@ -370,14 +371,17 @@ def apply_change(machine, segments, change, rng):
     if a != 1.0:
         locked = (shaft_locked(freq, psd_b, change)
                   if change.structure == "floor" or not change.lines_follow_path else None)
+        broadband = floor_b
         if change.structure == "floor":     # the structure read where the floor is broadband
             broadband = np.exp(np.interp(freq, freq[~locked], np.log(floor_b[~locked])))
             moved = path_ratio(freq, freq, broadband, a, FLOOR_RATIO_OCTAVE)
         else:
             moved = path_ratio(freq, machine.path.freq_hz, np.asarray(machine.path.gain) ** 2,
                                a, PATH_RATIO_OCTAVE)
-        if not change.lines_follow_path:
-            moved[locked] = 1.0
+        if not change.lines_follow_path:    # what is locked stays, the broadband under it moves
+            under = np.minimum(broadband, psd_b)
+            held = np.sqrt((psd_b - under + under * moved ** 2) / np.maximum(psd_b, 1e-300))
+            moved[locked] = held[locked]
         scale *= moved
     if change.force is not None:
         e = int(change.edge)
