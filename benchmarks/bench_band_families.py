@@ -19,7 +19,7 @@ for the defect's bearing (every bearing on a healthy record).
 A family **stands out** where its line, in one band, rises over the baseline's mean in
 the same band by the judge's rule (:func:`cmsim.discrepancy.judge.standing_out`:
 :data:`~cmsim.discrepancy.judge.FAMILY_Z` σ and :data:`~cmsim.discrepancy.judge.FAMILY_RISE_DB`
-dB; σ of :func:`~cmsim.discrepancy.judge.sigma_of`: the baseline's segment-to-segment
+dB; σ of :func:`~cmsim.discrepancy.columns.sigma_of`: the baseline's segment-to-segment
 spread over both means' segments and the judge's floor, and with ``--realisations N`` the
 spread of the baseline's mean and N other healthy records' of the same machine, as the
 library's realisation spread). The report gives, per
@@ -39,7 +39,8 @@ import numpy as np
 from bench_compare import SEED0, _angle_case, _model_case
 
 from cmsim.discrepancy.angle_domain import draw_machine, write_machine
-from cmsim.discrepancy.judge import sigma_of, standing_out
+from cmsim.discrepancy.columns import sigma_of
+from cmsim.discrepancy.judge import standing_out
 from cmsim.discrepancy.synthetic import hidden_effect_record
 from cmsim.features import N_ENVELOPE_BANDS, band_family_columns, segments
 from cmsim.measured import read_record

@@ -2,7 +2,8 @@
 
 A cause is one small class: a catalogue ``name``, the ``parameter`` it fits with its
 ``bounds`` (SI), the ``probes`` tried when ranking, the components it may sit on, and
-:meth:`Cause.apply`, which returns the extended :class:`ModelSetup`. Register it with
+:meth:`Cause.apply`, which returns the extended
+:class:`~cmsim.discrepancy.model_setup.ModelSetup`. Register it with
 :func:`register_cause`::
 
     @register_cause
@@ -23,7 +24,8 @@ modes' frequencies) and ``noise`` (sensor and background noise). They are *nuisa
 :mod:`cmsim.discrepancy.compare` refits them for every simulated setup within a prior range
 (:data:`NUISANCES`), and names them only when the record needs them far outside it.
 
-Layering: imports :mod:`cmsim.faults` and :mod:`cmsim.rig` only.
+Layering: imports :mod:`cmsim.faults`, :mod:`cmsim.rig` and the setup it extends
+(:mod:`cmsim.discrepancy.model_setup`) only.
 """
 
 from __future__ import annotations
@@ -35,14 +37,11 @@ from dataclasses import dataclass, replace
 from cmsim.errors import ParameterError
 from cmsim.faults import (BallDefect, Eccentricity, InnerRaceDefect, OuterRaceDefect,
                           RollingSlip, SpeedFluctuation, ToothBreakage)
-from cmsim.rig import HousingPath, OperatingPoint, Rig
+from cmsim.discrepancy.model_setup import NOMINAL_NOISE_RATIO, ModelSetup
 
 __all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
            "MACHINE_BACKGROUND_SPREAD", "register_cause", "applicable_causes",
            "NOMINAL_NOISE_RATIO", "STATISTICS"]
-
-#: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
-NOMINAL_NOISE_RATIO = 0.1
 
 #: The ``noise`` cause through a calibrated machine scales the machine's background up to
 #: this factor and adds white noise beyond (a scaled baseline background cannot change the
@@ -54,84 +53,6 @@ MACHINE_BACKGROUND_SPREAD = 1.25
 #: fault from another, so a fault is told from the others by the rest of its signature, its
 #: *family* (:meth:`Cause.family`).
 STATISTICS = ("kurtosis_log", "crest_log")
-
-
-@dataclass(frozen=True)
-class ModelSetup:
-    """Everything the model of a record is built from.
-
-    Attributes
-    ----------
-    rig : Rig
-    op : OperatingPoint
-    faults : tuple of Fault
-        Catalogue faults added to the model.
-    housing : HousingPath
-        Transfer path from bearing forces to the sensor.
-    noise_ratio : float
-        Sensor noise RMS relative to the healthy nominal model signal's RMS.
-    mixed_friction : bool
-        Tooth friction from the mixed-lubrication film of the rig's lubricant (roughness,
-        viscosity; ``simulate(losses=...)``) instead of the rig's constant coefficient.
-    machine : cmsim.machine.Machine or None
-        The calibrated machine whose path and background replace ``housing`` and the
-        sensor noise (:mod:`cmsim.machine`).
-    frequency_factor : float
-        Scale of the machine path's frequencies (1: as calibrated).
-    structure : str
-        Where the machine's structural response that ``frequency_factor`` moves is read:
-        ``"path"``, its calibrated path; ``"floor"``, its baseline's broadband floor
-        (:class:`cmsim.machine.change.Change`).
-    lines_follow_path : bool
-        Whether the baseline's lines move with the machine's path when its frequencies
-        scale (``frequency_factor``): True, they reach the sensor through the structure;
-        False, by another way (the mains picked up by the cable, a line drawn at the sensor).
-    background_gain : float
-        Factor on the machine's background (1: as calibrated).
-    white_noise : float
-        White noise at the machine's sensor, RMS relative to its background noise's
-        (:meth:`Machine.sensor_signal <cmsim.machine.Machine.sensor_signal>`).
-    background_level : float
-        Factor on the machine's whole background (coloured noise and lines) beyond what
-        ``background_gain`` refits within its spread: the ``background`` cause (1: none).
-    shaft_forces : tuple of (float, float)
-        (shaft order, relative amplitude): a rotating force laid on the bearing force after
-        the dynamics, ``F̄ + (F − F̄)·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
-        misalignment: order 2); quasi-static, the shaft rate being far below the modes.
-    """
-
-    rig: Rig
-    op: OperatingPoint
-    faults: tuple = ()
-    housing: HousingPath = HousingPath()
-    noise_ratio: float = NOMINAL_NOISE_RATIO
-    mixed_friction: bool = False
-    machine: object = None
-    frequency_factor: float = 1.0
-    background_gain: float = 1.0
-    white_noise: float = 0.0
-    shaft_forces: tuple = ()
-    background_level: float = 1.0
-    structure: str = "path"
-    lines_follow_path: bool = True
-
-    def with_faults(self, *faults):
-        """Same setup with ``faults`` added."""
-        return replace(self, faults=self.faults + tuple(faults))
-
-    def dynamics_key(self):
-        """What the simulated forces depend on (not the measurement chain nor the shaft
-        forces laid on the force after the dynamics)."""
-        return repr(replace(self, housing=None, noise_ratio=0.0, machine=None,
-                            frequency_factor=1.0, background_gain=1.0, white_noise=0.0,
-                            shaft_forces=(), background_level=1.0, structure="path",
-                            lines_follow_path=True))
-
-    def chain_key(self):
-        """What the sensor signal depends on besides the dynamics."""
-        return (self.housing, self.noise_ratio, self.frequency_factor, self.background_gain,
-                self.white_noise, self.shaft_forces, self.background_level, self.structure,
-                self.lines_follow_path)
 
 
 @dataclass(frozen=True)
@@ -234,8 +155,8 @@ class Cause:
     absorbs: typing.ClassVar[tuple] = ()
     #: It moves the structure's frequencies (a sensor remounted, a housing changed): against
     #: a machine, where the structure's response is read and whether the baseline's lines
-    #: move with it are a nuisance profiled (:attr:`ModelSetup.structure`,
-    #: :attr:`ModelSetup.lines_follow_path`; :mod:`cmsim.discrepancy.signatures`).
+    #: move with it are a nuisance profiled (``structure`` and ``lines_follow_path`` of
+    #: :class:`~cmsim.discrepancy.model_setup.ModelSetup`; :mod:`cmsim.discrepancy.signatures`).
     moves_path: typing.ClassVar[bool] = False
 
     def judged_on(self, names, component):

@@ -16,7 +16,7 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    over its segments): z = (record − baseline) / σ, σ² the baseline's segment-to-segment
    spread² over each mean's segments (1/n_fit + 1/n_baseline), + the model's realisation
    spread² (what one healthy run differs from another by, which averaging segments does not
-   remove) + a floor (:data:`FLOOR_SHARE` of
+   remove) + a floor (:data:`~cmsim.discrepancy.columns.FLOOR_SHARE` of
    :func:`~cmsim.discrepancy.evaluator.feature_floor`). χ²₀ is the
    robust χ² of the record against the baseline (:func:`~cmsim.discrepancy.evaluator.chi2`,
    calibrated: far departures rise). A record whose χ²₀ per feature stays within
@@ -83,7 +83,8 @@ import time
 import numpy as np
 
 from cmsim.discrepancy.causes import CAUSES, STATISTICS
-from cmsim.discrepancy.evaluator import feature_floor, path_free, rises, weight
+from cmsim.discrepancy.columns import chi2_rows, compared_columns, feature_sigma, interpolated
+from cmsim.discrepancy.evaluator import path_free, rises, weight
 from cmsim.discrepancy.operating_point import at_operating_point, record_load
 from cmsim.discrepancy.ranking import _consistent, decide
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
@@ -93,11 +94,9 @@ from cmsim.machine.calibration import feature_rows
 from cmsim.run import signal_info
 from cmsim.spectra.misfit import misfit
 
-__all__ = ["judge", "decide_record", "feature_sigma", "sigma_of", "chi2_rows", "compared_columns",
-           "interpolated", "standing_out", "shape_moved", "NONE_CHI2_PER_FEATURE", "ALARM_Z",
-           "MIN_EVIDENCE", "MIN_SHARE", "FLOOR_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE",
-           "RANGE_DELTA_CHI2",
-           "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z"]
+__all__ = ["judge", "decide_record", "standing_out", "shape_moved", "NONE_CHI2_PER_FEATURE",
+           "ALARM_Z", "MIN_EVIDENCE", "MIN_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE",
+           "RANGE_DELTA_CHI2", "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.
 NONE_CHI2_PER_FEATURE = 2.5
@@ -111,10 +110,6 @@ MIN_EVIDENCE = 16.0
 #: Least share of the record's departure (χ²₀ − features) a cause named on the whole record
 #: removes.
 MIN_SHARE = 0.5
-
-#: The model-uncertainty floor of a feature's σ against a baseline, as a share of
-#: :func:`~cmsim.discrepancy.evaluator.feature_floor` (the baseline is measured, not modelled).
-FLOOR_SHARE = 0.5
 
 #: Points read between two sizes of a library entry (interpolated features).
 INTERPOLATION_STEPS = 4
@@ -147,62 +142,6 @@ RANGE_DELTA_CHI2 = 4.0
 LEVEL_DIRECTION_Z = 3.0
 
 
-def chi2_rows(meas, pred, sigma, names):
-    """Robust χ² of predicted feature rows against measured features: THE misfit
-    (:func:`cmsim.spectra.misfit.misfit`), each feature weighted by
-    :func:`~cmsim.discrepancy.evaluator.weight`, calibrated (every feature but the statistics
-    rises beyond its cap: :func:`~cmsim.discrepancy.evaluator.rises`).
-
-    Parameters
-    ----------
-    meas, sigma : numpy.ndarray, shape (m,)
-        Measured features and their uncertainties.
-    pred : numpy.ndarray, shape (r, m)
-        Predicted features, a row each.
-    names : sequence of str
-        Feature names (their weights and rules).
-
-    Returns
-    -------
-    (numpy.ndarray of shape (r,), numpy.ndarray of shape (r, m))
-        χ² of each row and each feature's share of it.
-    """
-    return misfit(meas, pred, sigma, np.array([weight(k) for k in names]),
-                  np.array([rises(k, True) for k in names], dtype=bool))
-
-
-def interpolated(values, table, steps):
-    """(values, table) of a library entry with ``steps`` points between consecutive values
-    (log-linear), as a comparison reads the grid.
-
-    Parameters
-    ----------
-    values : sequence of float
-        The entry's parameter values, increasing.
-    table : numpy.ndarray, shape (len(values), n)
-        Its features at each value.
-    steps : int
-        Points per interval.
-
-    Returns
-    -------
-    (numpy.ndarray, numpy.ndarray)
-    """
-    values = np.asarray(values, dtype=float)
-    if values.size < 2:
-        return values, table
-    u = np.log(values) if np.all(values > 0) else values
-    out_u, out_t = [], []
-    for i in range(values.size - 1):
-        for t in np.arange(steps) / steps:
-            out_u.append(u[i] + t * (u[i + 1] - u[i]))
-            out_t.append(table[i] + t * (table[i + 1] - table[i]))
-    out_u.append(u[-1])
-    out_t.append(table[-1])
-    back = np.exp(out_u) if np.all(values > 0) else np.asarray(out_u)
-    return back, np.asarray(out_t)
-
-
 def _record_rows(record, machine, seg_s, max_segments):
     x = record.signal
     spans = segments(x.size, record.fs_hz, seg_s, max_segments)
@@ -214,85 +153,6 @@ def _record_rows(record, machine, seg_s, max_segments):
                                record.model_frequencies(), list(machine.rig.bearing_names),
                                scale, bands=BAND_FAMILIES)
     return names, rows
-
-
-def compared_columns(names, lib, fit, held):
-    """The features a record and its machine's library are compared on: read by both,
-    finite in the record's fit and held-out rows and in the baseline's mean, one of each set
-    of identical record columns (the two shafts of a 1:1 rig read alike).
-
-    Parameters
-    ----------
-    names : sequence of str
-        The record's feature names (the columns of ``fit`` and ``held``).
-    lib : SignatureLibrary
-    fit, held : numpy.ndarray, shape (segments, len(names))
-        The record's fit and held-out segment rows.
-
-    Returns
-    -------
-    (numpy.ndarray, numpy.ndarray, list of str)
-        Library columns, record columns and the names compared.
-    """
-    li, ri, seen = [], [], []
-    for j, k in enumerate(names):
-        if k not in lib.names:
-            continue
-        i = lib.column(k)
-        col = np.concatenate([fit[:, j], held[:, j]])
-        if not (np.any(np.isfinite(fit[:, j])) and np.any(np.isfinite(held[:, j]))
-                and math.isfinite(lib.mean[i])):
-            continue
-        if any(np.array_equal(col, c, equal_nan=True) for c in seen):
-            continue
-        seen.append(col)
-        li.append(i)
-        ri.append(j)
-    return (np.array(li, dtype=int), np.array(ri, dtype=int), [lib.names[i] for i in li])
-
-
-def feature_sigma(lib, li, names, n_fit):
-    """σ of each compared feature (module docstring, step 2).
-
-    Parameters
-    ----------
-    lib : SignatureLibrary
-        The machine's library.
-    li : numpy.ndarray of int
-        The compared features' columns in the library.
-    names : sequence of str
-        Their names.
-    n_fit : int
-        Segments the record's mean is taken over.
-
-    Returns
-    -------
-    numpy.ndarray
-    """
-    return sigma_of(lib.spread[li], lib.realisation[li], names, n_fit, lib.segments)
-
-
-def sigma_of(spread, realisation, names, n_fit, n_baseline):
-    """σ of features against a baseline (module docstring, step 2), from the baseline's
-    segment-to-segment ``spread``, the ``realisation`` spread (run to run) and the judge's
-    floor: spread²·(1/n_fit + 1/n_baseline) + realisation² + floor² (NaN spreads count 0).
-
-    Parameters
-    ----------
-    spread, realisation : numpy.ndarray
-        Per feature.
-    names : sequence of str
-        Their names (the floor is the feature kind's).
-    n_fit, n_baseline : int
-        Segments the record's and the baseline's means are taken over.
-
-    Returns
-    -------
-    numpy.ndarray
-    """
-    floor = np.array([FLOOR_SHARE * feature_floor(k) for k in names])
-    return np.sqrt(np.nan_to_num(spread) ** 2 * (1.0 / max(n_fit, 1) + 1.0 / n_baseline)
-                   + np.nan_to_num(realisation) ** 2 + floor ** 2)
 
 
 def standing_out(features, meas, reference, sigma, names):

@@ -14,9 +14,9 @@ import numpy as np
 
 from cmsim.discrepancy.causes import CAUSES
 from cmsim.discrepancy.evaluator import weight
+from cmsim.discrepancy.columns import chi2_rows, compared_columns, feature_sigma, interpolated
 from cmsim.discrepancy.judge import (ALARM_Z, INTERPOLATION_STEPS, NONE_CHI2_PER_FEATURE,
-                                     chi2_rows, compared_columns, decide_record,
-                                     feature_sigma, interpolated)
+                                     decide_record)
 from cmsim.errors import ParameterError
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine.calibration import feature_rows
@@ -89,8 +89,8 @@ def detectability(machine, causes=None):
 def baseline_consistency(machine):
     """The machine's baseline judged against itself, as a record is judged: the mean of its
     odd segments against the mean of its even ones, with the comparison's σ
-    (:func:`~cmsim.discrepancy.judge.feature_sigma`) and χ²
-    (:func:`~cmsim.discrepancy.judge.chi2_rows`). A baseline whose halves differ by
+    (:func:`~cmsim.discrepancy.columns.feature_sigma`) and χ²
+    (:func:`~cmsim.discrepancy.columns.chi2_rows`). A baseline whose halves differ by
     more than a record may before it departs (χ² per feature over
     :data:`~cmsim.discrepancy.judge.NONE_CHI2_PER_FEATURE`, or a feature
     :data:`~cmsim.discrepancy.judge.ALARM_Z` σ off) is not stationary: healthy records of

@@ -14,7 +14,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cmsim.discrepancy.judge import (FAMILY_RISE_DB, decide_record, feature_sigma)
+from cmsim.discrepancy.columns import feature_sigma
+from cmsim.discrepancy.judge import FAMILY_RISE_DB, decide_record
 from cmsim.machine.library import SignatureEntry, SignatureLibrary
 
 NAMES = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "kurtosis_log", "crest_log",
