@@ -136,9 +136,10 @@ def feature_sigma(lib, li, names, n_fit):
 
 
 def sigma_of(spread, realisation, names, n_fit, n_baseline):
-    """σ of features against a baseline (:mod:`cmsim.discrepancy.judge`, step 2), from the baseline's
-    segment-to-segment ``spread``, the ``realisation`` spread (run to run) and the judge's
-    floor: spread²·(1/n_fit + 1/n_baseline) + realisation² + floor² (NaN spreads count 0).
+    """σ of features against a baseline (:mod:`cmsim.discrepancy.judge`, step 2), from the
+    baseline's segment-to-segment ``spread``, the ``realisation`` spread (run to run) and the
+    judge's floor: spread²·(1/n_fit + 1/n_baseline) + realisation² + floor² (NaN spreads
+    count 0).
 
     Parameters
     ----------
