@@ -295,18 +295,19 @@ def path_ratio(freq, grid, power, factor, octave):
 MESH_REGION_ORDERS = 4.0
 
 
-def shaft_locked(freq, psd, change):
+def shaft_locked(freq, lines, change):
     """The bins of a baseline's spectrum that are locked to the shafts, not its broadband
-    (a moved path keeps their locked power and moves only the broadband under them):
-    every line it has (:func:`~cmsim.spectra.line_detector.detect_lines`, however many) and,
-    on a gear rig, each mesh harmonic (``change.pin_hz``) with :data:`MESH_REGION_ORDERS`
-    orders of the faster shaft on each side (its sidebands, smeared by the speed's wobble,
-    which the floor's running median reads as broadband).
+    (a moved path keeps their locked power and moves only the broadband under them): its
+    ``lines`` and, on a gear rig, each mesh harmonic (``change.pin_hz``) with
+    :data:`MESH_REGION_ORDERS` orders of the faster shaft on each side (its sidebands,
+    smeared by the speed's wobble, which the floor's running median reads as broadband).
 
     Parameters
     ----------
-    freq, psd : numpy.ndarray
-        The baseline's PSD and its frequencies, Hz.
+    freq : numpy.ndarray
+        The baseline's PSD frequencies, Hz.
+    lines : sequence of DetectedLine
+        Its lines (:func:`~cmsim.spectra.line_detector.detect_lines`).
     change : Change
         Its mesh harmonics and shaft rates.
 
@@ -315,7 +316,7 @@ def shaft_locked(freq, psd, change):
     numpy.ndarray of bool
     """
     out = np.zeros(freq.size, dtype=bool)
-    for ln in detect_lines(freq, psd, max_lines=freq.size)[0]:
+    for ln in lines:
         out[ln.bins] = True
     reach = MESH_REGION_ORDERS * max(change.shaft_hz, change.input_hz)
     for f in change.pin_hz:
@@ -369,8 +370,7 @@ def apply_change(machine, segments, change, rng):
         for ln in found:
             base_lines[ln.bins] = True
     if a != 1.0:
-        locked = (shaft_locked(freq, psd_b, change)
-                  if change.structure == "floor" or not change.lines_follow_path else None)
+        locked = shaft_locked(freq, found, change)
         broadband = floor_b
         if change.structure == "floor":     # the structure read where the floor is broadband
             broadband = np.exp(np.interp(freq, freq[~locked], np.log(floor_b[~locked])))
