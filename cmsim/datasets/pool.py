@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import gc
 import multiprocessing
 import numbers
 import operator
@@ -286,8 +287,9 @@ def _run_pool(fn, tasks, done, n_workers, method):
     pool = process_pool(n_workers, method)
     futures, delivered = {}, set()
     try:
-        for key, args in tasks:
-            futures[pool.submit(fn, *args)] = (key, args)
+        with _frozen_for_fork(method):
+            for key, args in tasks:
+                futures[pool.submit(fn, *args)] = (key, args)
         remaining = set(futures)
         while remaining:
             finished, remaining = wait(remaining, return_when=FIRST_COMPLETED)
@@ -305,6 +307,28 @@ def _run_pool(fn, tasks, done, n_workers, method):
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
     return [futures[f] for f in futures if f not in delivered]
+
+
+@contextlib.contextmanager
+def _frozen_for_fork(method):
+    """While the pool forks its workers (at its first task), every object of this process
+    is moved out of the garbage collector's reach (:func:`gc.freeze`), then handed back.
+
+    A forked worker starts with a copy of this process's objects (numba, numpy, scipy and
+    the caches: about 190 000 of them). Left tracked, each of the worker's full collections
+    walks them all, and writing their collector headers copies their pages: about 2 % of a
+    dataset record's CPU and 15 % of a worker's page faults (``cmsim dataset``, 400 gear
+    records). Frozen, the worker collects only what it made; this process keeps collecting
+    as before.
+    """
+    if method != "fork":
+        yield
+        return
+    gc.freeze()
+    try:
+        yield
+    finally:
+        gc.unfreeze()
 
 
 def _deliver_finished(futures, delivered, done):
