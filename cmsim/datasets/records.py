@@ -235,14 +235,18 @@ def _machine_references(spec, todo, batch_size):
 #: Most records a dataset integrates together by default (:func:`default_batch_size`): B runs
 #: in one time loop, the record the inner array axis (:mod:`cmsim.dynamics.batch`). Measured
 #: on the 2-core build machine (docs/benchmarks.md): a record of the paper rig costs, in CPU,
-#: 0.77 of its cost alone in a batch of 32 and 0.69-0.74 in one of 64 (8: 1.14-1.19).
-BATCH_SIZE = 64
+#: 0.77 of its cost alone in a batch of 32 and 0.69-0.74 in one of 64 (8: 1.14-1.19); a batch
+#: itself costs about 6.7 µs a step whatever its size, so 400 gear records in batches of at
+#: most 128 (of 124, 124, 78 and 75 records) took 0.98 of the CPU of batches of at most 64
+#: (of 62 and 38-39; in-process, 281 records: 0.98 as well).
+BATCH_SIZE = 128
 #: Samples (duration × sample rate) a default batch holds at most: a batch's arrays grow
 #: with it (64 one-second records at 25.6 kHz of the paper rig peaked at 0.53 GiB in one
 #: process, 0.30 before the batch, each record keeping only the columns its channels read:
-#: 0.87 when every record kept every state), so 64 such records, and fewer of longer or
-#: faster ones, keep a worker well under 1 GiB.
-BATCH_SAMPLES = 64 * 25_600
+#: 0.87 when every record kept every state; the 400-record gear spec's largest process at
+#: 0.64 GiB in batches of 124), so 128 such records, and fewer of longer or faster ones, keep
+#: a worker under 1 GiB.
+BATCH_SAMPLES = 128 * 25_600
 #: Smallest batch that pays (a batch of 16 costs 0.87-0.88 of its records alone, one of 8
 #: more than alone): a spec whose records would batch fewer keeps each record alone.
 BATCH_MIN = 16
