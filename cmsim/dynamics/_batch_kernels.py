@@ -39,7 +39,7 @@ from numba import njit
 
 from cmsim.dynamics._bearing_kernels import (BI_FAULTY, BI_NB, BI_T, BI_X, BI_Y, BP_C, BP_CAGE,
                                              BP_DAMP, BP_K, BP_P, BP_PHASE, BP_SENSE)
-from cmsim.dynamics._batch_mesh_kernels import _clamped_lookup, mesh_forces_batch_jit
+from cmsim.dynamics._batch_mesh_kernels import _grid_place, _read_at, mesh_forces_batch_jit
 from cmsim.dynamics._mesh_kernels import (MI_BALL_SLIP, MI_FAULTY_BALLS, MI_MODE, MI_ON,
                                           MI_PROFILE, MI_TDOF, MODE_TABLE, MP_JDT, MP_OMREF,
                                           MP_PDT, MP_PT0, mesh_forces_jit)
@@ -85,7 +85,10 @@ class BatchBuffers(NamedTuple):
     g1: np.ndarray        # (n,) its forces
     d1: np.ndarray        # (n_diag,) its output forces
     mesh: np.ndarray      # (R_SIZE, B) the tooth contacts' per-run values
-    slots: np.ndarray     # (slots, SG_SIZE, B) their per-slot geometry
+    slots: np.ndarray     # (slots, BS_SIZE, B) their per-slot geometry
+    slip_u: np.ndarray    # (B,) each run's place on its slip grid at this time
+    slip_i: np.ndarray    # (B,) int64 its interval
+    slip_f: np.ndarray    # (B,) its fraction of the interval
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -311,18 +314,24 @@ def _profiles(t, prof, mp, tdof, g, tau, sr, ar):
 
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _slip_batch(t, b_int, jitter, rows, ng, jdt, b_cos, b_sin, slip_cos, slip_sin, cage_slip,
-                balls):
+                balls, ju, ji, jf):
     """Every run's cage slip angles ``cage_slip`` (nb, B) at time ``t`` and, with ``balls``,
     its balls' offsets with slip ``slip_cos``, ``slip_sin`` (nb, max_balls, B) (as
     :func:`cmsim.dynamics._bearing_kernels.slip_offsets_jit` and ``cage_slip_jit`` run by
     run). ``jitter`` is the runs' slip grids flat ((B, nb, rows, ng) run first, rows =
-    max_balls + 1, the cage last), ``jdt`` (B,) their spacing."""
+    max_balls + 1, the cage last), ``jdt`` (B,) their spacing; ``ju``, ``ji``, ``jf`` (B,)
+    scratch for each run's place on its grids."""
     nb = b_int.shape[0]
+    # every grid of a run is read at one place: found once (the same numbers as a lookup
+    # each)
+    for l in range(ju.shape[0]):
+        ju[l] = t / jdt[l]
+        ji[l], jf[l] = _grid_place(ju[l], ng)
     for ib in range(nb):
         cs = cage_slip[ib]
         for l in range(cs.shape[0]):
-            cs[l] = _clamped_lookup(jitter, ((l * nb + ib) * rows + rows - 1) * ng, ng,
-                                    t / jdt[l])
+            cs[l] = _read_at(jitter, ((l * nb + ib) * rows + rows - 1) * ng, ng, ju[l], ji[l],
+                             jf[l])
         if not balls:
             continue
         for i in range(b_int[ib, BI_NB]):
@@ -331,7 +340,7 @@ def _slip_batch(t, b_int, jitter, rows, ng, jdt, b_cos, b_sin, slip_cos, slip_si
             oc = slip_cos[ib, i]
             os_ = slip_sin[ib, i]
             for l in range(cs.shape[0]):
-                j = _clamped_lookup(jitter, ((l * nb + ib) * rows + i) * ng, ng, t / jdt[l])
+                j = _read_at(jitter, ((l * nb + ib) * rows + i) * ng, ng, ju[l], ji[l], jf[l])
                 j2 = j * j
                 cj = 1.0 - j2 * (0.5 - j2 * (1.0 / 24.0))
                 sj = j * (1.0 - j2 * (1.0 / 6.0 - j2 * (1.0 / 120.0)))
@@ -358,7 +367,7 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
     if slip:
         _slip_batch(t, S.b_int[0], S.jitter.reshape(-1), S.jitter.shape[2], S.jitter.shape[3],
                     L.m_par[MP_JDT], L.b_cos, L.b_sin, V.slip_cos, V.slip_sin, V.cage_slip,
-                    moved)
+                    moved, B.slip_u, B.slip_i, B.slip_f)
     if S.b_int.shape[1] > 0:
         if moved:
             _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, V.slip_cos, V.slip_sin)

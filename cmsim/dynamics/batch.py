@@ -119,7 +119,8 @@ def _integrate_batch(setups, chunk_steps=BATCH_CHUNK_STEPS):
                      y0, np.zeros((n_diag, n_runs)),
                      *(np.zeros(n_runs) for _ in range(11)), np.zeros(dim),
                      np.zeros(dim // 2), np.zeros(n_diag), np.zeros((R_SIZE, n_runs)),
-                     np.zeros((max(int(S.m_int[0, MI_SLOTS]), 1), BS_SIZE, n_runs)))
+                     np.zeros((max(int(S.m_int[0, MI_SLOTS]), 1), BS_SIZE, n_runs)),
+                     np.zeros(n_runs), np.zeros(n_runs, dtype=np.int64), np.zeros(n_runs))
     max_disp = np.array([max_displacement_m(m) for m in models])
     status = np.full(n_runs, -1, dtype=np.int64)
     h = 1.0 / (first.fs_hz * first.substeps)
