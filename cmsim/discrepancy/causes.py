@@ -153,6 +153,11 @@ class Cause:
     #: record, on features it does not raise, this fault is named
     #: (:mod:`cmsim.discrepancy.judge`).
     absorbs: typing.ClassVar[tuple] = ()
+    #: Features of its family on which its change adds a component at its own phase to one
+    #: the machine already has (a mass turning off-centre adds a once-per-revolution force to
+    #: the rotor's residual unbalance): the sum moves either way, so there the record stands
+    #: out of a reshaping cause's prediction downwards as well as upwards (:attr:`absorbs`).
+    either_way: typing.ClassVar[tuple] = ()
     #: It moves the structure's frequencies (a sensor remounted, a housing changed): against
     #: a machine, where the structure's response is read and whether the baseline's lines
     #: move with it are a nuisance profiled (``structure`` and ``lines_follow_path`` of
@@ -298,6 +303,7 @@ class EccentricityCause(Cause):
     #: sidebands under 2 dB up to 0.15 mm), while its mass turning off-centre lifts the
     #: once-per-revolution line, which a speed fluctuation lowers.
     absorbs = ("speed_fluctuation",)
+    either_way = ("raw_fr_h1_db",)
 
     def apply(self, setup, value, component):
         return setup.with_faults(Eccentricity(gear=_gear_index(component), amplitude_m=value))

@@ -51,7 +51,9 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`: an eccentric gear's run-out modulates
       the mesh as a speed fluctuation does) where that fault's family stands out over the
       reshaping cause's prediction on a feature it does not raise (the once-per-revolution
-      line an eccentric gear's mass lifts and a speed fluctuation lowers); its size is read
+      line an eccentric gear's mass lifts and a speed fluctuation lowers), or either way
+      where the fault adds to what the machine has at its own phase (that mass's force to
+      the rotor's residual unbalance: the line falls as well as rises); its size is read
       with its change laid beside the reshaping cause's.
    b. *A family that stands out.* Where no cause reads the whole record (a real machine
       rings a spall's impacts at a resonance its healthy baseline never showed, which the
@@ -377,7 +379,9 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
     """The fault whose own change holds the reshaping cause ``top``'s
     (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`) and whose family stands out where
     ``top``'s prediction leaves the record — :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB`
-    over it, on a feature ``top`` does not raise; else None. Of such faults on several
+    over it, on a feature ``top`` does not raise, or either way on a feature where the fault
+    adds to what the machine has at its own phase
+    (:attr:`~cmsim.discrepancy.causes.Cause.either_way`); else None. Of such faults on several
     components, the one on the sensor's shaft (the shaft-order lines that stand out are
     its). Its prediction is ``top``'s with the fault's own change on the features of its
     family ``top`` does not raise (its size read there), and the row says what it was read
@@ -392,6 +396,10 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
             continue
         out = [i for i in standing_out([names.index(k) for k in r["family"]], meas, pred,
                                        sigma, names) if raised[i] <= 0.0]
+        # where its change adds to a component the machine has at its own phase, the record
+        # departs downwards too (the prediction standing out over the record)
+        out += standing_out([names.index(k) for k in r["family"]
+                             if k in r["cause"].either_way], pred, meas, sigma, names)
         if out:     # a component's name starts with its shaft's number ("1G1", "1b1")
             found.append((r["component"] is None or r["component"][0] != sensor_bearing[0],
                           r["chi2"], r, out))
