@@ -9,8 +9,8 @@ caller)::
     perf record -F 2999 -o /tmp/batch.perf -- python benchmarks/profile_batch_kernel.py run
     python benchmarks/profile_batch_kernel.py report /tmp/batch.perf
 
-``run`` simulates records of ``datasets/gear_faults.toml`` (``--records`` of each fault
-kind, in batches of ``--batch``) in this process; ``report`` prints the share of all samples
+``run`` simulates records of ``datasets/gear_faults.toml`` (``--records`` of each kernel
+layout, in batches of ``--batch``) in this process; ``report`` prints the share of all samples
 per kernel function and per other library (libm, libpython, the kernel ...). Needs Linux
 ``perf`` and binutils' ``nm``.
 """
@@ -20,11 +20,12 @@ from __future__ import annotations
 import argparse
 import bisect
 import collections
-import glob
 import json
+import os
 import re
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -53,30 +54,37 @@ def _run(args):
     print(f"{ENTRY} loaded at {address:#x} (written to {args.address})")
 
 
-def _kernel_symbols():
-    """``[(offset, short name)]`` of the cached batch kernel's functions, sorted."""
-    cached = sorted(glob.glob(str(ROOT / "cmsim" / "dynamics" / "__pycache__" /
-                                  f"_batch_kernels.{ENTRY}-*.nbc")))
-    if not cached:
-        sys.exit("no cached batch kernel: run `... profile_batch_kernel.py run` first")
-    data = Path(cached[-1]).read_bytes()
-    obj = Path("/tmp") / "cmsim_batch_kernel.o"
-    obj.write_bytes(data[data.find(b"\x7fELF"):])
-    out = subprocess.run(["nm", "--defined-only", str(obj)], capture_output=True, text=True,
-                         check=True).stdout
-    symbols = []
-    for line in out.splitlines():
-        parts = line.split()
-        if len(parts) == 3 and parts[1] in "TtWw":
-            m = re.search(r"\d(_[a-z_]+_kernels)\d+([A-Za-z_]+?)B\d", parts[2])
-            symbols.append((int(parts[0], 16), f"{m.group(1)}.{m.group(2)}" if m else
-                            parts[2][:60], parts[2]))
-    return sorted(symbols)
+def _kernel_symbols(entry_symbol):
+    """``[(offset, short name, symbol)]`` of the functions of the cached object file that
+    holds ``entry_symbol`` (the loaded batch kernel), sorted: every ``.nbc`` of the kernel
+    in the source tree's ``__pycache__`` and under ``NUMBA_CACHE_DIR`` is looked at."""
+    roots = [ROOT / "cmsim" / "dynamics" / "__pycache__"]
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        roots.append(Path(os.environ["NUMBA_CACHE_DIR"]))
+    cached = [p for root in roots for p in root.rglob(f"_batch_kernels.{ENTRY}-*.nbc")]
+    for path in cached:
+        data = path.read_bytes()
+        with tempfile.NamedTemporaryFile(suffix=".o") as obj:
+            obj.write(data[data.find(b"\x7fELF"):])
+            obj.flush()
+            out = subprocess.run(["nm", "--defined-only", obj.name], capture_output=True,
+                                 text=True, check=True).stdout
+        symbols = []
+        for line in out.splitlines():
+            parts = line.split()
+            if len(parts) == 3 and parts[1] in "TtWw":
+                m = re.search(r"\d(_[a-z_]+_kernels)\d+([A-Za-z_]+?)B\d", parts[2])
+                symbols.append((int(parts[0], 16), f"{m.group(1)}.{m.group(2)}" if m else
+                                parts[2][:60], parts[2]))
+        if any(full == entry_symbol for _, _, full in symbols):
+            return sorted(symbols)
+    sys.exit(f"no cached batch kernel holds {entry_symbol[:60]}...: run "
+             f"`... profile_batch_kernel.py run` again")
 
 
 def _report(args):
     loaded = json.loads(Path(args.address).read_text())
-    symbols = _kernel_symbols()
+    symbols = _kernel_symbols(loaded["symbol"])
     entry = next(off for off, _, full in symbols if full == loaded["symbol"])
     offsets = [s[0] for s in symbols]
     script = subprocess.run(["perf", "script", "-i", args.data, "-F", "ip,dso"],
@@ -104,7 +112,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="step", required=True)
     run = sub.add_parser("run")
-    run.add_argument("--records", type=int, default=124, help="records of each fault kind")
+    run.add_argument("--records", type=int, default=124,
+                     help="records of each kernel layout (fault kinds that share a batch)")
     run.add_argument("--batch", type=int, default=128)
     run.add_argument("--address", default=f"/tmp/{ADDRESS_FILE}")
     report = sub.add_parser("report")

@@ -15,8 +15,9 @@ Interruptions
 Processes
     On Linux the pool forks (``start_method="fork"``) after the caller has loaded the numba
     kernels, so workers start at once and do not compile; elsewhere it spawns. A worker
-    exits on its own when its parent disappears (a killed run leaves no orphans), and keeps
-    the memory its tasks free for the next one (:func:`keep_freed_memory`).
+    exits on its own when its parent disappears (a killed run leaves no orphans), keeps
+    the memory its tasks free for the next one (:func:`keep_freed_memory`), and its garbage
+    collector leaves the objects it was forked with alone (:func:`_frozen_for_fork`).
 """
 
 from __future__ import annotations
@@ -318,10 +319,11 @@ def _frozen_for_fork(method):
     the caches: about 190 000 of them). Left tracked, each of the worker's full collections
     walks them all, and writing their collector headers copies their pages: about 2 % of a
     dataset record's CPU and 15 % of a worker's page faults (``cmsim dataset``, 400 gear
-    records). Frozen, the worker collects only what it made; this process keeps collecting
-    as before.
+    records). Frozen, the worker collects only what it made; this process collects them
+    all again afterwards (in its oldest generation). A process that froze objects itself
+    is left as it is (its workers inherit that freeze).
     """
-    if method != "fork":
+    if method != "fork" or gc.get_freeze_count() > 0:
         yield
         return
     gc.freeze()

@@ -44,7 +44,7 @@ from cmsim.run import Run
 from cmsim.sensors import add_sensors
 
 __all__ = ["simulate_record", "simulate_records", "run_record", "run_records",
-           "BATCH_SIZE", "BATCH_SAMPLES", "BATCH_MIN", "BATCH_FROM_RECORDS",
+           "BATCH_SIZE", "BATCH_SAMPLES", "BATCH_SAMPLES_FULL", "BATCH_MIN", "BATCH_FROM_RECORDS",
            "default_batch_size", "base_row",
            "manifest_features", "FEATURE_SIGNALS",
            "FORMAT"]
@@ -237,16 +237,18 @@ def _machine_references(spec, todo, batch_size):
 #: on the 2-core build machine (docs/benchmarks.md): a record of the paper rig costs, in CPU,
 #: 0.77 of its cost alone in a batch of 32 and 0.69-0.74 in one of 64 (8: 1.14-1.19); a batch
 #: itself costs about 6.7 µs a step whatever its size, so 400 gear records in batches of at
-#: most 128 (of 124, 124, 78 and 75 records) took 0.98 of the CPU of batches of at most 64
-#: (of 62 and 38-39; in-process, 281 records: 0.98 as well).
+#: most 128 (of 124, 123, 78 and 75 records) took 0.98 of the CPU of batches of at most 64
+#: (of 61-62 and 37-39; in-process, 281 records: 0.98 as well).
 BATCH_SIZE = 128
-#: Samples (duration × sample rate) a default batch holds at most: a batch's arrays grow
-#: with it (64 one-second records at 25.6 kHz of the paper rig peaked at 0.53 GiB in one
-#: process, 0.30 before the batch, each record keeping only the columns its channels read:
-#: 0.87 when every record kept every state; the 400-record gear spec's largest process at
-#: 0.64 GiB in batches of 124), so 128 such records, and fewer of longer or faster ones, keep
-#: a worker under 1 GiB.
+#: Samples (duration × sample rate) a default batch holds at most where each record keeps
+#: only the columns its channels read: a batch's arrays grow with it (64 one-second records
+#: at 25.6 kHz of the paper rig peaked at 0.53 GiB in one process, 0.30 before the batch; the
+#: 400-record gear spec's largest process at 0.64 GiB in batches of 124), so 128 such
+#: records, and fewer of longer or faster ones, keep a worker under 1 GiB.
 BATCH_SAMPLES = 128 * 25_600
+#: The same where each record keeps its whole run (a spec without channels: every state and
+#: force, 64 one-second records peaked at 0.87 GiB).
+BATCH_SAMPLES_FULL = 64 * 25_600
 #: Smallest batch that pays (a batch of 16 costs 0.87-0.88 of its records alone, one of 8
 #: more than alone): a spec whose records would batch fewer keeps each record alone.
 BATCH_MIN = 16
@@ -257,7 +259,8 @@ BATCH_FROM_RECORDS = 64
 
 def default_batch_size(spec):
     """Records of ``spec`` integrated together when no batch size is given: up to
-    :data:`BATCH_SIZE`, as many as :data:`BATCH_SAMPLES` allows, for a spec of at least
+    :data:`BATCH_SIZE`, as many as :data:`BATCH_SAMPLES` allows (:data:`BATCH_SAMPLES_FULL`
+    for records that keep their whole run), for a spec of at least
     :data:`BATCH_FROM_RECORDS` records whose tooth contact is not the on-line hybrid solve
     (the batch kernel runs that record by record); 1 (each record alone on the single-run
     kernel) otherwise, and where fewer than :data:`BATCH_MIN` would fit.
@@ -279,7 +282,8 @@ def default_batch_size(spec):
     hybrid = spec.mesh == "hybrid" or isinstance(spec.mesh, HybridMeshModel)
     if spec.n_records < BATCH_FROM_RECORDS or hybrid:
         return 1
-    size = min(BATCH_SIZE, int(BATCH_SAMPLES // (spec.duration_s * spec.fs_hz)))
+    samples = BATCH_SAMPLES if spec.channels is not None else BATCH_SAMPLES_FULL
+    size = min(BATCH_SIZE, int(samples // (spec.duration_s * spec.fs_hz)))
     return size if size >= BATCH_MIN else 1
 
 

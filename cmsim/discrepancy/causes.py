@@ -300,8 +300,10 @@ class EccentricityCause(Cause):
     #: Its run-out modulates the mesh once per revolution; how much depends on the gears'
     #: stiffness and the load's inertia, which a calibrated machine does not know (the
     #: model's own modulation, through the contact geometry of a light output, lifts the
-    #: sidebands under 2 dB up to 0.15 mm), while its mass turning off-centre lifts the
-    #: once-per-revolution line, which a speed fluctuation lowers.
+    #: sidebands under 2 dB up to 0.15 mm), while its mass turning off-centre adds a
+    #: once-per-revolution force to the rotor's residual unbalance at its own phase: the 1×
+    #: line rises (a speed fluctuation lowers it) or, against that unbalance, falls further
+    #: than any speed fluctuation lowers it.
     absorbs = ("speed_fluctuation",)
     either_way = ("raw_fr_h1_db",)
 

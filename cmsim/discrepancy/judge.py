@@ -379,17 +379,24 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
     """The fault whose own change holds the reshaping cause ``top``'s
     (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`) and whose family stands out where
     ``top``'s prediction leaves the record — :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB`
-    over it, on a feature ``top`` does not raise, or either way on a feature where the fault
-    adds to what the machine has at its own phase
+    over it, on a feature ``top`` does not raise, or under the least ``top`` leaves at any
+    size that reads the record as well (its ``range``), on a feature where the fault adds to
+    what the machine has at its own phase
     (:attr:`~cmsim.discrepancy.causes.Cause.either_way`); else None. Of such faults on several
     components, the one on the sensor's shaft (the shaft-order lines that stand out are
     its). Its prediction is ``top``'s with the fault's own change on the features of its
-    family ``top`` does not raise (its size read there), and the row says what it was read
-    beside (``"beside"``)."""
+    family ``top`` does not raise (its size read there, not on a feature that fell), and the
+    row says what it was read beside (``"beside"``)."""
     if top["cause"].signature is not None:
         return None
     pred = top["prediction"]
     raised = pred - base
+    # the least ``top`` leaves on each feature at the sizes that read the record as well as
+    # its best (within RANGE_DELTA_CHI2: its ``range``)
+    lo, hi = top["range"]
+    lowest = np.min([pred] + [table[(values >= lo) & (values <= hi)].min(axis=0, initial=np.inf)
+                              for _, values, table in
+                              tables.get((top["name"], top["component"]), [])], axis=0)
     found = []
     for r in rows:
         if top["name"] not in r["cause"].absorbs:
@@ -397,18 +404,21 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
         out = [i for i in standing_out([names.index(k) for k in r["family"]], meas, pred,
                                        sigma, names) if raised[i] <= 0.0]
         # where its change adds to a component the machine has at its own phase, the record
-        # departs downwards too (the prediction standing out over the record)
-        out += standing_out([names.index(k) for k in r["family"]
-                             if k in r["cause"].either_way], pred, meas, sigma, names)
-        if out:     # a component's name starts with its shaft's number ("1G1", "1b1")
+        # departs downwards too: below the least ``top`` leaves there at any size that reads
+        # the record as well
+        fell = standing_out([names.index(k) for k in r["family"]
+                             if k in r["cause"].either_way], lowest, meas, sigma, names)
+        if out or fell:     # a component's name starts with its shaft's number ("1G1", "1b1")
             found.append((r["component"] is None or r["component"][0] != sensor_bearing[0],
-                          r["chi2"], r, out))
+                          r["chi2"], r, out + fell, fell))
     if not found:
         return None
-    _, _, r, out = min(found, key=lambda f: f[:2])
+    _, _, r, out, fell = min(found, key=lambda f: f[:2])
     # the fault's change on its family where the reshaping cause does not raise it, the
-    # reshaping cause's elsewhere (its size read there)
-    own = np.array([k in r["family"] and raised[i] <= 0.0 for i, k in enumerate(names)])
+    # reshaping cause's elsewhere (its size read there; not on a feature that fell, which
+    # the fault's change, adding at an unknown phase, is no reading of)
+    own = np.array([k in r["family"] and raised[i] <= 0.0 and i not in fell
+                    for i, k in enumerate(names)])
     best = None
     for e, values, table in tables[(r["name"], r["component"])]:
         both = pred[None, :] + np.where(own, table - base[None, :], 0.0)

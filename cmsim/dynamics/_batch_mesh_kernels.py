@@ -64,11 +64,10 @@ from cmsim.mesh_stiffness._kernels import mesh_line_jit, pair_contact_jit
  R_CP2, R_SP2) = range(29)
 R_SIZE = 29
 # columns of ``sg`` after the single-run kernel's SG_* ones: the slot's teeth, corner contact
-# flag, overlap, radii of curvature, the path tables' damping and friction coefficients, and
-# the pair's normal force, its force on gear 2 and its moments on both gears
-(BS_K1, BS_K2, BS_CORNER, BS_DELTA, BS_CHI1, BS_CHI2, BS_CPAIR, BS_MU, BS_FN, BS_F2X, BS_F2Y,
- BS_M1, BS_M2) = range(SG_SIZE, SG_SIZE + 13)
-BS_SIZE = SG_SIZE + 13
+# flag, overlap, radii of curvature, and the path tables' damping and friction coefficients
+(BS_K1, BS_K2, BS_CORNER, BS_DELTA, BS_CHI1, BS_CHI2, BS_CPAIR, BS_MU) = range(SG_SIZE,
+                                                                          SG_SIZE + 8)
+BS_SIZE = SG_SIZE + 8
 
 
 
@@ -102,8 +101,9 @@ def _clamped_lookup(a, i0, m, u):
     whole and fractional parts), ``a[i0]`` for ``u <= 0`` and ``a[i0 + m − 1]`` for ``u >=
     m − 1``, as :func:`cmsim.mesh_stiffness._kernels.table_lookup2_jit` returns them; branch
     free (the index clamped, the ends selected), so a loop over runs vectorises. ``a`` is
-    flat, ``m`` >= 2. Several tables of one length read at one ``u``: :func:`_grid_place`
-    once, then :func:`_read_at` each (the same numbers)."""
+    flat, ``m`` >= 2. Many tables of one length read at one ``u`` in separate loops (the
+    slip grids of every ball): :func:`_grid_place` once, then :func:`_read_at` each (the
+    same numbers; within one loop LLVM finds the common place itself)."""
     i, f = _grid_place(u, m)
     return _read_at(a, i0, m, u, i, f)
 
@@ -418,19 +418,17 @@ def _slot_loads(z1, z2, mp, sg, teeth_on, m_t, tk1, te1, tk2, te2, m_tab, tab_k,
             if teeth_on:
                 k1 = _tooth_index(k1r[l], z1)
                 k2 = _tooth_index(k2r[l], z2)
-                i, f = _grid_place(u, m_t)
-                fa = _read_at(tk1, (l * z1 + k1) * m_t, m_t, u, i, f)
-                ea = _read_at(te1, (l * z1 + k1) * m_t, m_t, u, i, f)
-                fb = _read_at(tk2, (l * z2 + k2) * m_t, m_t, u, i, f)
-                eb = _read_at(te2, (l * z2 + k2) * m_t, m_t, u, i, f)
+                fa = _clamped_lookup(tk1, (l * z1 + k1) * m_t, m_t, u)
+                ea = _clamped_lookup(te1, (l * z1 + k1) * m_t, m_t, u)
+                fb = _clamped_lookup(tk2, (l * z2 + k2) * m_t, m_t, u)
+                eb = _clamped_lookup(te2, (l * z2 + k2) * m_t, m_t, u)
                 f_teeth = fa * fb
                 delta -= ea + eb
             chi1 = chi1_r[l]
             chi2 = chi2_r[l]
             req_out[l] = chi1 * chi2 / (chi1 + chi2) if chi1 > 0.0 and chi2 > 0.0 else 0.0
-            i, f = _grid_place(u, m_tab)
-            k_pair = _read_at(tab_k, l * m_tab, m_tab, u, i, f)
-            e_pair = _read_at(tab_e, l * m_tab, m_tab, u, i, f)
+            k_pair = _clamped_lookup(tab_k, l * m_tab, m_tab, u)
+            e_pair = _clamped_lookup(tab_e, l * m_tab, m_tab, u)
             k_pair *= f_teeth
             overlap = delta - e_pair
             el_out[l] = k_pair * overlap if overlap > 0.0 else 0.0
@@ -454,111 +452,87 @@ def _path_table(col, mp, sg, table):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _pair_force(on, nx_r, ny_r, px_r, py_r, el_r, gap_r, kp_r, req_r, cp_r, mu_r, c1x, c1y,
-                c2x, c2y, w1, w2, u1x, u1y, u2x, u2y, beta, dthr, koster, mu_c, v0, ctab_on,
-                mutab_on, fn_out, f2x_out, f2y_out):
-    """One slot's normal force ``fn_out`` (with its damping; zero out of the zone) and the
-    force on gear 2 ``f2x_out``, ``f2y_out`` (normal and smoothed Coulomb friction) for every
-    run, as :func:`~cmsim.dynamics._mesh_kernels._apply_pair_forces` computes them. Plain
-    rows in, three rows out and no branch: a loop the vectoriser takes (a run out of the zone
-    computes on its stale values, and its force is then zero)."""
-    for l in range(on.shape[0]):
-        nx = nx_r[l]
-        ny = ny_r[l]
-        rx1 = px_r[l] - c1x[l]
-        ry1 = py_r[l] - c1y[l]
-        rx2 = px_r[l] - c2x[l]
-        ry2 = py_r[l] - c2y[l]
-        dvx = (u1x[l] - w1[l] * ry1) - (u2x[l] - w2[l] * ry2)
-        dvy = (u1y[l] + w1[l] * rx1) - (u2y[l] + w2[l] * rx2)
-        approach = dvx * nx + dvy * ny
-        elastic = el_r[l]
-        c_pair = cp_r[l] if ctab_on else beta[l] * kp_r[l]
-        fe = elastic + c_pair * approach
-        fe = 0.0 if fe < 0.0 else fe
-        gap = max(gap_r[l], dthr[l])
-        x = req_r[l] / (2.0 * gap)
-        fk = koster[l] * x * math.sqrt(x) * approach
-        fn = fe if elastic > 0.0 else (fk if approach > 0.0 else 0.0)
-        fn = fn if on[l] != 0.0 else 0.0
-        slide = dvx * ny - dvy * nx
-        mu = mu_r[l] if mutab_on else mu_c[l]
-        ff = mu * fn * slide / math.sqrt(slide * slide + v0[l] * v0[l])
-        fn_out[l] = fn
-        f2x_out[l] = fn * nx + ff * ny
-        f2y_out[l] = fn * ny - ff * nx
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _pair_moments(px_r, py_r, c1x, c1y, c2x, c2y, f2x, f2y, m1_out, m2_out):
-    """One slot's moments on both gears for every run (counter-clockwise positive; shaft-2
-    rotation counts clockwise): ``r × f₂`` from each gear's centre to the contact, taken
-    from the gear's moment."""
-    for l in range(px_r.shape[0]):
-        rx1 = px_r[l] - c1x[l]
-        ry1 = py_r[l] - c1y[l]
-        rx2 = px_r[l] - c2x[l]
-        ry2 = py_r[l] - c2y[l]
-        m1_out[l] = rx1 * f2y[l] - ry1 * f2x[l]
-        m2_out[l] = rx2 * f2y[l] - ry2 * f2x[l]
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _add_where_loaded(g_row, f, fn):
-    """``g_row += f`` for every run whose pair force ``fn`` is not zero (a run whose force is
-    zero keeps its value untouched, as the single-run kernel leaves it)."""
-    for l in range(g_row.shape[0]):
-        g_row[l] = g_row[l] + f[l] if fn[l] != 0.0 else g_row[l]
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _subtract_where_loaded(g_row, f, fn):
-    """``g_row −= f`` for every run whose pair force ``fn`` is not zero."""
-    for l in range(g_row.shape[0]):
-        g_row[l] = g_row[l] - f[l] if fn[l] != 0.0 else g_row[l]
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _copy_row(src, dst):
-    """``dst[:] = src`` (two rows of one length)."""
-    for l in range(src.shape[0]):
-        dst[l] = src[l]
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
 def _slot_forces(y, n, i1, i2, g, r, mp, sg, ctab_on, mutab_on, diag, want_diag):
     """Every slot's normal force with its damping and smoothed Coulomb friction, and their
     forces and moments on both gears, for every run, slot after slot (as
     :func:`~cmsim.dynamics._mesh_kernels._apply_pair_forces`: a run whose force is zero
-    keeps its forces untouched), in passes that each write a few rows (:func:`_pair_force`,
-    :func:`_pair_moments`, one pass per force row), so each vectorises. Columns
-    ``BS_CPAIR``, ``BS_MU`` hold the path tables' values where ``ctab_on``, ``mutab_on``."""
+    keeps its forces untouched). Columns ``BS_CPAIR``, ``BS_MU`` hold the path tables'
+    values where ``ctab_on``, ``mutab_on``."""
     c1x = r[R_C1X]
     c1y = r[R_C1Y]
     c2x = r[R_C2X]
     c2y = r[R_C2Y]
+    w1 = r[R_W1]
+    w2 = r[R_W2]
+    u1x = y[n + i1]
+    u1y = y[n + i1 + 1]
+    u2x = y[n + i2]
+    u2y = y[n + i2 + 1]
+    beta = mp[MP_BETA]
+    dthr = mp[MP_DTHR]
+    koster = mp[MP_KOSTER]
+    mu_c = mp[MP_MU]
+    v0 = mp[MP_V0]
+    g1x = g[i1]
+    g1y = g[i1 + 1]
+    g1t = g[i1 + 2]
+    g2x = g[i2]
+    g2y = g[i2 + 1]
+    g2t = g[i2 + 2]
     d0 = int(mp[MP_DIAGB, 0])
     for j in range(sg.shape[0]):
         sj = sg[j]
-        fn = sj[BS_FN]
-        f2x = sj[BS_F2X]
-        f2y = sj[BS_F2Y]
-        _pair_force(sj[SG_ON], sj[SG_NX], sj[SG_NY], sj[SG_PX], sj[SG_PY], sj[SG_ELASTIC],
-                    sj[SG_GAP], sj[SG_KPAIR], sj[SG_REQ], sj[BS_CPAIR], sj[BS_MU], c1x, c1y,
-                    c2x, c2y, r[R_W1], r[R_W2], y[n + i1], y[n + i1 + 1], y[n + i2],
-                    y[n + i2 + 1], mp[MP_BETA], mp[MP_DTHR], mp[MP_KOSTER], mp[MP_MU],
-                    mp[MP_V0], ctab_on, mutab_on, fn, f2x, f2y)
-        if want_diag:
-            _copy_row(fn, diag[d0 + j])
-        _pair_moments(sj[SG_PX], sj[SG_PY], c1x, c1y, c2x, c2y, f2x, f2y, sj[BS_M1],
-                      sj[BS_M2])
-        # force on gear 2: fn·n + ff·t; on gear 1: the opposite
-        _add_where_loaded(g[i2], f2x, fn)
-        _add_where_loaded(g[i2 + 1], f2y, fn)
-        _subtract_where_loaded(g[i1], f2x, fn)
-        _subtract_where_loaded(g[i1 + 1], f2y, fn)
-        _subtract_where_loaded(g[i1 + 2], sj[BS_M1], fn)
-        _subtract_where_loaded(g[i2 + 2], sj[BS_M2], fn)
+        on = sj[SG_ON]
+        nx_r = sj[SG_NX]
+        ny_r = sj[SG_NY]
+        px_r = sj[SG_PX]
+        py_r = sj[SG_PY]
+        el_r = sj[SG_ELASTIC]
+        gap_r = sj[SG_GAP]
+        kp_r = sj[SG_KPAIR]
+        req_r = sj[SG_REQ]
+        cp_r = sj[BS_CPAIR]
+        mu_r = sj[BS_MU]
+        d_out = diag[d0 + j]
+        for l in range(on.shape[0]):
+            if on[l] == 0.0:
+                # out of the zone: no force (the single-run kernel's zero), forces untouched
+                if want_diag:
+                    d_out[l] = 0.0
+                continue
+            nx = nx_r[l]
+            ny = ny_r[l]
+            rx1 = px_r[l] - c1x[l]
+            ry1 = py_r[l] - c1y[l]
+            rx2 = px_r[l] - c2x[l]
+            ry2 = py_r[l] - c2y[l]
+            dvx = (u1x[l] - w1[l] * ry1) - (u2x[l] - w2[l] * ry2)
+            dvy = (u1y[l] + w1[l] * rx1) - (u2y[l] + w2[l] * rx2)
+            approach = dvx * nx + dvy * ny
+            elastic = el_r[l]
+            c_pair = cp_r[l] if ctab_on else beta[l] * kp_r[l]
+            fe = elastic + c_pair * approach
+            fe = 0.0 if fe < 0.0 else fe
+            gap = max(gap_r[l], dthr[l])
+            x = req_r[l] / (2.0 * gap)
+            fk = koster[l] * x * math.sqrt(x) * approach
+            fn = fe if elastic > 0.0 else (fk if approach > 0.0 else 0.0)
+            if want_diag:
+                d_out[l] = fn
+            slide = dvx * ny - dvy * nx
+            mu = mu_r[l] if mutab_on else mu_c[l]
+            ff = mu * fn * slide / math.sqrt(slide * slide + v0[l] * v0[l])
+            # force on gear 2: fn·n + ff·t ; on gear 1: the opposite
+            f2x = fn * nx + ff * ny
+            f2y = fn * ny - ff * nx
+            loaded = fn != 0.0
+            g2x[l] = g2x[l] + f2x if loaded else g2x[l]
+            g2y[l] = g2y[l] + f2y if loaded else g2y[l]
+            g1x[l] = g1x[l] - f2x if loaded else g1x[l]
+            g1y[l] = g1y[l] - f2y if loaded else g1y[l]
+            # moments (counter-clockwise positive); shaft-2 rotation counts clockwise
+            g1t[l] = g1t[l] - (rx1 * f2y - ry1 * f2x) if loaded else g1t[l]
+            g2t[l] = g2t[l] - (rx2 * f2y - ry2 * f2x) if loaded else g2t[l]
 
 
 @njit(cache=True, inline="always", error_model="numpy")

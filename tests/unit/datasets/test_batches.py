@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from cmsim.datasets import DatasetSpec, generate_dataset, load
-from cmsim.datasets.records import (BATCH_FROM_RECORDS, BATCH_MIN, BATCH_SAMPLES, BATCH_SIZE,
+from cmsim.datasets.records import (BATCH_FROM_RECORDS, BATCH_MIN, BATCH_SAMPLES,
+                                    BATCH_SAMPLES_FULL, BATCH_SIZE,
                                     default_batch_size, simulate_record, simulate_records)
 from cmsim.errors import ParameterError
 
@@ -107,6 +108,13 @@ def test_a_large_spec_batches_by_default_and_its_records_keep_their_bits():
         longer = DatasetSpec.from_dict({**raw, "sensor": {**SPEC["sensor"],
                                                           "duration_s": duration}})
         assert default_batch_size(longer) == (size if size >= BATCH_MIN else 1)
+    # records that keep their whole run (channels = "all") hold every state: half the
+    # samples
+    whole = {**SPEC["sensor"], "channels": "all"}
+    assert BATCH_SAMPLES_FULL == BATCH_SAMPLES // 2
+    for duration, size in ((BATCH_SAMPLES / fs / 20, 1), (BATCH_SAMPLES / fs / 40, 20)):
+        full = DatasetSpec.from_dict({**raw, "sensor": {**whole, "duration_s": duration}})
+        assert default_batch_size(full) == size           # 10 records would not pay: 1
     plans = [spec.record(i) for i in range(5)]
     together = simulate_records(spec, plans)             # the default: one batch of 5
     for i in (0, 3):

@@ -57,7 +57,7 @@ def test_a_worker_reuses_the_memory_its_tasks_free(method):
 
 
 def _frozen_objects():
-    """Objects the garbage collector of this process leaves alone."""
+    """How many objects the garbage collector of this process leaves alone."""
     return gc.get_freeze_count()
 
 
@@ -75,3 +75,18 @@ def test_a_forked_worker_s_collector_leaves_its_parent_s_objects_alone():
     run_tasks(_frozen_objects, [(0, ())], lambda key, n: counts.append(n), workers=1,
               start_method="spawn")
     assert counts == [0]
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork")
+def test_a_process_that_froze_its_objects_itself_keeps_its_freeze():
+    gc.freeze()
+    try:
+        frozen = gc.get_freeze_count()
+        counts = []
+        run_tasks(_frozen_objects, [(0, ())], lambda key, n: counts.append(n), workers=1,
+                  start_method="fork")
+        # still frozen (a frozen object the run freed leaves it, hence not ==)
+        assert gc.get_freeze_count() > 0.99 * frozen
+        assert counts[0] > 0.99 * frozen
+    finally:
+        gc.unfreeze()
