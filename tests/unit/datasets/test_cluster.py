@@ -103,9 +103,13 @@ def _kill_a_local_worker(times):
     def kill(row):
         if len(killed) < times:
             workers = [p.pid for p in multiprocessing.active_children() if p.pid != row["pid"]]
-            victim = workers[0] if workers else row["pid"]
-            os.kill(victim, signal.SIGKILL)
-            killed.append(victim)
+            for victim in workers + [row["pid"]]:
+                try:
+                    os.kill(victim, signal.SIGKILL)
+                except ProcessLookupError:     # gone since it was listed (killed before)
+                    continue
+                killed.append(victim)
+                return
 
     return kill, killed
 
