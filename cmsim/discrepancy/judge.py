@@ -195,9 +195,9 @@ def shape_moved(meas, reference, sigma, names):
     -------
     list of int
     """
-    return [i for i, k in enumerate(names) if k.startswith("shape_")
-            and abs(meas[i] - reference[i]) >= FAMILY_Z * sigma[i]
-            and abs(meas[i] - reference[i]) >= FAMILY_RISE_DB]
+    shape = [i for i, k in enumerate(names) if k.startswith("shape_")]
+    return sorted(standing_out(shape, meas, reference, sigma, names)
+                  + standing_out(shape, reference, meas, sigma, names))
 
 
 def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
