@@ -6,11 +6,11 @@ Layering: imports :mod:`cmsim.rig` only.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 from cmsim.rig import HousingPath, OperatingPoint, Rig
 
-__all__ = ["ModelSetup", "NOMINAL_NOISE_RATIO"]
+__all__ = ["ModelSetup", "NOMINAL_NOISE_RATIO", "CHAIN_FIELDS"]
 
 #: Sensor noise of the nominal model, as a fraction of the healthy model signal's RMS.
 NOMINAL_NOISE_RATIO = 0.1
@@ -80,15 +80,20 @@ class ModelSetup:
         return replace(self, faults=self.faults + tuple(faults))
 
     def dynamics_key(self):
-        """What the simulated forces depend on (not the measurement chain nor the shaft
-        forces laid on the force after the dynamics)."""
-        return repr(replace(self, housing=None, noise_ratio=0.0, machine=None,
-                            frequency_factor=1.0, background_gain=1.0, white_noise=0.0,
-                            shaft_forces=(), background_level=1.0, structure="path",
-                            lines_follow_path=True))
+        """What the simulated forces depend on (not the machine, the measurement chain nor
+        the shaft forces laid on the force after the dynamics: :data:`CHAIN_FIELDS` at their
+        defaults)."""
+        return repr(replace(self, machine=None,
+                            **{f.name: f.default for f in fields(self) if f.name in CHAIN_FIELDS}))
 
     def chain_key(self):
-        """What the sensor signal depends on besides the dynamics."""
-        return (self.housing, self.noise_ratio, self.frequency_factor, self.background_gain,
-                self.white_noise, self.shaft_forces, self.background_level, self.structure,
-                self.lines_follow_path)
+        """What the sensor signal depends on besides the dynamics (:data:`CHAIN_FIELDS`)."""
+        return tuple(getattr(self, name) for name in CHAIN_FIELDS)
+
+
+#: Fields of :class:`ModelSetup` that shape the sensor signal after the dynamics (the
+#: measurement chain, the machine's background and path, the shaft forces laid on the force):
+#: its :meth:`~ModelSetup.chain_key`, and at their defaults in its
+#: :meth:`~ModelSetup.dynamics_key`.
+CHAIN_FIELDS = ("housing", "noise_ratio", "frequency_factor", "background_gain", "white_noise",
+                "shaft_forces", "background_level", "structure", "lines_follow_path")
