@@ -82,7 +82,12 @@ def interpolated(values, table, steps):
 def compared_columns(names, lib, fit, held):
     """The features a record and its machine's library are compared on: read by both,
     finite in the record's fit and held-out rows and in the baseline's mean, one of each set
-    of identical record columns (the two shafts of a 1:1 rig read alike).
+    of columns the record and the library both read alike (the two shafts of a 1:1 rig).
+    Two families whose lines lie within the line rule's tolerance of each other read one line
+    of the record alike, but not the library's: the model makes each fault's line where its
+    kinematics put it, so each family keeps its column and the record's one line is read as
+    either (the angle generator's ball at 2·BSF, 3 % over the BPFI it shared a window with,
+    was read as an inner race: the ball's own line was dropped as a copy of it).
 
     Parameters
     ----------
@@ -106,12 +111,23 @@ def compared_columns(names, lib, fit, held):
         if not (np.any(np.isfinite(fit[:, j])) and np.any(np.isfinite(held[:, j]))
                 and math.isfinite(lib.mean[i])):
             continue
-        if any(np.array_equal(col, c, equal_nan=True) for c in seen):
+        if any(np.array_equal(col, c, equal_nan=True) and _read_alike(lib, i, s)
+               for c, s in seen):
             continue
-        seen.append(col)
+        seen.append((col, i))
         li.append(i)
         ri.append(j)
     return (np.array(li, dtype=int), np.array(ri, dtype=int), [lib.names[i] for i in li])
+
+
+def _read_alike(lib, i, j):
+    """Whether the library's columns ``i`` and ``j`` hold the same numbers (its baseline's
+    mean and spread, every entry's prediction)."""
+    cols = [i, j]
+    return (np.array_equal(*lib.mean[cols], equal_nan=True)
+            and np.array_equal(*lib.spread[cols], equal_nan=True)
+            and all(np.array_equal(*e.features[:, cols].T, equal_nan=True)
+                    for e in lib.entries))
 
 
 def feature_sigma(lib, li, names, n_fit):

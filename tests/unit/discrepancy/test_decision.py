@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cmsim.discrepancy.columns import feature_sigma
+from cmsim.discrepancy.columns import compared_columns, feature_sigma
 from cmsim.discrepancy.judge import FAMILY_RISE_DB, decide_record
 from cmsim.machine.library import SignatureEntry, SignatureLibrary
 
@@ -354,3 +354,38 @@ def test_a_fault_with_none_of_its_family_risen_yields_to_one_whose_family_stands
     assert (d["finding"], d["decided_on"]) == (finding, "whole")
     if finding == "bearing_outer_race":
         assert [r["name"] for r in d["ties"]][:1] == ["tooth_fault"]
+
+
+def test_a_line_two_families_share_is_read_as_either_where_the_library_tells_them_apart():
+    """The angle generator's ball (2·BSF 3 % over BPFI) lifts one envelope line both
+    families' windows hold: the record reads the two columns alike, the library (the model
+    makes each fault's line where its kinematics put it) does not. Each keeps its column,
+    and the ball, whose prediction leaves the inner race's sidebands where they are, is
+    named; with the ball's column dropped as a copy, the inner race was. Columns the library
+    reads alike too (the two shafts of a 1:1 rig) stay one."""
+    names = ("env_bpfi_1b1_h1_db", "env_bsf2_1b1_h1_db", "env_bpfi_1b1_sb_db",
+             "kurtosis_log", "crest_log")
+    m = len(names)
+    sizes = (3e-5, 3e-4, 3e-3)
+    inner, ball = np.zeros((3, m)), np.zeros((3, m))
+    inner[:, 0] = inner[:, 2] = [0.0, 10.0, 20.0]    # BPFI and its shaft-rate sidebands
+    ball[:, 1] = [0.0, 10.0, 20.0]                   # 2·BSF
+    lib = _baseline_at_zero(
+        names, np.full(m, 2.0),
+        SignatureEntry("bearing_inner_race", "1b1", "documented", "size_m", sizes, inner),
+        SignatureEntry("bearing_ball", "1b1", "documented", "size_m", sizes, ball))
+    rng = np.random.default_rng(0)
+    fit, held = rng.normal(0.0, 1.0, (4, m)), rng.normal(0.0, 1.0, (4, m))
+    for rows in (fit, held):
+        rows[:, 0] += 20.0
+        rows[:, 1] = rows[:, 0]                      # one line in both windows
+    li, ri, cnames = compared_columns(list(names), lib, fit, held)
+    assert cnames == list(names)
+    meas = fit[:, ri].mean(axis=0)
+    d = decide_record(lib, li, cnames, meas, feature_sigma(lib, li, cnames, 4), "1b1")
+    assert (d["finding"], d["top"]["component"]) == ("bearing_ball", "1b1")
+
+    alike = replace(lib, entries=tuple(replace(e, features=e.features[:, [0, 0, 2, 3, 4]])
+                                       for e in lib.entries))
+    assert compared_columns(list(names), alike, fit, held)[2] == [
+        "env_bpfi_1b1_h1_db", "env_bpfi_1b1_sb_db", "kurtosis_log", "crest_log"]
