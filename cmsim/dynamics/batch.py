@@ -88,6 +88,15 @@ def _batch_arrays(models):
     return S, L, V
 
 
+def _faulty_teeth(tk, te):
+    """1.0 where a run's tooth has tables of its own (a factor other than 1 or a separation
+    other than 0 anywhere along its path), else 0.0; ``tk``, ``te`` (B, Z, m) the stacked
+    per-tooth tables, the flags flat (B·Z,) as the batch kernel's slot loads read them (a
+    tooth flagged 0 reads no table)."""
+    own = np.any(tk != 1.0, axis=2) | np.any(te != 0.0, axis=2)
+    return np.ascontiguousarray(own.astype(np.float64).reshape(-1))
+
+
 def _block_columns(size, cols):
     """The columns (int64, sorted) the runs' filters read, of ``size``: each run's ``cols``
     (None: all of them)."""
@@ -120,7 +129,8 @@ def _integrate_batch(setups, chunk_steps=BATCH_CHUNK_STEPS):
                      *(np.zeros(n_runs) for _ in range(11)), np.zeros(dim),
                      np.zeros(dim // 2), np.zeros(n_diag), np.zeros((R_SIZE, n_runs)),
                      np.zeros((max(int(S.m_int[0, MI_SLOTS]), 1), BS_SIZE, n_runs)),
-                     np.zeros(n_runs), np.zeros(n_runs, dtype=np.int64), np.zeros(n_runs))
+                     np.zeros(n_runs), np.zeros(n_runs, dtype=np.int64), np.zeros(n_runs),
+                     _faulty_teeth(S.tk1, S.te1), _faulty_teeth(S.tk2, S.te2))
     max_disp = np.array([max_displacement_m(m) for m in models])
     status = np.full(n_runs, -1, dtype=np.int64)
     h = 1.0 / (first.fs_hz * first.substeps)

@@ -16,7 +16,7 @@ import cmsim
 from cmsim.dynamics._batch_mesh_kernels import BS_SIZE, R_LEN, R_SIZE, mesh_forces_batch_jit
 from cmsim.dynamics._mesh_kernels import MI_SLOTS, mesh_forces_jit
 from cmsim.dynamics._rhs_kernels import make_work
-from cmsim.dynamics.batch import _batch_arrays, kernel_layout
+from cmsim.dynamics.batch import _batch_arrays, _faulty_teeth, kernel_layout
 from cmsim.dynamics.simulation import prepare_run
 from cmsim.faults import Eccentricity, ToothCrack, ToothSpall
 
@@ -72,7 +72,8 @@ def _batched(setups, ys, taus, srs, want_diag):
         g = np.zeros((n, n_runs))
         d = np.zeros((n_diag, n_runs))
         mesh_forces_batch_jit(np.ascontiguousarray(np.stack(y, axis=-1)), n, g, S, L.m_par,
-                              L.geo, tau, sr, V.psi, r, sg, d, want_diag)
+                              L.geo, tau, sr, V.psi, r, sg, _faulty_teeth(S.tk1, S.te1),
+                              _faulty_teeth(S.tk2, S.te2), d, want_diag)
         out.append([(g[:, l].copy(), d[:, l].copy()) for l in range(n_runs)])
     return out, V
 
@@ -142,7 +143,8 @@ def test_corner_contacts_and_zone_changes_are_exercised():
         g = np.zeros((n, len(setups)))
         d = np.zeros((len(setups[0].model.output_force_names), len(setups)))
         mesh_forces_batch_jit(np.ascontiguousarray(np.stack(y, axis=-1)), n, g, S, L.m_par,
-                              L.geo, tau, sr, V.psi, r, sg, d, False)
+                              L.geo, tau, sr, V.psi, r, sg, _faulty_teeth(S.tk1, S.te1),
+                              _faulty_teeth(S.tk2, S.te2), d, False)
         for j in range(sg.shape[0]):
             for l in range(len(setups)):
                 if sg[j, SG_ON, l]:
