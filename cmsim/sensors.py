@@ -43,9 +43,9 @@ import re
 from fractions import Fraction
 
 import numpy as np
-from scipy.signal import firwin, kaiserord, resample_poly
+from scipy.signal import firwin, kaiserord, resample_poly, sosfilt
 
-from cmsim._kernels import HOUSING_BLOCK, housing_path_jit
+from cmsim._kernels import HOUSING_BLOCK, housing_modes_jit
 from cmsim.dynamics.decimation import AntiAliasFilter
 from cmsim.errors import ParameterError, check_range
 from cmsim.rig import HousingPath
@@ -55,7 +55,7 @@ __all__ = ["housing_sos", "housing_acceleration", "decimate", "sensor_rate_ratio
            "tacho_signal", "add_sensors",
            "TACHO_LEVEL_V", "TACHO_PULSE_WIDTH_RAD", "ANTI_ALIAS_DB", "ANTI_ALIAS_PASSBAND",
            "STEPS_PER_MODE_PERIOD", "INTERPOLATION_KAISER_BETA", "INTERPOLATION_ZERO_CROSSINGS",
-           "interpolation_filter"]
+           "interpolation_filter", "slow_rate_modes"]
 
 #: High level of the tacho pulse, V (TTL output of an optical or magnetic key-phasor).
 TACHO_LEVEL_V = 5.0
@@ -164,20 +164,100 @@ def housing_acceleration(force_n, fs_hz, path):
     if not np.all(np.isfinite(x)):
         raise ParameterError("force_n must be finite (no NaN or inf)", param="force_n")
     fs = check_range("fs_hz", fs_hz, 0.0, lo_open=True, unit="Hz")
-    k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs))
     # H(0) = 0: remove the first force sample, so the record starts at rest and the
-    # zero padding of the interpolation continues that constant force
-    # every mode's biquad (sosfilt's) over the force interpolated by k (a Nyquist filter:
-    # keeps x at i·k), their sum kept at the original instants
-    taps, before = _interpolation_phases(k)
-    n = x.shape[0]
-    signals = np.zeros((int(np.prod(x.shape[1:])), n + taps.shape[1] - 1))
+    # zero padding of the interpolation continues that constant force; every mode's biquad
+    # over the force interpolated by k, their sum kept at the original instants, run at the
+    # force's own rate (cmsim._kernels)
+    num, den, lead, k, h = slow_rate_modes(path, fs)
+    n, before = x.shape[0], num.shape[1] - 1 - lead
+    signals = np.zeros((int(np.prod(x.shape[1:])), n + num.shape[1] - 1))
     signals[:, before:before + n] = (x - x[0]).reshape(n, -1).T
-    sos = housing_sos(path, fs * k)
+    init = _first_outputs(signals[:, before:before + n], path, fs, k, h)
     out = np.empty((signals.shape[0], n))
-    housing_path_jit(signals, taps, sos, np.empty((signals.shape[0], sos.shape[0], 2)),
-                     np.empty((signals.shape[0], k, HOUSING_BLOCK)), out)
+    housing_modes_jit(signals, num, den, init, np.empty((num.shape[0], HOUSING_BLOCK)),
+                      np.empty((num.shape[0], 2)), out)
     return out[0] if x.ndim == 1 else out.T
+
+
+def _modes_and_factor(path, fs_hz):
+    """(k, the modes' biquads at k·fs): the interpolation factor that gives the highest mode
+    :data:`STEPS_PER_MODE_PERIOD` samples a period."""
+    k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs_hz))
+    return k, housing_sos(path, fs_hz * k)
+
+
+def _interpolated_impulse(h, k, lead, n_fast):
+    """The interpolated samples (k per input, from 0) of a unit input at input ``lead``."""
+    half = (h.size - 1) // 2
+    out = np.zeros(n_fast)
+    lo = lead * k - half
+    out[max(lo, 0):lead * k + half + 1] = h[max(-lo, 0):]
+    return out
+
+
+@functools.lru_cache(maxsize=16)
+def slow_rate_modes(path, fs_hz):
+    """The housing modes at a force's own rate (:mod:`cmsim._kernels`): mode s is
+    ``num[s](z) / (1 + den[s, 0]·z⁻¹ + den[s, 1]·z⁻²)`` with its input read ``lead`` samples
+    ahead, the same system as its biquad at k·fs over the force interpolated by
+    :func:`interpolation_filter` and kept every k-th sample. The numerator is the mode's
+    impulse response in that form times the denominator, whose poles are the biquad's to the
+    k-th power; it ends once the interpolation's span has passed (what rounding leaves
+    beyond is checked under 1e-12 of its largest).
+
+    Parameters
+    ----------
+    path : HousingPath
+        Housing modes.
+    fs_hz : float
+        The force's sample rate, Hz.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, int, int, numpy.ndarray)
+        ``num`` (modes, taps), ``den`` (modes, 2), ``lead``, the factor k and the
+        interpolation filter (read-only).
+    """
+    k, sos = _modes_and_factor(path, fs_hz)
+    h = interpolation_filter(k) if k > 1 else np.ones(1)
+    lead = ((h.size - 1) // 2) // k
+    n_taps = 2 * lead + 3
+    # each impulse response over its numerator's span and far enough past it to check its end
+    n_slow = n_taps + 64
+    impulse = _interpolated_impulse(h, k, lead, n_slow * k)
+    num, den = np.empty((len(sos), n_taps)), np.empty((len(sos), 2))
+    for s, section in enumerate(sos):
+        resp = sosfilt(section[None, :], impulse)[::k]
+        a = np.real(np.poly(np.roots([1.0, section[4], section[5]]) ** k))
+        full = np.convolve(resp, a)[:n_slow]
+        if np.max(np.abs(full[n_taps:])) > 1e-12 * np.max(np.abs(full)):
+            raise AssertionError("a housing mode's form at the force's rate did not end "
+                                 "with the interpolation's span")
+        num[s], den[s] = full[:n_taps], a[1:]
+    for a in (num, den, h):
+        a.setflags(write=False)
+    return num, den, lead, k, h
+
+
+def _first_outputs(x, path, fs_hz, k, h):
+    """(C, modes, 2): each mode's first two outputs over forces ``x`` (C, n) as the
+    interpolated form gives them, its biquad at rest at the first sample (the interpolated
+    samples before it, its look-ahead into the first inputs, never fed)."""
+    half = (h.size - 1) // 2
+    m = np.arange(k + 1)[:, None]                     # fast samples 0 … k
+    i = np.arange(min(x.shape[1], (k + half) // k + 1))[None, :]
+    tap = m + half - i * k
+    taps = np.where((tap >= 0) & (tap <= 2 * half), h[np.clip(tap, 0, 2 * half)], 0.0)
+    # (C, k + 1); summed along each row alone, so a force reads alike beside others
+    fast = (x[:, None, :i.shape[1]] * taps[None, :, :]).sum(axis=2)
+    _, sos = _modes_and_factor(path, fs_hz)
+    out = np.zeros((x.shape[0], len(sos), 2))
+    for s, section in enumerate(sos):
+        y = sosfilt(section[None, :], fast, axis=1)
+        out[:, s, 0] = y[:, 0]
+        if x.shape[1] > 1:
+            out[:, s, 1] = y[:, k]
+    return out
 
 
 def interpolation_filter(k):
@@ -187,30 +267,6 @@ def interpolation_filter(k):
     it keeps the input samples)."""
     half = INTERPOLATION_ZERO_CROSSINGS * k
     return k * firwin(2 * half + 1, 1.0 / k, window=("kaiser", INTERPOLATION_KAISER_BETA))
-
-
-@functools.lru_cache(maxsize=16)
-def _interpolation_phases(k):
-    """``(taps, before)``: :func:`interpolation_filter` laid out by phase for
-    :func:`cmsim._kernels.housing_path_jit` — row t holds the taps of fast sample j·k + t
-    for the inputs j − before … j − before + D − 1 (zero where the filter has none) —
-    designed once per factor and read-only; ``[[1.0]]`` for k = 1."""
-    if k == 1:
-        taps = np.ones((1, 1))
-        before = 0
-    else:
-        h = interpolation_filter(k)
-        half = (h.size - 1) // 2
-        before = half // k                   # inputs j − before … j + after reach phase t
-        after = (k - 1 + half) // k
-        taps = np.zeros((k, before + after + 1))
-        for t in range(k):
-            for d in range(-before, after + 1):
-                tap = t + half - d * k       # the tap of input j + d at fast sample j·k + t
-                if 0 <= tap <= 2 * half:
-                    taps[t, d + before] = h[tap]
-    taps.setflags(write=False)
-    return taps, before
 
 
 def _kaiser_lowpass(fs_hz, fs_out_hz):
