@@ -168,22 +168,15 @@ def housing_acceleration(force_n, fs_hz, path):
     # zero padding of the interpolation continues that constant force; every mode's biquad
     # over the force interpolated by k, their sum kept at the original instants, run at the
     # force's own rate (cmsim._kernels)
-    num, den, lead, k, h = slow_rate_modes(path, fs)
+    num, den, lead, k, h, sos = slow_rate_modes(path, fs)
     n, before = x.shape[0], num.shape[1] - 1 - lead
     signals = np.zeros((int(np.prod(x.shape[1:])), n + num.shape[1] - 1))
     signals[:, before:before + n] = (x - x[0]).reshape(n, -1).T
-    init = _first_outputs(signals[:, before:before + n], path, fs, k, h)
+    init = _first_outputs(signals[:, before:before + n], sos, k, h)
     out = np.empty((signals.shape[0], n))
     housing_modes_jit(signals, num, den, init, np.empty((num.shape[0], HOUSING_BLOCK)),
                       np.empty((num.shape[0], 2)), out)
     return out[0] if x.ndim == 1 else out.T
-
-
-def _modes_and_factor(path, fs_hz):
-    """(k, the modes' biquads at k·fs): the interpolation factor that gives the highest mode
-    :data:`STEPS_PER_MODE_PERIOD` samples a period."""
-    k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs_hz))
-    return k, housing_sos(path, fs_hz * k)
 
 
 def _interpolated_impulse(h, k, lead, n_fast):
@@ -214,12 +207,19 @@ def slow_rate_modes(path, fs_hz):
 
     Returns
     -------
-    (numpy.ndarray, numpy.ndarray, int, int, numpy.ndarray)
-        ``num`` (modes, taps), ``den`` (modes, 2), ``lead``, the factor k and the
-        interpolation filter (read-only).
+    (numpy.ndarray, numpy.ndarray, int, int, numpy.ndarray, numpy.ndarray)
+        ``num`` (modes, taps), ``den`` (modes, 2), ``lead``, the factor k, the
+        interpolation filter and the modes' biquads at k·fs (read-only). With k = 1 the
+        biquads themselves (their double zero at DC exact).
     """
-    k, sos = _modes_and_factor(path, fs_hz)
-    h = interpolation_filter(k) if k > 1 else np.ones(1)
+    k = max(1, math.ceil(STEPS_PER_MODE_PERIOD * max(path.natural_frequencies_hz) / fs_hz))
+    sos = housing_sos(path, fs_hz * k)
+    if k == 1:
+        num, den, h = sos[:, :3].copy(), sos[:, 4:].copy(), np.ones(1)
+        for a in (num, den, h, sos):
+            a.setflags(write=False)
+        return num, den, 0, 1, h, sos
+    h = interpolation_filter(k)
     lead = ((h.size - 1) // 2) // k
     n_taps = 2 * lead + 3
     # each impulse response over its numerator's span and far enough past it to check its end
@@ -234,15 +234,16 @@ def slow_rate_modes(path, fs_hz):
             raise AssertionError("a housing mode's form at the force's rate did not end "
                                  "with the interpolation's span")
         num[s], den[s] = full[:n_taps], a[1:]
-    for a in (num, den, h):
+    for a in (num, den, h, sos):
         a.setflags(write=False)
-    return num, den, lead, k, h
+    return num, den, lead, k, h, sos
 
 
-def _first_outputs(x, path, fs_hz, k, h):
+def _first_outputs(x, sos, k, h):
     """(C, modes, 2): each mode's first two outputs over forces ``x`` (C, n) as the
-    interpolated form gives them, its biquad at rest at the first sample (the interpolated
-    samples before it, its look-ahead into the first inputs, never fed)."""
+    interpolated form gives them (to rounding: its sums run in another order), each biquad
+    of ``sos`` at rest at the first sample (the interpolated samples before it, its
+    look-ahead into the first inputs, never fed)."""
     half = (h.size - 1) // 2
     m = np.arange(k + 1)[:, None]                     # fast samples 0 … k
     i = np.arange(min(x.shape[1], (k + half) // k + 1))[None, :]
@@ -250,10 +251,9 @@ def _first_outputs(x, path, fs_hz, k, h):
     taps = np.where((tap >= 0) & (tap <= 2 * half), h[np.clip(tap, 0, 2 * half)], 0.0)
     # (C, k + 1); summed along each row alone, so a force reads alike beside others
     fast = (x[:, None, :i.shape[1]] * taps[None, :, :]).sum(axis=2)
-    _, sos = _modes_and_factor(path, fs_hz)
     out = np.zeros((x.shape[0], len(sos), 2))
     for s, section in enumerate(sos):
-        y = sosfilt(section[None, :], fast, axis=1)
+        y = sosfilt(section[None, :].copy(), fast, axis=1)   # it takes a writable sos
         out[:, s, 0] = y[:, 0]
         if x.shape[1] > 1:
             out[:, s, 1] = y[:, k]

@@ -122,10 +122,11 @@ def compared_columns(names, lib, fit, held):
 
 def _read_alike(lib, i, j):
     """Whether the library's columns ``i`` and ``j`` hold the same numbers (its baseline's
-    mean and spread, every entry's prediction)."""
+    mean, spread and realisation spread, every entry's prediction)."""
     cols = [i, j]
     return (np.array_equal(*lib.mean[cols], equal_nan=True)
             and np.array_equal(*lib.spread[cols], equal_nan=True)
+            and np.array_equal(*lib.realisation[cols], equal_nan=True)
             and all(np.array_equal(*e.features[:, cols].T, equal_nan=True)
                     for e in lib.entries))
 
