@@ -179,13 +179,17 @@ def housing_acceleration(force_n, fs_hz, path):
     return out[0] if x.ndim == 1 else out.T
 
 
-def _interpolated_impulse(h, k, lead, n_fast):
-    """The interpolated samples (k per input, from 0) of a unit input at input ``lead``."""
+def _interpolated(x, h, k, n_fast):
+    """The first ``n_fast`` samples of forces ``x`` (C, n) interpolated by k through ``h``
+    (:func:`interpolation_filter`): fast sample m = Σ_i x[i]·h[m + half − i·k], the inputs
+    before the first and after the last zero. Each row is summed alone, so a force reads
+    alike beside others."""
     half = (h.size - 1) // 2
-    out = np.zeros(n_fast)
-    lo = lead * k - half
-    out[max(lo, 0):lead * k + half + 1] = h[max(-lo, 0):]
-    return out
+    m = np.arange(n_fast)[:, None]
+    i = np.arange(min(x.shape[1], (n_fast - 1 + half) // k + 1))[None, :]
+    tap = m + half - i * k
+    taps = np.where((tap >= 0) & (tap <= 2 * half), h[np.clip(tap, 0, 2 * half)], 0.0)
+    return (x[:, None, :i.shape[1]] * taps[None, :, :]).sum(axis=2)
 
 
 @functools.lru_cache(maxsize=16)
@@ -224,7 +228,9 @@ def slow_rate_modes(path, fs_hz):
     n_taps = 2 * lead + 3
     # each impulse response over its numerator's span and far enough past it to check its end
     n_slow = n_taps + 64
-    impulse = _interpolated_impulse(h, k, lead, n_slow * k)
+    unit = np.zeros((1, n_slow))
+    unit[0, lead] = 1.0                               # a unit input at input ``lead``
+    impulse = _interpolated(unit, h, k, n_slow * k)[0]
     num, den = np.empty((len(sos), n_taps)), np.empty((len(sos), 2))
     for s, section in enumerate(sos):
         resp = sosfilt(section[None, :], impulse)[::k]
@@ -244,13 +250,7 @@ def _first_outputs(x, sos, k, h):
     interpolated form gives them (to rounding: its sums run in another order), each biquad
     of ``sos`` at rest at the first sample (the interpolated samples before it, its
     look-ahead into the first inputs, never fed)."""
-    half = (h.size - 1) // 2
-    m = np.arange(k + 1)[:, None]                     # fast samples 0 … k
-    i = np.arange(min(x.shape[1], (k + half) // k + 1))[None, :]
-    tap = m + half - i * k
-    taps = np.where((tap >= 0) & (tap <= 2 * half), h[np.clip(tap, 0, 2 * half)], 0.0)
-    # (C, k + 1); summed along each row alone, so a force reads alike beside others
-    fast = (x[:, None, :i.shape[1]] * taps[None, :, :]).sum(axis=2)
+    fast = _interpolated(x, h, k, k + 1)              # fast samples 0 … k
     out = np.zeros((x.shape[0], len(sos), 2))
     for s, section in enumerate(sos):
         y = sosfilt(section[None, :].copy(), fast, axis=1)   # it takes a writable sos

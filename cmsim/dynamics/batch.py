@@ -25,6 +25,7 @@ from cmsim.dynamics._batch_mesh_kernels import BS_SIZE, R_SIZE
 from cmsim.dynamics._mesh_kernels import MI_SLOTS
 from cmsim.dynamics._rhs_kernels import KernelParams, Work, make_work
 from cmsim.dynamics.integrator import SCHEMES
+from cmsim.dynamics.model import teeth_with_own_tables
 from cmsim.dynamics.simulation import compile_kernels, finish_run, integrate_prepared
 from cmsim.dynamics.time_loop import (MAX_ROTATION_DEVIATION_RAD, _Decimator, decimation,
                                       diverged_at, max_displacement_m)
@@ -89,12 +90,11 @@ def _batch_arrays(models):
 
 
 def _faulty_teeth(tk, te):
-    """1.0 where a run's tooth has tables of its own (a factor other than 1 or a separation
-    other than 0 anywhere along its path), else 0.0; ``tk``, ``te`` (B, Z, m) the stacked
-    per-tooth tables, the flags flat (B·Z,) as the batch kernel's slot loads read them (a
-    tooth flagged 0 reads no table)."""
-    own = np.any(tk != 1.0, axis=2) | np.any(te != 0.0, axis=2)
-    return np.ascontiguousarray(own.astype(np.float64).reshape(-1))
+    """1.0 where a run's tooth has tables of its own
+    (:func:`~cmsim.dynamics.model.teeth_with_own_tables`), else 0.0; ``tk``, ``te``
+    (B, Z, m) the stacked per-tooth tables, the flags flat (B·Z,) as the batch kernel's slot
+    loads read them (a tooth flagged 0 reads no table)."""
+    return np.ascontiguousarray(teeth_with_own_tables(tk, te).astype(np.float64).reshape(-1))
 
 
 def _block_columns(size, cols):

@@ -48,7 +48,7 @@ from cmsim.mesh_stiffness._kernels import GEO_SIZE
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 
-__all__ = ["DynamicModel", "build_model"]
+__all__ = ["DynamicModel", "build_model", "teeth_with_own_tables"]
 
 
 @dataclass(frozen=True)
@@ -400,6 +400,23 @@ def _checked_mesh(rig, mesh):
     return table, online
 
 
+def teeth_with_own_tables(tk, te):
+    """Which teeth have per-tooth tables of their own: a stiffness factor other than 1 or a
+    separation other than 0 anywhere along the path (the last axis); the others are
+    nominal, and their look-up returns 1 and 0 to the bit.
+
+    Parameters
+    ----------
+    tk, te : numpy.ndarray, shape (..., Z, m)
+        Per-tooth stiffness factors and separations (one run's, or several stacked).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (..., Z)
+    """
+    return np.any(tk != 1.0, axis=-1) | np.any(te != 0.0, axis=-1)
+
+
 def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
     """``(b_int, (b_def, b_off, tk1, tk2, te1, te2, ecc))`` for the kernel from FaultArrays."""
     nb, max_balls = rm.ball_cos.shape
@@ -425,8 +442,8 @@ def _fault_fields(rm, m_int, fa, m_par_grid=(0.0, 1.0)):
     rig = rm.rig
     tk1, tk2, te1, te2 = (np.ascontiguousarray(a, dtype=float) for a in
                           (fa.tooth_factor1, fa.tooth_factor2, fa.tooth_sep1, fa.tooth_sep2))
-    teeth = rig.gears is not None and (np.any(tk1 != 1.0) or np.any(tk2 != 1.0)
-                                       or np.any(te1 != 0.0) or np.any(te2 != 0.0))
+    teeth = rig.gears is not None and (np.any(teeth_with_own_tables(tk1, te1))
+                                       or np.any(teeth_with_own_tables(tk2, te2)))
     if teeth:
         s0, ds = (float(v) for v in fa.tooth_grid_m)
         if abs(s0 - m_par_grid[0]) > 1e-12 or abs(ds - m_par_grid[1]) > 1e-12 * abs(ds):
