@@ -163,6 +163,13 @@ class Cause:
     #: move with it are a nuisance profiled (``structure`` and ``lines_follow_path`` of
     #: :class:`~cmsim.discrepancy.model_setup.ModelSetup`; :mod:`cmsim.discrepancy.signatures`).
     moves_path: typing.ClassVar[bool] = False
+    #: It adds rotating forces at shaft orders (unbalance, misalignment): their lines reach
+    #: the sensor through the machine's gain at the shaft orders, which a healthy baseline
+    #: does not pin (the force behind its own 1× line, the residual unbalance, is unknown),
+    #: while the load they swing modulates lines the baseline has, a ratio the path cancels:
+    #: the modulation against the line is a nuisance profiled
+    #: (:data:`~cmsim.discrepancy.signatures.SHAFT_MODULATIONS`).
+    rotates: typing.ClassVar[bool] = False
 
     def judged_on(self, names, component):
         """The features of ``names`` this cause is judged on (its :attr:`signature`).
@@ -409,6 +416,7 @@ class _ShaftForce(Cause):
     bounds = (0.02, 2.0)
     probes = (0.1, 0.5)
     force_level = True
+    rotates = True
     orders = ()
 
     def apply(self, setup, value, component):

@@ -471,6 +471,9 @@ def _variant_words(variant):
     if variant == "documented":
         return ""
     base, _, gain = variant.partition("; path x")
+    if base.startswith("modulation x"):
+        return (f" (the load it swings modulating {base[len('modulation x'):]} times its "
+                "share: its size read on its line)")
     parts = [] if base == "documented" else [f"its model in {base.replace('um', 'µm')}"
                                               if base == "line contact"
                                               else f"its model with a {base.replace('um', 'µm')}"]

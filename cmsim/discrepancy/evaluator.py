@@ -93,18 +93,19 @@ def path_free(name):
     return not name.startswith(PATH_DEPENDENT)
 
 
-def _shaft_forces(force, fs, shaft_hz, terms, seed):
+def _shaft_forces(force, fs, shaft_hz, terms, seed, modulation=1.0):
     """(modulated force, rotating forces) of the rotating shaft forces ``terms`` ((order,
     relative amplitude) …) on ``force``: the dynamic force modulated by the load they
-    swing, F̄ + (F − F̄)·(1 + Σ a cos(kθ + kφ)), and the forces themselves,
-    (order, a·L, kφ) each, L = :func:`~cmsim.machine.static_load` of F. (Modulating the
+    swing, F̄ + (F − F̄)·(1 + Σ m·a cos(kθ + kφ)) (``modulation`` m), and the forces
+    themselves, (order, a·L, kφ) each, L = :func:`~cmsim.machine.static_load` of F. (Modulating the
     whole force, F·(1 + m) + L·m, cancelled the rotating force under a negative static load,
     F̄ = −L: an unbalance of three times the load moved the 1× line by 0.0 dB.)"""
     if not terms:
         return force, ()
     mean, static = float(force.mean()), static_load(force)
     phase = np.random.default_rng([int(seed), 65537]).uniform(0.0, 2.0 * math.pi)
-    mod = rotating_force(force.size, fs, shaft_hz, [(k, a, k * phase) for k, a in terms])
+    mod = rotating_force(force.size, fs, shaft_hz, [(k, modulation * a, k * phase)
+                                                    for k, a in terms])
     return mean + (force - mean) * (1.0 + mod), tuple((k, a * static, k * phase)
                                                       for k, a in terms)
 
@@ -186,7 +187,8 @@ def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="
     """The sensor signal of a simulated force (on ``bearing``) through ``setup``'s shaft
     forces (at the rate of that bearing's shaft) and chain."""
     fr = rig_frequencies(setup.rig, setup.op).bearing(bearing).shaft_hz
-    force, rotating = _shaft_forces(force, fs, fr, setup.shaft_forces, seed)
+    force, rotating = _shaft_forces(force, fs, fr, setup.shaft_forces, seed,
+                                    setup.shaft_modulation)
     if rotating:
         force = force + rotating_force(force.size, fs, fr, rotating)
     return sensor_signal(force, edge, n, fs, setup.housing, setup.noise_ratio, noise_ref_rms,

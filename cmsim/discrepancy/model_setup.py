@@ -58,6 +58,12 @@ class ModelSetup:
         (shaft order, relative amplitude): a rotating force laid on the bearing force after
         the dynamics, ``F̄ + (F − F̄)·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
         misalignment: order 2); quasi-static, the shaft rate being far below the modes.
+    shaft_modulation : float
+        Depth of the load modulation the shaft forces swing, relative to their amplitude
+        (1: the ``a`` above): how far a rotating force swings the mesh and the bearings'
+        dynamic load against the line it makes depends on the machine's stiffnesses and on
+        its gain at the shaft orders, which a healthy baseline does not pin (a nuisance,
+        :data:`~cmsim.discrepancy.signatures.SHAFT_MODULATIONS`).
     """
 
     rig: Rig
@@ -74,6 +80,7 @@ class ModelSetup:
     background_level: float = 1.0
     structure: str = "path"
     lines_follow_path: bool = True
+    shaft_modulation: float = 1.0
 
     def with_faults(self, *faults):
         """Same setup with ``faults`` added."""
@@ -96,4 +103,5 @@ class ModelSetup:
 #: its :meth:`~ModelSetup.chain_key`, and at their defaults in its
 #: :meth:`~ModelSetup.dynamics_key`.
 CHAIN_FIELDS = ("housing", "noise_ratio", "frequency_factor", "background_gain", "white_noise",
-                "shaft_forces", "background_level", "structure", "lines_follow_path")
+                "shaft_forces", "background_level", "structure", "lines_follow_path",
+                "shaft_modulation")

@@ -16,7 +16,7 @@ from cmsim.rig import HousingPath, OperatingPoint, Rig
 OTHER = {"housing": HousingPath((1000.0,), (0.05,), (1.0,)), "noise_ratio": 0.5,
          "frequency_factor": 1.1, "background_gain": 2.0, "white_noise": 0.1,
          "shaft_forces": ((1, 0.1),), "background_level": 2.0, "structure": "floor",
-         "lines_follow_path": False}
+         "lines_follow_path": False, "shaft_modulation": 3.0}
 
 
 def _setup(**kw):

@@ -48,3 +48,33 @@ def test_through_a_machine_the_line_takes_the_machine_gain_at_its_order():
     y = m.sensor_signal(np.zeros(n), 0, n, 0, rotating=(FR, ((1, 30.0, 0.0), (2, 10.0, 0.0))))
     assert _line(y, FR) == pytest.approx(4e-2 * 30.0, rel=1e-3)       # its own gain
     assert _line(y, 2 * FR) == pytest.approx(1e-3 * 10.0, rel=1e-3)    # the path's
+
+
+@pytest.mark.parametrize("modulation", [0.3, 1.0, 3.0])
+def test_the_load_a_rotating_force_swings_is_a_nuisance_its_line_is_not(modulation):
+    """``shaft_modulation`` m scales the sidebands the force swings (m·a/2 of the dynamic
+    part) and leaves its line (a·|F̄|): a value of every modulation variant sizes the force on
+    its line. The library computes those variants for the causes that rotate, after every
+    other entry."""
+    from cmsim.discrepancy import CAUSES
+    from cmsim.discrepancy.causes import ModelSetup
+    from cmsim.discrepancy.compare import _variant_words
+    from cmsim.discrepancy.signatures import SHAFT_MODULATIONS, _variants
+
+    t = np.arange(int(FS)) / FS
+    dynamic = 5.0 * np.cos(2 * math.pi * 400.0 * t)
+    modulated, rotating = _shaft_forces(100.0 + dynamic, FS, FR, ((1, 0.3),), seed=4,
+                                        modulation=modulation)
+    total = modulated + rotating_force(t.size, FS, FR, rotating)
+    assert _line(total, FR) == pytest.approx(0.3 * 100.0, rel=1e-3)
+    for f in (375.0, 425.0):
+        assert _line(total, f) == pytest.approx(modulation * 0.15 * 5.0, rel=1e-3)
+
+    nominal = ModelSetup(rig=Rig.paper_2016(), op=OperatingPoint(1500.0, 50.0))
+    for name, rotates in (("unbalance", True), ("misalignment", True),
+                          ("bearing_inner_race", False), ("eccentricity", False)):
+        got = {label: s.shaft_modulation for label, s in _variants(CAUSES[name](), nominal)}
+        want = {f"modulation x{m:g}": m for m in SHAFT_MODULATIONS} if rotates else {}
+        assert {k: v for k, v in got.items() if v != 1.0} == want
+        assert got["documented"] == 1.0
+    assert "3 times its share" in _variant_words("modulation x3")
