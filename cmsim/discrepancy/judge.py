@@ -361,9 +361,13 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
                     top = new
         else:
             # b. no cause reads the whole record: a fault whose own family stands out over
-            # the baseline, judged on its signature (ranking.decide)
+            # the baseline, judged on its signature (ranking.decide) — where its change, at
+            # the size its signature reads, takes the whole record nearer than the baseline
+            # alone (the angle generator's unbalance, read on the sidebands it shares with a
+            # misalignment whose 2× line the record does not have, whole record −52)
             faults = [r for r in by_signature.values()
-                      if r["cause"].signature is not None and r["nameable"]]
+                      if r["cause"].signature is not None and r["nameable"]
+                      and r["total"] > 0.0]
             top, ties = decide(sorted(faults, key=lambda r: -r["delta_chi2"]),
                                sensor_bearing, chi0)
             how = "family" if top is not None else ""

@@ -101,6 +101,35 @@ def test_a_fault_named_on_its_family_only_where_the_family_stands_out(lift, find
         assert d["decided_on"] == "family" and d["top"]["component"] == "1b1"
 
 
+@pytest.mark.parametrize("other, finding", [(0.0, "bearing_outer_race"),
+                                            (10.0, "unexplained")])
+def test_a_fault_is_named_on_its_family_only_where_its_whole_change_reads_the_record(
+        other, finding):
+    """A record whose outer-race family stands 8 dB over the baseline and whose low bands
+    moved far where no cause moves them, read by an outer race whose change also lifts the
+    inner race's family by ``other`` dB, which the record kept at the baseline: where the
+    fault's whole change takes the record farther from its prediction than the baseline
+    alone is, its family standing out does not make it the record's fault."""
+    names = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "env_bpfi_1b1_h1_db",
+             "env_bpfi_1b1_h2_db", "shape_b0_db", "shape_b1_db")
+    outer = np.zeros((3, len(names)))
+    outer[:, :2] = np.array([[0.0], [5.0], [20.0]])
+    outer[1:, 2:4] = other
+    spread = np.ones(len(names))
+    spread[:4] = 3.5
+    lib = _baseline_at_zero(names, spread,
+                            SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                                           (3e-5, 3e-4, 3e-3), outer))
+    li = np.arange(len(names))
+    meas = np.array([8.0, 8.0, 0.0, 0.0, -30.0, -30.0])
+    d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
+                      "1b1")
+    row = d["by_signature"][0]
+    assert row["name"] == "bearing_outer_race" and row["stands_out"]
+    assert row["delta_chi2"] > 0.0 and (row["total"] > 0.0) == (other == 0.0)
+    assert d["finding"] == finding, (row["delta_chi2"], row["total"])
+
+
 def test_a_cause_that_adds_power_is_no_candidate_for_a_quieter_record():
     """The shape bands moved as noise moves them, but the record is 12 dB quieter: noise
     cannot make a machine quieter."""
