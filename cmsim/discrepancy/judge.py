@@ -60,7 +60,10 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       calibrated path cannot know), a fault is named on its own signature
       (:func:`~cmsim.discrepancy.ranking.decide`: its evidence on the features it moves, its
       family moved towards the record), provided one feature of its family stands
-      :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB` over the baseline. A cause whose change
+      :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB` over the baseline and its change, at the
+      variant and size its signature reads best, reads the record's features nearer than
+      the baseline alone over all of them as its signature weighs them (its row's
+      ``total``; the path profiled out as below). A cause whose change
       is impacts ringing the structure
       (:attr:`~cmsim.discrepancy.causes.Cause.rings_structure`) is judged there with the
       path profiled out: each feature that depends on the transfer path, and the
@@ -362,9 +365,12 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         else:
             # b. no cause reads the whole record: a fault whose own family stands out over
             # the baseline, judged on its signature (ranking.decide) — where its change, at
-            # the size its signature reads, takes the whole record nearer than the baseline
-            # alone (the angle generator's unbalance, read on the sidebands it shares with a
-            # misalignment whose 2× line the record does not have, whole record −52)
+            # the variant and size its signature reads best, takes the record's features
+            # nearer than the baseline alone, over all of them as its signature weighs them
+            # and with the path profiled out for a change ringing the structure (``total``:
+            # the angle generator's unbalance read as a misalignment whose 2× line the record
+            # lacks, −52). Read at that one variant and size only: another within the
+            # signature's range might read the record better and is not asked
             faults = [r for r in by_signature.values()
                       if r["cause"].signature is not None and r["nameable"]
                       and r["total"] > 0.0]

@@ -56,7 +56,8 @@ class ModelSetup:
         ``background_gain`` refits within its spread: the ``background`` cause (1: none).
     shaft_forces : tuple of (float, float)
         (shaft order, relative amplitude): a rotating force laid on the bearing force after
-        the dynamics, ``F̄ + (F − F̄)·(1 + a·cos(kθ)) + a·|F̄|·cos(kθ)`` (unbalance: order 1,
+        the dynamics, ``F̄ + (F − F̄)·(1 + m·a·cos(kθ)) + a·L·cos(kθ)`` (``m`` the
+        ``shaft_modulation``, ``L`` :func:`~cmsim.machine.static_load`; unbalance: order 1,
         misalignment: order 2); quasi-static, the shaft rate being far below the modes.
     shaft_modulation : float
         Depth of the load modulation the shaft forces swing, relative to their amplitude

@@ -21,6 +21,11 @@ bearing defect's entries are computed for the documented clearance and for each 
 each change relative to the healthy model *of that variant*: a comparison takes the variant
 that fits the record best (a profile likelihood), so a family that stands out over the
 baseline is not vetoed by a statistic the model makes differently under another load zone.
+Where a change rings the structure, the path's gain there is profiled too
+(:data:`PATH_GAINS`); for a rotating force (unbalance, misalignment), the depth of the load
+modulation it swings against the line it makes (:data:`SHAFT_MODULATIONS`: the line reaches
+the sensor through a gain at the shaft orders no healthy baseline pins; these variants are
+computed after every other entry, which keeps its noise draws).
 A moved transfer path (:attr:`~cmsim.discrepancy.causes.Cause.moves_path`) is profiled the
 same way over where the structure's response is read: the calibrated path, the baseline's
 lines moving with it; or the baseline's broadband floor, its lines held (the floor tells
@@ -328,6 +333,31 @@ def _variants(cause, nominal):
     return out
 
 
+def _entry_jobs(causes, rig, sensor_component, nominal, n_sizes):
+    """The library's entry jobs (``("entry", (cause, component, healthy setup, values, gains,
+    index))``) and what each is (cause name, component, variant label, parameter, values),
+    in the order their noise draws are keyed by (``index``): every cause on every component
+    under each of its variants, the load modulation variants of the rotating causes last,
+    so the other entries keep the draws they had before those variants were computed (a
+    library computed earlier holds them as they are)."""
+    jobs, meta, modulated = [], [], []
+    for cause in causes:
+        pname, values = value_grid(cause, n_sizes * DENSER.get(cause.name, 1))
+        for comp in cause.components(rig, sensor_component):
+            gains = PATH_GAINS if cause.rings_structure else (1.0,)
+            for label, healthy in _variants(cause, nominal):
+                job = (cause, comp, healthy, values, gains)
+                if healthy.shaft_modulation != 1.0:
+                    modulated.append((job, (cause.name, comp, label, pname, values)))
+                    continue
+                jobs.append(("entry", (*job, len(jobs))))
+                meta.append((cause.name, comp, label, pname, values))
+    for job, m in modulated:
+        jobs.append(("entry", (*job, len(jobs))))
+        meta.append(m)
+    return jobs, meta
+
+
 def build_library(machine, *, causes=None, n_sizes=N_SIZES, n_segments=LIBRARY_SEGMENTS,
                   seed=0, workers=1, progress=None):
     """The signature library of a calibrated machine (module docstring).
@@ -367,23 +397,9 @@ def build_library(machine, *, causes=None, n_sizes=N_SIZES, n_segments=LIBRARY_S
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         spread = np.nanstd(spread_rows, axis=0, ddof=1)
-    jobs, meta, modulated = [], [], []
-    for cause in (list(causes) if causes is not None else applicable_causes(machine.rig)):
-        pname, values = value_grid(cause, n_sizes * DENSER.get(cause.name, 1))
-        for comp in cause.components(machine.rig, signal_info(machine.model_signal).component):
-            gains = PATH_GAINS if cause.rings_structure else (1.0,)
-            for label, healthy in _variants(cause, nominal):
-                job = (cause, comp, healthy, values, gains)
-                if healthy.shaft_modulation != 1.0:
-                    modulated.append((job, (cause.name, comp, label, pname, values)))
-                    continue
-                jobs.append(("entry", (*job, len(jobs))))
-                meta.append((cause.name, comp, label, pname, values))
-    # the modulation variants last: the other entries keep the noise they were drawn with
-    # before those variants were (a library computed earlier holds them as they are)
-    for job, m in modulated:
-        jobs.append(("entry", (*job, len(jobs))))
-        meta.append(m)
+    causes = list(causes) if causes is not None else applicable_causes(machine.rig)
+    jobs, meta = _entry_jobs(causes, machine.rig, signal_info(machine.model_signal).component,
+                             nominal, n_sizes)
     real_jobs = [("realisation", (nominal, int(seed) + 7777 * j, j))
                  for j in range(REALISATIONS + 1)]
     results = _run(lib, real_jobs + jobs, workers, progress)

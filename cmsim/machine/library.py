@@ -10,7 +10,9 @@ The library holds
   through the baseline: cage phases, slip — what one record of a healthy machine differs
   from another by beyond the spread within one);
 * one **entry** per cause, component and nuisance variant (the load zone of a bearing
-  defect's model: its clearance, its load): the cause's parameter values (a grid over its
+  defect's model: its clearance, its load; the path's gain where a change rings the
+  structure; the load modulation a rotating force swings against its line): the cause's
+  parameter values (a grid over its
   bounds) and, per value, the mean of each feature over the baseline's segments with the
   cause's change laid on them (:func:`cmsim.machine.change.apply_change`).
 """

@@ -78,3 +78,29 @@ def test_the_load_a_rotating_force_swings_is_a_nuisance_its_line_is_not(modulati
         assert {k: v for k, v in got.items() if v != 1.0} == want
         assert got["documented"] == 1.0
     assert "3 times its share" in _variant_words("modulation x3")
+
+
+def test_the_modulation_variants_come_last_and_leave_every_other_entry_its_noise(monkeypatch):
+    """A library's entries draw their noise by their job's index: with the modulation
+    variants of the rotating causes every other entry keeps the index it had without them
+    (a library computed before them is the same where it overlaps), and those variants
+    follow, one per modulation, after all the others."""
+    from cmsim.discrepancy import signatures
+    from cmsim.discrepancy.causes import ModelSetup, applicable_causes
+
+    rig = Rig.paper_2016()
+    nominal = ModelSetup(rig=rig, op=OperatingPoint(1500.0, 50.0))
+    causes = applicable_causes(rig)
+
+    def indexed():
+        jobs, meta = signatures._entry_jobs(causes, rig, "1b1", nominal, 3)
+        return {m[:3]: job[1][-1] for job, m in zip(jobs, meta)}
+
+    now = indexed()
+    monkeypatch.setattr(signatures, "SHAFT_MODULATIONS", ())
+    before = indexed()
+    added = set(now) - set(before)
+    assert added == {(c, None, f"modulation x{m:g}") for c in ("unbalance", "misalignment")
+                     for m in (0.3, 3.0)}
+    assert all(now[k] == before[k] for k in before)
+    assert sorted(now[k] for k in added) == list(range(len(before), len(now)))
