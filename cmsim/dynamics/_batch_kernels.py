@@ -89,8 +89,8 @@ class BatchBuffers(NamedTuple):
     slip_u: np.ndarray    # (B,) each run's place on its slip grid at this time
     slip_i: np.ndarray    # (B,) int64 its interval
     slip_f: np.ndarray    # (B,) its fraction of the interval
-    teeth1: np.ndarray    # (B·Z1,) 1 where a run's tooth of gear 1 has tables of its own
-    teeth2: np.ndarray    # (B·Z2,) the same for gear 2 (0: nominal, its look-ups skipped)
+    own1: np.ndarray      # (B·Z1,) 1 where a run's tooth of gear 1 has tables of its own
+    own2: np.ndarray      # (B·Z2,) the same for gear 2 (0: nominal, its look-ups skipped)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -399,7 +399,7 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
     if mesh_on and table:
         # the tooth contacts of every run in passes over the runs (the same numbers)
         mesh_forces_batch_jit(y, n, g, S, L.m_par, L.geo, B.tau, B.sr, V.psi, B.mesh,
-                              B.slots, B.teeth1, B.teeth2, diag, want_diag)
+                              B.slots, B.own1, B.own2, diag, want_diag)
     _springs(y, n, g, S.spring_ends[0], L.springs)
     _accelerations(y, n, g, L.minv, L.omega, B.ar, dydt, row)
 

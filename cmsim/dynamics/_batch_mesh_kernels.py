@@ -388,13 +388,13 @@ def _corner_slots(z1, z2, r, sg, geo_runs, teeth1, teeth2, psi_anchor):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _slot_loads(z1, z2, mp, sg, teeth_on, teeth1, teeth2, m_t, tk1, te1, tk2, te2, m_tab,
+def _slot_loads(z1, z2, mp, sg, teeth_on, own1, own2, m_t, tk1, te1, tk2, te2, m_tab,
                 tab_k, tab_e):
     """Every slot's elastic force, gap, pair stiffness and equivalent radius of every run
     (the table-mode end of :func:`~cmsim.dynamics._mesh_kernels._slot_geometry`): per-tooth
     factor and separation, the pair stiffness table. The tables flat: ``tk1`` …
     (B·Z·m_t,), ``tab_k``, ``tab_e`` (B·m_tab,). Gathers: a scalar loop (LLVM versions no
-    loop whose reads it cannot bound). A tooth whose flag in ``teeth1``/``teeth2`` is 0
+    loop whose reads it cannot bound). A tooth whose flag in ``own1``/``own2`` is 0
     has the nominal tables (factor 1, separation 0: what their look-up returns, to the
     bit), so it reads none: a faulty gear has one or a few teeth of its own, and reading
     every tooth's tables (230 kB a record) was the largest share of the contacts' time."""
@@ -423,10 +423,10 @@ def _slot_loads(z1, z2, mp, sg, teeth_on, teeth1, teeth2, m_t, tk1, te1, tk2, te
                 k1 = _tooth_index(k1r[l], z1)
                 k2 = _tooth_index(k2r[l], z2)
                 fa, ea, fb, eb = 1.0, 0.0, 1.0, 0.0
-                if teeth1[l * z1 + k1] != 0.0:
+                if own1[l * z1 + k1] != 0.0:
                     fa = _clamped_lookup(tk1, (l * z1 + k1) * m_t, m_t, u)
                     ea = _clamped_lookup(te1, (l * z1 + k1) * m_t, m_t, u)
-                if teeth2[l * z2 + k2] != 0.0:
+                if own2[l * z2 + k2] != 0.0:
                     fb = _clamped_lookup(tk2, (l * z2 + k2) * m_t, m_t, u)
                     eb = _clamped_lookup(te2, (l * z2 + k2) * m_t, m_t, u)
                 f_teeth = fa * fb
@@ -543,7 +543,7 @@ def _slot_forces(y, n, i1, i2, g, r, mp, sg, ctab_on, mutab_on, diag, want_diag)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def mesh_forces_batch_jit(y, n, g, S, mp, geo, tau, sr, psi_anchor, r, sg, teeth1, teeth2,
+def mesh_forces_batch_jit(y, n, g, S, mp, geo, tau, sr, psi_anchor, r, sg, own1, own2,
                           diag, want_diag):
     """Tooth-pair forces of every run in table mode (the single-run
     :func:`~cmsim.dynamics._mesh_kernels.mesh_forces_jit` for ``MODE_TABLE``, run by run the
@@ -551,7 +551,7 @@ def mesh_forces_batch_jit(y, n, g, S, mp, geo, tau, sr, psi_anchor, r, sg, teeth
     B), ``tau``, ``sr`` (B,) each run's equivalent time and relative speed, ``psi_anchor``
     (B, 2, AN_SIZE) the involute origins' anchors; ``S`` the stacked KernelParams (run
     first), ``mp``, ``geo``, ``r``, ``sg`` as the module docstring lays them out;
-    ``teeth1``, ``teeth2`` (B·Z) 1 where a run's tooth has per-tooth tables of its own
+    ``own1``, ``own2`` (B·Z) 1 where a run's tooth has per-tooth tables of its own
     (:func:`cmsim.dynamics.batch._faulty_teeth`)."""
     m_int = S.m_int[0]
     i1 = m_int[MI_G1]
@@ -578,7 +578,7 @@ def mesh_forces_batch_jit(y, n, g, S, mp, geo, tau, sr, psi_anchor, r, sg, teeth
     tab_e = S.tab_e.reshape(-1)
     _involute_slots(z1, z2, r, mp, geo, sg)
     _corner_slots(z1, z2, r, sg, S.geo, S.teeth1, S.teeth2, psi_anchor)
-    _slot_loads(z1, z2, mp, sg, teeth_on, teeth1, teeth2, m_t, tk1, te1, tk2, te2, m_tab,
+    _slot_loads(z1, z2, mp, sg, teeth_on, own1, own2, m_t, tk1, te1, tk2, te2, m_tab,
                 tab_k, tab_e)
     ctab_on = m_int[MI_CTAB] != 0
     mutab_on = m_int[MI_MUTAB] != 0
