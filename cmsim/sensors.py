@@ -181,15 +181,12 @@ def housing_acceleration(force_n, fs_hz, path):
 
 def _interpolated(x, h, k, n_fast):
     """The first ``n_fast`` samples of forces ``x`` (C, n) interpolated by k through ``h``
-    (:func:`interpolation_filter`): fast sample m = Σ_i x[i]·h[m + half − i·k], the inputs
-    before the first and after the last zero. Each row is summed alone, so a force reads
-    alike beside others."""
+    (:func:`interpolation_filter`), :func:`scipy.signal.resample_poly`'s: fast sample
+    m = Σ_i x[i]·h[m + half − i·k], the inputs before the first and after the last zero.
+    Only the inputs those samples reach are interpolated."""
     half = (h.size - 1) // 2
-    m = np.arange(n_fast)[:, None]
-    i = np.arange(min(x.shape[1], (n_fast - 1 + half) // k + 1))[None, :]
-    tap = m + half - i * k
-    taps = np.where((tap >= 0) & (tap <= 2 * half), h[np.clip(tap, 0, 2 * half)], 0.0)
-    return (x[:, None, :i.shape[1]] * taps[None, :, :]).sum(axis=2)
+    reach = min(x.shape[1], (n_fast - 1 + half) // k + 1)
+    return resample_poly(x[:, :reach], k, 1, axis=1, window=h / k)[:, :n_fast]
 
 
 @functools.lru_cache(maxsize=16)
