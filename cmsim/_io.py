@@ -11,11 +11,13 @@ import math
 import os
 import tempfile
 import zipfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["atomic_write", "atomic_write_text", "atomic_write_bytes", "atomic_savez",
+__all__ = ["atomic_write", "atomic_write_all", "atomic_write_text", "atomic_write_bytes",
+           "atomic_savez", "savez_writer",
            "staging_dir", "READ_ERRORS", "finite"]
 
 #: What reading a file a user brings can raise when the file is missing, truncated, of the
@@ -25,8 +27,9 @@ __all__ = ["atomic_write", "atomic_write_text", "atomic_write_bytes", "atomic_sa
 READ_ERRORS = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile)
 
 
-def _atomic(path, write, sync=True):
-    path = Path(path)
+def _staged(path, write):
+    """``write(fh)`` into a new temporary file beside ``path`` with ``path``'s permissions;
+    return the temporary's name (removed again if ``write`` raises)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
@@ -34,16 +37,81 @@ def _atomic(path, write, sync=True):
             write(fh)
             fh.flush()
             os.fchmod(fh.fileno(), 0o666 & ~_umask())
-            if sync:
-                os.fsync(fh.fileno())
+    except BaseException:
+        _unlink(tmp)
+        raise
+    return tmp
+
+
+def _unlink(tmp):
+    try:
+        os.unlink(tmp)
+    except FileNotFoundError:
+        pass
+
+
+def _fsync(name):
+    """Force the file ``name`` to the disk (POSIX syncs a file opened to read; Windows'
+    commit needs it open to write)."""
+    fd = os.open(name, os.O_RDONLY if os.name == "posix" else os.O_RDWR)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _atomic(path, write, sync=True):
+    path = Path(path)
+    tmp = _staged(path, write)
+    try:
+        if sync:
+            _fsync(tmp)
         os.replace(tmp, path)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except FileNotFoundError:
-            pass
+        _unlink(tmp)
         raise
     return path
+
+
+def atomic_write_all(jobs, threads=16):
+    """Write each ``(path, write)`` of ``jobs`` as :func:`atomic_write` does, as one batch:
+    every file is written to its temporary in turn, all of them are forced to the disk at once
+    (``threads`` wait on the disk side by side, so the file system commits them together
+    instead of once per file, and writing costs no thread switches), then each is renamed
+    into place in order. Interrupted, it leaves no temporary behind, and no file is renamed
+    before all are on the disk.
+
+    Parameters
+    ----------
+    jobs : iterable of (str or Path, callable)
+        Each file's path and its writer ``write(fh)`` (``fh`` a binary file object).
+    threads : int
+        Most files forced to the disk at once.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The paths, in order.
+    """
+    staged = []
+    try:
+        for path, write in jobs:
+            path = Path(path)
+            staged.append((_staged(path, write), path))
+        if len(staged) == 1:
+            _fsync(staged[0][0])
+        elif staged:
+            with ThreadPoolExecutor(max_workers=min(len(staged), threads)) as pool:
+                list(pool.map(_fsync, [tmp for tmp, _ in staged]))
+        done = []
+        while staged:
+            os.replace(*staged[0])
+            done.append(staged.pop(0)[1])
+        return done
+    except BaseException:
+        for tmp, _ in staged:
+            _unlink(tmp)
+        raise
 
 
 def _umask():
@@ -93,10 +161,24 @@ def atomic_write_text(path, text, sync=True):
     return atomic_write_bytes(path, text.encode("utf-8"), sync)
 
 
+def savez_writer(compressed=False, **arrays):
+    """A writer ``write(fh)`` of ``np.savez`` (``np.savez_compressed``) of ``arrays``, for
+    :func:`atomic_write` and :func:`atomic_write_all`.
+
+    Parameters
+    ----------
+    compressed : bool
+        Deflate the arrays.
+    **arrays : array_like
+        The arrays, by name.
+    """
+    saver = np.savez_compressed if compressed else np.savez
+    return lambda fh: saver(fh, **arrays)
+
+
 def atomic_savez(path, compressed=False, **arrays):
     """``np.savez`` to ``path`` atomically (no ``.npz`` suffix is appended)."""
-    saver = np.savez_compressed if compressed else np.savez
-    return _atomic(path, lambda fh: saver(fh, **arrays))
+    return _atomic(path, savez_writer(compressed, **arrays))
 
 
 def finite(value):

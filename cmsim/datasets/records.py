@@ -25,12 +25,11 @@ import math
 import os
 import time
 import traceback
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
-from cmsim._io import atomic_savez
+from cmsim._io import atomic_write_all, savez_writer
 from cmsim.datasets.manifest import RECORDS_DIR, file_sha256, json_default, write_row
 from cmsim.datasets.spec import mesh_key
 from cmsim.dynamics.batch import simulate_batch
@@ -417,9 +416,10 @@ def run_records(spec, indices, out_dir, plans=None, batch_size=None):
     in order (status ``"ok"``, or ``"failed"`` with the error: a failed record does not stop
     the others).
 
-    The files are written side by side in threads: each is forced to the disk before its
-    row is written (:func:`cmsim.datasets.manifest.write_row`), and the file system then
-    commits them together instead of once per record.
+    The files are written one after another and forced to the disk together
+    (:func:`cmsim._io.atomic_write_all`), each before its row is written
+    (:func:`cmsim.datasets.manifest.write_row`): the file system commits them at once instead
+    of once per record, and no thread contends for the worker's core while they are encoded.
 
     Parameters
     ----------
@@ -449,44 +449,43 @@ def run_records(spec, indices, out_dir, plans=None, batch_size=None):
         rows.append(row)
     results = simulate_records(spec, plans, batch_size)
     spent = (time.perf_counter() - start) / max(len(plans), 1)
-    if len(rows) == 1:                     # (starting a thread costs more than it saves)
-        return [_write_record(spec, out, rows[0], results[0], spent)]
-    with ThreadPoolExecutor(max_workers=min(len(rows), 16)) as pool:
-        return list(pool.map(lambda rr: _write_record(spec, out, *rr, spent),
-                             zip(rows, results)))
-
-
-def _write_record(spec, out, row, result, spent):
-    """Write one record's file (atomically, synced) then its sidecar row; return the row."""
-    start = time.perf_counter()
-    if isinstance(result, Exception):
-        row.update(status="failed", error=" ".join(f"{type(result).__name__}: {result}".split()),
-                   wall_s=spent)
-        if os.environ.get("CMSIM_DEBUG"):
-            traceback.print_exception(result)
+    t_save = time.perf_counter()
+    files = [(out / row["path"], _record_file(spec, row, result))
+             for row, result in zip(rows, results) if not isinstance(result, Exception)]
+    atomic_write_all(files)
+    save_s = (time.perf_counter() - t_save) / max(len(files), 1)
+    for row, result in zip(rows, results):
+        if isinstance(result, Exception):
+            row.update(status="failed", error=" ".join(f"{type(result).__name__}: {result}"
+                                                       .split()), wall_s=spent)
+            if os.environ.get("CMSIM_DEBUG"):
+                traceback.print_exception(result)
+        else:
+            path = out / row["path"]
+            row["bytes"] = path.stat().st_size
+            row["sha256"] = file_sha256(path)
+            row["save_s"] = save_s
+            row["wall_s"] = spent + row["features_s"] + save_s
         write_row(out, row)
-        return row
+    return rows
+
+
+def _record_file(spec, row, result):
+    """Fill ``row`` with a simulated record's status, sizes, timings and manifest features;
+    return the writer of its file (meta with the row, then the arrays)."""
     arrays, meta = result
-    path = out / row["path"]
     t_features = time.perf_counter()
     if spec.channels is None:
         signals = {k: v for k, v in arrays.items() if k not in ("t", "source")}
         row.update(manifest_features(Run(arrays["t"], signals, meta)))
     timing = meta["timing_s"]
-    t_save = time.perf_counter()
     row.update(status="ok", n_samples=int(next(iter(arrays.values())).size
                                           if spec.channels else arrays["t"].size),
                fs_hz=meta["fs_hz"], integration_s=timing["integration"],
                setup_s=timing["setup"], sensors_s=timing["sensors"],
-               features_s=t_save - t_features)
+               features_s=time.perf_counter() - t_features)
     meta["row"] = row
-    atomic_savez(path, meta=json.dumps(meta, default=json_default), **arrays)
-    row["bytes"] = path.stat().st_size
-    row["sha256"] = file_sha256(path)
-    row["save_s"] = time.perf_counter() - t_save
-    row["wall_s"] = spent + time.perf_counter() - start
-    write_row(out, row)
-    return row
+    return savez_writer(meta=json.dumps(meta, default=json_default), **arrays)
 
 
 def run_record(spec, index, out_dir):
