@@ -63,7 +63,10 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB` over the baseline and its change, at the
       variant and size its signature reads best, reads the record's features nearer than
       the baseline alone over all of them as its signature weighs them (its row's
-      ``total``; the path profiled out as below). A cause whose change
+      ``total``; the path profiled out as below); a fault that rings the structure must
+      also stand out so over the prediction of the reshaping cause that reads the record
+      best, if one reaches :data:`MIN_EVIDENCE` (a load moves the ball-pass lines too).
+      A cause whose change
       is impacts ringing the structure
       (:attr:`~cmsim.discrepancy.causes.Cause.rings_structure`) is judged there with the
       path profiled out: each feature that depends on the transfer path, and the
@@ -370,10 +373,18 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             # and with the path profiled out for a change ringing the structure (``total``:
             # the angle generator's unbalance read as a misalignment whose 2× line the record
             # lacks, −52). Read at that one variant and size only: another within the
-            # signature's range might read the record better and is not asked
+            # signature's range might read the record better and is not asked. A fault that
+            # rings the structure must also stand out over the prediction of the reshaping
+            # cause that reads the record best: a load moves which balls carry it, and with
+            # them the ball-pass lines (cmsim's own torque mismatch of seed 3 was read as an
+            # inner race whose lines its load change lifts as far)
+            reshaped = next((r["prediction"] for r in cands if r["cause"].signature is None
+                             and r["evidence"] >= MIN_EVIDENCE), None)
             faults = [r for r in by_signature.values()
                       if r["cause"].signature is not None and r["nameable"]
-                      and r["total"] > 0.0]
+                      and r["total"] > 0.0 and (
+                          reshaped is None or not r["cause"].rings_structure
+                          or standing_out(r["out"], meas, reshaped, sigma, names))]
             top, ties = decide(sorted(faults, key=lambda r: -r["delta_chi2"]),
                                sensor_bearing, chi0)
             how = "family" if top is not None else ""

@@ -130,6 +130,37 @@ def test_a_fault_is_named_on_its_family_only_where_its_whole_change_reads_the_re
     assert d["finding"] == finding, (row["delta_chi2"], row["total"])
 
 
+@pytest.mark.parametrize("env, finding", [(0.0, "bearing_outer_race"), (8.0, "unexplained")])
+def test_a_family_the_best_reshaping_reading_lifts_as_far_names_no_fault(env, finding):
+    """The record's envelope lines 8 dB over the baseline, its kurtosis up and its low bands
+    moved far where no cause moves them: no cause reads most of the record. A load change
+    reads its kurtosis and lifts the envelope lines by ``env`` dB (a torque moves which balls
+    carry the load, and with them the ball-pass lines): where it lifts them as far as the
+    record, they stand out over no one's prediction but the baseline's, and the outer race
+    is not named on them (cmsim's own torque mismatch was named an inner race so)."""
+    from cmsim.discrepancy.judge import MIN_EVIDENCE
+
+    outer = np.zeros((3, len(NAMES)))
+    outer[:, ENV] = np.array([[0.0], [5.0], [20.0]])
+    load = np.zeros((2, len(NAMES)))
+    load[:, 2] = [0.0, 3.0]                                      # kurtosis_log
+    load[1, ENV] = env
+    lib = replace(_library(), entries=(
+        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), outer),
+        SignatureEntry("torque_mismatch", None, "documented", "load_factor", (1.0, 3.0),
+                       load)))
+    li = np.arange(len(NAMES))
+    meas = np.array([8.0, 8.0, 3.0, 0.0, -30.0, -30.0, 0.0])
+    d = decide_record(lib, li, list(NAMES), meas, feature_sigma(lib, li, list(NAMES), 8),
+                      "1b1")
+    load_row = next(r for r in d["ranked"] if r["name"] == "torque_mismatch")
+    assert d["decided_on"] in ("family", "") and load_row["evidence"] >= MIN_EVIDENCE
+    row = next(r for r in d["by_signature"] if r["name"] == "bearing_outer_race")
+    assert row["stands_out"] and row["total"] > 0.0
+    assert d["finding"] == finding, [(r["name"], r["evidence"]) for r in d["ranked"]]
+
+
 def test_a_cause_that_adds_power_is_no_candidate_for_a_quieter_record():
     """The shape bands moved as noise moves them, but the record is 12 dB quieter: noise
     cannot make a machine quieter."""
