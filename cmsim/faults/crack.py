@@ -168,8 +168,13 @@ def cracked_tooth_compliance(profile, contact_radius_m, depth_m, angle_rad, n_no
     y_s = crack_start(profile)[0]
 
     def h_eff(h, y):
-        cut = (y >= y_s) & (h > h_q)                # thickness h + h_q behind the crack
-        return np.where(cut, 0.5 * (h + h_q), h)
+        # thickness h + h_q behind the crack, where h > h_q (the mean, then under h), from
+        # its start on; one temporary the size of the beam's nodes, not six
+        out = h + h_q
+        out *= 0.5
+        np.minimum(out, h, out=out)
+        np.copyto(out, h, where=y < y_s)
+        return out
 
     return tooth_compliance(profile, contact_radius_m, n_nodes=n_nodes, thinned=h_eff)
 

@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmsim.errors import ModelWarning, ParameterError, check_range, check_type
+from cmsim.mesh_stiffness._beam_kernels import beam_sums_jit
 from cmsim.mesh_stiffness.geometry import ToothProfile, involute_half_angle
 from cmsim.rig import GearPair, SpurGear
 
@@ -223,13 +224,15 @@ def cantilever_compliance(half_thickness_m, length_m, load_offset_m, load_angle_
     bending, shear, axial = (np.empty_like(d) for _ in range(3))
     w = _simpson_weights(t.size)
     for sl, u, arm2, c2, s2 in blocks:
-        h = np.asarray(half_thickness_m(u), dtype=float) * np.ones_like(u)
-        if not (np.all(np.isfinite(h)) and np.all(h > 0.0)):
+        h = np.asarray(half_thickness_m(u), dtype=float)
+        if h.shape != u.shape:
+            h = h * np.ones_like(u)
+        if not (h.min() > 0.0 and np.isfinite(h.max())):            # NaN fails the first
             raise ParameterError("half_thickness_m must return finite values > 0 on the beam")
-        inv_a = 1.0 / (2.0 * h * face_width_m)
-        inv_i = 1.0 / (2.0 / 3.0 * h ** 3 * face_width_m)
-        bending[sl] = (arm2 * inv_i) @ w * d[sl] / E
-        ja = inv_a @ w * d[sl]
+        sums = np.empty((2, h.shape[0]))
+        beam_sums_jit(np.ascontiguousarray(h), arm2, w, float(face_width_m), sums[0], sums[1])
+        bending[sl] = sums[0] * d[sl] / E
+        ja = sums[1] * d[sl]
         shear[sl] = _SHEAR_FACTOR * c2 * ja / G
         axial[sl] = s2 * ja / E
     return bending, shear, axial
