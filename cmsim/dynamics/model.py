@@ -39,7 +39,8 @@ from cmsim.dynamics._mesh_kernels import (MI_BALL_SLIP, MI_CTAB, MI_ECC, MI_FAUL
                                           MP_PDT, MP_PHIT0, MP_PSI10, MP_PSI20, MP_PT0, MP_SINT0,
                                           MP_SIZE, MP_SLO, MP_TAB0, MP_TABD, MP_TDT, MP_V0,
                                           MP_ZAFTER, MP_ZBEFORE, no_hybrid)
-from cmsim.dynamics._rhs_kernels import KernelParams, make_work, no_faults, no_profile, rhs_jit
+from cmsim.dynamics._rhs_kernels import (KernelParams, make_work, no_faults, no_profile, rhs_jit,
+                                         static_residual_jit)
 from cmsim.dynamics.rig_model import RigModel, rig_model
 from cmsim.errors import ParameterError, check_range
 from cmsim.faults import check_faults, compile_faults, rig_with_faults
@@ -187,9 +188,20 @@ class DynamicModel:
         return (dydt[0], diag) if want_diag else dydt[0]
 
     def static_residual(self, t, q):
-        """M·q̈ at rest relative to the nominal rotation (velocities zero), shape (n,)."""
-        y = np.concatenate([q, np.zeros(self.n_dof)])
-        return self.mass * self.rhs(t, y)[self.n_dof:]
+        """M·q̈ at rest relative to the nominal rotation (velocities zero), shape (n,): the
+        kernel's right-hand side as :meth:`rhs` evaluates it, with fresh scratch each call,
+        in one numba call on buffers the model keeps (a quasi-static start takes some 65)."""
+        n = self.n_dof
+        buffers = self.__dict__.get("_static_buffers")
+        if buffers is None:                       # (a frozen dataclass: kept beside its fields)
+            P = self.kernel_params
+            buffers = (make_work(P), make_work(P), np.empty(2 * n), np.empty((1, 2 * n)),
+                       np.zeros(len(self.output_force_names)))
+            self.__dict__["_static_buffers"] = buffers
+        out = np.empty(n)
+        static_residual_jit(float(t), np.ascontiguousarray(q, dtype=float), self.mass,
+                            self.kernel_params, *buffers, out)
+        return out
 
     def loa_direction(self, shaft_index):
         """Unit vector (x, y) of the line of action for shaft ``shaft_index`` (0 or 1).
