@@ -29,57 +29,59 @@ READ_ERRORS = (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZi
 
 def _staged(path, write):
     """``write(fh)`` into a new temporary file beside ``path`` with ``path``'s permissions;
-    return the temporary's name (removed again if ``write`` raises)."""
+    return its descriptor, still open (the data handed to the system), and its name, for
+    :func:`_settle` (removed again if ``write`` raises)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        with os.fdopen(fd, "wb") as fh:
+        with os.fdopen(fd, "wb", closefd=False) as fh:
             write(fh)
             fh.flush()
-            os.fchmod(fh.fileno(), 0o666 & ~_umask())
+            os.fchmod(fd, 0o666 & ~_umask())
     except BaseException:
+        os.close(fd)
         _unlink(tmp)
         raise
-    return tmp
+    return fd, tmp
+
+
+def _settle(fd, tmp, path, sync=True):
+    """Force a staged temporary to the disk through its own descriptor (``sync``), close it
+    and rename it to ``path``; return ``path``."""
+    try:
+        if sync:
+            os.fsync(fd)
+    finally:
+        os.close(fd)
+    os.replace(tmp, path)
+    return path
 
 
 def _unlink(tmp):
     try:
         os.unlink(tmp)
-    except FileNotFoundError:
+    except OSError:                   # gone already (renamed), or held open elsewhere
         pass
-
-
-def _fsync(name):
-    """Force the file ``name`` to the disk (POSIX syncs a file opened to read; Windows'
-    commit needs it open to write)."""
-    fd = os.open(name, os.O_RDONLY if os.name == "posix" else os.O_RDWR)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 def _atomic(path, write, sync=True):
     path = Path(path)
-    tmp = _staged(path, write)
+    fd, tmp = _staged(path, write)
     try:
-        if sync:
-            _fsync(tmp)
-        os.replace(tmp, path)
+        _settle(fd, tmp, path, sync)
     except BaseException:
         _unlink(tmp)
         raise
     return path
 
 
-def atomic_write_all(jobs, threads=16):
-    """Write each ``(path, write)`` of ``jobs`` as :func:`atomic_write` does, as one batch:
-    every file is written to its temporary in turn, all of them are forced to the disk at once
-    (``threads`` wait on the disk side by side, so the file system commits them together
-    instead of once per file, and writing costs no thread switches), then each is renamed
-    into place in order. Interrupted, it leaves no temporary behind, and no file is renamed
-    before all are on the disk.
+def atomic_write_all(jobs, threads=16, chunk=64):
+    """Write each ``(path, write)`` of ``jobs`` as :func:`atomic_write` does, in batches of
+    ``chunk``: the files of a batch are written to their temporaries in turn, then forced to
+    the disk side by side (``threads`` wait on it together, so the file system commits them
+    at once instead of once per file, and writing them costs no thread switches), each
+    renamed into place once it is there. Interrupted, it leaves no temporary behind; the
+    files renamed stay, each whole.
 
     Parameters
     ----------
@@ -87,31 +89,34 @@ def atomic_write_all(jobs, threads=16):
         Each file's path and its writer ``write(fh)`` (``fh`` a binary file object).
     threads : int
         Most files forced to the disk at once.
+    chunk : int
+        Most files open at once.
 
     Returns
     -------
     list of pathlib.Path
         The paths, in order.
     """
-    staged = []
-    try:
-        for path, write in jobs:
-            path = Path(path)
-            staged.append((_staged(path, write), path))
-        if len(staged) == 1:
-            _fsync(staged[0][0])
-        elif staged:
-            with ThreadPoolExecutor(max_workers=min(len(staged), threads)) as pool:
-                list(pool.map(_fsync, [tmp for tmp, _ in staged]))
-        done = []
-        while staged:
-            os.replace(*staged[0])
-            done.append(staged.pop(0)[1])
-        return done
-    except BaseException:
-        for tmp, _ in staged:
-            _unlink(tmp)
-        raise
+    jobs, done = list(jobs), []
+    for lo in range(0, len(jobs), chunk):
+        staged, settling = [], False
+        try:
+            for path, write in jobs[lo:lo + chunk]:
+                path = Path(path)
+                staged.append((*_staged(path, write), path))
+            settling = True                         # each _settle closes its descriptor
+            if len(staged) == 1:
+                done.append(_settle(*staged[0]))
+            else:
+                with ThreadPoolExecutor(max_workers=min(len(staged), threads)) as pool:
+                    done += pool.map(lambda s: _settle(*s), staged)
+        except BaseException:
+            for fd, tmp, _ in staged:
+                if not settling:
+                    os.close(fd)
+                _unlink(tmp)
+            raise
+    return done
 
 
 def _umask():

@@ -420,6 +420,8 @@ def run_records(spec, indices, out_dir, plans=None, batch_size=None):
     (:func:`cmsim._io.atomic_write_all`), each before its row is written
     (:func:`cmsim.datasets.manifest.write_row`): the file system commits them at once instead
     of once per record, and no thread contends for the worker's core while they are encoded.
+    A failed record's row is written first; a record whose file is in place but whose row
+    was not written (an interruption) is adopted from its file on a resume.
 
     Parameters
     ----------
@@ -449,23 +451,27 @@ def run_records(spec, indices, out_dir, plans=None, batch_size=None):
         rows.append(row)
     results = simulate_records(spec, plans, batch_size)
     spent = (time.perf_counter() - start) / max(len(plans), 1)
-    t_save = time.perf_counter()
-    files = [(out / row["path"], _record_file(spec, row, result))
-             for row, result in zip(rows, results) if not isinstance(result, Exception)]
-    atomic_write_all(files)
-    save_s = (time.perf_counter() - t_save) / max(len(files), 1)
     for row, result in zip(rows, results):
-        if isinstance(result, Exception):
+        if isinstance(result, Exception):     # its row first: it waits on no file
             row.update(status="failed", error=" ".join(f"{type(result).__name__}: {result}"
                                                        .split()), wall_s=spent)
             if os.environ.get("CMSIM_DEBUG"):
                 traceback.print_exception(result)
-        else:
-            path = out / row["path"]
-            row["bytes"] = path.stat().st_size
-            row["sha256"] = file_sha256(path)
-            row["save_s"] = save_s
-            row["wall_s"] = spent + row["features_s"] + save_s
+            write_row(out, row)
+    files = [(out / row["path"], _record_file(spec, row, result))
+             for row, result in zip(rows, results) if not isinstance(result, Exception)]
+    t_save = time.perf_counter()
+    atomic_write_all(files)
+    written = (time.perf_counter() - t_save) / max(len(files), 1)
+    for row, result in zip(rows, results):
+        if isinstance(result, Exception):
+            continue
+        t_row = time.perf_counter()
+        path = out / row["path"]
+        row["bytes"] = path.stat().st_size
+        row["sha256"] = file_sha256(path)
+        row["save_s"] = written + time.perf_counter() - t_row
+        row["wall_s"] = spent + row["features_s"] + row["save_s"]
         write_row(out, row)
     return rows
 
