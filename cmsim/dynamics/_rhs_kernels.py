@@ -29,7 +29,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import literal_unroll, njit
 
 from cmsim.dynamics._bearing_kernels import (DF_SIZE, bearing_forces_jit, cage_slip_jit,
                                              faulty_bearing_forces_jit, slip_offsets_jit,
@@ -304,6 +304,10 @@ def rhs_jit(t, y, dydt, row, P, diag, want_diag, W):
             dydt[row, n + i] -= P.omega[i] * ar
 
 
+#: The fields of :class:`Work` by position (what :func:`static_residual_jit` resets).
+_WORK_INDICES = tuple(range(len(Work._fields)))
+
+
 @njit(cache=True, error_model="numpy")
 def static_residual_jit(t, q, mass, P, W, W0, y, dydt, diag, out):
     """``out = M·q̈`` at rest (velocities zero) at time ``t`` for displacements ``q``: the
@@ -311,14 +315,8 @@ def static_residual_jit(t, q, mass, P, W, W0, y, dydt, diag, out):
     :func:`make_work`, so that each call reads as with new arrays) — one numba call per
     residual of a quasi-static solve instead of seventeen allocations. ``y`` (2n,),
     ``dydt`` (1, 2n), ``diag`` buffers."""
-    for a, b in ((W.g, W0.g), (W.cage_slip, W0.cage_slip), (W.hwork, W0.hwork),
-                 (W.hdelta, W0.hdelta), (W.hrho1, W0.hrho1), (W.hrho2, W0.hrho2),
-                 (W.hchi1, W0.hchi1), (W.hchi2, W0.hchi2), (W.hout, W0.hout),
-                 (W.hext, W0.hext), (W.hstat, W0.hstat), (W.def_gain, W0.def_gain)):
-        a[:] = b
-    for a, b in ((W.cage, W0.cage), (W.slip_cos, W0.slip_cos), (W.slip_sin, W0.slip_sin),
-                 (W.slots, W0.slots), (W.psi, W0.psi)):
-        a[:, :] = b
+    for i in literal_unroll(_WORK_INDICES):        # every field of Work, whatever its shape
+        W[i][...] = W0[i]
     n = q.shape[0]
     for i in range(n):
         y[i] = q[i]

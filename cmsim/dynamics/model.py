@@ -23,6 +23,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -191,17 +192,18 @@ class DynamicModel:
         """M·q̈ at rest relative to the nominal rotation (velocities zero), shape (n,): the
         kernel's right-hand side as :meth:`rhs` evaluates it, with fresh scratch each call,
         in one numba call on buffers the model keeps (a quasi-static start takes some 65)."""
-        n = self.n_dof
-        buffers = self.__dict__.get("_static_buffers")
-        if buffers is None:                       # (a frozen dataclass: kept beside its fields)
-            P = self.kernel_params
-            buffers = (make_work(P), make_work(P), np.empty(2 * n), np.empty((1, 2 * n)),
-                       np.zeros(len(self.output_force_names)))
-            self.__dict__["_static_buffers"] = buffers
-        out = np.empty(n)
+        out = np.empty(self.n_dof)
         static_residual_jit(float(t), np.ascontiguousarray(q, dtype=float), self.mass,
-                            self.kernel_params, *buffers, out)
+                            self.kernel_params, *self._static_buffers, out)
         return out
+
+    @functools.cached_property
+    def _static_buffers(self):
+        """Scratch, its fresh copy, state, slope and force buffers of :meth:`static_residual`
+        (one model's solve at a time: not shared between threads)."""
+        P, n = self.kernel_params, self.n_dof
+        return (make_work(P), make_work(P), np.empty(2 * n), np.empty((1, 2 * n)),
+                np.zeros(len(self.output_force_names)))
 
     def loa_direction(self, shaft_index):
         """Unit vector (x, y) of the line of action for shaft ``shaft_index`` (0 or 1).
