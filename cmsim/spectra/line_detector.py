@@ -18,16 +18,19 @@ model's lines, which lines a model force makes — it is found here:
 
 The machine's calibration (:mod:`cmsim.machine.calibration`) reads a baseline's and a model
 force's lines with it, and a cause's change on a baseline (:mod:`cmsim.machine.change`)
-finds the lines the healthy model makes with it.
+finds the lines the healthy model makes with it — four spectra per record of a
+machine-calibrated dataset, every entry of a signature library: the claim of each line's
+bins and their sums run in numba (:mod:`cmsim.spectra._line_kernels`, the same lines to the
+bit as the plain loop).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from cmsim.spectra._line_kernels import line_spans_jit, span_sums_jit
 from cmsim.spectra.floor import median_window_bins, running_median_floor
 
 __all__ = ["DetectedLine", "detect_lines", "line_free", "LINE_MIN_DB", "FLOOR_HALF_WIDTH_HZ",
@@ -111,44 +114,18 @@ def detect_lines(freq, psd, *, min_db=LINE_MIN_DB, half_width_hz=FLOOR_HALF_WIDT
     med = median_floor(freq, psd, half_width_hz)
     ratio = psd / med
     thr = 10.0 ** (min_db / 10.0)
-    n = psd.size                         # local maxima standing out, bins 2 to n - 3
-    mid = psd[2:n - 2]
-    peaks = (np.flatnonzero((ratio[2:n - 2] > thr) & (freq[2:n - 2] >= lowest_hz)
-                            & (mid >= psd[1:n - 3]) & (mid >= psd[3:n - 1])) + 2).tolist()
-    owner = np.full(psd.size, -1)        # the line each bin belongs to
-    spans = []
-    for i in sorted(peaks, key=lambda j: -psd[j]):
-        if owner[i] >= 0:                # a local maximum within a stronger line's bins
-            continue
-        lo, hi = _line_span(ratio, owner, i, thr, max(2, math.ceil(tolerance * freq[i] / df)))
-        owner[lo:hi] = len(spans)
-        spans.append((i, slice(lo, hi)))
+    owner, peak, lo, hi = line_spans_jit(np.asarray(freq, dtype=float), psd, ratio, thr,
+                                         float(lowest_hz), float(tolerance), df)
     k = median_window_bins(freq, half_width_hz)
     masked = np.where(owner >= 0, med, psd)
     floor = np.maximum(np.convolve(np.pad(masked, k // 2, mode="edge"), np.ones(k) / k,
                                    mode="valid"), 1e-300)
-    kept = []
-    above = np.maximum(psd - floor, 0.0)
-    for i, bins in spans:
-        excess = float(np.sum(above[bins])) * df
-        if excess > 0:
-            kept.append(DetectedLine(float(freq[i]), math.sqrt(2.0 * excess), bins))
-    kept.sort(key=lambda ln: -ln.amplitude)
-    return kept[:max_lines], floor
-
-
-def _line_span(ratio, owner, i, thr, most):
-    """(lo, hi) bins of the line peaking at bin ``i``: its Hann main lobe (± 2 bins) and the
-    contiguous bins beside it still standing ``thr`` over the median, at most ``most`` each
-    side, none that a stronger line holds (``owner`` >= 0)."""
-    lo = hi = i
-    while (lo - 1 >= 0 and owner[lo - 1] < 0 and i - (lo - 1) <= most
-           and (i - (lo - 1) <= 2 or ratio[lo - 1] > thr)):
-        lo -= 1
-    while (hi + 1 < ratio.size and owner[hi + 1] < 0 and hi + 1 - i <= most
-           and (hi + 1 - i <= 2 or ratio[hi + 1] > thr)):
-        hi += 1
-    return lo, hi + 1
+    excess = span_sums_jit(np.maximum(psd - floor, 0.0), lo, hi) * df
+    keep = np.flatnonzero(excess > 0)             # in the order claimed, then strongest first
+    amplitude = np.sqrt(2.0 * excess[keep])
+    best = np.argsort(-amplitude, kind="stable")[:max_lines]
+    return [DetectedLine(float(freq[peak[keep[j]]]), float(amplitude[j]),
+                         slice(int(lo[keep[j]]), int(hi[keep[j]]))) for j in best], floor
 
 
 def line_free(freq, psd, *, min_db=LINE_MIN_DB, half_width_hz=FLOOR_HALF_WIDTH_HZ):
