@@ -21,7 +21,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 
-__all__ = ["Background", "BackgroundLine", "LINE_REFERENCES"]
+__all__ = ["Background", "BackgroundLine", "LINE_REFERENCES", "sum_of_cosines"]
 
 #: What a line's frequency follows: the input shaft's order, the output shaft's, or nothing.
 LINE_REFERENCES = ("input", "output", "fixed")
@@ -124,15 +124,34 @@ class Background:
         # white unit-variance noise has a one-sided density 2/fs: rescale to psd
         return gain * np.fft.irfft(spec * np.sqrt(psd * fs_hz / 2.0), n)
 
-    def deterministic(self, t, shaft_hz, rng, gain=1.0):
-        """The lines at instants ``t`` (s), shaft rates ``shaft_hz`` = (input, output) Hz,
-        each with a phase drawn from ``rng``; ``gain`` scales them."""
-        x = np.zeros_like(np.asarray(t, dtype=float))
-        for line in self.lines:
-            phase = rng.uniform(0.0, 2.0 * math.pi)
-            x += gain * line.amplitude * np.cos(2.0 * math.pi * line.frequency_hz(shaft_hz) * t
-                                                + phase)
-        return x
+    def deterministic(self, n, fs_hz, shaft_hz, rng, gain=1.0):
+        """``n`` samples at ``fs_hz`` (from t = 0) of the lines at shaft rates ``shaft_hz`` =
+        (input, output) Hz, each with a phase drawn from ``rng`` in the lines' order;
+        ``gain`` scales them.
+
+        Parameters
+        ----------
+        n : int
+            Samples.
+        fs_hz : float
+            Sample rate, Hz.
+        shaft_hz : tuple of float
+            (input, output) shaft rates, Hz.
+        rng : numpy.random.Generator
+            Source of the phases.
+        gain : float
+            Factor on the amplitudes.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+        """
+        if not self.lines:
+            return np.zeros(n)
+        freq = np.array([line.frequency_hz(shaft_hz) for line in self.lines])
+        amp = gain * np.array([line.amplitude for line in self.lines])
+        phase = rng.uniform(0.0, 2.0 * math.pi, len(self.lines))
+        return sum_of_cosines(freq, amp, phase, n, fs_hz)
 
     def synthesize(self, n, fs_hz, shaft_hz, rng, noise_gain=1.0, line_gain=1.0):
         """``n`` samples of the whole background (noise plus lines).
@@ -154,12 +173,48 @@ class Background:
         -------
         numpy.ndarray, shape (n,)
         """
-        t = np.arange(n) / fs_hz
         return (self.noise(n, fs_hz, rng, noise_gain)
-                + self.deterministic(t, shaft_hz, rng, line_gain))
+                + self.deterministic(n, fs_hz, shaft_hz, rng, line_gain))
 
     def to_dict(self):
         """Plain dict for the machine file."""
         return {"freq_hz": list(self.freq_hz), "psd": list(self.psd),
                 "lines": [{"reference": ln.reference, "value": ln.value,
                            "amplitude": ln.amplitude} for ln in self.lines]}
+
+
+def sum_of_cosines(freq_hz, amplitude, phase_rad, n, fs_hz):
+    """Σ_l a_l·cos(2π·f_l·k/fs + φ_l) at the samples k = 0 … n − 1.
+
+    The instants are split as k = i·B + j (B ≈ √n): e^{iω k} = e^{iω i B}·e^{iω j}, so the sum
+    over the lines is one complex matrix product of an (n/B × L) and an (L × B) table instead
+    of L·n cosines (89 lines of a 12 000-sample record: 0.5 ms instead of 11). Each factor is
+    an exponential of its own argument, so the phase is as exact as the direct cosine's
+    (its argument reaches 2π·f·T, rounded alike).
+
+    Parameters
+    ----------
+    freq_hz, amplitude, phase_rad : array_like, shape (L,)
+        The lines.
+    n : int
+        Samples.
+    fs_hz : float
+        Sample rate, Hz.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+
+    Examples
+    --------
+    >>> x = sum_of_cosines([50.0], [2.0], [0.0], 4, 200.0)
+    >>> [float(round(v, 12)) + 0.0 for v in x]
+    [2.0, 0.0, -2.0, 0.0]
+    """
+    w = 2.0 * math.pi * np.asarray(freq_hz, dtype=float) / fs_hz
+    c = np.asarray(amplitude, dtype=float) * np.exp(1j * np.asarray(phase_rad, dtype=float))
+    b = max(1, math.isqrt(max(int(n), 1)))
+    rows = -(-int(n) // b)
+    outer = c[None, :] * np.exp(1j * np.outer(np.arange(rows) * float(b), w))
+    inner = np.exp(1j * np.outer(w, np.arange(b, dtype=float)))
+    return (outer @ inner).real.reshape(-1)[:n]
