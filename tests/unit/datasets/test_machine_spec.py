@@ -7,6 +7,8 @@ what contradicts the machine (another rig, another sample rate, a missing file).
 """
 
 import dataclasses
+import hashlib
+import json
 
 import numpy as np
 import pytest
@@ -208,3 +210,21 @@ def test_a_machine_spec_s_references_run_in_batches_and_keep_the_records_bits(
             # float32 channels: one unit in the last place of the signal's range at most
             tol = max(np.ptp(ref), np.max(np.abs(ref))) * 2.0 ** -22
             assert np.max(np.abs(np.asarray(a[ch], dtype=float) - ref)) <= tol, ch
+
+
+def test_a_record_key_is_the_hash_of_its_whole_description(tmp_path):
+    """The shared fields (the machine's path, background and baseline among them) are
+    encoded once per spec, not once per record; a key stays the digest of the record's
+    whole description, so a dataset made before resumes on the same keys."""
+    spec = DatasetSpec.from_dict(_spec_dict(tmp_path), base_dir=tmp_path)
+    whole = spec.to_dict()
+    for i in range(len(spec)):
+        plan = spec.record(i)
+        record = {"id": plan.record_id, "seed": plan.sim_seed, "params": plan.params,
+                  "rig": spec.record_rig(plan).to_dict(),
+                  "op": dataclasses.asdict(spec.record_operating_point(plan)),
+                  "faults": [f.to_dict() for f in plan.faults],
+                  **{k: whole[k] for k in ("channels", "fs_hz", "duration_s", "warmup_s",
+                                           "substeps", "mesh", "losses", "machine")}}
+        text = json.dumps(record, sort_keys=True, default=str)
+        assert spec.record_key(plan) == hashlib.sha256(text.encode()).hexdigest()[:16]
