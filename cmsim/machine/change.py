@@ -50,7 +50,7 @@ from scipy.ndimage import map_coordinates
 from cmsim.errors import ParameterError
 from cmsim.machine.path import smooth_log
 from cmsim.spectra.floor import segment_psd
-from cmsim.spectra.line_detector import detect_lines
+from cmsim.spectra.line_detector import detect_lines, span_sums
 from cmsim.spectra.lines import line_bins
 
 __all__ = ["Change", "apply_change", "pinned_correction", "path_ratio", "SHARED_LINE_DB",
@@ -324,6 +324,59 @@ def shaft_locked(freq, lines, change):
     return out
 
 
+def _positions(lo, hi):
+    """(bins, span of each) of the spans ``lo[j]:hi[j]`` laid end to end (empty ones
+    dropped)."""
+    width = np.maximum(hi - lo, 0)
+    owner = np.repeat(np.arange(lo.size), width)
+    return np.arange(width.sum()) + np.repeat(lo - (np.cumsum(width) - width), width), owner
+
+
+def _scale_lines(scale, spans, psd_h, psd_c, psd_b, floor_b, gain2):
+    """Scale the baseline's spectrum on the bins of each line the healthy model makes (module
+    docstring): what the model adds to the line, added through the path (``gain2``, |H|²);
+    what it takes away, taken from the baseline's own line in proportion, as far as the
+    model's line makes it; a line the baseline never showed, left. The lines' bins are
+    disjoint."""
+    if not spans:
+        return
+    p_h, p_c, p_b, f_b, g2 = (span_sums(v, spans) for v in (psd_h, psd_c, psd_b, floor_b,
+                                                               gain2))
+    lo = np.array([b.start for b in spans])
+    hi = np.array([b.stop for b in spans])
+    g2 = g2 / (hi - lo)                                  # the path's mean |H|² over the line
+    with np.errstate(divide="ignore", invalid="ignore"):
+        kept = ~((p_b <= 0.0) | (p_h <= 0.0))
+        adds = kept & (p_c >= p_h)                      # added through the path
+        # the baseline's line, in proportion — as far as the model makes it (a baseline's
+        # shaft line is its unbalance, not a weak model line there)
+        shared = kept & ~adds & (p_b - f_b >= (10.0 ** (SHARED_LINE_DB / 10.0) - 1.0) * f_b)
+        reach = g2 * p_h / (p_b - f_b)
+        share = np.where(reach < 1.0, reach, 1.0)
+        target = np.where(adds, p_b + g2 * (p_c - p_h),
+                          f_b + (p_b - f_b) * (1.0 - share * (1.0 - p_c / p_h)))
+        factor = np.sqrt(target / p_b)
+    sel = np.flatnonzero(adds | shared)
+    bins, owner = _positions(lo[sel], hi[sel])
+    scale[bins] *= factor[sel][owner]
+
+
+def _notch_lines(notch, f_long, df_long, freq, df, spans):
+    """Notch ``spans`` (bins of the segments' grid ``freq``, spacing ``df``) out of a long
+    spectrum (grid ``f_long``, spacing ``df_long``) with raised-cosine edges a segment bin
+    wide, each reaching a bin beyond its line; overlapping notches keep the deeper."""
+    if not spans:
+        return
+    lo = freq[[b.start for b in spans]] - 0.5 * df
+    hi = freq[[b.stop - 1 for b in spans]] + 0.5 * df
+    first = np.maximum(((lo - df) / df_long).astype(np.int64), 0)
+    stop = np.minimum(((hi + df) / df_long).astype(np.int64) + 2, f_long.size)
+    bins, owner = _positions(first, stop)
+    f = f_long[bins]
+    edge_w = np.clip(np.maximum(lo[owner] - f, f - hi[owner]) / df, 0.0, 1.0)
+    np.minimum.at(notch, bins, 0.5 - 0.5 * np.cos(np.pi * edge_w))
+
+
 def _add_power(scale, bins, p_base, p_add):
     """Scale the spectrum's ``bins``, holding ``p_base`` of power, so that ``p_add`` adds to
     it: a line at an unknown phase against the baseline's own adds its power."""
@@ -399,23 +452,7 @@ def apply_change(machine, segments, change, rng):
             freq, lines, psd_h, psd_b, floor_b, machine.path.magnitude(freq, a) ** 2,
             change.pin_hz) ** 2
         gain2 = gain2 * change.path_gain ** 2
-        for ln in lines:
-            b = ln.bins
-            p_h, p_c = float(psd_h[b].sum()), float(psd_c[b].sum())
-            p_b, f_b = float(psd_b[b].sum()), float(floor_b[b].sum())
-            if p_b <= 0.0 or p_h <= 0.0:
-                continue
-            g2 = float(np.mean(gain2[b]))
-            if p_c >= p_h:                  # what the model adds, added through the path
-                target = p_b + g2 * (p_c - p_h)
-            elif p_b - f_b >= (10.0 ** (SHARED_LINE_DB / 10.0) - 1.0) * f_b:
-                # the baseline's line, in proportion — as far as the model makes it (a
-                # baseline's shaft line is its unbalance, not a weak model line there)
-                share = min(1.0, g2 * p_h / (p_b - f_b))
-                target = f_b + (p_b - f_b) * (1.0 - share * (1.0 - p_c / p_h))
-            else:
-                continue                    # a line the baseline never showed
-            scale[b] *= math.sqrt(target / p_b)
+        _scale_lines(scale, [ln.bins for ln in lines], psd_h, psd_c, psd_b, floor_b, gain2)
         # the broadband the model loses: the baseline scaled by the model's ratio there (its
         # modulation, what an envelope reads, shrinks with it) and the machine's background
         # filling in what it scaled away (the background is stationary and stays): a band
@@ -455,13 +492,8 @@ def apply_change(machine, segments, change, rng):
         f_long = np.fft.rfftfreq(d.size, 1.0 / fs)
         notch = np.ones(f_long.size)        # raised-cosine edges a bin wide: a brick-wall
         df_long = f_long[1] - f_long[0]     # notch rings in time, and a segment reads its
-        for bins in [ln.bins for ln in lines] + made:                    # edge ringing
-            lo, hi = freq[bins.start] - 0.5 * df, freq[bins.stop - 1] + 0.5 * df
-            # the edges reach a bin beyond the line: the notch is 1 farther out
-            near = slice(max(int((lo - df) / df_long), 0),
-                         min(int((hi + df) / df_long) + 2, f_long.size))
-            edge_w = np.clip(np.maximum(lo - f_long[near], f_long[near] - hi) / df, 0.0, 1.0)
-            notch[near] = np.minimum(notch[near], 0.5 - 0.5 * np.cos(np.pi * edge_w))
+        _notch_lines(notch, f_long, df_long, freq, df,                    # edge ringing
+                     [ln.bins for ln in lines] + made)
         spec = spec * notch
         d = np.fft.irfft(spec, d.size)
         _, psd_d = segment_psd(list(d[span].reshape(k, n)), fs)

@@ -26,15 +26,15 @@ bit as the plain loop).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from cmsim.spectra._line_kernels import line_spans_jit, span_sums_jit
 from cmsim.spectra.floor import median_window_bins, running_median_floor
 
-__all__ = ["DetectedLine", "detect_lines", "line_free", "LINE_MIN_DB", "FLOOR_HALF_WIDTH_HZ",
-           "LINE_TOLERANCE", "MAX_LINES"]
+__all__ = ["DetectedLine", "detect_lines", "line_free", "span_sums", "LINE_MIN_DB",
+           "FLOOR_HALF_WIDTH_HZ", "LINE_TOLERANCE", "MAX_LINES"]
 
 #: Least height of a narrow line over the running median, dB (the median of a PSD averaged
 #: over ~10 segments exceeds this by chance in about one bin in a thousand).
@@ -49,9 +49,9 @@ LINE_TOLERANCE = 0.004
 MAX_LINES = 300
 
 
-@dataclass(frozen=True)
-class DetectedLine:
-    """A narrow line of a power spectrum.
+class DetectedLine(NamedTuple):
+    """A narrow line of a power spectrum (a named tuple: a spectrum of a model force holds a
+    few hundred, made afresh for every change a machine's library lays).
 
     Attributes
     ----------
@@ -126,6 +126,30 @@ def detect_lines(freq, psd, *, min_db=LINE_MIN_DB, half_width_hz=FLOOR_HALF_WIDT
     best = np.argsort(-amplitude, kind="stable")[:max_lines]
     return [DetectedLine(float(freq[peak[keep[j]]]), float(amplitude[j]),
                          slice(int(lo[keep[j]]), int(hi[keep[j]]))) for j in best], floor
+
+
+def span_sums(values, spans):
+    """The sum of ``values`` over each span, as numpy sums the slice (to the bit).
+
+    Parameters
+    ----------
+    values : numpy.ndarray, shape (m,)
+        Values per bin (float64).
+    spans : sequence of slice
+        Bins of each span (steps of 1), e.g. the ``bins`` of detected lines.
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(spans),)
+
+    Examples
+    --------
+    >>> span_sums(np.arange(10.0), [slice(0, 3), slice(5, 10)]).tolist()
+    [3.0, 35.0]
+    """
+    lo = np.fromiter((b.start for b in spans), dtype=np.int64, count=len(spans))
+    hi = np.fromiter((b.stop for b in spans), dtype=np.int64, count=len(spans))
+    return span_sums_jit(np.ascontiguousarray(values, dtype=float), lo, hi)
 
 
 def line_free(freq, psd, *, min_db=LINE_MIN_DB, half_width_hz=FLOOR_HALF_WIDTH_HZ):

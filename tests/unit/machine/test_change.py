@@ -16,7 +16,8 @@ import pytest
 from scipy.special import jv
 
 from cmsim.machine import Background, Machine, TransferPath
-from cmsim.machine.change import Change, apply_change, warp_speed
+from cmsim.machine.change import (SHARED_LINE_DB, Change, _notch_lines, _scale_lines,
+                                  apply_change, warp_speed)
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.spectra.floor import segment_psd
 
@@ -227,3 +228,61 @@ def test_a_mesh_harmonic_s_smeared_hump_is_no_part_of_the_structure_read_from_th
     assert _power(moved, 1500.0, 100) == pytest.approx(_power(segs, 1500.0, 100), rel=0.05)
     blind = apply_change(machine, segs, replace(change, pin_hz=()), np.random.default_rng(3))
     assert 10 * math.log10(_power(segs, 1500.0, 100) / _power(blind, 1500.0, 100)) > 3.0
+
+
+def _scale_lines_loop(scale, spans, psd_h, psd_c, psd_b, floor_b, gain2):
+    """The model's lines laid on the baseline's, one line at a time (the module docstring's
+    rule as first written)."""
+    for b in spans:
+        p_h, p_c = float(psd_h[b].sum()), float(psd_c[b].sum())
+        p_b, f_b = float(psd_b[b].sum()), float(floor_b[b].sum())
+        if p_b <= 0.0 or p_h <= 0.0:
+            continue
+        g2 = float(np.mean(gain2[b]))
+        if p_c >= p_h:
+            target = p_b + g2 * (p_c - p_h)
+        elif p_b - f_b >= (10.0 ** (SHARED_LINE_DB / 10.0) - 1.0) * f_b:
+            share = min(1.0, g2 * p_h / (p_b - f_b))
+            target = f_b + (p_b - f_b) * (1.0 - share * (1.0 - p_c / p_h))
+        else:
+            continue
+        scale[b] *= math.sqrt(target / p_b)
+
+
+def _notch_loop(notch, f_long, df_long, freq, df, spans):
+    for bins in spans:
+        lo, hi = freq[bins.start] - 0.5 * df, freq[bins.stop - 1] + 0.5 * df
+        near = slice(max(int((lo - df) / df_long), 0),
+                     min(int((hi + df) / df_long) + 2, f_long.size))
+        edge_w = np.clip(np.maximum(lo - f_long[near], f_long[near] - hi) / df, 0.0, 1.0)
+        notch[near] = np.minimum(notch[near], 0.5 - 0.5 * np.cos(np.pi * edge_w))
+
+
+def test_the_lines_are_laid_and_notched_all_at_once_as_one_at_a_time():
+    """Every line of the healthy model at once, to the bit what the loop over them made:
+    lines the model adds to, lines it weakens that the baseline shows or never showed, lines
+    over an empty baseline; notches overlapping each other and the spectrum's ends."""
+    rng = np.random.default_rng(11)
+    freq = np.arange(2049) * 2.0
+    widths = rng.integers(5, 30, 60)                        # disjoint, some touching
+    starts = 1 + np.concatenate([[0], np.cumsum(widths + rng.integers(0, 4, 60))[:-1]])
+    spans = [slice(int(s), int(s + w)) for s, w in zip(starts, widths)
+             if s + w <= freq.size - 3]
+    spans.append(slice(freq.size - 3, freq.size))           # at the top end
+    rng.shuffle(spans)                                      # in no order of frequency
+    psd_h = rng.lognormal(0.0, 1.0, freq.size)
+    psd_c = psd_h * rng.choice([0.3, 0.9, 1.0, 2.0], freq.size)
+    floor_b = rng.lognormal(-1.0, 0.3, freq.size)
+    psd_b = floor_b * rng.choice([1.0, 3.0, 30.0], freq.size)
+    psd_b[spans[3]] = 0.0                                    # a baseline with nothing there
+    gain2 = rng.lognormal(0.0, 0.5, freq.size)
+    got = rng.lognormal(0.0, 0.1, freq.size)
+    want, before = got.copy(), got.copy()
+    _scale_lines(got, spans, psd_h, psd_c, psd_b, floor_b, gain2)
+    _scale_lines_loop(want, spans, psd_h, psd_c, psd_b, floor_b, gain2)
+    assert np.array_equal(got, want) and np.sum(got != before) > 500
+    f_long = np.fft.rfftfreq(8 * 4096 + 200, 1.0 / 4096.0)
+    got, want = np.ones(f_long.size), np.ones(f_long.size)
+    _notch_lines(got, f_long, f_long[1], freq, 2.0, spans)
+    _notch_loop(want, f_long, f_long[1], freq, 2.0, spans)
+    assert np.array_equal(got, want) and np.sum(got < 1.0) > 1000
