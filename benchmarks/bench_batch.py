@@ -23,6 +23,13 @@ machine load (the machine is shared: the ratios carry, the absolute figures do n
 4. with ``--command``: ``cmsim dataset SPEC --workers 2`` itself on the spec as shipped (its
    own record count, its default batch size), as a user runs it, against the bound.
 
+With ``--machine BASELINE`` (a healthy record, e.g. CWRU's ``normal_0.npz`` under
+``CMSIM_DATA``), the spec is made machine-calibrated first: a machine is calibrated on the
+record (:func:`cmsim.machine.calibrate`, no library: a dataset needs none) into the temporary
+folder, and the spec's ``[rig]`` replaced by ``[machine] file`` (without the settings the
+machine owns, its channel the machine's). No machine file ships: it holds the baseline's
+samples.
+
 ``--plot`` draws records per hour against batch size with the bound (docs/benchmarks.md).
 """
 
@@ -63,6 +70,28 @@ print(json.dumps({"wall_s": time.perf_counter() - t0, "failed": s.records_failed
                   "cpu_s": me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime,
                   "worker_rss_kb": kids.ru_maxrss}))
 """
+
+
+def machine_spec(spec_path, baseline, tmp):
+    """The spec ``spec_path`` through a machine calibrated on ``baseline`` (module docstring):
+    the path of the spec written in ``tmp``."""
+    import tomli_w
+
+    from cmsim.datasets.spec_toml import MACHINE_OWNS, read_toml
+    from cmsim.machine import calibrate
+    from cmsim.measured import read_record
+    machine = calibrate([read_record(baseline)])
+    machine.save(Path(tmp) / "machine.toml")
+    raw = read_toml(spec_path)
+    raw.pop("rig", None)
+    raw["machine"] = {"file": "machine.toml"}
+    raw["dataset"]["name"] = f"{raw['dataset']['name']}_machine"
+    for name in MACHINE_OWNS:
+        raw.get("nuisances", {}).pop(name, None)
+    raw.setdefault("sensor", {})["channels"] = [machine.channel]
+    out = Path(tmp) / "machine_spec.toml"
+    out.write_text(tomli_w.dumps(raw))
+    return out
 
 
 def spec_rig_args(spec_path, tmp):
@@ -127,6 +156,8 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--command", action="store_true",
                     help="also run `cmsim dataset SPEC` on the spec as shipped")
+    ap.add_argument("--machine", metavar="BASELINE",
+                    help="make the spec machine-calibrated on this healthy record first")
     ap.add_argument("--plot", type=Path)
     ap.add_argument("--json", type=Path)
     args = ap.parse_args(argv)
@@ -139,6 +170,9 @@ def main(argv=None):
     res = {"cpu": name, "cores": cores, "load": load, "simd": width,
            "spec": Path(args.spec).name, "records": args.records, "sizes": sizes}
     with tempfile.TemporaryDirectory(prefix="bench_batch_") as tmp:
+        if args.machine:
+            args.spec = str(machine_spec(args.spec, args.machine, tmp))
+            res["machine"] = args.machine
         rig_args, spec = spec_rig_args(args.spec, tmp)
         bound_run(rig_args, tmp)                           # warm: kernels from the cache
         generate_run(args.spec, 4, 2, tmp)
