@@ -131,14 +131,10 @@ class Background:
 
         Parameters
         ----------
-        n : int
-            Samples.
-        fs_hz : float
-            Sample rate, Hz.
-        shaft_hz : tuple of float
-            (input, output) shaft rates, Hz.
+        n, fs_hz, shaft_hz
+            As :meth:`synthesize`.
         rng : numpy.random.Generator
-            Source of the phases.
+            Source of the phases, one per line.
         gain : float
             Factor on the amplitudes.
 
