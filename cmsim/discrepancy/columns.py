@@ -122,17 +122,20 @@ def compared_columns(names, lib, fit, held):
 
 def _read_alike(lib, i, j):
     """Whether the library's columns ``i`` and ``j`` hold the same numbers (its baseline's
-    mean, spread and realisation spread, every entry's prediction)."""
+    mean, spread and run-to-run spreads, every entry's prediction)."""
     cols = [i, j]
     return (np.array_equal(*lib.mean[cols], equal_nan=True)
             and np.array_equal(*lib.spread[cols], equal_nan=True)
             and np.array_equal(*lib.realisation[cols], equal_nan=True)
+            and np.array_equal(*lib.run_spread[cols], equal_nan=True)
             and all(np.array_equal(*e.features[:, cols].T, equal_nan=True)
                     for e in lib.entries))
 
 
-def feature_sigma(lib, li, names, n_fit):
-    """σ of each compared feature (:mod:`cmsim.discrepancy.judge`, step 2).
+def feature_sigma(lib, li, names, n_fit, *, standing=False):
+    """σ of each compared feature (:mod:`cmsim.discrepancy.judge`, step 2): with the
+    library's realisation spread (the χ²'s), or with ``standing`` its run spread (the gate of
+    a family that stands out: :attr:`~cmsim.machine.library.SignatureLibrary.run_spread`).
 
     Parameters
     ----------
@@ -144,12 +147,15 @@ def feature_sigma(lib, li, names, n_fit):
         Their names.
     n_fit : int
         Segments the record's mean is taken over.
+    standing : bool
+        The run spread instead of the realisation spread.
 
     Returns
     -------
     numpy.ndarray
     """
-    return sigma_of(lib.spread[li], lib.realisation[li], names, n_fit, lib.segments)
+    run = lib.run_spread if standing else lib.realisation
+    return sigma_of(lib.spread[li], run[li], names, n_fit, lib.segments)
 
 
 def sigma_of(spread, realisation, names, n_fit, n_baseline):

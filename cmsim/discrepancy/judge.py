@@ -16,7 +16,9 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    over its segments): z = (record − baseline) / σ, σ² the baseline's segment-to-segment
    spread² over each mean's segments (1/n_fit + 1/n_baseline), + the model's realisation
    spread² (what one healthy run differs from another by, which averaging segments does not
-   remove) + a floor (:data:`~cmsim.discrepancy.columns.FLOOR_SHARE` of
+   remove; the gate of a family that stands out, :func:`standing_out`, reads the model's
+   run spread there instead: :attr:`~cmsim.machine.library.SignatureLibrary.run_spread`)
+   + a floor (:data:`~cmsim.discrepancy.columns.FLOOR_SHARE` of
    :func:`~cmsim.discrepancy.evaluator.feature_floor`). χ²₀ is the
    robust χ² of the record against the baseline (:func:`~cmsim.discrepancy.evaluator.chi2`,
    calibrated: far departures rise). A record whose χ²₀ per feature stays within
@@ -206,7 +208,7 @@ def shape_moved(meas, reference, sigma, names):
                   + standing_out(shape, reference, meas, sigma, names))
 
 
-def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
+def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate_sigma=None):
     """Steps 2-4 of the module docstring on a record's mean features.
 
     Parameters
@@ -223,6 +225,10 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         The model bearing the sensor sits on.
     causes : sequence of str, optional
         The causes considered (default every one of the library).
+    gate_sigma : numpy.ndarray, optional
+        The σ of the gate of a family that stands out (:func:`standing_out`,
+        :func:`shape_moved`; default ``sigma``): the baseline's spread with the model's run
+        spread (:func:`~cmsim.discrepancy.columns.feature_sigma`'s ``standing``).
 
     Returns
     -------
@@ -234,6 +240,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         or ``""``), ``chi2`` (χ²₀), ``n_eff``, ``z`` (departures).
     """
     base = lib.mean[li][None, :]
+    gate = sigma if gate_sigma is None else gate_sigma
     # each feature's robust loss is read once and weighed twice: as the whole record's χ²
     # weighs it, and as a fault's own signature does (chi2_rows's misfit, its shares)
     w = np.array([weight(k) for k in names])
@@ -296,7 +303,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         # over the baseline: its evidence elsewhere (a broadband that lowers the raw lines
         # over their median, the statistics) any impulsive cause would share
         fam = [names.index(k) for k in r["family"] if path_free(k)]
-        out = standing_out(fam, meas, lib.mean[li], sigma, names)
+        out = standing_out(fam, meas, lib.mean[li], gate, names)
         r["family_z"] = float(max((z0[i] for i in fam), default=0.0))
         r["stands_out"] = bool(out)
         r["out"] = out
@@ -324,7 +331,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
         any(r["stands_out"] and r["cause"].rings_structure for r in by_signature.values())) or (
         # a band of the spectrum's shape that moved as far, either way, too: they share one
         # family's weight, so resonances moved by 20 % (bands 5-8 sigma, 6-7 dB) read none
-        bool(shape_moved(meas, lib.mean[li], sigma, names)))
+        bool(shape_moved(meas, lib.mean[li], gate, names)))
     finding, top, ties, how = "none", None, [], ""
     if departs:
         if cands and explains(cands[0]):
@@ -341,13 +348,13 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             # tooth fault whose sidebands stayed where they were)
             rivals = ties if top["cause"].signature is None else cands[1:]
             out = [r for r in rivals if r["cause"].signature is not None
-                   and standing_out(r["out"], meas, top["prediction"], sigma, names)]
+                   and standing_out(r["out"], meas, top["prediction"], gate, names)]
             if out and not top["stands_out"]:
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]
                 top = new
-            absorbed = _absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, names,
-                                    sensor_bearing)
+            absorbed = _absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, gate,
+                                    names, sensor_bearing)
             if absorbed is not None:
                 ties, top, how = [top], absorbed, "beside"
             elif top["cause"].signature is not None:
@@ -384,7 +391,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
                       if r["cause"].signature is not None and r["nameable"]
                       and r["total"] > 0.0 and (
                           reshaped is None or not r["cause"].rings_structure
-                          or standing_out(r["out"], meas, reshaped, sigma, names))]
+                          or standing_out(r["out"], meas, reshaped, gate, names))]
             top, ties = decide(sorted(faults, key=lambda r: -r["delta_chi2"]),
                                sensor_bearing, chi0)
             how = "family" if top is not None else ""
@@ -396,7 +403,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None):
             "decided_on": how, "chi2": chi0, "n_eff": n_eff, "z": z0}
 
 
-def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
+def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearing):
     """The fault whose own change holds the reshaping cause ``top``'s
     (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`) and whose family stands out where
     ``top``'s prediction leaves the record — :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB`
@@ -407,7 +414,8 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
     components, the one on the sensor's shaft (the shaft-order lines that stand out are
     its). Its prediction is ``top``'s with the fault's own change on the features of its
     family ``top`` does not raise (its size read there, not on a feature that fell), and the
-    row says what it was read beside (``"beside"``)."""
+    row says what it was read beside (``"beside"``). ``sigma`` is the χ²'s, ``gate`` the
+    stand-out gate's."""
     if top["cause"].signature is not None:
         return None
     pred = top["prediction"]
@@ -423,12 +431,12 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, names, sensor_bearing):
         if top["name"] not in r["cause"].absorbs:
             continue
         out = [i for i in standing_out([names.index(k) for k in r["family"]], meas, pred,
-                                       sigma, names) if raised[i] <= 0.0]
+                                       gate, names) if raised[i] <= 0.0]
         # where its change adds to a component the machine has at its own phase, the record
         # departs downwards too: below the least ``top`` leaves there at any size that reads
         # the record as well
         fell = standing_out([names.index(k) for k in r["family"]
-                             if k in r["cause"].either_way], lowest, meas, sigma, names)
+                             if k in r["cause"].either_way], lowest, meas, gate, names)
         if out or fell:     # a component's name starts with its shaft's number ("1G1", "1b1")
             found.append((r["component"] is None or r["component"][0] != sensor_bearing[0],
                           r["chi2"], r, out + fell, fell))
@@ -514,7 +522,8 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     n_fit = int(np.min(np.sum(np.isfinite(fit[:, ri]), axis=0))) if ri.size else 1
     sigma = feature_sigma(lib, li, cnames, n_fit)
     sensor = signal_info(machine.model_signal).component
-    d = decide_record(lib, li, cnames, meas, sigma, sensor, causes)
+    d = decide_record(lib, li, cnames, meas, sigma, sensor, causes,
+                      gate_sigma=feature_sigma(lib, li, cnames, n_fit, standing=True))
     top, z0, n_eff, chi0 = d["top"], d["z"], d["n_eff"], d["chi2"]
     if top is not None and "beside" in top:
         b = top["beside"]

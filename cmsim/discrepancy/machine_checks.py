@@ -63,6 +63,7 @@ def detectability(machine, causes=None):
     li = np.array([i for i, m in enumerate(lib.mean) if math.isfinite(m)], dtype=int)
     names = [lib.names[i] for i in li]
     sigma = feature_sigma(lib, li, names, DETECT_FIT_SEGMENTS)
+    gate = feature_sigma(lib, li, names, DETECT_FIT_SEGMENTS, standing=True)
     sensor = signal_info(machine.model_signal).component
     out = []
     for e in lib.entries:
@@ -77,7 +78,7 @@ def detectability(machine, causes=None):
         for v, row in zip(values, table):
             if not np.all(np.isfinite(row)):
                 continue
-            d = decide_record(lib, li, names, row, sigma, sensor)
+            d = decide_record(lib, li, names, row, sigma, sensor, gate_sigma=gate)
             if d["finding"] == e.cause and d["top"]["component"] == e.component:
                 smallest = float(v)
                 break

@@ -76,7 +76,7 @@ def at_operating_point(machine, lib, op):
     """(library, note): the library with every reference and prediction moved by the model's
     change from the machine's documented load to the record's, where they differ by more than
     :data:`LOAD_TOLERANCE` (the baseline at 0 % load, a record at 50 %), each feature's
-    realisation spread widened by that change's own size
+    run-to-run spreads widened by that change's own size
     (:data:`OPERATING_SHIFT_UNCERTAINTY`); else as it is.
 
     Parameters
@@ -102,8 +102,10 @@ def at_operating_point(machine, lib, op):
         return lib, ("the record's documented load differs from the machine's, and the model "
                      "at it diverged: read against the baseline as it is")
     shift = np.nan_to_num(shift)
-    realisation = np.hypot(np.nan_to_num(lib.realisation), OPERATING_SHIFT_UNCERTAINTY * shift)
-    moved = replace(lib, mean=lib.mean + shift, realisation=realisation, entries=tuple(
+    realisation, run_spread = (np.hypot(np.nan_to_num(v), OPERATING_SHIFT_UNCERTAINTY * shift)
+                               for v in (lib.realisation, lib.run_spread))
+    moved = replace(lib, mean=lib.mean + shift, realisation=realisation,
+                    run_spread=run_spread, entries=tuple(
         replace(e, features=e.features + shift[None, :]) for e in lib.entries))
     return moved, (f"the record's documented load (torque {op.torque_nm:g} N m, radial load "
                    f"{op.radial_load_n:g} N) is not the machine's ({machine.op.torque_nm:g} N m,"

@@ -38,7 +38,15 @@ the model's own, twice, and keeps the larger: the healthy model with :data:`REAL
 other seeds laid on the baseline as a change, and those runs through the machine's twin
 (path and background, :meth:`~cmsim.machine.Machine.sensor_signal`) — the change operator
 keeps a baseline's envelope lines where two healthy runs differ only by their cages'
-phases, which on a gear rig's four bearings move them by 10 dB from run to run.
+phases, which on a gear rig's four bearings move them by 2-5 dB from run to run. The twin's
+runs are read twice: with their background drawn afresh (the **realisation** spread, which
+the χ² reads: a fresh draw of the background lines' phases swings an envelope's shaft-rate
+line by up to 20 dB — the sidebands' phases decide whether the mesh is amplitude- or
+phase-modulated — and so does any change the library predicts less well than the phases
+it was made with), and with the machine's own lines, their noise afresh (the **run
+spread**, which the gate of a family that stands out reads: the baseline's segments hold
+such a line within 0.4-0.5 dB on the angle-domain generator's gear machines, where the
+realisation spread put 10-13 dB under it).
 
 Layering: builds on :mod:`cmsim.machine` (the change operator, the library's container) and
 the cause catalogue (:mod:`cmsim.discrepancy.causes`).
@@ -272,19 +280,23 @@ class _Library:
 
     def realisation(self, job):
         """(names, mean features of the baseline with another healthy run of the model laid
-        on it, mean features of that run through the twin)."""
+        on it, mean features of that run through the twin — its background drawn afresh,
+        and with the machine's own lines)."""
         healthy, seed, index = job
         h, c = self.force(healthy), self.force(healthy, seed)
         if h is None or c is None:
-            return None, None, None
+            return None, None, None, None
         names, laid = self.features(Change(force=c[0], healthy=h[0], edge=h[1],
                                            pin_hz=_mesh_harmonics(self.freqs, self.fs)),
                                     [self.seed, 999_983, index])
         k, n = self.segs.shape
-        twin = self.machine.sensor_signal(c[0], c[1], k * n, seed)
-        got, rows = feature_rows(twin.reshape(k, n), self.fs, self.freqs, self.bearings,
-                                 self.machine.unit_scale, bands=BAND_FAMILIES)
-        return names, laid, _nanmean(rows) if got == names else None
+        twins = []
+        for line_seed in (None, self.seed):
+            twin = self.machine.sensor_signal(c[0], c[1], k * n, seed, line_seed=line_seed)
+            got, rows = feature_rows(twin.reshape(k, n), self.fs, self.freqs, self.bearings,
+                                     self.machine.unit_scale, bands=BAND_FAMILIES)
+            twins.append(_nanmean(rows) if got == names else None)
+        return names, laid, *twins
 
 
 #: The library of a worker process (:func:`_adopt`).
@@ -405,13 +417,9 @@ def build_library(machine, *, causes=None, n_sizes=N_SIZES, n_segments=LIBRARY_S
     results = _run(lib, real_jobs + jobs, workers, progress)
     base_mean = _nanmean(base_rows)
     laid = [r[1] for r in results[:len(real_jobs)][1:] if r[1] is not None]
-    twin = [r[2] for r in results[:len(real_jobs)] if r[2] is not None]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        spreads = [np.nanstd(np.vstack(rows), axis=0, ddof=1)
-                   for rows in (laid + [base_mean], twin) if len(rows) >= 2]
-        realisation = (np.nanmax(np.vstack(spreads), axis=0) if spreads
-                       else np.zeros(len(names)))
+    realisation, run_spread = (
+        _run_to_run(laid + [base_mean], [r[k] for r in results[:len(real_jobs)]
+                                         if r[k] is not None], len(names)) for k in (2, 3))
     entries = []
     for (cause, comp, label, pname, values), (got, by_gain) in zip(meta,
                                                                    results[len(real_jobs):]):
@@ -421,10 +429,22 @@ def build_library(machine, *, causes=None, n_sizes=N_SIZES, n_segments=LIBRARY_S
             entries.append(SignatureEntry(cause, comp, _variant_label(label, g), pname,
                                           values, table))
     return SignatureLibrary(names=tuple(names), mean=base_mean, spread=spread,
-                            realisation=realisation, entries=tuple(entries),
+                            realisation=realisation, run_spread=run_spread,
+                            entries=tuple(entries),
                             segment_s=machine.segment_s, segments=int(segs.shape[0]),
                             speed_rpm=machine.op.speed_rpm, torque_nm=machine.op.torque_nm,
                             radial_load_n=machine.op.radial_load_n, seed=int(seed))
+
+
+def _run_to_run(laid, twin, n):
+    """The larger of the two run-to-run spreads (module docstring) of each feature: over the
+    rows of the runs laid on the baseline (the baseline's own mean with them) and over the
+    rows of the runs through the twin; zeros where neither has two rows."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        spreads = [np.nanstd(np.vstack(rows), axis=0, ddof=1)
+                   for rows in (laid, twin) if len(rows) >= 2]
+        return np.nanmax(np.vstack(spreads), axis=0) if spreads else np.zeros(n)
 
 
 def _run(lib, jobs, workers, progress):

@@ -6,9 +6,14 @@ every comparison against the machine.
 The library holds
 
 * the **reference**: each feature's mean over the baseline's segments, its segment-to-segment
-  spread, and its realisation spread (how far another healthy run of the model moves it
-  through the baseline: cage phases, slip — what one record of a healthy machine differs
-  from another by beyond the spread within one);
+  spread, and two run-to-run spreads of the model beyond the spread within one record: the
+  **realisation** spread (another healthy run laid on the baseline, or through the machine's
+  twin with its background drawn afresh, lines' phases included: a feature that hangs on
+  how a mesh's sidebands are phased swings with them, and so it does under any change the
+  library predicts less well — the χ² reads it), and the **run spread** (the same runs, the
+  twin's background lines as the machine's own: cage phases and slip alone — what a record
+  of a healthy machine differs from its baseline by, which the gate of a family that stands
+  out reads);
 * one **entry** per cause, component and nuisance variant (the load zone of a bearing
   defect's model: its clearance, its load; the path's gain where a change rings the
   structure; the load modulation a rotating force swings against its line): the cause's
@@ -30,8 +35,9 @@ from cmsim.errors import ParameterError
 
 __all__ = ["SignatureLibrary", "SignatureEntry", "LIBRARY_FORMAT_VERSION"]
 
-#: Version of the library's table in a machine file.
-LIBRARY_FORMAT_VERSION = 1
+#: Version of the library's table in a machine file (2: the run spread's row after the
+#: realisation's; a version-1 table is read with its realisation spread as the run spread).
+LIBRARY_FORMAT_VERSION = 2
 
 
 def _pack(a):
@@ -100,6 +106,9 @@ class SignatureLibrary:
         Operating point the library was computed at (the machine's).
     seed : int
         Seed of the model runs.
+    run_spread : numpy.ndarray or None, shape (n_features,)
+        The model's run-to-run spread with the machine's own background lines (module
+        docstring); None: the realisation spread.
     """
 
     names: tuple
@@ -113,10 +122,13 @@ class SignatureLibrary:
     torque_nm: float
     radial_load_n: float
     seed: int = 0
+    run_spread: np.ndarray | None = None
 
     def __post_init__(self):
         m = len(self.names)
-        for name in ("mean", "spread", "realisation"):
+        if self.run_spread is None:
+            object.__setattr__(self, "run_spread", self.realisation)
+        for name in ("mean", "spread", "realisation", "run_spread"):
             v = np.asarray(getattr(self, name), dtype=float)
             if v.shape != (m,):
                 raise ParameterError(f"library {name} has shape {v.shape}, expected ({m},)",
@@ -136,7 +148,7 @@ class SignatureLibrary:
     def to_dict(self):
         """Plain dict for the machine file: an index of the entries (readable) and every
         table as float32, zlib-compressed, base64."""
-        rows = np.vstack([self.mean, self.spread, self.realisation]
+        rows = np.vstack([self.mean, self.spread, self.realisation, self.run_spread]
                          + [e.features for e in self.entries])
         return {"format_version": LIBRARY_FORMAT_VERSION, "names": list(self.names),
                 "segment_s": self.segment_s, "segments": self.segments,
@@ -156,14 +168,15 @@ class SignatureLibrary:
         data : dict
             The machine file's ``[library]`` table.
         """
-        if data.get("format_version") != LIBRARY_FORMAT_VERSION:
+        version = data.get("format_version")
+        if version not in (1, LIBRARY_FORMAT_VERSION):
             raise ParameterError(f"signature library format_version "
                                  f"{data.get('format_version')!r} is not supported (this cmsim "
-                                 f"reads {LIBRARY_FORMAT_VERSION}); run cmsim calibrate again",
+                                 f"reads 1-{LIBRARY_FORMAT_VERSION}); run cmsim calibrate again",
                                  param="machine")
         names = tuple(data["names"])
         rows = _unpack(data["tables_float32_zlib_base64"], (int(data["rows"]), len(names)))
-        entries, i = [], 3
+        entries, i = [], (3 if version == 1 else 4)
         for e in data["entries"]:
             k = len(e["values"])
             entries.append(SignatureEntry(str(e["cause"]), e["component"] or None,
@@ -174,6 +187,7 @@ class SignatureLibrary:
             raise ParameterError("the signature library is damaged (its index and tables "
                                  "disagree)", param="machine")
         return cls(names=names, mean=rows[0], spread=rows[1], realisation=rows[2],
+                   run_spread=rows[2] if version == 1 else rows[3],
                    entries=tuple(entries), segment_s=float(data["segment_s"]),
                    segments=int(data["segments"]), speed_rpm=float(data["speed_rpm"]),
                    torque_nm=float(data["torque_nm"]),

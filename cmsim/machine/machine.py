@@ -221,7 +221,8 @@ class Machine:
         return (fr1, fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1)
 
     def sensor_signal(self, force, edge, n, seed, *, speed_rpm=None, frequency_factor=1.0,
-                      noise_gain=1.0, line_gain=1.0, rotating=None, white_noise=0.0):
+                      noise_gain=1.0, line_gain=1.0, rotating=None, white_noise=0.0,
+                      line_seed=None):
         """The machine's sensor signal of a model force (:func:`model_force`'s output).
 
         Parameters
@@ -246,6 +247,10 @@ class Machine:
             White noise added at the sensor, RMS relative to the calibrated background
             noise's (a noise the machine's baseline did not have: a sensor, a cable, a
             loose mount).
+        line_seed : int, optional
+            Seed of the background lines' phases alone (default: drawn with the noise from
+            ``seed``): records of one machine share their lines' phases (whether its mesh is
+            amplitude- or phase-modulated is the machine's) and differ in their noise.
 
         Returns
         -------
@@ -260,8 +265,14 @@ class Machine:
         fr1 = (self.op.speed_rpm if speed_rpm is None else speed_rpm) / 60.0
         fr2 = fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1
         rng = np.random.default_rng([int(seed), 104729])
-        y = y + self.background.synthesize(n, self.fs_hz, (fr1, fr2), rng, noise_gain,
-                                           line_gain)
+        if line_seed is None:
+            y = y + self.background.synthesize(n, self.fs_hz, (fr1, fr2), rng, noise_gain,
+                                               line_gain)
+        else:
+            y = y + self.background.noise(n, self.fs_hz, rng, noise_gain) \
+                + self.background.deterministic(n, self.fs_hz, (fr1, fr2),
+                                                np.random.default_rng([int(line_seed), 104729]),
+                                                line_gain)
         if white_noise > 0.0:
             y = y + white_noise * self.background.noise_rms(self.fs_hz) \
                 * rng.standard_normal(n)

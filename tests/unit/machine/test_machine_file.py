@@ -11,7 +11,7 @@ import pytest
 from cmsim.errors import ParameterError
 from cmsim.machine import Background, Machine, TransferPath
 from cmsim.machine.baseline import Baseline
-from cmsim.machine.library import SignatureEntry, SignatureLibrary
+from cmsim.machine.library import SignatureEntry, SignatureLibrary, _pack, _unpack
 from cmsim.rig import OperatingPoint, Rig
 
 
@@ -20,6 +20,7 @@ def _library(m=3):
     return SignatureLibrary(
         names=tuple(f"f{i}" for i in range(m)), mean=rng.standard_normal(m),
         spread=np.abs(rng.standard_normal(m)), realisation=np.full(m, np.nan),
+        run_spread=np.arange(m, dtype=float),
         entries=(SignatureEntry("noise", None, "documented", "noise_ratio", (0.2, 1.0),
                                 rng.standard_normal((2, m))),
                  SignatureEntry("bearing_inner_race", "1b1", "line contact; path x0.3",
@@ -51,6 +52,7 @@ def test_the_baseline_and_library_round_trip(tmp_path):
     assert got.names == lib.names and got.segments == lib.segments and got.seed == lib.seed
     assert np.allclose(got.mean, lib.mean.astype(np.float32), rtol=0, atol=0)
     assert np.isnan(got.realisation).all()
+    assert np.array_equal(got.run_spread, np.arange(3.0))
     for a, b in zip(lib.entries, got.entries):
         assert (a.cause, a.component, a.variant, a.values) == (b.cause, b.component,
                                                                 b.variant, b.values)
@@ -103,3 +105,19 @@ def test_baseline_segments_stay_within_each_record_and_a_piece_within_one():
 def test_a_baseline_with_nan_is_refused():
     with pytest.raises(ParameterError, match="NaN"):
         Baseline((np.array([0.0, np.nan, 1.0]),), 1000.0)
+
+
+def test_a_version_one_library_reads_its_realisation_as_its_run_spread():
+    """Libraries before the run spread (format 1: the reference's three rows, then the
+    entries') read on; a format this cmsim does not know is refused by name."""
+    lib = _library()
+    d = lib.to_dict()
+    rows = _unpack(d["tables_float32_zlib_base64"], (d["rows"], len(lib.names)))
+    old = np.delete(rows, 3, axis=0)
+    d1 = {**d, "format_version": 1, "rows": old.shape[0], "tables_float32_zlib_base64": _pack(old)}
+    got = SignatureLibrary.from_dict(d1)
+    assert np.array_equal(got.run_spread, got.realisation, equal_nan=True)
+    assert [np.array_equal(a.features, b.features) for a, b in zip(got.entries,
+            SignatureLibrary.from_dict(d).entries)] == [True, True]
+    with pytest.raises(ParameterError, match="format_version 3 is not supported"):
+        SignatureLibrary.from_dict({**d, "format_version": 3})
