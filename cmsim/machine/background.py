@@ -149,7 +149,8 @@ class Background:
         phase = rng.uniform(0.0, 2.0 * math.pi, len(self.lines))
         return sum_of_cosines(freq, amp, phase, n, fs_hz)
 
-    def synthesize(self, n, fs_hz, shaft_hz, rng, noise_gain=1.0, line_gain=1.0):
+    def synthesize(self, n, fs_hz, shaft_hz, rng, noise_gain=1.0, line_gain=1.0,
+                   line_rng=None):
         """``n`` samples of the whole background (noise plus lines).
 
         Parameters
@@ -164,13 +165,16 @@ class Background:
             Source of the noise and of the line phases.
         noise_gain, line_gain : float
             Factors on the noise and on the lines.
+        line_rng : numpy.random.Generator, optional
+            Source of the line phases apart from the noise's (default ``rng``, after it).
 
         Returns
         -------
         numpy.ndarray, shape (n,)
         """
         return (self.noise(n, fs_hz, rng, noise_gain)
-                + self.deterministic(n, fs_hz, shaft_hz, rng, line_gain))
+                + self.deterministic(n, fs_hz, shaft_hz, rng if line_rng is None else line_rng,
+                                     line_gain))
 
     def to_dict(self):
         """Plain dict for the machine file."""

@@ -265,14 +265,10 @@ class Machine:
         fr1 = (self.op.speed_rpm if speed_rpm is None else speed_rpm) / 60.0
         fr2 = fr1 / self.rig.gears.ratio if self.rig.gears is not None else fr1
         rng = np.random.default_rng([int(seed), 104729])
-        if line_seed is None:
-            y = y + self.background.synthesize(n, self.fs_hz, (fr1, fr2), rng, noise_gain,
-                                               line_gain)
-        else:
-            y = y + self.background.noise(n, self.fs_hz, rng, noise_gain) \
-                + self.background.deterministic(n, self.fs_hz, (fr1, fr2),
-                                                np.random.default_rng([int(line_seed), 104729]),
-                                                line_gain)
+        y = y + self.background.synthesize(
+            n, self.fs_hz, (fr1, fr2), rng, noise_gain, line_gain,
+            line_rng=None if line_seed is None else np.random.default_rng([int(line_seed),
+                                                                           104729]))
         if white_noise > 0.0:
             y = y + white_noise * self.background.noise_rms(self.fs_hz) \
                 * rng.standard_normal(n)

@@ -41,3 +41,25 @@ def test_the_lines_phases_are_drawn_in_their_order():
     np.testing.assert_allclose(got, want, atol=1e-12)
     quiet = Background(freq_hz=(0.0, 5000.0), psd=(1e-9, 1e-9))
     assert np.array_equal(quiet.deterministic(10, 1000.0, shafts, rng), np.zeros(10))
+
+
+def test_records_of_one_machine_share_its_lines_phases_and_differ_in_noise():
+    """``sensor_signal(line_seed=)``: the lines' phases from their own seed, the noise from
+    the record's. With a silent background noise two records of one line seed are the same,
+    and another line seed moves the lines."""
+    from cmsim.machine import Machine, TransferPath
+    from cmsim.rig import OperatingPoint, Rig
+    bg = Background(freq_hz=(0.0, 6000.0), psd=(0.0, 0.0),
+                    lines=(BackgroundLine("fixed", 1000.0, 1.0), BackgroundLine("input", 3.0, 0.5)))
+    m = Machine(name="m", rig=Rig.paper_2016(), channel="DE", model_signal="accel_1b1_y",
+                fs_hz=12000.0, op=OperatingPoint(1500.0, 10.0),
+                path=TransferPath("F_1b1_y", (0.0, 6000.0), (1e-3, 1e-3), "g"), background=bg)
+    force = np.zeros(2400)
+    a = m.sensor_signal(force, 0, 2000, seed=1, line_seed=5)
+    b = m.sensor_signal(force, 0, 2000, seed=2, line_seed=5)
+    c = m.sensor_signal(force, 0, 2000, seed=1, line_seed=6)
+    assert np.array_equal(a, b) and np.max(np.abs(a - c)) > 0.1
+    # without a line seed, the lines' phases follow the record's seed, after its noise
+    d = m.sensor_signal(force, 0, 2000, seed=1)
+    e = m.sensor_signal(force, 0, 2000, seed=2)
+    assert np.max(np.abs(d - e)) > 0.1
