@@ -126,7 +126,10 @@ def text(res):
                "beside": "what it changes holds the change that reads the whole record best "
                          "(the near tie), and its own family stands out over that change",
                "family": "its own family stands out over the baseline and no cause reads the "
-                         "whole record"}.get(res.get("decided_on", ""))
+                         "whole record",
+               "within error": "no family stands out and no cause reads the whole record "
+                               "within the baseline's spread; it reads it best of every "
+                               "cause, within the error of the model's change"}.get(res.get("decided_on", ""))
         if how:
             lines.append(f"named because {how}")
     family = not machine or res.get("decided_on") == "family"     # evidence on own features
