@@ -28,7 +28,8 @@ def _shaft_gains(lines, rig, bearing, fr, df, forces):
     """({order: gain}, force N, share of the static load): the gains, sensor unit per N,
     from a rotating force at the orders 1 to :data:`SHAFT_ORDERS` of the sensor bearing's
     shaft (turning at ``fr`` Hz) to the sensor, read from the baseline's lines there (an
-    order without a line gets none: the path's own gain there is used).
+    order without a line gets none: :meth:`~cmsim.machine.Machine.rotating_gain` carries the
+    path's shape there at the level of the nearest order that has one).
 
     The model makes no shaft line, so no model line reads the path there, yet an unbalance
     or a misalignment is judged there: held on the path's assumed f² shape from its lowest

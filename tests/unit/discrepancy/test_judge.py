@@ -60,7 +60,7 @@ def test_a_known_shaft_line_over_a_healthy_record_is_unbalance_sized_in_closed_f
                                  machine.fs_hz, 1.0, 0)
     load = static_load(force[edge:edge + n])
     fr = machine.op.speed_rpm / 60.0
-    a = 0.6                                               # relative amplitude of the force
+    a = 1.5                                               # relative amplitude of the force
     amp = machine.rotating_gain(1, fr) * a * load         # its line at the sensor
     t = np.arange(rec.signal.size) / rec.fs_hz
     r = judge(_with(rec, rec.signal + amp * np.cos(2 * np.pi * fr * t + 0.4)), machine)

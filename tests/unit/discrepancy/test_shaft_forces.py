@@ -7,6 +7,7 @@ line reaches the sensor through the machine's own gain at that order.
 """
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -47,7 +48,11 @@ def test_through_a_machine_the_line_takes_the_machine_gain_at_its_order():
     n = int(FS)
     y = m.sensor_signal(np.zeros(n), 0, n, 0, rotating=(FR, ((1, 30.0, 0.0), (2, 10.0, 0.0))))
     assert _line(y, FR) == pytest.approx(4e-2 * 30.0, rel=1e-3)       # its own gain
-    assert _line(y, 2 * FR) == pytest.approx(1e-3 * 10.0, rel=1e-3)    # the path's
+    # 2× unpinned: the (flat) path's shape at 1×'s level, 40 times the path's own
+    assert _line(y, 2 * FR) == pytest.approx(4e-2 * 10.0, rel=1e-3)
+    bare = replace(m, shaft_gain={})
+    y = bare.sensor_signal(np.zeros(n), 0, n, 0, rotating=(FR, ((2, 10.0, 0.0),)))
+    assert _line(y, 2 * FR) == pytest.approx(1e-3 * 10.0, rel=1e-3)    # the path's alone
 
 
 @pytest.mark.parametrize("modulation", [0.3, 1.0, 3.0])

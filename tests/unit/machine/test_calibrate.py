@@ -74,8 +74,8 @@ def test_the_machine_file_says_the_path_at_the_shaft_rates_is_not_read(case):
 def test_a_rotating_force_is_read_against_the_baseline_residual_unbalance(case):
     """The gain of a rotating force at the input shaft's 1× and 2× is the baseline's line
     there over the force of a G 6.3 residual unbalance, m·G·Ω/2 on each bearing (m: the
-    driving gear and the shaft's bearing nodes); none at 3× (no line), where the path's own
-    gain is used; the machine file says so, and keeps the gains."""
+    driving gear and the shaft's bearing nodes); none at 3× (no line), where the path's
+    shape is carried at 2×'s level; the machine file says so, and keeps the gains."""
     rig, _, _, m = case
     shaft = rig.shafts[0]
     mass = rig.gears.driving.mass_kg + shaft.bearing_1.mass_kg + shaft.bearing_2.mass_kg
@@ -85,7 +85,8 @@ def test_a_rotating_force_is_read_against_the_baseline_residual_unbalance(case):
     for line in LINES[:2]:
         got = m.rotating_gain(int(line.value), fr)
         assert abs(20 * math.log10(got * force / line.amplitude)) < 1.0, line
-    assert m.rotating_gain(3, fr) == pytest.approx(float(m.path.magnitude(3 * fr)))
+    assert m.rotating_gain(3, fr) == pytest.approx(
+        float(m.path.magnitude(3 * fr)) * m.shaft_gain[2] / float(m.path.magnitude(2 * fr)))
     note = [n for n in m.notes if n.startswith("rotating forces reach the sensor")]
     assert len(note) == 1 and "G 6.3" in note[0] and f"{force:.3g} N" in note[0], m.notes
     assert Machine.from_dict(m.to_dict()).shaft_gain == m.shaft_gain

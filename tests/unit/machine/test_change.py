@@ -286,3 +286,22 @@ def test_the_lines_are_laid_and_notched_all_at_once_as_one_at_a_time():
     _notch_lines(got, f_long, f_long[1], freq, 2.0, spans)
     _notch_loop(want, f_long, f_long[1], freq, 2.0, spans)
     assert np.array_equal(got, want) and np.sum(got < 1.0) > 1000
+
+
+def test_an_order_the_baseline_does_not_pin_takes_the_path_s_shape_at_its_pinned_level():
+    """A path whose gain rises as f² (0.01 at 25 Hz, 0.04 at 50, 0.09 at 75), the 2× order
+    pinned at 2 per N (50 times the path there): 1× and 3× read the path's shape at that
+    level (0.5 and 4.5), an order as near to 2× and 4× the lower's (2× for 3×); unpinned
+    everywhere, the path's own."""
+    f = np.array([0.0, 25.0, 50.0, 75.0, 100.0, FS / 2])
+    path = TransferPath("F_1b1_y", tuple(f), tuple(np.maximum(0.01 * (f / 25.0) ** 2, 1e-4)))
+    m = Machine(name="f2", rig=Rig.paper_2016(), channel="acc", model_signal="accel_1b1_y",
+                fs_hz=FS, op=OperatingPoint(60.0 * SHAFT_HZ, 50.0), path=path,
+                background=Background((0.0, FS / 2), (NOISE, NOISE)), shaft_gain={2: 2.0})
+    assert m.rotating_gain(2, SHAFT_HZ) == 2.0
+    assert m.rotating_gain(1, SHAFT_HZ) == pytest.approx(0.5, rel=1e-6)
+    assert m.rotating_gain(3, SHAFT_HZ) == pytest.approx(4.5, rel=1e-6)
+    both = replace(m, shaft_gain={2: 2.0, 4: 1.6})         # 4× pinned at 10 times the path
+    assert both.rotating_gain(3, SHAFT_HZ) == pytest.approx(4.5, rel=1e-6)
+    assert replace(m, shaft_gain={}).rotating_gain(3, SHAFT_HZ) == pytest.approx(0.09,
+                                                                                rel=1e-6)
