@@ -127,9 +127,9 @@ def text(res):
                          "(the near tie), and its own family stands out over that change",
                "family": "its own family stands out over the baseline and no cause reads the "
                          "whole record",
-               "within error": "no family stands out and no cause reads the whole record "
-                               "within the baseline's spread; it reads it best of every "
-                               "cause, within the error of the model's change"}.get(res.get("decided_on", ""))
+               "within error": "it reads the whole record best of every cause, within "
+                               "the error of the model's own change (no family stands out)"
+               }.get(res.get("decided_on", ""))
         if how:
             lines.append(f"named because {how}")
     family = not machine or res.get("decided_on") == "family"     # evidence on own features

@@ -285,7 +285,8 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
             continue
         tables.setdefault((e.cause, e.component), []).append((e, values[ok], table[ok]))
         loss = misfit(meas, table, sigma, 1.0, rising)[1]
-        sig_e = np.sqrt(sigma ** 2 + (PREDICTION_ERROR * np.nan_to_num(table - lib.mean[li])) ** 2)
+        # step c's χ²: each feature's σ widened by the prediction's own error there
+        sig_e = np.hypot(sigma, PREDICTION_ERROR * np.nan_to_num(table - lib.mean[li]))
         chi_e = (w * misfit(meas, table, sig_e, 1.0, rising)[1]).sum(axis=1)
         per_full, per_sig = w * loss, w_sig * loss
         chi = per_full.sum(axis=1)
@@ -314,7 +315,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                           "per_feature": dict(zip(names, delta.tolist())),
                           "total": float(delta.sum()), "delta_chi2": float(delta[sel].sum()),
                           "evidence": float(chi0 - per[b].sum()),
-                          "evidence_e": float(chi0 - chi_e[b])}
+                          "evidence_within_error": float(chi0 - chi_e[b])}
     rows_out = sorted(ranked.values(), key=lambda r: r["chi2"])
     for r in list(rows_out) + list(by_signature.values()):
         # a fault that rings the structure is named only where its own family stands out
@@ -336,7 +337,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
 
     def explains(r, allowance=False):
         return r["evidence"] >= MIN_EVIDENCE and (
-            r["evidence_e"] if allowance else r["evidence"]) >= MIN_SHARE * excess
+            r["evidence_within_error"] if allowance else r["evidence"]) >= MIN_SHARE * excess
 
     departs = chi0 / max(n_eff, 1e-9) > NONE_CHI2_PER_FEATURE or (
         z0.size > 0 and float(np.nanmax(np.abs(z0))) >= ALARM_Z) or (
@@ -351,51 +352,46 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
         # a band of the spectrum's shape that moved as far, either way, too: they share one
         # family's weight, so resonances moved by 20 % (bands 5-8 sigma, 6-7 dB) read none
         bool(shape_moved(meas, lib.mean[li], gate, names)))
-    def whole(top):
-        # step a on the cause whose prediction reads the whole record best
-        how = "whole"
-        ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]]
-        # a fault whose own family stands clearly out where the winner's prediction
-        # leaves it wins a near tie on the whole record against a cause whose family
-        # does not (an outer race that lifted its envelope lines 19 dB tied a torque
-        # mismatch, 137 against 139; a clearance that lifts the cage line itself keeps
-        # it against a ball defect whose family holds that line)
-        # nor, however far ahead, is a fault named on the whole record with none of its
-        # own family risen, where another fault's family stands out over its prediction
-        # (a gear machine's outer race: the envelope lines 25 dB up, read best as a
-        # tooth fault whose sidebands stayed where they were)
-        rivals = ties if top["cause"].signature is None else cands[1:]
-        out = [r for r in rivals if r["cause"].signature is not None
-               and standing_out(r["out"], meas, top["prediction"], gate, names)]
-        if out and not top["stands_out"]:
-            new = max(out, key=lambda r: r["family_z"])
-            ties = [r for r in [top] + ties if r is not new]
-            top = new
-        absorbed = _absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, gate,
-                                names, sensor_bearing)
-        if absorbed is not None:
-            ties, top, how = [top], absorbed, "beside"
-        elif top["cause"].signature is not None:
-            # faults the whole record cannot tell apart are told apart by their own
-            # signatures (a broken tooth's once-per-revolution impacts light a bearing's
-            # envelope lines too; its sidebands are its own)
-            tied = {(r["name"], r["component"]) for r in [top] + ties
-                    if r["cause"].signature is not None}
-            own = [r for r in by_signature.values() if (r["name"], r["component"]) in tied
-                   and r["nameable"]]
-            best = max(own, key=lambda r: r["delta_chi2"], default=None)
-            if best is not None and (best["name"], best["component"]) != (
-                    top["name"], top["component"]):
-                new = next(r for r in cands if (r["name"], r["component"])
-                           == (best["name"], best["component"]))
-                ties = [r for r in [top] + ties if r is not new]
-                top = new
-        return top, ties, how
-
     finding, top, ties, how = "none", None, [], ""
     if departs:
         if cands and explains(cands[0]):
-            top, ties, how = whole(cands[0])
+            top, how = cands[0], "whole"
+            ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]]
+            # a fault whose own family stands clearly out where the winner's prediction
+            # leaves it wins a near tie on the whole record against a cause whose family
+            # does not (an outer race that lifted its envelope lines 19 dB tied a torque
+            # mismatch, 137 against 139; a clearance that lifts the cage line itself keeps
+            # it against a ball defect whose family holds that line)
+            # nor, however far ahead, is a fault named on the whole record with none of its
+            # own family risen, where another fault's family stands out over its prediction
+            # (a gear machine's outer race: the envelope lines 25 dB up, read best as a
+            # tooth fault whose sidebands stayed where they were)
+            rivals = ties if top["cause"].signature is None else cands[1:]
+            out = [r for r in rivals if r["cause"].signature is not None
+                   and standing_out(r["out"], meas, top["prediction"], gate, names)]
+            if out and not top["stands_out"]:
+                new = max(out, key=lambda r: r["family_z"])
+                ties = [r for r in [top] + ties if r is not new]
+                top = new
+            absorbed = _absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, gate,
+                                    names, sensor_bearing)
+            if absorbed is not None:
+                ties, top, how = [top], absorbed, "beside"
+            elif top["cause"].signature is not None:
+                # faults the whole record cannot tell apart are told apart by their own
+                # signatures (a broken tooth's once-per-revolution impacts light a bearing's
+                # envelope lines too; its sidebands are its own)
+                tied = {(r["name"], r["component"]) for r in [top] + ties
+                        if r["cause"].signature is not None}
+                own = [r for r in by_signature.values() if (r["name"], r["component"]) in tied
+                       and r["nameable"]]
+                best = max(own, key=lambda r: r["delta_chi2"], default=None)
+                if best is not None and (best["name"], best["component"]) != (
+                        top["name"], top["component"]):
+                    new = next(r for r in cands if (r["name"], r["component"])
+                               == (best["name"], best["component"]))
+                    ties = [r for r in [top] + ties if r is not new]
+                    top = new
         else:
             # b. no cause reads the whole record: a fault whose own family stands out over
             # the baseline, judged on its signature (ranking.decide) — where its change, at

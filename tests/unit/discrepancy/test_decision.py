@@ -516,12 +516,12 @@ def test_a_reshaping_cause_is_named_within_its_prediction_s_own_error(low, high,
     miss far beyond that error."""
     from cmsim.discrepancy.judge import MIN_SHARE, PREDICTION_ERROR
     d = _reshaped_by_a_load(low, high, fault)
-    assert d["finding"] == finding, [(r["name"], r["evidence"], r["evidence_e"])
+    assert d["finding"] == finding, [(r["name"], r["evidence"], r["evidence_within_error"])
                                      for r in d["ranked"]]
     load = next(r for r in d["ranked"] if r["name"] == "torque_mismatch")
     excess = d["chi2"] - d["n_eff"]
     if (low, high) == (3.0, 17.0):
-        assert load["evidence"] < MIN_SHARE * excess <= load["evidence_e"]
+        assert load["evidence"] < MIN_SHARE * excess <= load["evidence_within_error"]
         assert 0.2 <= PREDICTION_ERROR <= 0.5
     if finding == "torque_mismatch":
         assert d["decided_on"] == ("whole" if low == 7.0 else "within error")
