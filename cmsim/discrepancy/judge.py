@@ -46,7 +46,9 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       (:func:`~cmsim.discrepancy.ranking.decide`'s rule) — a load, a clearance, a changed
       path or a louder machine reshape every feature and are told apart here, as are faults
       the model makes the way the machine does. Faults within :data:`NEAR_TIE` of the best
-      one's evidence are told apart by their evidence on their own signatures. A fault is a
+      one's evidence are told apart by their evidence on their own signatures, over the
+      features their change lifts above the baseline (and the statistics): a family that
+      fell, as the envelope's band moves under any impulsive fault, is no fault's. A fault is a
       candidate here where its family stands out (below), or where its prediction reads the
       whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`). A reshaping
       cause that reads best yields to a fault whose own change holds it
@@ -380,12 +382,13 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
             elif top["cause"].signature is not None:
                 # faults the whole record cannot tell apart are told apart by their own
                 # signatures (a broken tooth's once-per-revolution impacts light a bearing's
-                # envelope lines too; its sidebands are its own)
+                # envelope lines too; its sidebands are its own), on what each adds
                 tied = {(r["name"], r["component"]) for r in [top] + ties
                         if r["cause"].signature is not None}
                 own = [r for r in by_signature.values() if (r["name"], r["component"]) in tied
                        and r["nameable"]]
-                best = max(own, key=lambda r: r["delta_chi2"], default=None)
+                best = max(own, key=lambda r: _added_evidence(r, names, lib.mean[li]),
+                           default=None)
                 if best is not None and (best["name"], best["component"]) != (
                         top["name"], top["component"]):
                     new = next(r for r in cands if (r["name"], r["component"])
@@ -427,6 +430,18 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                                    key=lambda r: (r["cause"].signature is None,
                                                   -r["delta_chi2"])),
             "decided_on": how, "chi2": chi0, "n_eff": n_eff, "z": z0}
+
+
+def _added_evidence(row, names, base):
+    """A fault's evidence on its own signature (``row`` of ``by_signature``), over the
+    features its change lifts above the baseline and the shared statistics: a fault adds its
+    family, and a family that fell is no fault's (every impulsive fault moves the band the
+    envelope is read in, so a healthy gear rig's 39-dB outer-race envelope line fell 34 dB
+    under cmsim's own broken tooth, and credited the outer race, whose change lowers it
+    too, with the tie)."""
+    pred = row["prediction"]
+    return sum(v for k, v in row["per_feature"].items() if k in row["judged_on"] and (
+        k in STATISTICS or pred[names.index(k)] >= base[names.index(k)]))
 
 
 def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearing):

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from cmsim.discrepancy.columns import compared_columns, feature_sigma
-from cmsim.discrepancy.judge import FAMILY_RISE_DB, decide_record
+from cmsim.discrepancy.judge import FAMILY_RISE_DB, NEAR_TIE, decide_record
 from cmsim.machine.library import SignatureEntry, SignatureLibrary
 
 NAMES = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "kurtosis_log", "crest_log",
@@ -526,3 +526,42 @@ def test_a_reshaping_cause_is_named_within_its_prediction_s_own_error(low, high,
     if finding == "torque_mismatch":
         assert d["decided_on"] == ("whole" if low == 7.0 else "within error")
         assert d["top"]["value"] > 2.5
+
+
+@pytest.mark.parametrize("sb_rise, finding", [(0.0, "tooth_fault"),
+                                               (10.0, "bearing_outer_race")])
+def test_a_near_tie_is_told_apart_on_what_each_fault_adds_not_on_a_family_that_fell(
+        sb_rise, finding):
+    """A record whose outer-race envelope line fell 20 dB (the band the envelope is read in
+    moved, as under any impulsive fault), its second harmonic up 8 dB, its once-per-revolution
+    sidebands up 8 and the envelope line's shaft sidebands up ``sb_rise``: an outer race
+    (which lowers the line as far, lifts the harmonic and 70 % of the once-per-revolution
+    sidebands) reads the whole record best, a broken tooth (the line lowered, the sidebands
+    lifted) within the near tie, and both lift the line's sidebands as the record does. On
+    its own signature the outer race's evidence is mostly the line that fell, which the
+    tooth's signature does not hold; on what each lifts, the tooth's sidebands outweigh the
+    outer race's harmonic, and the harmonic with the line's sidebands outweighs them."""
+    names = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "sb1_fr1_k1_db", "sb1_fr1_k2_db",
+             "env_bpfo_1b1_sb_db")
+    m = len(names)
+    meas = np.array([-20.0, 8.0, 8.0, 8.0, sb_rise])
+    outer = np.zeros((2, m))
+    outer[1] = [-20.0, 8.0, 5.6, 5.6, sb_rise]
+    tooth = np.zeros((2, m))
+    tooth[1] = [-20.0, 0.0, 8.0, 8.0, sb_rise]
+    outer[0], tooth[0] = outer[1] / 2, tooth[1] / 2
+    lib = _baseline_at_zero(
+        names, np.ones(m),
+        SignatureEntry("bearing_outer_race", "1b1", "documented", "size_m", (1e-4, 1e-3),
+                       outer),
+        SignatureEntry("tooth_fault", "2G1", "documented", "lost_height_m", (1e-4, 1e-3),
+                       tooth))
+    li = np.arange(m)
+    d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
+                      "1b1")
+    whole = {r["name"]: r["evidence"] for r in d["ranked"]}
+    assert whole["bearing_outer_race"] > whole["tooth_fault"] >= NEAR_TIE * whole[
+        "bearing_outer_race"]
+    own = {r["name"]: r["delta_chi2"] for r in d["by_signature"]}
+    assert own["bearing_outer_race"] > own["tooth_fault"]      # the fall, counted
+    assert (d["finding"], d["decided_on"]) == (finding, "whole")
