@@ -118,7 +118,8 @@ from cmsim.spectra.misfit import misfit
 
 __all__ = ["judge", "decide_record", "standing_out", "shape_moved", "NONE_CHI2_PER_FEATURE",
            "ALARM_Z", "MIN_EVIDENCE", "MIN_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE",
-           "RANGE_DELTA_CHI2", "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z"]
+           "RANGE_DELTA_CHI2", "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z",
+           "PREDICTION_ERROR", "within_error"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.
 NONE_CHI2_PER_FEATURE = 2.5
@@ -287,9 +288,6 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
             continue
         tables.setdefault((e.cause, e.component), []).append((e, values[ok], table[ok]))
         loss = misfit(meas, table, sigma, 1.0, rising)[1]
-        # step c's χ²: each feature's σ widened by the prediction's own error there
-        sig_e = np.hypot(sigma, PREDICTION_ERROR * np.nan_to_num(table - lib.mean[li]))
-        chi_e = (w * misfit(meas, table, sig_e, 1.0, rising)[1]).sum(axis=1)
         per_full, per_sig = w * loss, w_sig * loss
         chi = per_full.sum(axis=1)
         per_prof = per_sig
@@ -316,8 +314,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                           "family": cause.family(names, e.component),
                           "per_feature": dict(zip(names, delta.tolist())),
                           "total": float(delta.sum()), "delta_chi2": float(delta[sel].sum()),
-                          "evidence": float(chi0 - per[b].sum()),
-                          "evidence_within_error": float(chi0 - chi_e[b])}
+                          "evidence": float(chi0 - per[b].sum())}
     rows_out = sorted(ranked.values(), key=lambda r: r["chi2"])
     for r in list(rows_out) + list(by_signature.values()):
         # a fault that rings the structure is named only where its own family stands out
@@ -337,9 +334,8 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
         r["nameable"] or r["chi2"] / max(n_eff, 1e-9) <= NONE_CHI2_PER_FEATURE)]
     excess = max(chi0 - n_eff, 0.0)
 
-    def explains(r, allowance=False):
-        return r["evidence"] >= MIN_EVIDENCE and (
-            r["evidence_within_error"] if allowance else r["evidence"]) >= MIN_SHARE * excess
+    def explains(r):
+        return r["evidence"] >= MIN_EVIDENCE and r["evidence"] >= MIN_SHARE * excess
 
     departs = chi0 / max(n_eff, 1e-9) > NONE_CHI2_PER_FEATURE or (
         z0.size > 0 and float(np.nanmax(np.abs(z0))) >= ALARM_Z) or (
@@ -387,8 +383,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                         if r["cause"].signature is not None}
                 own = [r for r in by_signature.values() if (r["name"], r["component"]) in tied
                        and r["nameable"]]
-                best = max(own, key=lambda r: _added_evidence(r, names, lib.mean[li]),
-                           default=None)
+                best = max(own, key=lambda r: _added_evidence(r, lib.mean[li]), default=None)
                 if best is not None and (best["name"], best["component"]) != (
                         top["name"], top["component"]):
                     new = next(r for r in cands if (r["name"], r["component"])
@@ -421,7 +416,10 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
             # c. the reshaping cause that reads the record best of all, within its
             # prediction's own error
             if (top is None and cands and cands[0] is rows_out[0]
-                    and cands[0]["cause"].signature is None and explains(cands[0], True)):
+                    and cands[0]["cause"].signature is None
+                    and cands[0]["evidence"] >= MIN_EVIDENCE
+                    and chi0 - within_error(cands[0], meas, lib.mean[li], sigma, names)
+                    >= MIN_SHARE * excess):
                 top, how = cands[0], "within error"
                 ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]]
         finding = top["name"] if top is not None else "unexplained"
@@ -432,16 +430,38 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
             "decided_on": how, "chi2": chi0, "n_eff": n_eff, "z": z0}
 
 
-def _added_evidence(row, names, base):
+def within_error(row, meas, base, sigma, names):
+    """The χ² of a cause's row (of ``decide_record``'s ``ranked``) with each feature's σ
+    widened by :data:`PREDICTION_ERROR` of the change its prediction makes there (step 4c).
+
+    Parameters
+    ----------
+    row : dict
+        The cause's best reading (its ``prediction``).
+    meas, base, sigma : numpy.ndarray
+        The record's features, the baseline's and their σ.
+    names : sequence of str
+        Feature names.
+
+    Returns
+    -------
+    float
+    """
+    pred = row["prediction"]
+    widened = np.hypot(sigma, PREDICTION_ERROR * np.nan_to_num(pred - base))
+    return float(chi2_rows(meas, pred[None, :], widened, names)[0][0])
+
+
+def _added_evidence(row, base):
     """A fault's evidence on its own signature (``row`` of ``by_signature``), over the
     features its change lifts above the baseline and the shared statistics: a fault adds its
     family, and a family that fell is no fault's (every impulsive fault moves the band the
     envelope is read in, so a healthy gear rig's 39-dB outer-race envelope line fell 34 dB
     under cmsim's own broken tooth, and credited the outer race, whose change lowers it
     too, with the tie)."""
-    pred = row["prediction"]
-    return sum(v for k, v in row["per_feature"].items() if k in row["judged_on"] and (
-        k in STATISTICS or pred[names.index(k)] >= base[names.index(k)]))
+    lifted = row["prediction"] >= base
+    return sum(v for i, (k, v) in enumerate(row["per_feature"].items())
+               if k in row["judged_on"] and (k in STATISTICS or lifted[i]))
 
 
 def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearing):

@@ -494,8 +494,8 @@ def _reshaped_by_a_load(low, high, unnameable_fault=False):
                                       (3e-5, 3e-4), np.vstack([meas + 2.0, meas + 2.0])))
     lib = _baseline_at_zero(names, np.ones(m), *entries)
     li = np.arange(m)
-    return decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
-                         "1b1")
+    sigma = feature_sigma(lib, li, list(names), 8)
+    return decide_record(lib, li, list(names), meas, sigma, "1b1"), (meas, sigma, names)
 
 
 @pytest.mark.parametrize("low, high, fault, finding", [
@@ -514,14 +514,14 @@ def test_a_reshaping_cause_is_named_within_its_prediction_s_own_error(low, high,
     change it predicts, and if no cause reads the record better: a fault that cannot be named
     (its family does not stand out) reading it better leaves it ``unexplained``; so does a
     miss far beyond that error."""
-    from cmsim.discrepancy.judge import MIN_SHARE, PREDICTION_ERROR
-    d = _reshaped_by_a_load(low, high, fault)
-    assert d["finding"] == finding, [(r["name"], r["evidence"], r["evidence_within_error"])
-                                     for r in d["ranked"]]
+    from cmsim.discrepancy.judge import MIN_SHARE, PREDICTION_ERROR, within_error
+    d, (meas, sigma, names) = _reshaped_by_a_load(low, high, fault)
+    assert d["finding"] == finding, [(r["name"], r["evidence"]) for r in d["ranked"]]
     load = next(r for r in d["ranked"] if r["name"] == "torque_mismatch")
     excess = d["chi2"] - d["n_eff"]
     if (low, high) == (3.0, 17.0):
-        assert load["evidence"] < MIN_SHARE * excess <= load["evidence_within_error"]
+        assert load["evidence"] < MIN_SHARE * excess <= d["chi2"] - within_error(
+            load, meas, np.zeros(len(names)), sigma, list(names))
         assert 0.2 <= PREDICTION_ERROR <= 0.5
     if finding == "torque_mismatch":
         assert d["decided_on"] == ("whole" if low == 7.0 else "within error")
