@@ -93,7 +93,11 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
 
    A record that departs and that no step explains is ``unexplained``, with where it
    departs.
-5. **Gain.** On the held-out segments, χ² per feature against the baseline (``before``) and
+5. **Which bearing's line.** A named bearing fault whose fundamental shares its line, at the
+   segments' resolution, with another bearing fault's that stands out as far yields to it
+   where the whole record, read at its full resolution, puts the line in the other's window
+   alone (:mod:`cmsim.discrepancy.resolution`).
+6. **Gain.** On the held-out segments, χ² per feature against the baseline (``before``) and
    against the baseline with the named cause's change (``after``).
 """
 
@@ -109,6 +113,7 @@ from cmsim.discrepancy.columns import chi2_rows, compared_columns, feature_sigma
 from cmsim.discrepancy.evaluator import path_free, rises, weight
 from cmsim.discrepancy.operating_point import at_operating_point, record_load
 from cmsim.discrepancy.ranking import _consistent, decide
+from cmsim.discrepancy.resolution import resolve_line
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
 from cmsim.errors import ParameterError
 from cmsim.features import segments
@@ -583,8 +588,15 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     n_fit = int(np.min(np.sum(np.isfinite(fit[:, ri]), axis=0))) if ri.size else 1
     sigma = feature_sigma(lib, li, cnames, n_fit)
     sensor = signal_info(machine.model_signal).component
-    d = decide_record(lib, li, cnames, meas, sigma, sensor, causes,
-                      gate_sigma=feature_sigma(lib, li, cnames, n_fit, standing=True))
+    gate = feature_sigma(lib, li, cnames, n_fit, standing=True)
+    d = decide_record(lib, li, cnames, meas, sigma, sensor, causes, gate_sigma=gate)
+    resolved = resolve_line(record, lib.segment_s, d, cnames, meas, lib.mean[li],
+                            lambda cols: standing_out(cols, meas, lib.mean[li], gate, cnames))
+    if resolved is not None:
+        new, why = resolved
+        d["ties"] = [r for r in [d["top"]] + d["ties"] if r is not new]
+        d["top"], d["finding"] = new, new["name"]
+        notes.append(why)
     top, z0, n_eff, chi0 = d["top"], d["z"], d["n_eff"], d["chi2"]
     if top is not None and "beside" in top:
         b = top["beside"]
