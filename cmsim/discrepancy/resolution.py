@@ -21,6 +21,14 @@ floor and band rule as the segments). The rival whose fundamental then stands
 :data:`RESOLUTION_DB` over the named one's is named instead: the line the segments read was
 its. Where the fundamentals coincide within the tolerance (2×BSF 2 % from BPFI) the whole
 record cannot tell them apart either, and the judge's reading stands.
+
+A defect's impacts make their whole comb from the fundamental up. A named bearing fault whose
+fundamental stands out in no band (:func:`fundamental_columns`), only a harmonic or a
+sideband, yields first to a bearing fault whose fundamental does, and whose change reads the
+record nearer than the baseline alone (its ``total``): the lone harmonic is the other's comb
+(the angle-domain generator's gear machine 9: a drive-end outer race's third BPFO harmonic,
+243 Hz, stood 11 dB up in the second BPFI harmonic's window, 239 Hz, while BPFI itself fell
+in every band and BPFO stood 10-14 dB up in five).
 """
 
 from __future__ import annotations
@@ -30,7 +38,8 @@ import numpy as np
 from cmsim.features.relative import envelope_columns
 from cmsim.spectra.lines import SLIP_TOLERANCE, line_bins
 
-__all__ = ["FUNDAMENTALS", "RESOLUTION_DB", "fundamental_hz", "overlapping", "resolve_line"]
+__all__ = ["FUNDAMENTALS", "RESOLUTION_DB", "fundamental_hz", "fundamental_columns", "overlapping",
+           "resolve_line"]
 
 #: A rival's fundamental, read over the whole record, stands this far over the named fault's
 #: to take the line, dB: a steady line gains 7.8 dB from 0.5-s segments to a 3-s record,
@@ -83,6 +92,37 @@ def overlapping(f1_hz, f2_hz, df_hz):
     return a is not None and b is not None and a.start < b.stop and b.start < a.stop
 
 
+def fundamental_columns(row, names):
+    """The columns of a bearing fault's row on which its fundamental stands out (its ``out``:
+    ``env_{family}_{bearing}_h1_db`` in the band rule's band, ``…_h1_bb{j}_db`` in the bank's).
+
+    Parameters
+    ----------
+    row : dict
+        A row of :func:`~cmsim.discrepancy.judge.decide_record` (``name``, ``component``,
+        ``out``).
+    names : sequence of str
+        Feature names.
+
+    Returns
+    -------
+    list of int
+    """
+    stem = f"env_{FUNDAMENTALS[row['name']]}_{row['component']}_h1_"
+    return [i for i in row["out"] if names[i].startswith(stem)]
+
+
+def _lone_harmonic(top, pool, names):
+    """The bearing fault whose fundamental stands out in most bands, where ``top``'s stands
+    out in none (module docstring), or None."""
+    if fundamental_columns(top, names):
+        return None
+    rivals = [r for r in pool if r["name"] in FUNDAMENTALS and r["component"] and r["nameable"]
+              and r["total"] > 0.0 and fundamental_columns(r, names)]
+    return max(rivals, key=lambda r: (len(fundamental_columns(r, names)), r["family_z"]),
+               default=None)
+
+
 def _name(cause, bearing):
     return f"{cause.replace('bearing_', '').replace('_', ' ')} of {bearing}"
 
@@ -98,7 +138,8 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
     segment_s : float
         Length of the segments the features were read on, s.
     decision : dict
-        :func:`~cmsim.discrepancy.judge.decide_record`'s result (``top``, ``ranked``).
+        :func:`~cmsim.discrepancy.judge.decide_record`'s result (``top``, ``ranked``,
+        ``by_signature``).
     names : sequence of str
         The compared features' names.
     meas, base : numpy.ndarray
@@ -109,15 +150,25 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
     Returns
     -------
     (dict, str) or None
-        The rival's row of ``decision["ranked"]`` and a note saying why.
+        The rival's row (of the rows the named fault was read among) and a note saying why.
     """
     top = decision["top"]
     if top is None or top["name"] not in FUNDAMENTALS or not top["component"]:
         return None
+    # the rows the named fault was read among: the whole record's or its own signature's
+    pool = (decision["ranked"] if any(r is top for r in decision["ranked"])
+            else decision["by_signature"])
+    comb = _lone_harmonic(top, pool, names)
+    if comb is not None:
+        return comb, (f"named the {_name(comb['name'], comb['component'])}, not the "
+                      f"{_name(top['name'], top['component'])}: the second's fundamental "
+                      "stands out in no band, the first's in "
+                      f"{len(fundamental_columns(comb, names))} (a harmonic alone is another "
+                      "family's line)")
     freqs = record.model_frequencies()
     f_top = fundamental_hz(freqs, top["name"], top["component"])
     rivals = []
-    for r in decision["ranked"]:
+    for r in pool:
         if (r["name"] not in FUNDAMENTALS or not r["component"] or not r["nameable"]
                 or (r["name"], r["component"]) == (top["name"], top["component"])):
             continue

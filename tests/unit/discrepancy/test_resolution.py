@@ -30,12 +30,17 @@ def _record(rate_hz, seconds=3.0, seed=0):
     return SimpleNamespace(signal=x, fs_hz=FS, model_frequencies=lambda: FREQS)
 
 
-def _row(name, component, nameable=True):
-    return {"name": name, "component": component, "nameable": nameable}
+def _row(name, component, nameable=True, out=None, total=1.0, family_z=5.0, names=NAMES):
+    """A row whose fundamental stands out (``out`` None) or the columns ``out``."""
+    if out is None:
+        fam = {"bearing_outer_race": "bpfo", "bearing_inner_race": "bpfi", "bearing_ball": "bsf2"}
+        out = [i for i, k in enumerate(names) if k == f"env_{fam.get(name)}_{component}_h1_db"]
+    return {"name": name, "component": component, "nameable": nameable, "out": out,
+            "total": total, "family_z": family_z}
 
 
 def _decision(top, *others):
-    return {"top": top, "ranked": [top, *others], "ties": []}
+    return {"top": top, "ranked": [top, *others], "by_signature": [], "ties": []}
 
 
 def test_two_lines_share_a_window_within_the_tolerance_and_one_and_a_half_bins_each():
@@ -70,8 +75,8 @@ def test_a_rival_named_on_the_whole_record_keeps_it_when_the_fundamentals_coinci
     rec = _record(183.0)
     rec.model_frequencies = lambda: freqs
     names = ["env_bpfi_1b1_h1_db", "env_bsf2_1b1_h1_db"]
-    got = resolve_line(rec, 0.5, _decision(_row("bearing_inner_race", "1b1"),
-                                           _row("bearing_ball", "1b1")),
+    got = resolve_line(rec, 0.5, _decision(_row("bearing_inner_race", "1b1", names=names),
+                                           _row("bearing_ball", "1b1", names=names)),
                        names, np.array([25.0, 25.0]), np.zeros(2), lambda cols: list(cols))
     assert got is None
 
@@ -92,3 +97,24 @@ def test_a_rival_that_does_not_stand_out_or_cannot_be_named_is_not_asked():
 def test_the_margin_is_what_a_steady_line_gains_from_segments_to_a_short_record():
     # 0.5-s segments to a 3-s record: 10 log10(6) = 7.8 dB; the margin stays below it
     assert RESOLUTION_DB < 10.0 * np.log10(3.0 / 0.5)
+
+
+def test_a_fault_standing_out_on_a_harmonic_alone_yields_to_one_whose_fundamental_stands_out():
+    # the inner race stands out on its 2nd harmonic only (another family's 3rd); the outer
+    # race's fundamental in the rule's band and two of the bank's
+    names = ["env_bpfi_1b1_h1_db", "env_bpfi_1b1_h2_db", "env_bpfo_1b1_h1_db",
+             "env_bpfo_1b1_h1_bb2_db", "env_bpfo_1b1_h1_bb3_db"]
+    inner = _row("bearing_inner_race", "1b1", out=[1], names=names)
+    outer = _row("bearing_outer_race", "1b1", out=[2, 3, 4], names=names, family_z=2.6)
+    rec = _record(150.0)
+    got = resolve_line(rec, 0.5, _decision(inner, outer), names, np.zeros(5), np.zeros(5),
+                       lambda cols: list(cols))
+    assert got is not None and got[0] is outer and "stands out in no band" in got[1]
+    # not where the inner race's own fundamental stands out in some band, nor for a rival
+    # whose change reads the record no nearer than the baseline
+    inner_own = _row("bearing_inner_race", "1b1", out=[0, 1], names=names)
+    assert resolve_line(rec, 0.5, _decision(inner_own, outer), names, np.zeros(5),
+                        np.zeros(5), lambda cols: []) is None
+    worse = _row("bearing_outer_race", "1b1", out=[2, 3, 4], names=names, total=-3.0)
+    assert resolve_line(rec, 0.5, _decision(inner, worse), names, np.zeros(5), np.zeros(5),
+                        lambda cols: []) is None
