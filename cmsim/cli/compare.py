@@ -128,7 +128,11 @@ def text(res):
                "family": "its own family stands out over the baseline and no cause reads the "
                          "whole record",
                "within error": "it reads the whole record best of every cause, within "
-                               "the error of the model's own change (no family stands out)"
+                               "the error of the model's own change (no family stands out)",
+               "full resolution": "its fundamental holds, over the whole record, the line "
+                                  "another bearing's family shared in the segments (see the note)",
+               "fundamental": "its fundamental stands out where the fault read first stood "
+                              "out on a harmonic alone (see the note)"
                }.get(res.get("decided_on", ""))
         if how:
             lines.append(f"named because {how}")

@@ -96,7 +96,9 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
 5. **Which bearing's line.** A named bearing fault whose fundamental shares its line, at the
    segments' resolution, with another bearing fault's that stands out as far yields to it
    where the whole record, read at its full resolution, puts the line in the other's window
-   alone (:mod:`cmsim.discrepancy.resolution`).
+   alone (``decided_on`` ``"full resolution"``), and one whose fundamental stands out in no
+   band, only a harmonic, to one whose fundamental does (``"fundamental"``;
+   :mod:`cmsim.discrepancy.resolution`).
 6. **Gain.** On the held-out segments, χ² per feature against the baseline (``before``) and
    against the baseline with the named cause's change (``after``).
 """
@@ -593,9 +595,9 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     resolved = resolve_line(record, lib.segment_s, d, cnames, meas, lib.mean[li],
                             lambda cols: standing_out(cols, meas, lib.mean[li], gate, cnames))
     if resolved is not None:
-        new, why = resolved
+        new, how, why = resolved
         d["ties"] = [r for r in [d["top"]] + d["ties"] if r is not new]
-        d["top"], d["finding"] = new, new["name"]
+        d.update(top=new, finding=new["name"], decided_on=how)
         notes.append(why)
     top, z0, n_eff, chi0 = d["top"], d["z"], d["n_eff"], d["chi2"]
     if top is not None and "beside" in top:

@@ -123,8 +123,13 @@ def _lone_harmonic(top, pool, names):
                default=None)
 
 
-def _name(cause, bearing):
-    return f"{cause.replace('bearing_', '').replace('_', ' ')} of {bearing}"
+_WORDS = {"bearing_outer_race": "an outer-race defect", "bearing_inner_race": "an inner-race defect",
+          "bearing_ball": "a ball defect"}
+
+
+def _name(record, row):
+    where = getattr(record, "components", {}).get(row["component"], row["component"])
+    return f"{_WORDS[row['name']]} on {where}"
 
 
 def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
@@ -149,8 +154,10 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
 
     Returns
     -------
-    (dict, str) or None
-        The rival's row (of the rows the named fault was read among) and a note saying why.
+    (dict, str, str) or None
+        The rival's row (of the rows the named fault was read among), how it was decided
+        (``"fundamental"``: the named one stood out on a harmonic alone; ``"full
+        resolution"``) and a note saying why.
     """
     top = decision["top"]
     if top is None or top["name"] not in FUNDAMENTALS or not top["component"]:
@@ -160,11 +167,10 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
             else decision["by_signature"])
     comb = _lone_harmonic(top, pool, names)
     if comb is not None:
-        return comb, (f"named the {_name(comb['name'], comb['component'])}, not the "
-                      f"{_name(top['name'], top['component'])}: the second's fundamental "
-                      "stands out in no band, the first's in "
-                      f"{len(fundamental_columns(comb, names))} (a harmonic alone is another "
-                      "family's line)")
+        return comb, "fundamental", (
+            f"named {_name(record, comb)}, not {_name(record, top)}: the second's fundamental "
+            f"stands out in no band, the first's in {len(fundamental_columns(comb, names))} "
+            "(a harmonic alone is another family's line)")
     freqs = record.model_frequencies()
     f_top = fundamental_hz(freqs, top["name"], top["component"])
     rivals = []
@@ -187,9 +193,8 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
     r, key, f = max(rivals, key=lambda t: fine[t[1]])
     if not fine[key] - fine[top_key] >= RESOLUTION_DB:
         return None
-    return r, (f"named the {_name(r['name'], r['component'])}, not the "
-               f"{_name(top['name'], top['component'])}: their fundamentals ({f:.1f} and "
-               f"{f_top:.1f} Hz) share a line in the {segment_s:g}-s segments; read over the "
-               f"whole record ({record.fs_hz / x.size:.2g} Hz), the line is the first's "
-               f"({fine[key]:.1f} dB over the envelope's floor, the second's "
-               f"{fine[top_key]:.1f} dB)")
+    return r, "full resolution", (
+        f"named {_name(record, r)}, not {_name(record, top)}: their fundamentals ({f:.1f} and "
+        f"{f_top:.1f} Hz) share a line in the {segment_s:g}-s segments; read over the whole "
+        f"record ({record.fs_hz / x.size:.2g} Hz), the line is the first's ({fine[key]:.1f} dB "
+        f"over the envelope's floor, the second's {fine[top_key]:.1f} dB)")

@@ -63,9 +63,9 @@ def test_the_line_goes_to_the_family_whose_window_holds_it_over_the_whole_record
     if named == "bearing_outer_race":
         assert got is None
     else:
-        row, why = got
-        assert row is ball
-        assert "ball of 1b1" in why and "outer race of 1b2" in why
+        row, how, why = got
+        assert row is ball and how == "full resolution"
+        assert "ball defect on 1b1" in why and "outer-race defect on 1b2" in why
 
 
 def test_a_rival_named_on_the_whole_record_keeps_it_when_the_fundamentals_coincide():
@@ -109,7 +109,8 @@ def test_a_fault_standing_out_on_a_harmonic_alone_yields_to_one_whose_fundamenta
     rec = _record(150.0)
     got = resolve_line(rec, 0.5, _decision(inner, outer), names, np.zeros(5), np.zeros(5),
                        lambda cols: list(cols))
-    assert got is not None and got[0] is outer and "stands out in no band" in got[1]
+    assert got is not None and got[0] is outer and got[1] == "fundamental"
+    assert "stands out in no band" in got[2]
     # not where the inner race's own fundamental stands out in some band, nor for a rival
     # whose change reads the record no nearer than the baseline
     inner_own = _row("bearing_inner_race", "1b1", out=[0, 1], names=names)
