@@ -106,16 +106,25 @@ def test_a_fault_standing_out_on_a_harmonic_alone_yields_to_one_whose_fundamenta
              "env_bpfo_1b1_h1_bb2_db", "env_bpfo_1b1_h1_bb3_db"]
     inner = _row("bearing_inner_race", "1b1", out=[1], names=names)
     outer = _row("bearing_outer_race", "1b1", out=[2, 3, 4], names=names, family_z=2.6)
-    rec = _record(150.0)
-    got = resolve_line(rec, 0.5, _decision(inner, outer), names, np.zeros(5), np.zeros(5),
+    rec = _record(150.0)                       # BPFO of 1b1: the outer race's own line
+    meas = np.array([3.0, 20.0, 15.0, 15.0, 15.0])
+    got = resolve_line(rec, 0.5, _decision(inner, outer), names, meas, np.zeros(5),
                        lambda cols: list(cols))
     assert got is not None and got[0] is outer and got[1] == "fundamental"
     assert "stands out in no band" in got[2]
+    # nor where the outer race's line the segments read is not its own over the whole record
+    # (impacts at 176.6 Hz: BPFO's window at 150 Hz holds only the floor at 0.33 Hz)
+    assert resolve_line(_record(176.6), 0.5, _decision(inner, outer), names, meas,
+                        np.zeros(5), lambda cols: list(cols)) is None
     # not where the inner race's own fundamental stands out in some band, nor for a rival
     # whose change reads the record no nearer than the baseline
     inner_own = _row("bearing_inner_race", "1b1", out=[0, 1], names=names)
-    assert resolve_line(rec, 0.5, _decision(inner_own, outer), names, np.zeros(5),
+    assert resolve_line(rec, 0.5, _decision(inner_own, outer), names, meas,
                         np.zeros(5), lambda cols: []) is None
+    # nor for a fault named with nothing of its own standing out (read on the whole record)
+    quiet = _row("bearing_inner_race", "1b1", out=[], names=names)
+    assert resolve_line(rec, 0.5, _decision(quiet, outer), names, meas, np.zeros(5),
+                        lambda cols: list(cols)) is None
     worse = _row("bearing_outer_race", "1b1", out=[2, 3, 4], names=names, total=-3.0)
-    assert resolve_line(rec, 0.5, _decision(inner, worse), names, np.zeros(5), np.zeros(5),
+    assert resolve_line(rec, 0.5, _decision(inner, worse), names, meas, np.zeros(5),
                         lambda cols: []) is None
