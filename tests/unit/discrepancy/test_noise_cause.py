@@ -1,11 +1,11 @@
 """The ``noise`` and ``background`` causes through a calibrated machine (issues 25, 16).
 
 Tier: closed form — the machine's background is a coloured noise of known RMS confined
-under 1 kHz, and its baseline that background alone. The noise cause scales the background
-up to :data:`MACHINE_BACKGROUND_SPREAD` and adds white noise beyond, so the record's RMS is
-the cause's ratio over the nominal one times the background's, and the noise beyond the
-spread reaches the bands the baseline's background leaves empty (a scaled background cannot
-change the spectrum's shape); a cause that only adds noise cannot make the baseline quieter.
+under 1 kHz, and its baseline that background alone. The noise cause adds white noise to
+the background as calibrated, so the record's RMS is the cause's ratio over the nominal one
+times the background's, and all it adds reaches the bands the baseline's background leaves
+empty (a scaled background cannot change the spectrum's shape); a cause that only adds noise
+cannot make the baseline quieter.
 The ``background`` cause scales the machine's whole background and keeps its shape.
 """
 
@@ -45,7 +45,7 @@ def _record(setup, nominal, m, baseline):
 
 
 @pytest.mark.parametrize("factor", [1.0, MACHINE_BACKGROUND_SPREAD, 2.5, 6.0])
-def test_the_noise_cause_sets_the_total_rms_and_whitens_beyond_the_spread(factor):
+def test_the_noise_cause_sets_the_total_rms_with_white_noise_alone(factor):
     m, nominal, baseline = _machine()
     setup = CAUSES["noise"]().apply(nominal, NOMINAL_NOISE_RATIO * factor, None)
     y = _record(setup, nominal, m, baseline)
@@ -55,7 +55,7 @@ def test_the_noise_cause_sets_the_total_rms_and_whitens_beyond_the_spread(factor
     spec = np.sum(np.abs(np.fft.rfft(y, axis=1)) ** 2, axis=0)
     f = np.fft.rfftfreq(N, 1.0 / FS)
     high = float(np.sum(spec[f > 1100.0]) / np.sum(spec))
-    white = max(factor ** 2 - MACHINE_BACKGROUND_SPREAD ** 2, 0.0)
+    white = factor ** 2 - 1.0               # what it adds to the background's power (1)
     # the white part spreads evenly to the Nyquist frequency: 0.78 of it above 1.1 kHz
     assert high == pytest.approx(white / factor ** 2 * (1.0 - 1100.0 / (FS / 2)), abs=0.01)
 
