@@ -16,8 +16,9 @@ resolution falls to its floor.
 So when the judge names a bearing fault, every other bearing fault whose fundamental's window
 overlaps the named one's at segment resolution, and whose fundamental stands out over the
 baseline there (:func:`~cmsim.discrepancy.judge.standing_out`), is read again with the named
-one over the whole record (:func:`~cmsim.features.relative.envelope_columns`: the same lines,
-floor and band rule as the segments). The rival whose fundamental then stands
+one over the whole record (its middle :data:`FULL_RESOLUTION_MAX_S` at most;
+:func:`~cmsim.features.relative.envelope_columns`: the same lines, floor and band rule as the
+segments). The rival whose fundamental then stands
 :data:`RESOLUTION_DB` over the named one's is named instead: the line the segments read was
 its. Where the fundamentals coincide within the tolerance (2×BSF 2 % from BPFI) the whole
 record cannot tell them apart either, and the judge's reading stands.
@@ -45,7 +46,7 @@ import numpy as np
 from cmsim.features.relative import envelope_columns
 from cmsim.spectra.lines import SLIP_TOLERANCE, line_bins
 
-__all__ = ["FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "fundamental_hz", "fundamental_columns", "overlapping",
+__all__ = ["FULL_RESOLUTION_MAX_S", "FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "fundamental_hz", "fundamental_columns", "overlapping",
            "resolve_line"]
 
 #: A rival's fundamental, read over the whole record, stands this far over the named fault's
@@ -58,6 +59,11 @@ RESOLUTION_DB = 6.0
 #: named faults of both compare benchmarks 4.5-18.5 dB), a line the segments' window
 #: borrowed from a neighbour falls to the floor (-2 to -25 dB on the same records).
 HOLD_DB = 0.0
+
+#: Longest span read at full resolution, s (the middle of a longer record): the envelope of
+#: 60 s at 25.6 kHz took 1.7 s, of 10 s at 12 kHz 0.09 s, and a long record's speed drift
+#: smears its lines the finer they are resolved.
+FULL_RESOLUTION_MAX_S = 12.0
 
 #: The envelope line that defines each bearing fault: its family's fundamental.
 FUNDAMENTALS = {"bearing_outer_race": "bpfo", "bearing_inner_race": "bpfi",
@@ -131,10 +137,14 @@ def _key(row):
 
 
 def _full_resolution(record, freqs, rows):
-    """The envelope columns of the rows' bearings read over the whole record."""
-    x = record.signal - record.signal.mean()
+    """The envelope columns of the rows' bearings read over the whole record (its middle
+    :data:`FULL_RESOLUTION_MAX_S` of a longer one), and that span's resolution, Hz."""
+    x = record.signal
+    n = min(x.size, int(round(FULL_RESOLUTION_MAX_S * record.fs_hz)))
+    x = x[(x.size - n) // 2:(x.size - n) // 2 + n]
     bearings = {b: freqs.bearing(b) for b in {r["component"] for r in rows}}
-    return envelope_columns(x, record.fs_hz, freqs.fr1_hz, bearings)
+    return envelope_columns(x - x.mean(), record.fs_hz, freqs.fr1_hz, bearings), \
+        record.fs_hz / n
 
 
 def _lone_harmonic(record, freqs, top, pool, names, meas):
@@ -147,7 +157,7 @@ def _lone_harmonic(record, freqs, top, pool, names, meas):
               and r["total"] > 0.0 and fundamental_columns(r, names) and _key(r) in names]
     if not rivals:
         return None
-    fine = _full_resolution(record, freqs, rivals)
+    fine, _ = _full_resolution(record, freqs, rivals)
     held = [r for r in rivals if fine[_key(r)] - meas[names.index(_key(r))] >= HOLD_DB]
     return max(held, key=lambda r: (len(fundamental_columns(r, names)), r["family_z"]),
                default=None)
@@ -215,7 +225,7 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
             rivals.append((r, key, f))
     if not rivals:
         return None
-    fine = _full_resolution(record, freqs, [top] + [r for r, _, _ in rivals])
+    fine, df = _full_resolution(record, freqs, [top] + [r for r, _, _ in rivals])
     top_key = _key(top)
     r, key, f = max(rivals, key=lambda t: fine[t[1]])
     if not fine[key] - fine[top_key] >= RESOLUTION_DB:
@@ -223,6 +233,6 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
     return r, "full resolution", (
         f"named {_name(record, r)}, not {_name(record, top)}: their fundamentals ({f:.1f} and "
         f"{f_top:.1f} Hz) share a line in the {segment_s:g}-s segments; read over the whole "
-        f"record ({record.fs_hz / record.signal.size:.2g} Hz), the line is the first's "
+        f"record ({df:.2g} Hz), the line is the first's "
         f"({fine[key]:.1f} dB "
         f"over the envelope's floor, the second's {fine[top_key]:.1f} dB)")

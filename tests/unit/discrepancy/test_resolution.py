@@ -6,7 +6,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from cmsim.discrepancy.resolution import RESOLUTION_DB, overlapping, resolve_line
+from cmsim.discrepancy.resolution import (
+    FULL_RESOLUTION_MAX_S,
+    RESOLUTION_DB,
+    overlapping,
+    resolve_line,
+)
 from cmsim.frequencies import BearingFrequencies, RigFrequencies
 
 FS = 12_000.0
@@ -128,3 +133,13 @@ def test_a_fault_standing_out_on_a_harmonic_alone_yields_to_one_whose_fundamenta
     worse = _row("bearing_outer_race", "1b1", out=[2, 3, 4], names=names, total=-3.0)
     assert resolve_line(rec, 0.5, _decision(inner, worse), names, meas, np.zeros(5),
                         lambda cols: []) is None
+
+
+def test_a_long_record_is_read_over_its_middle_twelve_seconds():
+    top = _row("bearing_outer_race", "1b2")
+    ball = _row("bearing_ball", "1b1")
+    row, how, why = resolve_line(_record(176.6, seconds=20.0), 0.5, _decision(top, ball),
+                                 NAMES, np.array([25.0, 25.0, 3.0]), np.zeros(3),
+                                 lambda cols: list(cols))
+    assert row is ball and how == "full resolution"
+    assert f"({1.0 / FULL_RESOLUTION_MAX_S:.2g} Hz)" in why
