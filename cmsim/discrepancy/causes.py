@@ -41,13 +41,25 @@ from cmsim.discrepancy.model_setup import NOMINAL_NOISE_RATIO, ModelSetup
 
 __all__ = ["ModelSetup", "Param", "Nuisance", "Cause", "CAUSES", "NUISANCES",
            "MACHINE_BACKGROUND_SPREAD", "register_cause", "applicable_causes",
-           "NOMINAL_NOISE_RATIO", "STATISTICS"]
+           "NOMINAL_NOISE_RATIO", "STATISTICS", "CAUSE_WORDS"]
 
 #: The ``background`` cause's least factor on the machine's background: a background louder
 #: by less is within the baseline's own spread. (The ``noise`` cause adds white noise to the
 #: background as calibrated, whatever its size: a scaled background cannot change the
 #: spectrum's shape, which a sensor's or a cable's noise does.)
 MACHINE_BACKGROUND_SPREAD = 1.25
+
+#: Words of a cause (its name → what an engineer calls it).
+CAUSE_WORDS = {
+    "bearing_outer_race": "outer-race defect", "bearing_inner_race": "inner-race defect",
+    "bearing_ball": "ball defect", "tooth_fault": "local tooth fault (broken tooth)",
+    "eccentricity": "gear eccentricity", "unbalance": "unbalance",
+    "misalignment": "misalignment", "speed_fluctuation": "speed fluctuation",
+    "torque_mismatch": "load other than documented", "clearance": "bearing clearance",
+    "preload": "bearing preload", "rolling_slip": "rolling slip",
+    "friction": "tooth friction", "transfer_path": "transfer path other than the model's",
+    "noise": "background noise other than the model's",
+    "background": "the machine's background louder than at its baseline"}
 
 #: Statistics of the whole signal that every impulsive fault moves (a bearing defect's and a
 #: tooth fault's signature share them): they add to a fault's evidence but never tell one

@@ -47,7 +47,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from cmsim.discrepancy.causes import (CAUSES, NUISANCES, ModelSetup,
+from cmsim.discrepancy.causes import (CAUSE_WORDS, CAUSES, NUISANCES, ModelSetup,
                                       applicable_causes)
 from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, feature_floor,
                                          path_free, weight)
@@ -89,16 +89,6 @@ RECORD_FLOOR = True
 #: The nominal models (see the module docstring).
 MODES = ("machine", "documented", "path-free")
 
-#: Words of a finding (cause name → what an engineer calls it).
-_WORDS = {"bearing_outer_race": "outer-race defect", "bearing_inner_race": "inner-race defect",
-          "bearing_ball": "ball defect", "tooth_fault": "local tooth fault (broken tooth)",
-          "eccentricity": "gear eccentricity", "unbalance": "unbalance",
-          "misalignment": "misalignment", "speed_fluctuation": "speed fluctuation",
-          "torque_mismatch": "load other than documented", "clearance": "bearing clearance",
-          "preload": "bearing preload", "rolling_slip": "rolling slip",
-          "friction": "tooth friction", "transfer_path": "transfer path other than the model's",
-          "noise": "background noise other than the model's",
-          "background": "the machine's background louder than at its baseline"}
 
 
 @dataclass
@@ -165,7 +155,7 @@ def describe(finding, component, parameters, ranges, against="model"):
                 f"{'spread' if against == 'baseline' else 'uncertainty'}")
     if finding == "unexplained":
         return f"the record departs from {ref} in ways no cause of the catalogue explains"
-    text = _WORDS.get(finding, finding.replace("_", " "))
+    text = CAUSE_WORDS.get(finding, finding.replace("_", " "))
     if component:
         text += f", {component.replace('_', '-')}" + (
             " bearing" if finding.startswith("bearing_") else "")

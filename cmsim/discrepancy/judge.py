@@ -592,7 +592,7 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     sensor = signal_info(machine.model_signal).component
     gate = feature_sigma(lib, li, cnames, n_fit, standing=True)
     d = decide_record(lib, li, cnames, meas, sigma, sensor, causes, gate_sigma=gate)
-    resolved = resolve_line(record, lib.segment_s, d, cnames, meas, lib.mean[li],
+    resolved = resolve_line(record, lib.segment_s, d, cnames, meas,
                             lambda cols: standing_out(cols, meas, lib.mean[li], gate, cnames))
     if resolved is not None:
         new, how, why = resolved

@@ -43,11 +43,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from cmsim.discrepancy.causes import CAUSE_WORDS
+from cmsim.features.envelope import envelope_lines
 from cmsim.features.relative import envelope_columns
 from cmsim.spectra.lines import SLIP_TOLERANCE, line_bins
 
-__all__ = ["FULL_RESOLUTION_MAX_S", "FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "fundamental_hz", "fundamental_columns", "overlapping",
-           "resolve_line"]
+__all__ = ["FULL_RESOLUTION_MAX_S", "FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "fundamental_hz",
+           "fundamental_columns", "overlapping", "resolve_line"]
 
 #: A rival's fundamental, read over the whole record, stands this far over the named fault's
 #: to take the line, dB: a steady line gains 7.8 dB from 0.5-s segments to a 3-s record,
@@ -86,8 +88,8 @@ def fundamental_hz(freqs, cause, bearing):
     -------
     float
     """
-    bf = freqs.bearing(bearing)
-    return {"bpfo": bf.bpfo_hz, "bpfi": bf.bpfi_hz, "bsf2": 2.0 * bf.bsf_hz}[FUNDAMENTALS[cause]]
+    first = f"{FUNDAMENTALS[cause]}_1"          # the family's first line, as the features read it
+    return next(ln.frequency_hz for ln in envelope_lines(freqs.bearing(bearing)) if ln.name == first)
 
 
 def overlapping(f1_hz, f2_hz, df_hz):
@@ -163,16 +165,12 @@ def _lone_harmonic(record, freqs, top, pool, names, meas):
                default=None)
 
 
-_WORDS = {"bearing_outer_race": "an outer-race defect", "bearing_inner_race": "an inner-race defect",
-          "bearing_ball": "a ball defect"}
-
-
 def _name(record, row):
     where = getattr(record, "components", {}).get(row["component"], row["component"])
-    return f"{_WORDS[row['name']]} on {where}"
+    return f"the {CAUSE_WORDS[row['name']]} of the {where.replace('_', '-')} bearing"
 
 
-def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
+def resolve_line(record, segment_s, decision, names, meas, stands_out):
     """The bearing fault the record's full resolution names instead of the judge's
     (module docstring), or None.
 
@@ -187,8 +185,8 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
         ``by_signature``).
     names : sequence of str
         The compared features' names.
-    meas, base : numpy.ndarray
-        The record's features and the baseline's.
+    meas : numpy.ndarray
+        The record's features.
     stands_out : callable
         ``stands_out(columns)``: those of the columns that stand out over the baseline.
 
@@ -233,6 +231,5 @@ def resolve_line(record, segment_s, decision, names, meas, base, stands_out):
     return r, "full resolution", (
         f"named {_name(record, r)}, not {_name(record, top)}: their fundamentals ({f:.1f} and "
         f"{f_top:.1f} Hz) share a line in the {segment_s:g}-s segments; read over the whole "
-        f"record ({df:.2g} Hz), the line is the first's "
-        f"({fine[key]:.1f} dB "
-        f"over the envelope's floor, the second's {fine[top_key]:.1f} dB)")
+        f"record ({df:.2g} Hz), the line is the first's ({fine[key]:.1f} dB over the "
+        f"envelope's floor, the second's {fine[top_key]:.1f} dB)")
