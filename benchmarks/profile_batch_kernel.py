@@ -9,7 +9,7 @@ caller)::
     perf record -F 2999 -o /tmp/batch.perf -- python benchmarks/profile_batch_kernel.py run
     python benchmarks/profile_batch_kernel.py report /tmp/batch.perf
 
-``run`` simulates records of ``datasets/gear_faults.toml`` (``--records`` of each kernel
+``run`` simulates records of ``--spec`` (``datasets/gear_faults.toml``; ``--records`` of each kernel
 layout, in batches of ``--batch``) in this process; ``report`` prints the share of all samples
 per kernel function and per other library (libm, libpython, the kernel ...). Needs Linux
 ``perf`` and binutils' ``nm``.
@@ -40,7 +40,7 @@ def _run(args):
     from cmsim.datasets.spec import DatasetSpec
     from cmsim.dynamics._batch_kernels import integrate_batch_jit
 
-    spec = DatasetSpec.load(ROOT / "datasets" / "gear_faults.toml")
+    spec = DatasetSpec.load(args.spec)
     groups = {}
     for i in range(spec.n_records):
         plan = spec.record(i)
@@ -115,6 +115,8 @@ def main():
     run.add_argument("--records", type=int, default=124,
                      help="records of each kernel layout (fault kinds that share a batch)")
     run.add_argument("--batch", type=int, default=128)
+    run.add_argument("--spec", type=Path, default=ROOT / "datasets" / "gear_faults.toml",
+                     help="the dataset spec whose records are run (default: gear_faults)")
     run.add_argument("--address", default=f"/tmp/{ADDRESS_FILE}")
     report = sub.add_parser("report")
     report.add_argument("data", help="perf.data of the run")

@@ -37,12 +37,14 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from cmsim.dynamics._bearing_kernels import (BI_FAULTY, BI_NB, BI_T, BI_X, BI_Y, BP_C, BP_CAGE,
-                                             BP_DAMP, BP_K, BP_P, BP_PHASE, BP_SENSE)
 from cmsim.dynamics._batch_mesh_kernels import _grid_place, _read_at, mesh_forces_batch_jit
+from cmsim.dynamics._bearing_kernels import (BI_DEF0, BI_FAULTY, BI_NB, BI_NDEF, BI_T, BI_X,
+                                             BI_Y, BP_C, BP_CAGE, BP_DAMP, BP_K, BP_P, BP_PHASE,
+                                             BP_SENSE, BP_SPIN, _defect_correction,
+                                             track_gains_jit)
 from cmsim.dynamics._mesh_kernels import (MI_BALL_SLIP, MI_FAULTY_BALLS, MI_MODE, MI_ON,
                                           MI_PROFILE, MI_TDOF, MODE_TABLE, MP_JDT, MP_OMREF,
-                                          MP_PDT, MP_PT0, mesh_forces_jit)
+                                          MP_PDT, MP_PT0, MP_TDT, mesh_forces_jit)
 from cmsim.dynamics._rhs_kernels import KernelParams, Work, defect_forces_jit, profile_at
 from cmsim.dynamics._rotation_kernels import (AN_ANGLE, AN_COS, AN_SIN, AN_VALID, ANCHOR_RAD,
                                               anchored_cos_sin_jit, rotate_small_jit)
@@ -234,6 +236,56 @@ def _bearing_out(ib, ix, iy, n, y, g, b_par, cc, sc, sum_x, sum_y, diag, want_di
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
+def _defect_changes(t, ib, it, ix, iy, n_balls, d0, nd, n, y, g, omega, b_par, ball_cos,
+                    ball_sin, anchor, cage_slip, tau, b_ang, b_def, gain, track, tdt, diag,
+                    want_diag):
+    """The change the race and ball defects of bearing ``ib`` (``BI_FAULTY`` 1: its healthy
+    law already applied) make to its forces, for every run: run by run the arithmetic of
+    :func:`cmsim.dynamics._bearing_kernels.faulty_bearing_forces_jit` (the same numbers in
+    the same order, so bit for bit the single-run kernel's change), without building each
+    run's parameter views. The cage angle's cos and sin come from the anchor the healthy
+    pass has just set at the same angle. ``track`` (B, m, n_grid) and ``tdt`` (B,): each
+    run's share of a ball defect the races meet, read at ``t`` into ``gain`` (B, m) where it
+    varies."""
+    rate_a = b_par[ib, BP_CAGE]
+    sense = b_par[ib, BP_SENSE]
+    phase = b_par[ib, BP_PHASE]
+    spin = b_par[ib, BP_SPIN]
+    k = b_par[ib, BP_K]
+    p = b_par[ib, BP_P]
+    c = b_par[ib, BP_C]
+    w = omega[it]
+    q = y[it]
+    qx = y[ix]
+    qy = y[iy]
+    slip = cage_slip[ib]
+    for l in range(q.shape[0]):
+        if track.shape[2] > 1:
+            track_gains_jit(track[l], tdt[l], t, gain[l])
+        rate = rate_a[l] * sense[l]
+        turned = w[l] * tau[l] + q[l]
+        angle = rate * turned + phase[l] + slip[l]
+        cc, sc = anchored_cos_sin_jit(anchor[:, :, l], ib, angle)
+        xr = qx[l] * cc + qy[l] * sc
+        yr = qy[l] * cc - qx[l] * sc
+        shaft = sense[l] * turned
+        forward = 1.0 if w[l] >= 0.0 else -1.0
+        fxr, fyr = _defect_correction(
+            xr, yr, ball_cos[:, :, l], ball_sin[:, :, l], ib, n_balls, k[l], p[l], c[l],
+            b_ang[l], b_def[l], d0, nd, angle, shaft, spin[l] * (shaft - angle),
+            forward * (1.0 if rate >= 0.0 else -1.0),
+            forward * (1.0 if rate - sense[l] >= 0.0 else -1.0),
+            forward * (1.0 if sense[l] - rate >= 0.0 else -1.0), gain[l])
+        fx = fxr * cc - fyr * sc
+        fy = fyr * cc + fxr * sc
+        g[ix, l] -= fx
+        g[iy, l] -= fy
+        if want_diag:
+            diag[2 * ib, l] += fx
+            diag[2 * ib + 1, l] += fy
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
 def _copy_flat(src, dst):
     """``dst[...] = src`` for two C-contiguous arrays of one shape, as one loop."""
     a = src.reshape(-1)
@@ -377,11 +429,23 @@ def rhs_batch_jit(t, y, dydt, row, S, L, V, B, diag, want_diag):
             _bearing_forces(y, n, g, S, L, V, B, diag, want_diag, L.b_cos, L.b_sin)
     mesh_on = S.m_int[0, MI_ON] != 0
     table = S.m_int[0, MI_MODE] == MODE_TABLE
-    faulty = S.b_def.shape[1] > 0 or S.m_int[0, MI_FAULTY_BALLS] != 0
+    # race and ball defects: a pass per faulty bearing over the runs; an off-size ball
+    # (the whole bearing ball by ball) through the single-run kernel run by run
+    faulty = S.m_int[0, MI_FAULTY_BALLS] != 0
+    if S.b_def.shape[1] > 0 and not faulty:
+        for ib in range(S.b_int.shape[1]):
+            if S.b_int[0, ib, BI_FAULTY] == 1:
+                _defect_changes(t, ib, S.b_int[0, ib, BI_T], S.b_int[0, ib, BI_X],
+                                S.b_int[0, ib, BI_Y], S.b_int[0, ib, BI_NB],
+                                S.b_int[0, ib, BI_DEF0], S.b_int[0, ib, BI_NDEF], n, y, g,
+                                L.omega, L.b_par, V.slip_cos if moved else L.b_cos,
+                                V.slip_sin if moved else L.b_sin, V.cage, V.cage_slip, B.tau,
+                                S.b_ang, S.b_def, V.def_gain, S.track, L.m_par[MP_TDT], diag,
+                                want_diag)
     if faulty or (mesh_on and not table):
-        # what branches per run through the single-run kernels (the same arithmetic in the
-        # same order), on each run's column of the state and the forces: bearing defects,
-        # the hybrid contact solve
+        # what branches per run in depth, through the single-run kernels (the same
+        # arithmetic in the same order) on each run's column of the state and the forces:
+        # off-size balls, the hybrid contact solve
         for l in range(n_runs):
             P = lane_params(S, l)
             W = lane_work(V, l)

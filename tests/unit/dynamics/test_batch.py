@@ -20,8 +20,8 @@ from cmsim.dynamics.profiles import SpeedProfile
 from cmsim.dynamics.simulation import integrate_prepared, prepare_run
 from cmsim.errors import IntegrationDiverged
 from cmsim.rig import PRESETS
-from cmsim.faults import (OuterRaceDefect, RollingSlip, SpeedFluctuation,
-                          ToothCrack, ToothSpall)
+from cmsim.faults import (BallDefect, InnerRaceDefect, OffSizeBall, OuterRaceDefect,
+                          RollingSlip, SpeedFluctuation, ToothCrack, ToothSpall)
 
 FS = 25_600.0
 DURATION = 0.03
@@ -96,6 +96,32 @@ def test_bearing_defects_batch_like_the_single_run_kernel():
     together = simulate_batch(runs)
     _near_reference(runs, together)
     _same(simulate_batch(runs[1:2])[0], together[1])
+
+
+def test_every_kind_of_bearing_defect_batches_like_the_single_run_kernel():
+    # inner race, a ball defect whose axis wanders (the share the races meet varies in time),
+    # two defects on one bearing, and an off-size ball (the whole bearing ball by ball, run
+    # by run through the single-run kernel): two runs of each, one batch per layout
+    rig = PRESETS["cwru_6205"]()
+    slip = RollingSlip(cage_speed_rms=0.01)
+    kinds = [(InnerRaceDefect("1b1", size_m=0.5e-3, depth_m=0.2e-3),),
+             (BallDefect("1b1", size_m=0.6e-3, depth_m=0.2e-3, axis_offset=0.3,
+                         wander_s=0.005),),
+             (OuterRaceDefect("1b1", size_m=0.4e-3, depth_m=0.2e-3),
+              InnerRaceDefect("1b1", size_m=0.3e-3, depth_m=0.3e-3)),
+             (OffSizeBall("1b1", ball=2, diameter_excess_m=3e-6),
+              OuterRaceDefect("1b1", size_m=0.4e-3, depth_m=0.2e-3))]
+    runs = [prepare_run(rig, cmsim.OperatingPoint(rpm, radial_load_n=load), DURATION,
+                        fs_hz=12_000.0, seed=20 + 2 * j + i, warmup_s=0.01,
+                        faults=(*faults, slip))
+            for j, faults in enumerate(kinds)
+            for i, (rpm, load) in enumerate(((1760.0, 400.0), (1795.0, 150.0)))]
+    assert len({kernel_layout(r) for r in runs}) == len(kinds)
+    together = simulate_batch(runs)
+    _near_reference(runs, together)
+    for i in (1, 2, 5, 6):
+        _same(simulate_batch([runs[i]])[0], together[i])        # a batch of one
+    _same(simulate_batch([runs[3], runs[2]])[1], together[2])    # another place
 
 
 def test_a_diverging_run_is_flagged_and_the_others_finish(gear):
