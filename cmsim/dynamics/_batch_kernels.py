@@ -8,10 +8,14 @@ right-hand side that are the same arithmetic on different numbers run as loops o
 runs that numba vectorises (SIMD lanes): the linear springs and dampers, the healthy Hertz
 ball sums of every bearing, the Runge-Kutta stage combinations. The tooth contacts from
 their tables (:mod:`cmsim.dynamics._batch_mesh_kernels`), the slip and the speed profile
-run in passes over the runs as well, branch-free where the single-run kernel branches. The
-parts that branch per run in depth — bearing defects and the on-line hybrid contact solve
-— call the single-run kernels of :mod:`cmsim.dynamics._rhs_kernels` on each run's views
-(:func:`lane_params`, :func:`lane_work`), so their physics is written once.
+run in passes over the runs as well, branch-free where the single-run kernel branches, and
+so does the change race and ball defects make (:func:`_defect_changes`: the single-run
+kernel's functions on each run's numbers as they lie). The parts that branch per run in
+depth — a bearing with an off-size ball, taken ball by ball, and the on-line hybrid contact
+solve — call the single-run kernels of :mod:`cmsim.dynamics._rhs_kernels` on each run's
+views (:func:`lane_params`, :func:`lane_work`: some thirty arrays re-viewed per run and
+right-hand side, which costs more than a defect's arithmetic), so their physics is written
+once.
 
 Independence of the runs (the contract :mod:`cmsim.dynamics.batch` tests): every operation on
 run ``l`` reads only run ``l``'s numbers, in the same order whatever B is and wherever the run
