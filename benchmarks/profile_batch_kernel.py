@@ -61,7 +61,10 @@ def _kernel_symbols(entry_symbol):
     roots = [ROOT / "cmsim" / "dynamics" / "__pycache__"]
     if os.environ.get("NUMBA_CACHE_DIR"):
         roots.append(Path(os.environ["NUMBA_CACHE_DIR"]))
-    cached = [p for root in roots for p in root.rglob(f"_batch_kernels.{ENTRY}-*.nbc")]
+    # the newest first: an older file of the kernel (another line number, the same
+    # symbols) is left behind when its source moves, and its offsets are not the loaded ones
+    cached = sorted((p for root in roots for p in root.rglob(f"_batch_kernels.{ENTRY}-*.nbc")),
+                    key=lambda p: p.stat().st_mtime, reverse=True)
     for path in cached:
         data = path.read_bytes()
         with tempfile.NamedTemporaryFile(suffix=".o") as obj:
