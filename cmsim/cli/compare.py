@@ -132,7 +132,10 @@ def text(res):
                "full resolution": "its fundamental holds, over the whole record, the line "
                                   "another bearing's family shared in the segments (see the note)",
                "fundamental": "its fundamental stands out where the fault read first stood "
-                              "out on a harmonic alone (see the note)"
+                              "out on a harmonic alone (see the note)",
+               "whole-record family": "its fundamental and second harmonic stand well over "
+                                      "the baseline's over the whole record, where no "
+                                      "segment showed them (see the note)"
                }.get(res.get("decided_on", ""))
         if how:
             lines.append(f"named because {how}")

@@ -97,7 +97,9 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    segments' resolution, with another bearing fault's that stands out as far yields to it
    where the whole record, read at its full resolution, puts the line in the other's window
    alone (``decided_on`` ``"full resolution"``), and one whose fundamental stands out in no
-   band, only a harmonic, to one whose fundamental does (``"fundamental"``;
+   band, only a harmonic, to one whose fundamental does (``"fundamental"``). Where nothing
+   is named, a bearing fault whose fundamental and second harmonic stand well over the
+   baseline's over the whole record is (``"whole-record family"``;
    :mod:`cmsim.discrepancy.resolution`).
 6. **Gain.** On the held-out segments, χ² per feature against the baseline (``before``) and
    against the baseline with the named cause's change (``after``).
@@ -115,7 +117,7 @@ from cmsim.discrepancy.columns import chi2_rows, compared_columns, feature_sigma
 from cmsim.discrepancy.evaluator import path_free, rises, weight
 from cmsim.discrepancy.operating_point import at_operating_point, record_load
 from cmsim.discrepancy.ranking import _consistent, decide
-from cmsim.discrepancy.resolution import resolve_line
+from cmsim.discrepancy.resolution import buried_family, resolve_line
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
 from cmsim.errors import ParameterError
 from cmsim.features import segments
@@ -592,11 +594,12 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     sensor = signal_info(machine.model_signal).component
     gate = feature_sigma(lib, li, cnames, n_fit, standing=True)
     d = decide_record(lib, li, cnames, meas, sigma, sensor, causes, gate_sigma=gate)
-    resolved = resolve_line(record, lib.segment_s, d, cnames, meas,
-                            lambda cols: standing_out(cols, meas, lib.mean[li], gate, cnames))
+    resolved = resolve_line(record, lib.segment_s, d, cnames, meas, lambda cols: standing_out(
+        cols, meas, lib.mean[li], gate, cnames)) or buried_family(
+            record, machine.baseline.records if machine.baseline else (), machine.op.speed_rpm, d)
     if resolved is not None:
         new, how, why = resolved
-        d["ties"] = [r for r in [d["top"]] + d["ties"] if r is not new]
+        d["ties"] = [r for r in [d["top"]] + d["ties"] if r is not new and r is not None]
         d.update(top=new, finding=new["name"], decided_on=how)
         notes.append(why)
     top, z0, n_eff, chi0 = d["top"], d["z"], d["n_eff"], d["chi2"]

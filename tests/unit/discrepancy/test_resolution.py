@@ -7,11 +7,14 @@ import numpy as np
 import pytest
 
 from cmsim.discrepancy.resolution import (
+    BURIED_RISE_DB,
     FULL_RESOLUTION_MAX_S,
     RESOLUTION_DB,
+    buried_family,
     overlapping,
     resolve_line,
 )
+from cmsim.discrepancy import resolution
 from cmsim.frequencies import BearingFrequencies, RigFrequencies
 
 FS = 12_000.0
@@ -144,3 +147,88 @@ def test_a_long_record_is_read_over_its_middle_twelve_seconds():
                                  lambda cols: list(cols))
     assert row is ball and how == "full resolution"
     assert f"({1.0 / FULL_RESOLUTION_MAX_S:.2g} Hz)" in why
+
+
+# ---------------------------------------------------------------- a family no segment showed
+
+def _bearing_at(rpm):
+    """The drive end's (1b1) and fan end's (1b2) families at ``rpm`` (1800 rpm: 30 Hz)."""
+    k = rpm / 1800.0
+    return RigFrequencies(fr1_hz=30.0 * k, bearings={
+        "1b1": BearingFrequencies(*(k * f for f in (30.0, 12.0, 107.0, 163.0, 70.0, 107.0))),
+        "1b2": BearingFrequencies(*(k * f for f in (30.0, 11.5, 121.0, 178.0, 77.0, 121.0)))})
+
+
+def _geared(seed, impacts_hz=None, rpm=1800.0, seconds=3.0, impact=0.5):
+    """A gear mesh (a 2-kHz tone modulated at the shaft rate) in white noise, with impacts
+    at ``impacts_hz`` ringing a 3-kHz resonance (a race under the mesh)."""
+    rng = np.random.default_rng(seed)
+    n = int(seconds * FS)
+    t = np.arange(n) / FS
+    mod = 1.0 + 0.3 * np.cos(2 * np.pi * rpm / 60.0 * t)
+    x = mod * np.sin(2 * np.pi * 2000.0 * t) + 0.3 * rng.standard_normal(n)
+    if impacts_hz:
+        hits = np.zeros(n)
+        hits[(np.arange(0.0, seconds, 1.0 / impacts_hz) * FS).astype(int)] = impact
+        ring = np.exp(-600.0 * t[:200]) * np.sin(2 * np.pi * 3000.0 * t[:200])
+        x += np.convolve(hits, ring)[:n]
+    return x
+
+
+def _geared_record(x, rpm=1800.0):
+    return SimpleNamespace(signal=x, fs_hz=FS, components={},
+                           model_frequencies=lambda speed_rpm=rpm: _bearing_at(speed_rpm))
+
+
+def _nothing_named():
+    rows = [_row(name, b, nameable=False, out=[]) for b in ("1b1", "1b2")
+            for name in ("bearing_outer_race", "bearing_inner_race", "bearing_ball")]
+    return {"top": None, "ranked": rows + [_row("clearance", None)], "by_signature": [],
+            "ties": []}
+
+
+def test_a_race_under_the_mesh_is_named_where_the_whole_record_shows_its_family():
+    # impacts at the drive end's BPFI with slip; the baseline another realisation without
+    baseline = [_geared(1).astype(np.float32)]
+    decision = _nothing_named()
+    row, how, why = buried_family(_geared_record(_geared(2, impacts_hz=163.0 * 1.01)),
+                                  baseline, 1800.0, decision)
+    assert (row["name"], row["component"], how) == ("bearing_inner_race", "1b1",
+                                                    "whole-record family")
+    assert "no segment showed" in why
+    # the healthy record of the same machine, and a record with something already named
+    assert buried_family(_geared_record(_geared(3)), baseline, 1800.0, decision) is None
+    named = dict(decision, top=decision["ranked"][0])
+    assert buried_family(_geared_record(_geared(2, impacts_hz=163.0 * 1.01)), baseline,
+                         1800.0, named) is None
+
+
+def test_impacts_too_weak_for_the_whole_record_to_show_name_nothing():
+    baseline = [_geared(1)]
+    weak = _geared_record(_geared(2, impacts_hz=163.0, impact=0.05))
+    assert buried_family(weak, baseline, 1800.0, _nothing_named()) is None
+
+
+def test_the_baseline_is_read_at_its_own_speed():
+    # ball passes at the fan end's BPFO in both (a healthy machine that shows them), the
+    # record 4 % faster: read at each one's speed, the line is the baseline's own
+    baseline = [_geared(1, rpm=1800.0, impacts_hz=121.0)]
+    faster = _geared_record(_geared(2, rpm=1872.0, impacts_hz=121.0 * 1.04), rpm=1872.0)
+    assert buried_family(faster, baseline, 1800.0, _nothing_named()) is None
+    # read at the record's speed, the baseline's window would miss its own line
+    assert buried_family(faster, baseline, 1872.0, _nothing_named()) is not None
+
+
+def test_two_bearings_whose_families_share_the_line_name_neither(monkeypatch):
+    freqs = _bearing_at(1800.0)
+    twin = RigFrequencies(fr1_hz=30.0, bearings={"1b1": freqs.bearing("1b1"),
+                                                 "1b2": freqs.bearing("1b1")})
+    rec = _geared_record(_geared(2, impacts_hz=163.0 * 1.01))
+    rec.model_frequencies = lambda speed_rpm=1800.0: twin
+    assert buried_family(rec, [_geared(1)], 1800.0, _nothing_named()) is None
+    monkeypatch.setattr(resolution, "BURIED_TIE_DB", 0.0)      # the tie is what refuses
+    assert buried_family(rec, [_geared(1)], 1800.0, _nothing_named()) is not None
+
+
+def test_the_rise_asked_lies_above_what_a_healthy_line_wanders_between_records():
+    assert BURIED_RISE_DB > 9.5
