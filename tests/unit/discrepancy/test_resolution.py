@@ -6,6 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from cmsim.discrepancy import resolution
 from cmsim.discrepancy.resolution import (
     BURIED_RISE_DB,
     FULL_RESOLUTION_MAX_S,
@@ -14,7 +15,6 @@ from cmsim.discrepancy.resolution import (
     overlapping,
     resolve_line,
 )
-from cmsim.discrepancy import resolution
 from cmsim.frequencies import BearingFrequencies, RigFrequencies
 
 FS = 12_000.0
