@@ -41,8 +41,8 @@ of that impulsive baseline (one of them not even its own: −0.2 dB over the who
 Where the segments name nothing (``none`` or ``unexplained``), a bearing's family may still
 stand over the whole record: under a gear mesh, a race's impacts fill no band of a 0.5-s
 segment, but their steady lines gain with the resolution as the floor does not. The record and
-the machine's baseline are then read over the same span at full resolution (each at its own
-speed's family), and a bearing fault whose fundamental and second harmonic both stand
+the machine's baseline are then read over spans of one length at full resolution (each at its
+own speed's family; the baseline's highest of up to :data:`BURIED_SPANS`), and a bearing fault whose fundamental and second harmonic both stand
 :data:`BURIED_RISE_DB` over the baseline's, its fundamental a line :data:`BURIED_LINE_DB` over
 the record's envelope floor, is named (``decided_on`` ``"whole-record family"``) — unless
 another bearing fault's family rises within :data:`BURIED_TIE_DB` of it (one line two
@@ -60,7 +60,8 @@ from cmsim.features.envelope import envelope_lines
 from cmsim.features.relative import envelope_columns
 from cmsim.spectra.lines import SLIP_TOLERANCE, line_bins
 
-__all__ = ["BURIED_LINE_DB", "BURIED_RISE_DB", "BURIED_TIE_DB", "FULL_RESOLUTION_MAX_S",
+__all__ = ["BURIED_LINE_DB", "BURIED_RISE_DB", "BURIED_SPANS", "BURIED_TIE_DB",
+           "FULL_RESOLUTION_MAX_S",
            "FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "buried_family", "fundamental_columns",
            "fundamental_hz", "overlapping", "resolve_line"]
 
@@ -91,6 +92,10 @@ BURIED_LINE_DB = 15.0
 #: Another bearing fault's family rising within this of the best: the line is not told
 #: apart, and nothing is named, dB.
 BURIED_TIE_DB = 3.0
+
+#: Spans of a long baseline read, each as long as the record: a healthy line's level
+#: wanders from span to span, and the record's rise is taken over their highest.
+BURIED_SPANS = 4
 
 #: The envelope line that defines each bearing fault: its family's fundamental.
 FUNDAMENTALS = {"bearing_outer_race": "bpfo", "bearing_inner_race": "bpfi",
@@ -223,7 +228,10 @@ def buried_family(record, baseline, baseline_rpm, decision):
     n = min(min(b.size for b in baseline), record.signal.size)
     fine, df = _full_resolution(record, record.model_frequencies(), rows, n=n)
     ref_freqs = record.model_frequencies(speed_rpm=baseline_rpm)
-    refs = [_full_resolution(record, ref_freqs, rows, x=b, n=n)[0] for b in baseline]
+    # every span of the record's length the baseline holds (up to BURIED_SPANS): the rise is
+    # read over the highest of them
+    refs = [_full_resolution(record, ref_freqs, rows, x=b[j * n:(j + 1) * n], n=n)[0]
+            for b in baseline for j in range(min(b.size // n, BURIED_SPANS))]
     rises = []
     for r in rows:
         keys = [_key(r), _key(r).replace("_h1_", "_h2_")]

@@ -1,5 +1,6 @@
 """Which bearing's line (cmsim.discrepancy.resolution): a line two families share at the
-segments' resolution is given to the one whose window holds it over the whole record."""
+segments' resolution is given to the one whose window holds it over the whole record, and a
+family no segment showed is named where the whole record shows it over the baseline."""
 
 from types import SimpleNamespace
 
@@ -201,6 +202,16 @@ def test_a_race_under_the_mesh_is_named_where_the_whole_record_shows_its_family(
     named = dict(decision, top=decision["ranked"][0])
     assert buried_family(_geared_record(_geared(2, impacts_hz=163.0 * 1.01)), baseline,
                          1800.0, named) is None
+
+
+def test_a_long_baseline_is_read_span_by_span_at_the_record_s_length():
+    # a 9-s baseline whose last 3 s carry the same impacts (a healthy machine that shows the
+    # line at times): the record's rise is read over the highest span, so nothing rises
+    quiet, loud = _geared(1, seconds=6.0), _geared(4, impacts_hz=163.0 * 1.01)
+    baseline = [np.concatenate([quiet, loud])]
+    rec = _geared_record(_geared(2, impacts_hz=163.0 * 1.01))
+    assert buried_family(rec, baseline, 1800.0, _nothing_named()) is None
+    assert buried_family(rec, [quiet], 1800.0, _nothing_named()) is not None
 
 
 def test_impacts_too_weak_for_the_whole_record_to_show_name_nothing():
