@@ -227,16 +227,24 @@ def buried_family(record, baseline, baseline_rpm, decision):
         return None
     n = min(min(b.size for b in baseline), record.signal.size)
     fine, df = _full_resolution(record, record.model_frequencies(), rows, n=n)
+    keys = [(_key(r), _key(r).replace("_h1_", "_h2_")) for r in rows]
+    lines = [k for k in keys if fine[k[0]] >= BURIED_LINE_DB]
+    if not lines:
+        return None                  # no line to name: the baseline need not be read
     ref_freqs = record.model_frequencies(speed_rpm=baseline_rpm)
     # every span of the record's length the baseline holds (up to BURIED_SPANS): the rise is
-    # read over the highest of them
-    refs = [_full_resolution(record, ref_freqs, rows, x=b[j * n:(j + 1) * n], n=n)[0]
-            for b in baseline for j in range(min(b.size // n, BURIED_SPANS))]
+    # read over the highest of them; once no line rises enough, no further span can help
+    ref = {}
+    for b in baseline:
+        for j in range(min(b.size // n, BURIED_SPANS)):
+            got = _full_resolution(record, ref_freqs, rows, x=b[j * n:(j + 1) * n], n=n)[0]
+            ref = {k: max(v, ref.get(k, -np.inf)) for k, v in got.items()}
+            if all(min(fine[k] - ref[k] for k in pair) < BURIED_RISE_DB for pair in lines):
+                return None
     rises = []
-    for r in rows:
-        keys = [_key(r), _key(r).replace("_h1_", "_h2_")]
-        up = [fine[k] - max(ref[k] for ref in refs) for k in keys]
-        rises.append((min(up), r, up, fine[keys[0]]))
+    for r, pair in zip(rows, keys):
+        up = [fine[k] - ref[k] for k in pair]
+        rises.append((min(up), r, up, fine[pair[0]]))
     rises.sort(key=lambda t: -t[0])
     best, r, up, level = rises[0]
     rival = next((t for t in rises[1:] if t[1]["component"] != r["component"]
