@@ -2,7 +2,7 @@
 false alarms, timing — on two generators, with and without a calibrated machine.
 
 Run: ``python benchmarks/bench_compare.py [--generator model|angle] [--machine] [--seeds N]
-[--budget B] [--workers W] [--effects ...] [--json OUT]``.
+[--first-seed S] [--budget B] [--workers W] [--effects ...] [--json OUT]``.
 
 * ``--generator model`` (:mod:`cmsim.discrepancy.synthetic`): records made by cmsim's own
   model with one hidden effect of the cause catalogue and measurement-chain nuisances; the
@@ -141,6 +141,9 @@ def main(argv=None):
     ap.add_argument("--generator", choices=("model", "angle"), default="model")
     ap.add_argument("--machine", action="store_true")
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first-seed", type=int, default=0,
+                    help="the machines' seeds start here: seeds a rule was not made looking at "
+                         "check it honestly")
     ap.add_argument("--budget", type=int, default=None)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--effects", nargs="*", default=None)
@@ -157,8 +160,9 @@ def main(argv=None):
     effects = a.effects or (catalogue + ["none", "none_gear"])
     clean_seeds = a.seeds if a.clean_seeds is None else a.clean_seeds
     jobs = [(e, s, budget, a.generator, a.machine)
-            for s in range(max(a.seeds, clean_seeds)) for e in effects
-            if s < (clean_seeds if e.startswith("none") else a.seeds)]
+            for s in range(a.first_seed, a.first_seed + max(a.seeds, clean_seeds))
+            for e in effects
+            if s - a.first_seed < (clean_seeds if e.startswith("none") else a.seeds)]
     run = one
     if a.machine:            # one task per machine: its library is built once
         groups = defaultdict(list)
