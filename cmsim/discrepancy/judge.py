@@ -91,8 +91,10 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       load), an error the baseline's spread does not hold. The ranking and steps a and b
       read the plain σ.
 
-   A record that departs and that no step explains is ``unexplained``, with where it
-   departs.
+   A cause named on shaft lines that rose only over a spectrum floor that fell, none of them
+   :data:`~cmsim.discrepancy.shaft_lines.LINE_RISE_DB` up in absolute level, is not named:
+   the record is decided again without it (:mod:`cmsim.discrepancy.shaft_lines`). A record
+   that departs and that no step explains is ``unexplained``, with where it departs.
 5. **Which bearing's line.** A named bearing fault whose fundamental shares its line, at the
    segments' resolution, with another bearing fault's that stands out as far yields to it
    where the whole record, read at its full resolution, puts the line in the other's window
@@ -116,8 +118,9 @@ from cmsim.discrepancy.causes import CAUSES, STATISTICS
 from cmsim.discrepancy.columns import chi2_rows, compared_columns, feature_sigma, interpolated
 from cmsim.discrepancy.evaluator import path_free, rises, weight
 from cmsim.discrepancy.operating_point import at_operating_point, record_load
-from cmsim.discrepancy.ranking import _consistent, decide
+from cmsim.discrepancy.ranking import _consistent, added_evidence, decide
 from cmsim.discrepancy.resolution import buried_family, resolve_line
+from cmsim.discrepancy.shaft_lines import held_lines
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
 from cmsim.errors import ParameterError
 from cmsim.features import segments
@@ -392,7 +395,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                         if r["cause"].signature is not None}
                 own = [r for r in by_signature.values() if (r["name"], r["component"]) in tied
                        and r["nameable"]]
-                best = max(own, key=lambda r: _added_evidence(r, lib.mean[li]), default=None)
+                best = max(own, key=lambda r: added_evidence(r, lib.mean[li]), default=None)
                 if best is not None and (best["name"], best["component"]) != (
                         top["name"], top["component"]):
                     new = next(r for r in cands if (r["name"], r["component"])
@@ -459,18 +462,6 @@ def within_error(row, meas, base, sigma, names):
     pred = row["prediction"]
     widened = np.hypot(sigma, PREDICTION_ERROR * np.nan_to_num(pred - base))
     return float(chi2_rows(meas, pred[None, :], widened, names)[0][0])
-
-
-def _added_evidence(row, base):
-    """A fault's evidence on its own signature (``row`` of ``by_signature``), over the
-    features its change lifts above the baseline and the shared statistics: a fault adds its
-    family, and a family that fell is no fault's (every impulsive fault moves the band the
-    envelope is read in, so a healthy gear rig's 39-dB outer-race envelope line fell 34 dB
-    under cmsim's own broken tooth, and credited the outer race, whose change lowers it
-    too, with the tie)."""
-    lifted = row["prediction"] >= base
-    return sum(v for i, (k, v) in enumerate(row["per_feature"].items())
-               if k in row["judged_on"] and (k in STATISTICS or lifted[i]))
 
 
 def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearing):
@@ -594,6 +585,11 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     sensor = signal_info(machine.model_signal).component
     gate = feature_sigma(lib, li, cnames, n_fit, standing=True)
     d = decide_record(lib, li, cnames, meas, sigma, sensor, causes, gate_sigma=gate)
+    d, why = held_lines(record, machine, d, cnames, meas, lib.mean[li], lib.segment_s,
+                        lambda out: decide_record(lib, li, cnames, meas, sigma, sensor, [
+                            c for c in causes or {e.cause for e in lib.entries}
+                            if c not in out], gate_sigma=gate))
+    notes.extend(why)
     resolved = resolve_line(record, lib.segment_s, d, cnames, meas, lambda cols: standing_out(
         cols, meas, lib.mean[li], gate, cnames)) or buried_family(
             record, machine.baseline.records if machine.baseline else (), machine.op.speed_rpm, d)

@@ -37,11 +37,11 @@ import math
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from cmsim.discrepancy.causes import CAUSES
+from cmsim.discrepancy.causes import CAUSES, STATISTICS
 from cmsim.discrepancy.evaluator import Budget
 from cmsim.errors import ParameterError
 
-__all__ = ["Nuisances", "rank", "refine", "fit", "decide", "nuisance_params",
+__all__ = ["Nuisances", "added_evidence", "rank", "refine", "fit", "decide", "nuisance_params",
            "MIN_DELTA_CHI2", "MIN_SIGNATURE_DELTA_CHI2", "MIN_FAMILY_DELTA_CHI2", "MIN_SCORE",
            "NOISE_SHAPE_DELTA_CHI2",
            "FIT_GRID", "REFINE_TOP", "FAR_MARGIN", "NEAR_TIE", "SEVERITY_DELTA_CHI2"]
@@ -151,6 +151,30 @@ class Nuisances:
             if best[0] >= start:
                 break
         return best
+
+
+def added_evidence(row, base):
+    """A fault's evidence on its own signature, over the features its change lifts above the
+    baseline and the shared statistics: a fault adds its family, and a family that fell is
+    no fault's (every impulsive fault moves the band the envelope is read in, so a healthy
+    gear rig's 39-dB outer-race envelope line fell 34 dB under cmsim's own broken tooth, and
+    credited the outer race, whose change lowers it too, with the tie).
+
+    Parameters
+    ----------
+    row : dict
+        The fault's row of :func:`~cmsim.discrepancy.judge.decide_record`'s ``by_signature``
+        (``prediction``, ``per_feature``, ``judged_on``).
+    base : numpy.ndarray
+        The baseline's features.
+
+    Returns
+    -------
+    float
+    """
+    lifted = row["prediction"] >= base
+    return sum(v for i, (k, v) in enumerate(row["per_feature"].items())
+               if k in row["judged_on"] and (k in STATISTICS or lifted[i]))
 
 
 def nuisance_params(setup, nominal):

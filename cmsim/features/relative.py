@@ -25,7 +25,7 @@ from cmsim.features.sidebands import sideband_energies
 from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
-__all__ = ["relative_features", "envelope_columns", "band_family_columns", "band_column",
+__all__ = ["relative_features", "raw_floor", "envelope_columns", "band_family_columns", "band_column",
            "segment_features", "segments", "N_SHAPE_BANDS", "N_ENVELOPE_BANDS",
            "shape_band_edges", "N_RELATIVE_GMF_HARMONICS"]
 
@@ -136,9 +136,7 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
     df = freq[1]
     out.update(_shape_bands(freq, amp ** 2, fs, df))
     fr = freqs.fr1_hz
-    top = max([bf.bpfi_hz for bf in bfs.values()] + [4.0 * fr])
-    sel = (freq >= 0.5 * fr) & (freq <= min(fs / 2, 20 * top))
-    floor = float(np.median(amp[sel]))
+    floor = raw_floor(freq, amp, fr, bfs.values())
     tol = SLIP_TOLERANCE
     out["raw_fr_h1_db"] = _db(line_amplitude(freq, amp, fr, tol), floor)
     out["raw_fr_h2_db"] = _db(line_amplitude(freq, amp, 2 * fr, tol), floor)
@@ -159,6 +157,30 @@ def relative_features(signal, fs_hz, freqs, bearings=None):
         out["tsa_residual_kurtosis_log"] = math.log(tk) if math.isfinite(tk) and tk > 0 \
             else math.nan
     return out
+
+
+def raw_floor(freq, amp, shaft_hz, bearings):
+    """The floor the raw lines of :func:`relative_features` are read over: the amplitude
+    spectrum's median between half the shaft rate and 20 × the highest BPFI (at least 4 ×
+    the shaft rate), or the Nyquist frequency.
+
+    Parameters
+    ----------
+    freq, amp : numpy.ndarray
+        An amplitude spectrum (0 to the Nyquist frequency) and its frequencies, Hz.
+    shaft_hz : float
+        The input shaft's rate, Hz.
+    bearings : iterable of cmsim.frequencies.BearingFrequencies
+        The bearings whose ball-pass lines are read.
+
+    Returns
+    -------
+    float
+        The floor, the spectrum's unit.
+    """
+    top = max([bf.bpfi_hz for bf in bearings] + [4.0 * shaft_hz])
+    sel = (freq >= 0.5 * shaft_hz) & (freq <= min(freq[-1], 20 * top))
+    return float(np.median(amp[sel]))
 
 
 def envelope_columns(x, fs_hz, shaft_hz, bearings):

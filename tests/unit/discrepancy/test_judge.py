@@ -68,6 +68,26 @@ def test_a_known_shaft_line_over_a_healthy_record_is_unbalance_sized_in_closed_f
     assert r["cause"]["value"] == pytest.approx(a, rel=0.3)
 
 
+def test_shaft_lines_standing_over_a_floor_that_fell_name_no_rotating_force(machine,
+                                                                           monkeypatch):
+    # SpectraQuest's broken tooth against its healthy records: the spectrum under 20 × BPFI
+    # 16 dB down, the 1× and 2× lines where they were — over the floor they rose 16 dB
+    rec = hidden_effect_record(None, SEED, sim_seed=SEED + 8).record
+    fr = machine.op.speed_rpm / 60.0
+    spec = np.fft.rfft(rec.signal)
+    f = np.fft.rfftfreq(rec.signal.size, 1.0 / rec.fs_hz)
+    lines = (np.abs(f - fr) < 0.03 * fr) | (np.abs(f - 2 * fr) < 0.06 * fr)
+    top = 20 * max(rec.model_frequencies().bearing(b).bpfi_hz for b in machine.rig.bearing_names)
+    spec[(f < top) & ~lines] *= 0.15
+    quieter = _with(rec, np.fft.irfft(spec, rec.signal.size))
+    r = judge(quieter, machine, refine=0)
+    assert r["finding"] not in ("misalignment", "unbalance"), r["finding"]
+    assert any("not named: their evidence is the shaft lines" in n for n in r["notes"])
+    # the check is what holds them back: asked no rise, the floor names a misalignment
+    monkeypatch.setattr("cmsim.discrepancy.shaft_lines.LINE_RISE_DB", -math.inf)
+    assert judge(quieter, machine, refine=0)["finding"] in ("misalignment", "unbalance")
+
+
 def test_white_noise_three_times_the_background_is_noise(machine):
     rec = hidden_effect_record(None, SEED, sim_seed=SEED + 9).record
     rms = machine.background.noise_rms(machine.fs_hz)
