@@ -5,17 +5,19 @@ The judge's features are scale-free: the shaft lines ``raw_fr_h1_db`` and ``raw_
 are read over the spectrum's median (:func:`~cmsim.features.relative.raw_floor`), so a record
 whose broadband fell reads its shaft lines as risen by as much. Against its own machine the
 record and the baseline share the sensor (where neither unit is known, its unstated unit):
-a line's rise in absolute level is its rise over the floor plus the floor's own change (each read at its
-own speed). A cause whose evidence on its own signature comes mostly
-(:data:`FLOOR_BORNE_SHARE`) from shaft lines none of which rose :data:`LINE_RISE_DB` in
-absolute level is named on a floor that fell, not on its lines: the record is decided again
-without it (another cause, or ``unexplained`` with where the record departs).
+a line's rise in absolute level is its rise over the floor plus the floor's own change (each
+read at its own speed). A cause whose evidence on its own signature comes mostly
+(:data:`FLOOR_BORNE_SHARE`) from shaft lines it reads risen, none of which rose
+:data:`LINE_RISE_DB` in absolute level, is named on a floor that fell, not on its lines: the
+record is decided again without it (another cause, or ``unexplained`` with where the record
+departs). A cause that reads the lines fallen (added noise: the floor rose) is not asked.
 
 SpectraQuest's broken-tooth records (``b30hz0``, ``b30hz50``) against the healthy ones of
-their gearbox: the floor 8.8 and 6.8 dB under the healthy records', the 1× and 2× input-shaft
-lines within 1.2 dB of theirs (their spread over 0.5-s segments 0.9-2.2 dB), read 8.5 and
-10.2 dB up over the floor — misalignment, unbalance and the input gear's eccentricity each
-drew half their evidence or more from them, and misalignment was named.
+their gearbox (channel a1, eight segments each): the floor 8.8 and 6.8 dB under the healthy
+records', the 1× and 2× input-shaft lines within 1.8 dB of theirs (their spread over the
+segments 0.9-2.2 dB), read 8.5 and 10.2 dB up over the floor — misalignment, unbalance and
+the input gear's eccentricity each drew half their evidence or more from them, and
+misalignment was named.
 """
 
 from __future__ import annotations
