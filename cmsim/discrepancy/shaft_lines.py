@@ -30,8 +30,9 @@ from cmsim.spectra.amplitude import amplitude_spectrum
 __all__ = ["FLOOR_BORNE_SHARE", "LINE_RISE_DB", "SHAFT_LINES", "floor_borne",
            "floor_change_db", "held_lines"]
 
-#: The raw shaft lines, read over :func:`~cmsim.features.relative.raw_floor`.
-SHAFT_LINES = ("raw_fr_h1_db", "raw_fr_h2_db")
+#: The raw shaft lines, read over :func:`~cmsim.features.relative.raw_floor`, and their
+#: orders in words.
+SHAFT_LINES = {"raw_fr_h1_db": "1×", "raw_fr_h2_db": "2×"}
 
 #: Share of a cause's evidence on its own signature (the features it raises nearer the
 #: record) the shaft lines carry for the check to apply.
@@ -116,12 +117,11 @@ def floor_borne(row, names, meas, base, floor_db):
     gain = {k: max(v, 0.0) for k, v in row["per_feature"].items() if k in row["judged_on"]}
     # the lines the cause reads risen over their floor (a cause that reads them fallen,
     # as added noise does, is named on the floor's rise: nothing here asks it)
-    lines = [k for k in SHAFT_LINES if k in names and gain.get(k, 0.0) > 0.0
-             and meas[names.index(k)] > base[names.index(k)]]
-    total = sum(gain.values())
-    if not lines or sum(gain[k] for k in lines) < FLOOR_BORNE_SHARE * total:
+    over = {k: float(meas[i] - base[i]) for k in SHAFT_LINES if k in names
+            for i in [names.index(k)] if gain.get(k, 0.0) > 0.0 and meas[i] > base[i]}
+    if not over or sum(gain[k] for k in over) < FLOOR_BORNE_SHARE * sum(gain.values()):
         return None
-    rises = {k: float(meas[names.index(k)] - base[names.index(k)]) + floor_db for k in lines}
+    rises = {k: v + floor_db for k, v in over.items()}
     return None if max(rises.values()) >= LINE_RISE_DB else rises
 
 
@@ -157,15 +157,14 @@ def held_lines(record, machine, decision, names, meas, base, seg_s, redecide):
     lines = None if floor_db is None else floor_borne(top, names, meas, base, floor_db)
     if lines is None:
         return decision, []
+    # the named cause is one of the rows: every cause any of whose readings the floor
+    # carries is held with it
     held = {r["name"] for r in list(decision["ranked"]) + list(decision["by_signature"])
-            if floor_borne(r, names, meas, base, floor_db) is not None} | {top["name"]}
+            if floor_borne(r, names, meas, base, floor_db) is not None}
     new = redecide(held)
     return new, [
         f"{', '.join(sorted(n.replace('_', ' ') for n in held))} not named: their evidence "
         f"is the shaft lines over the spectrum's floor, which lies {floor_db:+.1f} dB from "
         f"the baseline's, while the lines themselves moved "
-        + " and ".join(f"{v:+.1f} dB ({_ORDER[k]})" for k, v in lines.items())
+        + " and ".join(f"{v:+.1f} dB ({SHAFT_LINES[k]})" for k, v in lines.items())
         + f" (a line's rise asked: {LINE_RISE_DB:g} dB)"]
-
-
-_ORDER = {"raw_fr_h1_db": "1×", "raw_fr_h2_db": "2×"}
