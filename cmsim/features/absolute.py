@@ -238,11 +238,12 @@ def statistics(x):
     """
     x = np.asarray(x, dtype=float)
     d = x - x.mean()
-    m2 = float(np.mean(d * d))
+    d2 = d * d                            # (d²)², not d ** 4: numpy's pow is 40 times slower
+    m2 = float(np.mean(d2))
     if m2 <= 0.0:
         return 0.0, math.nan, math.nan
     rms = math.sqrt(m2)
-    return rms, float(np.mean(d ** 4)) / m2 ** 2, float(np.max(np.abs(d))) / rms
+    return rms, float(np.mean(d2 * d2)) / m2 ** 2, float(np.max(np.abs(d))) / rms
 
 
 def tsa_residual_kurtosis(x, fs, shaft_hz):

@@ -110,8 +110,9 @@ def prediction_residual(x, orders=PREDICTION_ORDERS):
         except (np.linalg.LinAlgError, ValueError):
             continue
         e = np.convolve(x, np.r_[1.0, -a], mode="valid")
-        m2 = float(np.mean(e * e))
-        k = float(np.mean(e ** 4)) / m2 ** 2 if m2 > 0 else -np.inf
+        e2 = e * e                        # (e²)², not e ** 4: numpy's pow is 40 times slower
+        m2 = float(np.mean(e2))
+        k = float(np.mean(e2 * e2)) / m2 ** 2 if m2 > 0 else -np.inf
         if k > best_k:
             best, best_k = e, k
     return best
