@@ -138,6 +138,31 @@ def test_kurtogram_min_bandwidth_removes_the_narrow_levels():
     assert kurtogram(x, FS, min_bandwidth_hz=3.0 * rep).band_hz == kept.band_hz
 
 
+@pytest.mark.parametrize("band, order", [((2000.0, 4000.0), 4), ((0.0, 1500.0), 4),
+                                         ((6000.0, FS / 2), 2), ((150.0, 400.0), 8),
+                                         ((3000.0, 3500.0), 1)])
+@pytest.mark.parametrize("n", [20_000, 6_453, 40])
+def test_bandpass_is_scipys_sosfiltfilt_to_the_bit(band, order, n):
+    """The band-pass keeps its filter's initial conditions instead of solving them at every
+    call (``sosfiltfilt``): the same padding, the same two passes, the same bits; a signal
+    no longer than the padding is refused, as scipy refuses it."""
+    from scipy.signal import butter, sosfiltfilt
+    x = _impulse_train(seconds=1.0)[:n] + 0.7      # an offset: the padding's odd extension
+    lo, hi = band
+    kind = ("lowpass", hi) if lo == 0.0 else ("highpass", lo) if hi >= FS / 2 else \
+        ("bandpass", band)
+    sos = butter(order, kind[1], btype=kind[0], fs=FS, output="sos")
+    try:
+        want = sosfiltfilt(sos, x)
+    except ValueError:
+        with pytest.raises(ParameterError, match="band-pass filter needs more than"):
+            bandpass(x, FS, band, filter_order=order)
+        return
+    got = bandpass(x, FS, band, filter_order=order)
+    assert np.array_equal(got, want)
+    assert np.array_equal(bandpass(x, FS, band, filter_order=order), want)   # kept, again
+
+
 @pytest.mark.parametrize("call, name", [
     (lambda: envelope_spectrum(np.ones(1000), 1000.0, (100.0, 600.0)), "band_hz"),
     (lambda: envelope_spectrum(np.ones(1000), 1000.0, (300.0, 200.0)), "band_hz"),
