@@ -23,7 +23,8 @@ import numpy as np
 from cmsim.datasets.pool import check_workers, process_pool
 from cmsim.discrepancy.causes import NOMINAL_NOISE_RATIO, STATISTICS
 from cmsim.errors import IntegrationDiverged, ParameterError
-from cmsim.features import N_ENVELOPE_BANDS, N_SHAPE_BANDS, band_column, relative_features
+from cmsim.features import (N_ENVELOPE_BANDS, N_SHAPE_BANDS, band_column, relative_features,
+                            segment_samples)
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine import Background, model_force, rotating_force, static_load
 from cmsim.run import signal_info
@@ -370,7 +371,7 @@ class Evaluator:
             if self.scale is None:
                 raise ParameterError("the record's floor needs its unit", param="floor")
             self.floor = record_floor(np.asarray(floor, dtype=float) * self.scale, self.fs,
-                                      int(round(seg_s * self.fs)))
+                                      segment_samples(self.fs, seg_s))
 
     def _forces(self, setup, seed):
         key = (setup.dynamics_key(), seed)
@@ -382,7 +383,8 @@ class Evaluator:
                 self.simulated.add(key)
             try:
                 self.forces[key] = model_force(setup.rig, setup.op, self.record.model_signal,
-                                               self.fs, self.seg_s, seed, faults=setup.faults,
+                                               self.fs, segment_samples(self.fs, self.seg_s)
+                                               / self.fs, seed, faults=setup.faults,
                                                mixed_friction=setup.mixed_friction)
             except (IntegrationDiverged, ParameterError):
                 self.forces[key] = None

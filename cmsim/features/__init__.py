@@ -33,14 +33,15 @@ from cmsim.features.lines import (EXACT_TOLERANCE, LINE_HALF_WIDTH_BINS, SLIP_TO
                                   line_window)
 from cmsim.features.relative import (N_ENVELOPE_BANDS, N_SHAPE_BANDS, band_column,
                                      band_family_columns, envelope_columns,
-                                     relative_features, segment_features, segments)
+                                     relative_features, segment_features, segment_samples,
+                                     segments)
 from cmsim.features.sidebands import (MAX_SIDEBAND_ORDER, N_SIDEBAND_HARMONICS,
                                       SIDEBAND_HALF_WIDTH)
 
 __all__ = ["FeatureRow", "LabelledLine", "extract_features", "run_features", "gmf_levels",
            "statistics", "relative_features", "envelope_columns", "band_family_columns",
            "band_column", "N_ENVELOPE_BANDS", "segment_features",
-           "segments",
+           "segments", "segment_samples",
            "line_amplitude", "line_window", "demodulation_band", "highest_fault_hz",
            "EnvelopeLine", "envelope_lines", "line_ratios", "family_scores",
            "demodulated_spectrum", "band_bank_features", "FAULT_FAMILIES",

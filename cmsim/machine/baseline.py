@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cmsim.errors import ParameterError
+from cmsim.features import segment_samples
 from cmsim.features import segments as segment_spans
 
 __all__ = ["Baseline"]
@@ -72,7 +73,7 @@ class Baseline:
         -------
         numpy.ndarray, shape (k, n)
         """
-        n = int(round(segment_s * self.fs_hz))
+        n = segment_samples(self.fs_hz, segment_s)
         total = sum(r.size // n for r in self.records)
         out = []
         for r in self.records:

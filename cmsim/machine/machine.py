@@ -27,6 +27,7 @@ import tomli_w
 from cmsim._io import atomic_write_text
 from cmsim.dynamics import simulate
 from cmsim.errors import ParameterError
+from cmsim.features import segment_samples
 from cmsim.losses import LossSettings
 from cmsim.machine.background import Background, BackgroundLine
 from cmsim.frequencies import rig_frequencies
@@ -41,10 +42,13 @@ from cmsim.run import signal_info
 __all__ = ["Machine", "model_force", "static_load", "rotating_force",
            "MACHINE_FORMAT_VERSION", "EDGE_S"]
 
-#: Version written in a machine file; :meth:`Machine.load` reads it and version 1 (a twin
-#: without its baseline's samples nor a signature library, which compare cannot judge a
-#: record with: it asks for a new calibration), and refuses any other.
-MACHINE_FORMAT_VERSION = 2
+#: Version written in a machine file; :meth:`Machine.load` reads it, version 2 (whose
+#: segments were ``round(segment_s · fs_hz)`` samples long: read where that is the length
+#: :func:`cmsim.features.segment_samples` gives now, refused with a request for a new
+#: calibration where it is not, as at SpectraQuest's rate) and version 1 (a twin without its
+#: baseline's samples nor a signature library, which compare cannot judge a record with: it
+#: asks for a new calibration), and refuses any other.
+MACHINE_FORMAT_VERSION = 3
 
 #: Tables a machine file of :data:`MACHINE_FORMAT_VERSION` must hold (a file cut short
 #: lacks one and is refused, naming it: the baseline's samples are written last). Its
@@ -101,6 +105,23 @@ def model_force(rig, op, model_signal, fs_hz, duration_s, seed, *, faults=(),
     edge = int(round(EDGE_S * run.fs_hz))
     n = int(round(duration_s * run.fs_hz))
     return np.asarray(run[name], dtype=float)[: n + 2 * edge], edge, n
+
+
+def _same_segments(data):
+    """Refuse a version-2 machine file (parsed) whose segments are not the length cmsim reads
+    now (:func:`cmsim.features.segment_samples`): its baseline's spread and its signature
+    library were read on segments of another length."""
+    try:
+        fs_hz = float(data["machine"]["fs_hz"])
+        segment_s = float(data["machine"].get("segment_s", 0.5))
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return                                 # from_dict names what is missing or malformed
+    old, now = int(round(segment_s * fs_hz)), segment_samples(fs_hz, segment_s)
+    if old != now:
+        raise ParameterError(f"this machine file was calibrated on segments of {old} samples; "
+                             f"cmsim now reads {segment_s:g}-s segments at {fs_hz:g} Hz as "
+                             f"{now} (a length whose FFT is fast): run cmsim calibrate again",
+                             param="machine")
 
 
 def static_load(force):
@@ -430,16 +451,18 @@ class Machine:
         if version is None and "machine" not in data:
             raise ParameterError("not a machine file (no format_version nor [machine] table; "
                                  "cmsim calibrate --out writes one)", param="machine")
-        if version not in (1, MACHINE_FORMAT_VERSION):
+        if version not in (1, 2, MACHINE_FORMAT_VERSION):
             raise ParameterError(f"machine format_version {version!r} is not supported (this "
-                                 f"cmsim reads versions 1 and {MACHINE_FORMAT_VERSION})",
+                                 f"cmsim reads versions 1 to {MACHINE_FORMAT_VERSION})",
                                  param="machine")
-        if version == MACHINE_FORMAT_VERSION:
+        if version in (2, 3):
             missing = [t for t in REQUIRED_TABLES if t not in data]
             if missing:
                 raise ParameterError(f"not a whole machine file (it lacks "
                                      f"{', '.join(repr(t) for t in missing)}: cut short? cmsim "
                                      "calibrate --out writes one)", param="machine")
+        if version == 2:
+            _same_segments(data)
         try:
             m, o, p, b = data["machine"], data["operating"], data["path"], data["background"]
             scale = float(m["unit_scale"])

@@ -93,7 +93,7 @@ from dataclasses import replace
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.features.relative import segments
+from cmsim.features.relative import segment_samples, segments
 from cmsim.frequencies import rig_frequencies
 from cmsim.machine.baseline import Baseline
 from cmsim.machine.calibration.background_lines import MESH_FAMILY_SIDEBANDS, _lines_and_floor
@@ -237,9 +237,10 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
         """Steps 2-4 on one model rig: (capped misfit, chi2 per feature, machine, twin's
         feature rows), the misfits the twin's against the fit segments."""
         # 2. the nominal model's force
-        force_runs = [model_force(model_rig, op, ref.model_signal, fs, seg_s, seed + 7777 * s)
+        run_s = segment_samples(fs, seg_s) / fs          # a segment's samples exactly
+        force_runs = [model_force(model_rig, op, ref.model_signal, fs, run_s, seed + 7777 * s)
                       for s in range(n_seeds)]
-        twin_forces = [model_force(model_rig, op, ref.model_signal, fs, seg_s,
+        twin_forces = [model_force(model_rig, op, ref.model_signal, fs, run_s,
                                    seed + 1 + 7777 * (s + n_seeds)) for s in range(N_TWIN_SEEDS)]
         forces = [force[edge:edge + n] for force, edge, n in force_runs]
         _, pf = segment_psd(forces, fs)

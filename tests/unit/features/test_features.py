@@ -227,3 +227,29 @@ def test_band_families_stand_out_in_the_band_where_the_impacts_ring():
     assert sum(weight(f"env_bpfo_DE_h1_bb{j}_db", signature=True)
                for j in range(N_ENVELOPE_BANDS)) == pytest.approx(1.0)
     assert not band_column("sb1_fr1_k3_db") and not band_column("env_bpfo_DE_band_db")
+
+
+def test_a_segment_is_the_nearest_length_with_a_fast_fft():
+    """0.5 s at the common rates is 0.5 s; at SpectraQuest's 12904.6 Hz it is 6480 samples
+    (6452 = 4 · 1613 has a large prime factor); every length is 2^a 3^b 5^c, the nearest to
+    round(seg_s · fs) (the smaller on a tie), within 3.3 % of it."""
+    from cmsim.features import segment_samples, segments
+    for fs in (10_000.0, 12_000.0, 20_000.0, 25_600.0, 48_000.0, 51_200.0):
+        assert segment_samples(fs, 0.5) == round(0.5 * fs)
+    assert segment_samples(12_904.558781928758, 0.5) == 6480
+    def smooth(m):
+        for p in (2, 3, 5):
+            while m % p == 0:
+                m //= p
+        return m == 1
+
+    rng = np.random.default_rng(5)
+    for fs in rng.uniform(1e3, 1e5, 200):
+        n0, n = round(0.5 * fs), segment_samples(fs, 0.5)
+        d = abs(n - n0)
+        assert smooth(n) and d <= 0.033 * n0
+        nearer = [c for c in range(n0 - d, n0 + d + 1)
+                  if smooth(c) and (abs(c - n0) < d or (abs(c - n0) == d and c < n))]
+        assert nearer == []
+    spans = segments(64_000, 12_904.558781928758, 0.5)
+    assert all(b - a == 6480 for a, b in spans) and len(spans) == 64_000 // 6480

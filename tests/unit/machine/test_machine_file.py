@@ -121,3 +121,23 @@ def test_a_version_one_library_reads_its_realisation_as_its_run_spread():
             SignatureLibrary.from_dict(d).entries)] == [True, True]
     with pytest.raises(ParameterError, match="format_version 3 is not supported"):
         SignatureLibrary.from_dict({**d, "format_version": 3})
+
+
+@pytest.mark.parametrize("fs_hz, refused", [(12_000.0, False), (25_600.0, False),
+                                            (12_904.558781928758, True), (48_828.125, True)])
+def test_a_version_2_file_is_read_only_where_its_segments_are_todays(tmp_path, fs_hz, refused):
+    """Version-2 files read 0.5-s segments as round(0.5 · fs) samples; cmsim now reads the
+    nearest length with no prime factor over 5. Where the two agree (the common rates) the
+    file is read as it is; where they do not, its spread and library were read on other
+    segments, and it is refused with a request for a new calibration, never used."""
+    from dataclasses import replace
+    m = replace(_machine(), fs_hz=fs_hz, baseline=Baseline(_machine().baseline.records, fs_hz))
+    d = m.to_dict()
+    assert d["format_version"] == 3
+    d["format_version"] = 2
+    if refused:
+        with pytest.raises(ParameterError, match="run cmsim calibrate again") as err:
+            Machine.from_dict(d)
+        assert f"segments of {round(0.5 * fs_hz)} samples" in str(err.value)
+    else:
+        assert Machine.from_dict(d).fs_hz == fs_hz
