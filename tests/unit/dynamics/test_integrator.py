@@ -29,7 +29,9 @@ M, KS, C, F0, X0 = 2.0, 8.0e6, 40.0, 300.0, 1e-4
 
 
 def sdof_packed():
-    """Kernel arrays of m x'' + c x' + k x = F0 (layout documented in dynamics._rhs_kernels)."""
+    """Kernel arrays of m x'' + c x' + k x = F0 (layout documented in dynamics._rhs_kernels),
+    read-only as every model's (:meth:`KernelParams.frozen`): writeable arrays are another
+    numba type, and the integrator compiled again for them alone (100 s of a cold CI)."""
     return KernelParams(np.array([1.0 / M]), np.array([[KS, C]]), np.array([F0]), np.zeros(1),
             np.zeros((0, BI_SIZE), dtype=np.int64), np.zeros((0, BP_SIZE)),
             np.zeros((0, 1)), np.zeros((0, 1)), np.zeros((0, 1, 1)),
@@ -38,7 +40,7 @@ def sdof_packed():
             np.array([[0, 0, 1]], dtype=np.int64), *no_hybrid(), np.zeros((0, DF_SIZE)),
             np.zeros((0, 1)), np.zeros((0, 1)), np.ones((1, 1)), np.ones((1, 1)),
             np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 3)), no_profile(),
-            np.zeros(1), np.zeros(1), np.ones((0, 1)))
+            np.zeros(1), np.zeros(1), np.ones((0, 1))).frozen()
 
 
 def sdof_exact(t):
