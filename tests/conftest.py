@@ -1,6 +1,83 @@
 """Session-wide test settings."""
 
+import fcntl
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
 import pytest
+
+#: Environment variable naming the lock the background compile of the batch integrator holds
+#: (:mod:`tests._warm_kernels`) while it runs.
+WARM_LOCK = "CMSIM_TEST_WARM_LOCK"
+
+#: Longest a batched test waits for that compile, s (then it compiles the kernel itself).
+WARM_WAIT_S = 900.0
+
+
+def pytest_configure(config):
+    """With ``-n N`` (the controller, before its workers start): compile the batch integrator
+    once, in a background process holding a lock its batched tests wait on (:mod:`tests._warm_kernels`
+    says why). Without workers, or in a worker, nothing."""
+    config.addinivalue_line("markers", "batch_kernels: the module integrates runs in batches "
+                            "(it waits for the session's background compile of that kernel)")
+    if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
+        return
+    fd, path = tempfile.mkstemp(prefix="cmsim-warm-", suffix=".lock")
+    # its mesh tables in the session's cache where one is set (CI), else in a cache of its
+    # own, never in the user's
+    cache = None if os.environ.get("CMSIM_CACHE_DIR") else tempfile.mkdtemp(prefix="cmsim-")
+    env = {**os.environ, **({"CMSIM_CACHE_DIR": cache} if cache else {})}
+    fcntl.flock(fd, fcntl.LOCK_EX)          # held by the child from here on (inherited)
+    config._cmsim_warm = (subprocess.Popen(
+        [sys.executable, "-m", "tests._warm_kernels"], cwd=Path(__file__).parents[1], env=env,
+        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        pass_fds=(fd,)), path, cache)
+    os.close(fd)
+    os.environ[WARM_LOCK] = path
+
+
+def pytest_unconfigure(config):
+    warm = getattr(config, "_cmsim_warm", None)
+    if warm is not None:
+        proc, path, cache = warm
+        if proc.poll() is None:
+            proc.kill()
+        proc.wait()
+        os.environ.pop(WARM_LOCK, None)
+        Path(path).unlink(missing_ok=True)
+        if cache:
+            shutil.rmtree(cache, ignore_errors=True)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def batch_kernels_compiled(request):
+    """A module marked ``batch_kernels`` starts once the session's background compile of the
+    batch integrator has ended (at most :data:`WARM_WAIT_S`), so that it loads the kernel
+    from the cache instead of compiling it a second time beside it."""
+    path = os.environ.get(WARM_LOCK)
+    if path is None or request.node.get_closest_marker("batch_kernels") is None:
+        return
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        deadline = time.monotonic() + WARM_WAIT_S
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                if time.monotonic() > deadline:
+                    break
+                time.sleep(0.5)
+    finally:
+        os.close(fd)
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -16,6 +16,10 @@ from cmsim.datasets.records import (BATCH_FROM_RECORDS, BATCH_MIN, BATCH_SAMPLES
                                     default_batch_size, simulate_record, simulate_records)
 from cmsim.errors import ParameterError
 
+#: Batched runs: the module waits for the session's one compile of the batch integrator
+#: (tests/conftest.py).
+pytestmark = pytest.mark.batch_kernels
+
 SPEC = {
     "dataset": {"name": "batches", "records": 8, "seed": 3},
     "rig": {"builtin": "paper_2016"},

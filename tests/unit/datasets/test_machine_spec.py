@@ -20,6 +20,10 @@ from cmsim.errors import ParameterError
 from cmsim.machine import Background, BackgroundLine, Machine, TransferPath, twin_mesh
 from cmsim.rig import OperatingPoint, Rig, Rotor
 
+#: Batched runs: the module waits for the session's one compile of the batch integrator
+#: (tests/conftest.py).
+pytestmark = pytest.mark.batch_kernels
+
 FS = 12_800.0
 GAIN = 0.01                     # sensor unit per N, flat
 LINE = BackgroundLine("fixed", 50.0, 0.3)

@@ -23,6 +23,10 @@ from cmsim.rig import PRESETS
 from cmsim.faults import (BallDefect, InnerRaceDefect, OffSizeBall, OuterRaceDefect,
                           RollingSlip, SpeedFluctuation, ToothCrack, ToothSpall)
 
+#: Batched runs: the module waits for the session's one compile of the batch integrator
+#: (tests/conftest.py).
+pytestmark = pytest.mark.batch_kernels
+
 FS = 25_600.0
 DURATION = 0.03
 
