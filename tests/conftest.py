@@ -1,6 +1,5 @@
 """Session-wide test settings."""
 
-import fcntl
 import os
 import shutil
 import subprocess
@@ -10,6 +9,11 @@ import time
 from pathlib import Path
 
 import pytest
+
+try:
+    import fcntl
+except ImportError:                 # not on Windows: no background compile there
+    fcntl = None
 
 #: Environment variable naming the lock the background compile of the batch integrator holds
 #: (:mod:`tests._warm_kernels`) while it runs.
@@ -21,11 +25,13 @@ WARM_WAIT_S = 900.0
 
 def pytest_configure(config):
     """With ``-n N`` (the controller, before its workers start): compile the batch integrator
-    once, in a background process holding a lock its batched tests wait on (:mod:`tests._warm_kernels`
-    says why). Without workers, or in a worker, nothing."""
+    once, in a background process holding a lock its batched tests wait on
+    (:mod:`tests._warm_kernels` says why). Without workers, in a worker or without ``fcntl``
+    (Windows), nothing."""
     config.addinivalue_line("markers", "batch_kernels: the module integrates runs in batches "
                             "(it waits for the session's background compile of that kernel)")
-    if hasattr(config, "workerinput") or not getattr(config.option, "numprocesses", None):
+    if (fcntl is None or hasattr(config, "workerinput")
+            or not getattr(config.option, "numprocesses", None)):
         return
     fd, path = tempfile.mkstemp(prefix="cmsim-warm-", suffix=".lock")
     # its mesh tables in the session's cache where one is set (CI), else in a cache of its
