@@ -34,10 +34,8 @@ def pytest_configure(config):
             or not getattr(config.option, "numprocesses", None)):
         return
     fd, path = tempfile.mkstemp(prefix="cmsim-warm-", suffix=".lock")
-    # its mesh tables in the session's cache where one is set (CI), else in a cache of its
-    # own, never in the user's
-    cache = None if os.environ.get("CMSIM_CACHE_DIR") else tempfile.mkdtemp(prefix="cmsim-")
-    env = {**os.environ, **({"CMSIM_CACHE_DIR": cache} if cache else {})}
+    cache = tempfile.mkdtemp(prefix="cmsim-")     # a cache of its own, as fe_cache's
+    env = {**os.environ, "CMSIM_CACHE_DIR": cache}
     fcntl.flock(fd, fcntl.LOCK_EX)          # held by the child from here on (inherited)
     config._cmsim_warm = (subprocess.Popen(
         [sys.executable, "-m", "tests._warm_kernels"], cwd=Path(__file__).parents[1], env=env,
@@ -56,8 +54,7 @@ def pytest_unconfigure(config):
         proc.wait()
         os.environ.pop(WARM_LOCK, None)
         Path(path).unlink(missing_ok=True)
-        if cache:
-            shutil.rmtree(cache, ignore_errors=True)
+        shutil.rmtree(cache, ignore_errors=True)
 
 
 @pytest.fixture(scope="module", autouse=True)
