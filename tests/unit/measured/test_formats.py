@@ -3,10 +3,10 @@
 Tier: behaviour. Each reader round-trips a recording written in its format — by the format's
 own library where one exists (pyuff ``UFF.write_sets``, ``nptdms.TdmsWriter``,
 ``scipy.io.savemat`` in the CWRU layout from a real CWRU record) and by cmsim's writer
-beside it — with the same samples, rate and unit; ``cmsim compare``, ``calibrate`` and
-``spectrum`` run on a ``.mat`` and a ``.uff`` with options only (no metadata.json), kept short
-(2 s records, ``--budget 10``); bad inputs give one line naming what to do; ``cmsim import``
-writes metadata that reads back. Nothing is written into the project (tmp_path only).
+beside it — with the same samples, rate and unit; ``cmsim compare`` and ``spectrum`` run on
+a ``.mat`` and a ``.uff`` with options only (no metadata.json), ``calibrate`` on the
+``.mat``, kept short (2 s records, ``--budget 10``); bad inputs give one line naming what to
+do; ``cmsim import`` writes metadata that reads back. Nothing is written into the project (tmp_path only).
 """
 
 import json
@@ -175,7 +175,7 @@ def test_wav_counts_with_a_calibration_factor(tmp_path):
 # ---------------------------------------------------------------------- the CLI, options only
 @needs_cwru
 @pytest.mark.parametrize("kind", [".mat", ".uff"])
-def test_compare_calibrate_and_spectrum_on_options_only(tmp_path, capsys, kind):
+def test_compare_and_spectrum_on_options_only(tmp_path, capsys, kind):
     path, rig, de, _ = _cwru_mat(tmp_path, N_SHORT)
     opts = ["--fs-hz", "12000", "--speed-rpm", "1797", "--rig", str(rig)]
     if kind == ".uff":
@@ -185,15 +185,25 @@ def test_compare_calibrate_and_spectrum_on_options_only(tmp_path, capsys, kind):
     assert main(["compare", str(path), *channel, *opts, "--budget", "10", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["finding"] and out["simulations"] <= 10
-    machine = tmp_path / "m.toml"
-    assert main(["calibrate", str(path), *channel, *opts, "--out", str(machine),
-                 "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
-    assert out["fs_hz"] == 12000.0 and machine.is_file()
     assert main(["spectrum", str(path), *opts, "--top", "3", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["unit"] == ("g" if kind == ".uff" else "") and out["n_peaks"] <= 3
     assert not (tmp_path / "metadata.json").exists()
+
+
+@needs_cwru
+def test_calibrate_on_options_only(tmp_path, capsys):
+    """A machine from a CWRU ``.mat`` that states neither rate nor unit: the options give
+    them. (Calibrate reads a record as compare does, by ``read_record``: the UFF case above
+    covers the reader; a second calibration would only build the same library again.)"""
+    path, rig, _, _ = _cwru_mat(tmp_path, N_SHORT)
+    machine = tmp_path / "m.toml"
+    assert main(["calibrate", str(path), "--channel", "X097_DE_time", "--fs-hz", "12000",
+                 "--speed-rpm", "1797", "--rig", str(rig), "--out", str(machine),
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["fs_hz"] == 12000.0 and out["channel"] == "X097_DE_time"
+    assert machine.is_file() and not (tmp_path / "metadata.json").exists()
 
 
 # ---------------------------------------------------------------------- bad inputs
