@@ -34,7 +34,7 @@ def _sdof_lawson(h, force, t_end=2e-3, scheme="lawson-ode3"):
     tab = SCHEMES[scheme]
     s = tab.stages
     P = sdof_packed()
-    P = P._replace(springs=np.zeros((1, 2)), fext=np.array([force]))
+    P = P._replace(springs=np.zeros((1, 2)), fext=np.array([force])).frozen()
     lin = np.array([[0.0, 1.0], [-KS / M, -C / M]])
     pad = np.zeros((s + 1, 1, CHAIN_STATES, CHAIN_STATES))
     back = np.zeros((s, 1, CHAIN_STATES, CHAIN_STATES))
