@@ -568,15 +568,20 @@ def integrate_batch_jit(t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, S, L
                     y[j, l] = B.y0[j, l]
         for sub in range(substeps):
             t = t0 + ((m_offset + m) * substeps + sub) * h
-            rhs_batch_jit(t, y, k, 0, S, L, V, B, diag, sub == 0)
-            if sub == 0:
-                for l in range(n_runs):
-                    for c in range(d_cols.shape[0]):
-                        out_diag[l, m, c] = diag[d_cols[c], l]
-                if m == n_out - 1:
-                    return
-            for st in range(1, ns):
-                _stage_state(y, k, st, h, rk_a, yi)
-                rhs_batch_jit(t + rk_c[st] * h, yi, k, st, S, L, V, B, diag, False)
+            # one call of the inlined right-hand side, its stage and its outputs switch as
+            # values: two calls (the first stage's, the others' with a constant False) made
+            # numba compile the whole right-hand side twice and six of its kernels twice more
+            for st in range(ns):
+                want = sub == 0 and st == 0
+                if st > 0:
+                    _stage_state(y, k, st, h, rk_a, yi)
+                rhs_batch_jit(t + rk_c[st] * h, yi if st > 0 else y, k, st, S, L, V, B, diag,
+                              want)
+                if want:
+                    for l in range(n_runs):
+                        for c in range(d_cols.shape[0]):
+                            out_diag[l, m, c] = diag[d_cols[c], l]
+                    if m == n_out - 1:
+                        return
             _step(y, k, h, rk_b, yi)
 
