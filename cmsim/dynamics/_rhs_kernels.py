@@ -457,28 +457,32 @@ def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, X, P, 
                 return m
         for sub in range(substeps):
             t = t0 + ((m_offset + m) * substeps + sub) * h
-            rhs_jit(t, y, k, 0, P, scratch, sub == 0, W)
-            if sub == 0:
-                for i in range(scratch.shape[0]):
-                    out_diag[m, i] = scratch[i]
-                if m == n_out - 1:
-                    return -1
-            # L carries the exact chains' kinematics: N has no position entries there
-            # (c_0 = 0: no propagation)
-            for b in range(n_ex):
-                for i in range(X.size[b] // 2):
-                    k[0, X.idx[b, i]] = 0.0
-            for st in range(1, ns):
-                for i in range(dim):
-                    acc = y[i]
-                    for jj in range(st):
-                        if rk_a[st, jj] != 0.0:          # (a zero weight adds nothing)
-                            acc += h * rk_a[st, jj] * k[jj, i]
-                    yi[i] = acc
-                if n_ex > 0:
-                    _propagate_jit(X, st, yi)
-                rhs_jit(t + rk_c[st] * h, yi, k, st, P, scratch, False, W)
-                if n_ex > 0:
+            # one call of the inlined right-hand side, its stage and its outputs switch as
+            # values (c_0 = 0): a second call with a constant False compiled it all twice
+            for st in range(ns):
+                if st > 0:
+                    for i in range(dim):
+                        acc = y[i]
+                        for jj in range(st):
+                            if rk_a[st, jj] != 0.0:          # (a zero weight adds nothing)
+                                acc += h * rk_a[st, jj] * k[jj, i]
+                        yi[i] = acc
+                    if n_ex > 0:
+                        _propagate_jit(X, st, yi)
+                want = sub == 0 and st == 0
+                rhs_jit(t + rk_c[st] * h, yi if st > 0 else y, k, st, P, scratch, want, W)
+                if want:
+                    for i in range(scratch.shape[0]):
+                        out_diag[m, i] = scratch[i]
+                    if m == n_out - 1:
+                        return -1
+                if st == 0:
+                    # L carries the exact chains' kinematics: N has no position entries
+                    # there (c_0 = 0: no propagation)
+                    for b in range(n_ex):
+                        for i in range(X.size[b] // 2):
+                            k[0, X.idx[b, i]] = 0.0
+                elif n_ex > 0:
                     _propagate_row_jit(X, st, k, st)
             for i in range(dim):
                 acc = 0.0
