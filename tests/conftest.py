@@ -83,6 +83,38 @@ def batch_kernels_compiled(request):
         os.close(fd)
 
 
+#: The integrators every model hands the same numba types (its parameters read-only:
+#: :meth:`~cmsim.dynamics._rhs_kernels.KernelParams.frozen`), by module. A second
+#: specialisation in a process is a test handing one of them another type (a writeable
+#: array): a whole recompile, 107 and 115 s of a cold CI the two times it happened unseen.
+ONE_SPECIALISATION = {"cmsim.dynamics._rhs_kernels": ("integrate_jit",),
+                      "cmsim.dynamics._batch_kernels": ("integrate_batch_jit",)}
+
+
+def specialisations(kernels=ONE_SPECIALISATION):
+    """``{name: signatures}`` of the ``kernels`` (module -> names) this process has compiled
+    or loaded (a module not imported yet has none)."""
+    out = {}
+    for module, names in kernels.items():
+        mod = sys.modules.get(module)
+        for name in names:
+            out[name] = list(getattr(mod, name).signatures) if mod is not None else []
+    return out
+
+
+@pytest.fixture(autouse=True)
+def integrators_compile_once():
+    """Fail the test that gives an integrator of :data:`ONE_SPECIALISATION` its second
+    numba specialisation in this process, naming both (the tests after it pass)."""
+    before = {k: len(v) for k, v in specialisations().items()}
+    yield
+    for name, sigs in specialisations().items():
+        if len(sigs) > max(before[name], 1):
+            pytest.fail(f"{name} compiled again for other argument types (the tests' "
+                        f"arrays must be the models' types, read-only parameters: "
+                        f"KernelParams.frozen): {sigs}", pytrace=False)
+
+
 @pytest.fixture(scope="session", autouse=True)
 def fe_cache(tmp_path_factory):
     """One FE influence-coefficient cache for the whole session, away from the user's.

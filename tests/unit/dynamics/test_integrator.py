@@ -7,10 +7,13 @@ stiff supports, a rotor on two bearings, bearing reactions balancing the mesh fo
 """
 
 import math
+import sys
+import types
 from dataclasses import replace
 
 import numpy as np
 import pytest
+from numba import njit
 from scipy.optimize import brentq
 
 import cmsim
@@ -41,6 +44,30 @@ def sdof_packed():
             np.zeros((0, 1)), np.zeros((0, 1)), np.ones((1, 1)), np.ones((1, 1)),
             np.zeros((1, 1)), np.zeros((1, 1)), np.zeros((2, 3)), no_profile(),
             np.zeros(1), np.zeros(1), np.ones((0, 1))).frozen()
+
+
+def test_the_suite_sees_a_test_that_compiles_an_integrator_again(monkeypatch):
+    """tests/conftest.py fails a test that gives an integrator a second specialisation (as
+    writeable parameters did twice, unseen): its reading of the signatures, on a small kernel
+    called with a writeable and then a read-only array."""
+    from tests.conftest import specialisations
+
+    @njit
+    def total(a):
+        return a.sum()
+
+    mod = types.ModuleType("toy_kernels")
+    mod.total = total
+    monkeypatch.setitem(sys.modules, "toy_kernels", mod)
+    kernels = {"toy_kernels": ("total",), "toy_not_imported": ("integrate",)}
+    a = np.ones(3)
+    total(a)
+    assert {k: len(v) for k, v in specialisations(kernels).items()} == {
+        "total": 1, "integrate": 0}
+    b = a.view()
+    b.setflags(write=False)
+    total(b)
+    assert len(specialisations(kernels)["total"]) == 2
 
 
 def sdof_exact(t):
