@@ -17,22 +17,16 @@ import tempfile
 from pathlib import Path
 
 from cmsim.datasets import DatasetSpec, generate_dataset
+from tests.unit.datasets.test_batches import SPEC as BATCHES
 
-#: What the batch tests integrate, in miniature.
-SPEC = {
-    "dataset": {"name": "warm", "records": 8, "seed": 3},
-    "rig": {"builtin": "paper_2016"},
-    "operating": {"speed_rpm": 1000.0, "torque_nm": 40.0},
-    "faults": {"healthy_share": 0.25,
-               "types": [{"type": "tooth_crack", "gear": [1, 2],
-                          "depth_m": {"min": 0.5e-3, "max": 2.0e-3}},
-                         {"type": "outer_race", "bearing": ["1b1"], "size_m": 1e-3,
-                          "depth_m": 1e-4}]},
-    "nuisances": {"slip": {"min": 0.0, "max": 0.01},
-                  "speed_wobble": {"min": 0.0, "max": 0.003}},
-    "sensor": {"channels": ["accel_1b1_y", "dte_um", "tacho"], "fs_hz": 25600.0,
-               "duration_s": 0.03, "warmup_s": 0.01},
-}
+#: An outer-race defect beside the batch tests' cracked teeth: the race-defect pass of the
+#: batched step compiles too.
+OUTER_RACE = {"type": "outer_race", "bearing": ["1b1"], "size_m": 1e-3, "depth_m": 1e-4}
+
+#: What the batch tests integrate (their spec, :mod:`tests.unit.datasets.test_batches`), with
+#: an outer race among its faults.
+SPEC = {**BATCHES, "dataset": {**BATCHES["dataset"], "name": "warm"},
+        "faults": {**BATCHES["faults"], "types": [*BATCHES["faults"]["types"], OUTER_RACE]}}
 
 
 def main():
