@@ -6,7 +6,8 @@ own library where one exists (pyuff ``UFF.write_sets``, ``nptdms.TdmsWriter``,
 beside it — with the same samples, rate and unit; ``cmsim compare`` and ``spectrum`` run on
 a ``.mat`` and a ``.uff`` with options only (no metadata.json), ``calibrate`` on the
 ``.mat``, kept short (2 s records, ``--budget 10``); bad inputs give one line naming what to
-do; ``cmsim import`` writes metadata that reads back. Nothing is written into the project (tmp_path only).
+do; ``cmsim import`` writes metadata that reads back. Nothing is written into the project
+(tmp_path only).
 """
 
 import json
