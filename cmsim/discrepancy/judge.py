@@ -45,10 +45,11 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       a noise only where no band of the spectrum's shape moved away
       (:func:`~cmsim.discrepancy.ranking.decide`'s rule) — a load, a clearance, a changed
       path or a louder machine reshape every feature and are told apart here, as are faults
-      the model makes the way the machine does. Faults within :data:`NEAR_TIE` of the best
-      one's evidence are told apart by their evidence on their own signatures, over the
-      features their change lifts above the baseline (and the statistics): a family that
-      fell, as the envelope's band moves under any impulsive fault, is no fault's. A fault is a
+      the model makes the way the machine does. Faults within
+      :data:`~cmsim.discrepancy.ranking.NEAR_TIE` of the best one's evidence are told apart
+      by their evidence on their own signatures, over the features their change lifts above
+      the baseline (and the statistics): a family that fell, as the envelope's band moves
+      under any impulsive fault, is no fault's. A fault is a
       candidate here where its family stands out (below), or where its prediction reads the
       whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`). A reshaping
       cause that reads best yields to a fault whose own change holds it
@@ -118,7 +119,8 @@ from cmsim.discrepancy.causes import CAUSES, STATISTICS
 from cmsim.discrepancy.columns import chi2_rows, compared_columns, feature_sigma, interpolated
 from cmsim.discrepancy.evaluator import path_free, rises, weight
 from cmsim.discrepancy.operating_point import at_operating_point, record_load
-from cmsim.discrepancy.ranking import _consistent, added_evidence, decide
+from cmsim.discrepancy.ranking import (NEAR_TIE, SEVERITY_DELTA_CHI2, _consistent,
+                                       added_evidence, decide)
 from cmsim.discrepancy.resolution import buried_family, resolve_line
 from cmsim.discrepancy.shaft_lines import held_lines
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
@@ -129,8 +131,8 @@ from cmsim.run import signal_info
 from cmsim.spectra.misfit import misfit
 
 __all__ = ["judge", "decide_record", "standing_out", "shape_moved", "NONE_CHI2_PER_FEATURE",
-           "ALARM_Z", "MIN_EVIDENCE", "MIN_SHARE", "INTERPOLATION_STEPS", "NEAR_TIE",
-           "RANGE_DELTA_CHI2", "FAMILY_Z", "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z",
+           "ALARM_Z", "MIN_EVIDENCE", "MIN_SHARE", "INTERPOLATION_STEPS", "FAMILY_Z",
+           "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z",
            "PREDICTION_ERROR", "within_error"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.
@@ -149,9 +151,6 @@ MIN_SHARE = 0.5
 #: Points read between two sizes of a library entry (interpolated features).
 INTERPOLATION_STEPS = 4
 
-#: A runner-up with at least this share of the winner's evidence is a near tie.
-NEAR_TIE = 0.8
-
 #: A structure-ringing fault is named only where one feature of its own family (its envelope
 #: lines, its sidebands: the path-free ones) stands out over the baseline: :data:`FAMILY_Z`
 #: of its σ upwards and, for a level in dB, :data:`FAMILY_RISE_DB` over the baseline's own
@@ -165,9 +164,6 @@ FAMILY_Z = 3.0
 
 #: See :data:`FAMILY_Z`, dB.
 FAMILY_RISE_DB = 6.0
-
-#: Rise of χ² over its best that bounds the reported range of a size (~2σ).
-RANGE_DELTA_CHI2 = 4.0
 
 #: A record whose level departs from the baseline's by this many σ tells the direction of
 #: its change: a prediction that moves the level the other way is not a candidate (power
@@ -315,7 +311,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
             key = (e.cause, e.component)
             if key in store and score[b] >= store[key]["score"]:
                 continue
-            within = values[score <= score[b] + RANGE_DELTA_CHI2]
+            within = values[score <= score[b] + SEVERITY_DELTA_CHI2]
             delta = p0[0] - per[b]
             store[key] = {"name": e.cause, "cause": cause, "component": e.component,
                           "variant": e.variant, "parameter": e.parameter,
@@ -482,7 +478,7 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_beari
     pred = top["prediction"]
     raised = pred - base
     # the least ``top`` leaves on each feature at the sizes that read the record as well as
-    # its best (within RANGE_DELTA_CHI2: its ``range``)
+    # its best (within SEVERITY_DELTA_CHI2: its ``range``)
     lo, hi = top["range"]
     lowest = np.min([pred] + [table[(values >= lo) & (values <= hi)].min(axis=0, initial=np.inf)
                               for _, values, table in
@@ -515,7 +511,7 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_beari
         chi = chi2_rows(meas, both, sigma, names)[1][:, own].sum(axis=1)
         k = int(np.argmin(chi))
         if best is None or chi[k] < best["score"]:
-            within = values[chi <= chi[k] + RANGE_DELTA_CHI2]
+            within = values[chi <= chi[k] + SEVERITY_DELTA_CHI2]
             best = {**r, "variant": e.variant, "value": float(values[k]),
                     "range": (float(within.min()), float(within.max())),
                     "chi2": float(chi2_rows(meas, both[k:k + 1], sigma, names)[0][0]),

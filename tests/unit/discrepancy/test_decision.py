@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from cmsim.discrepancy.columns import compared_columns, feature_sigma
-from cmsim.discrepancy.judge import FAMILY_RISE_DB, NEAR_TIE, decide_record
+from cmsim.discrepancy.judge import FAMILY_RISE_DB, decide_record
+from cmsim.discrepancy.ranking import NEAR_TIE
 from cmsim.machine.library import SignatureEntry, SignatureLibrary
 
 NAMES = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "kurtosis_log", "crest_log",
@@ -241,7 +242,6 @@ def test_a_fault_whose_family_stands_out_wins_a_near_tie_on_the_whole_record(oth
     6 dB the torque mismatch reads the whole record a little better, within the near tie,
     and the fault whose family stands out is named; at 7 dB the outer race holds under 0.8
     of the torque mismatch's evidence, no tie, and the better reading stands."""
-    from cmsim.discrepancy.judge import NEAR_TIE
 
     names = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "raw_fr_h1_db", "raw_fr_h2_db",
              "level_db", "raw_bpfi_1b1_db", "raw_bpfi_1b2_db")
@@ -403,7 +403,6 @@ def test_a_fault_with_none_of_its_family_risen_yields_to_one_whose_family_stands
     baseline, which the tooth fault's prediction leaves: 12 dB (3 σ and 6 dB over that
     prediction) is the outer race, however far behind on the whole record; 3 dB stays the
     tooth fault's reading."""
-    from cmsim.discrepancy.judge import NEAR_TIE
 
     quiet = tuple(f"raw_fr_h{k}_db" for k in range(1, 61))
     names = (("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "sb1_fr1_k1_db", "sb1_fr1_k2_db")
