@@ -166,21 +166,25 @@ def _run_warned(args):
     """``args.func(args)`` with every :class:`~cmsim.errors.RecordWarning` (a measured record
     read despite a doubt) and :class:`~cmsim.errors.ModelWarning` (a formula used beyond its
     fit) the library issues said through ``args.warn``, once per text; other warnings pass
-    on as they came."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", RecordWarning)
-        warnings.simplefilter("always", ModelWarning)
-        try:
+    on as they came, once per text and place, after the recording has ended (passed on
+    inside it, each was recorded again, and the first RuntimeWarning a command raised made
+    it loop for ever)."""
+    caught = []
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", RecordWarning)
+            warnings.simplefilter("always", ModelWarning)
             return args.func(args)
-        finally:
-            said = set()
-            for w in caught:
-                if issubclass(w.category, (RecordWarning, ModelWarning)):
-                    if str(w.message) not in said:
-                        said.add(str(w.message))
-                        args.warn(str(w.message))
-                else:
-                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    finally:
+        said = set()
+        for w in caught:
+            if issubclass(w.category, (RecordWarning, ModelWarning)):
+                if str(w.message) not in said:
+                    said.add(str(w.message))
+                    args.warn(str(w.message))
+            elif (key := (w.category, str(w.message), w.filename, w.lineno)) not in said:
+                said.add(key)
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def _fail(parser, args, message, status, option=None, extra=None):

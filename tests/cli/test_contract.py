@@ -425,6 +425,8 @@ CATALOGUE = [
       "fs_hz", "'12k'", numeric=True),
     R("compare-channel-2d", "compare {rec_2d}", "RECORD", "'DE'", "(24000, 2)", "1-D"),
     R("compare-record-all-zero", "compare {rec_zero}", "RECORD", "constant", "sensor"),
+    R("compare-channel-complex", "compare {rec_complex}", "RECORD", "'DE'", "complex values",
+      "real samples"),
     R("compare-record-nan", "compare {rec_nan}", "RECORD", "3 non-finite samples",
       "sample 100"),
     R("compare-wav-header-rate", "compare {rec_wav_rate}", "RECORD", "48000 Hz",
@@ -477,6 +479,11 @@ CATALOGUE = [
       numeric=True),
     R("spectrum-channel-2d", "spectrum {rec_2d}", "RECORD", "'DE'", "1-D"),
     R("spectrum-record-all-zero", "spectrum {rec_zero}", "RECORD", "constant"),
+    R("spectrum-channel-complex", "spectrum {rec_complex}", "RECORD", "complex values"),
+    R("calibrate-channel-complex", "calibrate {rec_complex} --out {work}/m.toml", "BASELINE",
+      "complex values"),
+    R("import-channel-complex", "import {rec_complex_dir} --out {work}/m.json", "DIR",
+      "complex values"),
     R("spectrum-record-nan", "spectrum {rec_nan}", "RECORD", "non-finite"),
     R("spectrum-wav-header-rate", "spectrum {rec_wav_rate}", "RECORD", "48000 Hz"),
     R("spectrum-measured-signal", "spectrum {record} --channel nosuch", "--channel", "DE"),
@@ -836,8 +843,9 @@ def _measured_folder(folder, arrays, *, fs_hz=12000.0, file="rec.npz", entry=Non
 
 def _bad_recordings(d):
     """Measured recordings damaged in each way a user's file can be (issue 26): truncated,
-    a numeric metadata value written as text, a 2-D channel, all zero, a few NaN, a WAV
-    whose header rate contradicts metadata.json."""
+    a numeric metadata value written as text, a 2-D channel, a complex channel (a spectrum
+    stored where a time history belongs), all zero, a few NaN, a WAV whose header rate
+    contradicts metadata.json."""
     x = np.random.default_rng(1).standard_normal(24000)
     ok = _measured_folder(d / "ok", {"DE": x, "FE": x})
     raw = ok.read_bytes()
@@ -847,6 +855,7 @@ def _bad_recordings(d):
          "rec_fs_text": _measured_folder(d / "fs_text", {"DE": x}, entry={"fs_hz": "12k"}),
          "rec_2d": _measured_folder(d / "two_d", {"DE": np.stack([x, x], 1), "FE": x}),
          "rec_zero": _measured_folder(d / "zero", {"DE": np.zeros_like(x)}),
+         "rec_complex": _measured_folder(d / "complex", {"DE": (x + 1j * x).astype(np.complex64)}),
          "rec_nan": _measured_folder(d / "nan", {"DE": with_nan}),
          "rec_unit_g": _measured_folder(d / "unit_g", {"DE": x}, sensors_unit="g")}
     wav = _measured_folder(d / "wav", None, file="rec.wav", entry={"channels": ["DE"]})
@@ -1238,3 +1247,21 @@ def test_a_model_warning_is_one_line_of_the_command_not_python_s(capsys, monkeyp
     app._run_warned(args)
     assert said == ["Sainsot fillet-foundation formula extrapolated (θf = 0.1 rad)"]
     assert "potential_energy.py" not in capsys.readouterr().err
+
+
+def test_a_warning_raised_in_a_loop_is_passed_on_once():
+    """A warning the library raises once per sample (numpy's, say) reaches the user once per
+    text and place: passing on each of them made a command look hung for minutes after its
+    work was done (a complex recording warned at every cast)."""
+    import warnings as w
+
+    def func(args):
+        for _ in range(20_000):
+            w.warn("casting discards something", RuntimeWarning)
+        return {}
+
+    args = types.SimpleNamespace(func=func, warn=lambda text: None)
+    with w.catch_warnings(record=True) as passed:
+        w.simplefilter("always")
+        app._run_warned(args)
+    assert [str(x.message) for x in passed] == ["casting discards something"]

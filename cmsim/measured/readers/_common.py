@@ -45,9 +45,17 @@ class SignalFile(NamedTuple):
 
 
 def channel_1d(path, name, a):
-    """A stored array as a 1-D channel: (n,), (n, 1) and (1, n) are one channel; any other
-    shape is refused (a silently dropped channel would let another one be compared)."""
+    """A stored array as a 1-D channel of real samples: (n,), (n, 1) and (1, n) are one
+    channel; any other shape is refused (a silently dropped channel would let another one be
+    compared), and so are samples that are not real numbers (complex values — a spectrum, an
+    FRF or an analytic signal — would lose their imaginary part in the conversion, text
+    would not convert)."""
     a = np.asarray(a)
+    if a.dtype.kind not in "biuf":
+        what = "complex values" if a.dtype.kind == "c" else f"{a.dtype} values"
+        raise ParameterError(f"record {path}: channel {name!r} holds {what}, not real "
+                             f"samples; store the real time history (a spectrum or an FRF "
+                             f"is not one)", param="record", allowed="real samples")
     if a.ndim == 2 and 1 in a.shape:
         a = a.reshape(-1)
     if a.ndim != 1:

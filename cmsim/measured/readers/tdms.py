@@ -7,10 +7,9 @@ from __future__ import annotations
 
 import io
 
-import numpy as np
-
 from cmsim._io import atomic_write_bytes
-from cmsim.measured.readers._common import SignalFile, one_rate, optional_module, rate_of_step
+from cmsim.measured.readers._common import (SignalFile, channel_1d, one_rate, optional_module,
+                                            rate_of_step)
 
 __all__ = []   # read and write: through READERS and WRITERS of the package
 
@@ -26,7 +25,7 @@ def read(path, names=None):
             if not len(c):
                 continue
             name = c.name if len(groups) == 1 else f"{g.name}/{c.name}"
-            signals[name] = np.asarray(c[:], dtype=float)
+            signals[name] = channel_1d(path, name, c[:])
             if c.properties.get("wf_increment"):
                 rates[name] = rate_of_step(float(c.properties["wf_increment"]), digits=15)
             unit = str(c.properties.get("unit_string") or "").strip()

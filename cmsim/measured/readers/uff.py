@@ -16,7 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.measured.readers._common import SignalFile, one_rate, optional_module, rate_of_step
+from cmsim.measured.readers._common import (SignalFile, channel_1d, one_rate, optional_module,
+                                            rate_of_step)
 
 __all__ = []   # read and write: through READERS and WRITERS of the package
 
@@ -50,10 +51,7 @@ def read(path, names=None):
         if not s.get("abscissa_spacing"):
             raise ParameterError(f"record {path}: set {name!r} has uneven abscissa spacing; "
                                  f"cmsim reads evenly sampled time data", param="record")
-        signals[name] = np.asarray(s["data"], dtype=float).reshape(-1)
-        if np.iscomplexobj(s["data"]):
-            raise ParameterError(f"record {path}: set {name!r} holds complex data (a "
-                                 f"spectrum or FRF), not a time history", param="record")
+        signals[name] = channel_1d(path, name, s["data"])
         rates[name] = rate_of_step(s["abscissa_inc"], digits=6)
         unit = _uff_text(s.get("ordinate_axis_units_lab"))
         if unit:
