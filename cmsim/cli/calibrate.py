@@ -84,6 +84,7 @@ def run(args):
     from cmsim.machine.report import write_calibration_report
 
     _check_out(args)
+    _check_distinct_baselines(args.baseline)
     if args.span is not None and not args.span[0] < args.span[1]:
         raise CLIError(f"--span {args.span[0]:g} {args.span[1]:g}: START must be below STOP",
                        option="--span")
@@ -133,18 +134,37 @@ def run(args):
     return out
 
 
-def _check_out(args):
-    """--out is a new file (or --force), and never an input: refused before any work."""
+def _found(path):
+    """The input as it will be read (also under CMSIM_DATA), or None where there is none:
+    reading it then says so."""
     from cmsim.measured.readers import resolve_path
 
+    try:
+        return resolve_path(path).resolve()
+    except ParameterError:
+        return None
+
+
+def _check_distinct_baselines(paths):
+    """Each healthy record once: a record given twice would count its segments twice in the
+    baseline's spread, which would then read narrower than the machine's own."""
+    seen = {}
+    for path in paths:
+        found = _found(path)
+        if found in seen:
+            raise CLIError(f"BASELINE {path}: given twice (also as {seen[found]}); give each "
+                           f"healthy record once", option="BASELINE")
+        if found is not None:
+            seen[found] = path
+
+
+def _check_out(args):
+    """--out is a new file (or --force), and never an input: refused before any work."""
     out = Path(args.out).resolve()
     for option, path in [("--rig", args.rig)] + [("BASELINE", b) for b in args.baseline]:
         if path is None:
             continue
-        try:                    # the input as it will be read: also under CMSIM_DATA
-            found = resolve_path(path).resolve()
-        except ParameterError:
-            found = None        # no such input: reading it says so, after this check
+        found = _found(path)
         if out in (Path(path).resolve(), found):
             raise CLIError(f"--out {args.out}: is the {option} input"
                            f"{'' if found in (None, Path(path).resolve()) else f' ({found})'}"

@@ -20,7 +20,9 @@
 from __future__ import annotations
 
 import argparse
+import os
 import re
+import tempfile
 from pathlib import Path
 
 from cmsim._io import READ_ERRORS, finite
@@ -197,7 +199,8 @@ def option_named_in(message, options):
 
 
 def check_paths(args, command, options):
-    """Input files exist and are files; outputs are not directories and have a parent.
+    """Input files exist and are files; outputs are not directories and have a parent a
+    file can be written in.
 
     Parameters
     ----------
@@ -229,6 +232,26 @@ def check_paths(args, command, options):
             if kind in ("out", "outdir") and not path.resolve().parent.is_dir():
                 raise CLIError(f"{option} {path}: directory {path.parent} does not exist",
                                option=option)
+            if kind in ("out", "outdir"):
+                where = path if kind == "outdir" and path.is_dir() else path.resolve().parent
+                why = _cannot_write_in(where)
+                if why:
+                    raise CLIError(f"{option} {path}: cannot write in {where} ({why})",
+                                   option=option)
+
+
+def _cannot_write_in(directory):
+    """Why no file can be made in ``directory`` (its permissions, a read-only or virtual
+    file system), or None: tried by making and removing an empty file there, the one test
+    every file system answers truly, before any work whose result would have nowhere to
+    go."""
+    try:
+        fd, name = tempfile.mkstemp(prefix=".cmsim-write-check-", dir=directory)
+    except OSError as exc:
+        return exc.strerror or type(exc).__name__
+    os.close(fd)
+    os.remove(name)
+    return None
 
 
 def load_file(option, path, loader, what):

@@ -45,6 +45,10 @@ def run(args):
     from cmsim.measured.importing import folder_metadata, write_folder_metadata
 
     out = args.out or args.dir / "metadata.json"
+    if args.channel and len(set(args.channel)) < len(args.channel):
+        raise CLIError(f"--channel must not repeat a name, got {' '.join(args.channel)}: a "
+                       f"channel documented twice could never be told from its namesake",
+                       option="--channel")
     if out.exists() and not args.force:
         raise CLIError(f"--out {out}: exists; give --force to overwrite it", option="--out")
     values = recording_values(args)

@@ -62,11 +62,21 @@ def run(args):
                            option="--signal")
         args.warn("--signal is deprecated: it is now --channel, as in compare and calibrate")
         args.channel = args.signal_alias
-    run_, default_signal = _read(args)
-    signal = args.channel or default_signal or "F_1b1_loa"
-    spec = run_spectrum(run_, signal, args.kind, band_hz=args.band_hz, max_hz=args.max_hz,
-                        resolution_hz=args.resolution_hz, bearing=args.bearing,
-                        max_peaks=args.top, threshold_db=args.threshold_db)
+    try:
+        run_, default_signal = _read(args)
+        signal = args.channel or default_signal or "F_1b1_loa"
+        spec = run_spectrum(run_, signal, args.kind, band_hz=args.band_hz,
+                            max_hz=args.max_hz, resolution_hz=args.resolution_hz,
+                            bearing=args.bearing, max_peaks=args.top,
+                            threshold_db=args.threshold_db)
+    except ParameterError as exc:
+        # the channel named by the old option: the message names the option as typed
+        if args.signal_alias is None or exc.param not in ("signal", "channel", "--channel"):
+            raise
+        text = " ".join(str(exc).split())
+        head, _, rest = text.partition(" ")
+        raise CLIError(f"--signal {rest}" if head in (exc.param, "--channel")
+                       else f"--signal {args.signal_alias}: {text}", option="--signal") from None
     out = {"run": str(args.record), "signal": spec.signal, "kind": spec.kind, "unit": spec.unit,
            "resolution_hz": spec.resolution_hz, "bearing": spec.bearing,
            "families": spec.families, "band_hz": list(spec.band_hz) if spec.band_hz else None,
