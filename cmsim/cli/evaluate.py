@@ -22,8 +22,9 @@ def register(sub):
                                    "5 % false alarms. See cmsim.diagnostics for the function's "
                                    "signature. What the function prints goes to stderr; what it "
                                    "raises (sys.exit too) is that record's error, with its "
-                                   "traceback in --json and --report. Exit status 2 if no "
-                                   "record was answered.")
+                                   "traceback in --json and --report, and so is ending the "
+                                   "process (os._exit, a crash: it runs in a child process). "
+                                   "Exit status 2 if no record was answered.")
     p.add_argument("dir", type=Path, metavar="DIR", nargs="?", help="dataset directory")
     p.add_argument("--algorithm", metavar="MODULE:FUNCTION",
                    help="built-in (envelope, tsa, sideband), package.module:function or "
@@ -72,7 +73,7 @@ def run(args):
         def progress(done, total):
             print(f"\rcmsim evaluate: {done}/{total} records", end="", file=sys.stderr,
                   flush=True)
-    ev = evaluate(dataset, func, progress=progress)
+    ev = evaluate(dataset, func, progress=progress, isolated=True)
     if progress is not None:
         print(file=sys.stderr)
     out = ev.to_dict()

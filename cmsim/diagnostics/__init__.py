@@ -24,7 +24,8 @@ types). A function may carry a ``label_map`` attribute (true label → its class
 tooth fault → ``"gear"``) that the harness applies to the answer key. The function never
 sees the answer key; if it raises on a record (``sys.exit`` included), that record is
 reported with the error and its traceback and left out of the scores, and the evaluation goes
-on. What it prints goes to stderr (:mod:`~cmsim.diagnostics.user_code`), so that
+on (with ``isolated=True``, as ``cmsim evaluate`` runs it, also where it ends the process
+itself: ``os._exit``, a crash in compiled code). What it prints goes to stderr (:mod:`~cmsim.diagnostics.user_code`), so that
 ``cmsim evaluate --json`` prints one JSON object on stdout; an evaluation in which it answered
 no record exits with status 2.
 

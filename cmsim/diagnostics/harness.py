@@ -40,7 +40,8 @@ from cmsim.diagnostics.diagnosis import Diagnosis, as_diagnosis
 from cmsim.diagnostics.metrics import (FALSE_ALARM_RATE, HEALTHY, accuracy, confusion_matrix,
                                        detection_vs_severity, f1_scores, macro_f1,
                                        one_vs_rest_auc)
-from cmsim.diagnostics.user_code import UserError, call_user, output_to_stderr
+from cmsim.diagnostics.user_code import (UserError, call_user, isolated_steps,
+                                         output_to_stderr)
 from cmsim.errors import ParameterError
 from cmsim.measured import load_measured
 
@@ -244,7 +245,7 @@ def _answer_key(rec, row, label_map):
 
 
 def evaluate(dataset, algorithm, *, label_map=None, false_alarm_rate=FALSE_ALARM_RATE,
-             progress=None):
+             progress=None, isolated=False):
     """Run ``algorithm`` on every record of ``dataset`` and score it.
 
     Parameters
@@ -260,6 +261,12 @@ def evaluate(dataset, algorithm, *, label_map=None, false_alarm_rate=FALSE_ALARM
         Share of healthy records allowed above the detection threshold (5 %).
     progress : callable, optional
         Called as ``progress(done, total)`` after each record.
+    isolated : bool
+        Run the algorithm in a forked child process
+        (:func:`~cmsim.diagnostics.user_code.isolated_steps`), so that one that ends the
+        process itself (``os._exit``, a crash in compiled code) fails that record, not the
+        evaluation (``cmsim evaluate``). Off by default: a function's own state (a list it
+        fills, a model it trains) then stays in the caller's process.
 
     Returns
     -------
@@ -274,18 +281,31 @@ def evaluate(dataset, algorithm, *, label_map=None, false_alarm_rate=FALSE_ALARM
         ds, ds_name = load_dataset(dataset), str(dataset)
     lmap = dict(label_map if label_map is not None else getattr(func, "label_map", {}) or {})
     rows, skipped, unreadable = _manifest_rows(ds)
+    rows = rows.to_dict("records")
     results = []
-    total = len(rows)
-    for i, row in enumerate(rows.to_dict("records")):
-        rid = str(row["record_id"])
+
+    def step(i, about):
+        """Record ``i``: ("unreadable", (id, why)) or ("answer", RecordResult)."""
+        rid = str(rows[i]["record_id"])
         try:
-            inputs, true, sev = _read_record(ds, row, lmap)
+            inputs, true, sev = _read_record(ds, rows[i], lmap)
         except READ_ERRORS as exc:          # the dataset's fault, not the algorithm's
-            unreadable.append((rid, " ".join(f"{exc}".split()) or type(exc).__name__))
-        else:
-            results.append(_run_algorithm(func, rid, inputs, true, sev))
+            return "unreadable", (rid, " ".join(f"{exc}".split()) or type(exc).__name__)
+        about((rid, true, sev))
+        return "answer", _run_algorithm(func, rid, inputs, true, sev)
+
+    def ended(info, why, wall_s):
+        rid, true, sev = info
+        return "answer", RecordResult(rid, true, sev, None, {}, math.nan,
+                                      f"ProcessEnded: the function ended the process ({why})",
+                                      wall_s)
+
+    steps = (isolated_steps(len(rows), step, ended) if isolated
+             else (step(i, lambda info: None) for i in range(len(rows))))
+    for i, (kind, value) in enumerate(steps):
+        (unreadable if kind == "unreadable" else results).append(value)
         if progress is not None:
-            progress(i + 1, total)
+            progress(i + 1, len(rows))
     return Evaluation(algorithm=name, dataset=ds_name, records=tuple(results),
                       metrics=score(results, skipped=skipped, unreadable=len(unreadable),
                                     false_alarm_rate=false_alarm_rate),

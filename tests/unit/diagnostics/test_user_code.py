@@ -127,3 +127,43 @@ def test_output_of_the_algorithm_module_on_import_goes_to_stderr(tmp_path, capfd
     assert callable(load_algorithm(f"{path}:f"))
     cap = capfd.readouterr()
     assert cap.out == "" and "importing" in cap.err and "fd 1 on import" in cap.err
+
+
+def test_a_function_that_ends_the_process_fails_its_record_when_isolated(capfd):
+    """``os._exit`` and a fatal signal cannot be caught: isolated (as ``cmsim evaluate``
+    runs it), the function runs in a forked child, and the record it ended fails with how it
+    ended while a new child goes on from the next one; cmsim's own process, its answers and
+    its stdout are untouched. In this process (the default) a function keeps its state."""
+    import faulthandler
+    import signal
+
+    seen = []
+
+    def crashes(signals, fs_hz, operating_point, frequencies):
+        seen.append(1)
+        x = signals["a"]
+        if x[0] == _Dataset(5).record("r2").signals["a"][0]:
+            os._exit(0)
+        if x[0] == _Dataset(5).record("r4").signals["a"][0]:
+            faulthandler.disable()          # pytest's dump of the child's crash: noise here
+            os.kill(os.getpid(), signal.SIGSEGV)
+        print("answered")
+        return "healthy"
+
+    ev = evaluate(_Dataset(5), crashes, isolated=True)
+    assert ev.errors == {"r2": "ProcessEnded: the function ended the process (exit status 0)",
+                         "r4": "ProcessEnded: the function ended the process (killed by "
+                               "SIGSEGV)"}
+    assert [r.record_id for r in ev.records] == ["r0", "r2", "r3", "r4"]   # r1 unreadable
+    assert [rid for rid, _ in ev.unreadable] == ["r1"]
+    assert ev.metrics["n_scored"] == 2 and ev.metrics["n_failed"] == 2
+    assert seen == []                       # it ran in the children
+    cap = capfd.readouterr()
+    assert cap.out == "" and cap.err.count("answered") == 2
+
+    def counts(signals, fs_hz, operating_point, frequencies):
+        seen.append(1)
+        return "healthy"
+
+    evaluate(_Dataset(5), counts)
+    assert len(seen) == 4                   # in this process by default
