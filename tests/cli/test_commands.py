@@ -81,6 +81,22 @@ def test_modes_json(capsys):
     assert f[15] == pytest.approx(14382, rel=0.03)
 
 
+def test_modes_of_a_bearing_rig_under_its_radial_load(capsys, tmp_path):
+    """A rig without gears is loaded by --radial-load-n alone (it was refused for want of
+    an option ``modes`` did not have): its modes stiffen with the load (Hertz)."""
+    from cmsim.rig.presets import cwru_6205_rig
+
+    cwru_6205_rig().save(tmp_path / "rig.toml")
+    freqs = []
+    for load in ("500", "5000"):
+        status, res = run_json(capsys, ["modes", "--torque-nm", "0", "--radial-load-n", load,
+                                        "--rig", str(tmp_path / "rig.toml"), "--positions",
+                                        "4"])
+        assert status == 0 and res["radial_load_n"] == float(load)
+        freqs.append(np.array(res["frequencies_hz"]))
+    assert np.all(freqs[1] >= freqs[0] - 1e-9) and np.any(freqs[1] > 1.05 * freqs[0])
+
+
 @pytest.mark.parametrize("argv, word", [
     (["simulate", "--speed-rpm", "0"], "--speed-rpm"),
     (["simulate", "--speed-rpm", "1000", "--torque-nm", "nan"], "--torque-nm"),

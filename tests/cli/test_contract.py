@@ -205,6 +205,8 @@ CATALOGUE = [
     R("modes-positions", "modes --torque-nm 10 --positions 3", "--positions", numeric=True),
     R("modes-torque-negative", "modes --torque-nm -5", "--torque-nm", numeric=True),
     R("modes-torque-missing", "modes", "--torque-nm"),
+    R("modes-bearing-rig-unloaded", "modes --torque-nm 0 --rig {bearing_rig}",
+      "--radial-load-n", "> 0 N", "without gears"),
     R("modes-rig-bool-mass", "modes --torque-nm 10 --rig {rig_bool_mass}", "--rig", "mass_kg"),
     R("modes-mesh-table-text", "modes --torque-nm 10 --mesh-table {text}", "--mesh-table"),
     # ---- mesh-table
