@@ -113,7 +113,10 @@ def ranged(rng):
         except ValueError:
             raise argparse.ArgumentTypeError(f"must be {rng.allowed}, got {text!r}") from None
         if not rng.contains(v):
-            raise argparse.ArgumentTypeError(f"must be {rng.allowed}, got {text}")
+            # a negative number in exponent notation reaches here written out (argparse
+            # takes "-1e-320" for an option): shown as a number, not 300 digits
+            shown = text if len(text) <= 24 else f"{v:.6g}"
+            raise argparse.ArgumentTypeError(f"must be {rng.allowed}, got {shown}")
         return v
 
     parse.__name__ = "int" if rng.integer else "float"
@@ -168,6 +171,8 @@ def user_message(exc, options):
     elif param in names:
         option = names[param]
     for name, opt in sorted(names.items(), key=lambda kv: -len(kv[0])):
+        # a flag the library names as its keyword set (force=True) is the option alone
+        msg = re.sub(rf"(?<![\w.\-]){re.escape(name)}=True\b", opt, msg)
         if name == param or "_" in name or name in _ALWAYS_REWRITE:
             msg = re.sub(rf"(?<![\w.\[\-\"/\\]){re.escape(name)}(?![\w\[\"/\\])", opt,
                          msg)

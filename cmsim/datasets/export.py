@@ -249,8 +249,8 @@ def _check_out(out, source, force):
     """``out`` is a new folder (or ``force`` and a folder) that neither is, holds nor lies in
     the source: replacing it must never remove what is being exported."""
     if out.exists() and not force:
-        raise ParameterError(f"out {out}: exists; give force (--force) to replace it (or a "
-                             f"new folder)", param="out", allowed="a new folder")
+        raise ParameterError(f"out {out}: exists; give force=True to replace it (or a new "
+                             f"folder)", param="out", allowed="a new folder")
     if out.exists() and not out.is_dir():
         raise ParameterError(f"out {out}: is a file (expected a folder)", param="out",
                              allowed="a folder")

@@ -173,14 +173,14 @@ def _manifest_columns(path, read):
     except READ_ERRORS + (ArrowException,) as exc:
         detail = " ".join(str(exc).split())[:200]
         raise ParameterError(f"{path} is corrupt ({type(exc).__name__}: {detail}); remove "
-                             f"it and re-run cmsim dataset on this directory: finished records "
-                             f"are recovered from their files", param="out") from None
+                             f"it and run the command again on this directory: finished "
+                             f"records are recovered from their files", param="out") from None
     columns = out if isinstance(out, list) else list(out.columns)
     missing = [c for c in ("record_id", "index", "status", "path") if c not in columns]
     if missing:
         raise ParameterError(f"{path} is not a cmsim manifest (no column {missing[0]!r}); "
-                             f"remove it and re-run cmsim dataset on this directory: finished "
-                             f"records are recovered from their files", param="out")
+                             f"remove it and run the command again on this directory: "
+                             f"finished records are recovered from their files", param="out")
     return out
 
 
@@ -294,8 +294,8 @@ def open_directory(spec, out_dir, force):
         if not force:
             diff = _spec_difference(old.get("spec", {}), mine["spec"])
             raise ParameterError(f"{out} holds a dataset of a different spec (differs in "
-                                 f"{', '.join(diff)}); use another directory, or --force "
-                                 f"(force=True) to replace it", param="out")
+                                 f"{', '.join(diff)}); use another directory, or force=True "
+                                 f"to replace it", param="out")
         kept = _keep_matching(spec, out)
     else:
         kept = 0

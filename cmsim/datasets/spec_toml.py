@@ -162,9 +162,14 @@ def toml_keywords(data, base_dir=None):
     """
     if not isinstance(data, dict):
         raise ParameterError(f"a dataset spec must be a table, got {type(data).__name__}")
+    if "format_version" in data:            # a rig's or a machine's file, never a spec's
+        raise spec_error("format_version", "a key of a rig or machine file, not of a dataset "
+                                           "spec (a spec names its rig in [rig] file = ..., its "
+                                           "machine in [machine] file = ...)")
     for key in data:
         if key not in _TABLES:
-            raise spec_error(key, f"unknown table; allowed: {sorted(_TABLES)}")
+            what = f"unknown {'table' if isinstance(data[key], dict) else 'key'}"
+            raise spec_error(key, f"{what}; allowed tables: {sorted(_TABLES)}")
         if not isinstance(data[key], dict):
             raise spec_error(key, "must be a table")
         for sub in data[key]:

@@ -268,7 +268,7 @@ def write_folder_metadata(path, metadata, *, force=False):
     """
     path = Path(path)
     if path.exists() and not force:
-        raise ParameterError(f"out: {path} exists; give force to overwrite it", param="out",
+        raise ParameterError(f"out: {path} exists; give force=True to overwrite it", param="out",
                              allowed="a new file, or force")
     checked_numbers(metadata, "fs_hz", path)
     for i, rec in enumerate(metadata.get("recordings") or []):

@@ -327,6 +327,9 @@ class Rig:
             ``faults`` list is left to :func:`cmsim.faults.load_faults`).
         """
         data = dict(data)
+        if isinstance(data.get("machine"), dict):
+            raise ParameterError("a machine file (cmsim calibrate writes them), not a rig: "
+                                 "give it to --machine")
         data.pop("faults", None)     # a [[faults]] list: read by cmsim.faults.load_faults
         version = data.pop("format_version", RIG_FORMAT_VERSION)
         if version != RIG_FORMAT_VERSION:

@@ -120,6 +120,10 @@ def read_file(path, names=None):
     """
     path = Path(path)
     reader = READERS.get(path.suffix.lower())
+    if path.is_dir():
+        raise ParameterError(f"record {path}: is a directory (expected a recording file: "
+                             f"{', '.join(READERS)})", param="record",
+                             allowed=", ".join(READERS))
     if reader is None:
         raise ParameterError(f"record {path}: unsupported file type {path.suffix!r}",
                              param="record", allowed=", ".join(READERS))
