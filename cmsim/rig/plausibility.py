@@ -47,6 +47,10 @@ def load_warnings(rig, op):
                 f"(ISO 6336); steel gears carry about 1500 MPa (results far above "
                 f"{PLAUSIBLE_CONTACT_STRESS_PA / 1e6:.0f} MPa are not physical)")
     if rig.gears is None:
+        if op.torque_nm != 0:
+            found.append(f"torque_nm {op.torque_nm:g} N m has no effect on a rig without "
+                         f"gears: no mesh carries it (its bearings are loaded by "
+                         f"radial_load_n)")
         c0 = rig.bearings[0].static_load_rating_n
         if op.radial_load_n == 0:
             found.append("a bearing rig without radial_load_n: the bearings carry no load and "
