@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_range
 
 __all__ = ["SignatureLibrary", "SignatureEntry", "LIBRARY_FORMAT_VERSION"]
 
@@ -174,6 +174,8 @@ class SignatureLibrary:
                                  f"{data.get('format_version')!r} is not supported (this cmsim "
                                  f"reads 1-{LIBRARY_FORMAT_VERSION}); run cmsim calibrate again",
                                  param="machine")
+        check_range('[library] "segment_s"', data["segment_s"], 0.0, 60.0, lo_open=True)
+        check_range('[library] "segments"', data["segments"], 1, 100_000)
         names = tuple(data["names"])
         rows = _unpack(data["tables_float32_zlib_base64"], (int(data["rows"]), len(names)))
         entries, i = [], (3 if version == 1 else 4)

@@ -26,7 +26,7 @@ import tomli_w
 
 from cmsim._io import atomic_write_text
 from cmsim.dynamics import simulate
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_range
 from cmsim.features import segment_samples
 from cmsim.losses import LossSettings
 from cmsim.machine.background import Background, BackgroundLine
@@ -465,6 +465,9 @@ class Machine:
             _same_segments(data)
         try:
             m, o, p, b = data["machine"], data["operating"], data["path"], data["background"]
+            for key, hi in (("fs_hz", 1e7), ("segment_s", 60.0)):   # edited by hand?
+                if key in m:
+                    check_range(f'[machine] "{key}"', m[key], 0.0, hi, lo_open=True)
             scale = float(m["unit_scale"])
             wobble = float(m.get("speed_wobble", -1.0))
             return cls(

@@ -69,6 +69,21 @@ def test_a_machine_file_cut_before_its_baseline_is_refused(tmp_path):
         Machine.load(tmp_path / "cut.toml")
 
 
+@pytest.mark.parametrize("table", ["machine", "library"])
+def test_a_segment_length_edited_to_nan_is_refused_by_name(tmp_path, table):
+    """A machine file edited by hand: a segment length that is no length is refused by its
+    table and key (the library's made compare fail as an internal error, the machine's was
+    read as it was)."""
+    _machine().save(tmp_path / "m.toml")
+    text = (tmp_path / "m.toml").read_text()
+    head = text.index(f"[{table}]")
+    at = text.index("segment_s = ", head)
+    end = text.index("\n", at)
+    (tmp_path / "nan.toml").write_text(text[:at] + "segment_s = nan" + text[end:])
+    with pytest.raises(ParameterError, match=rf'\[{table}\] "segment_s" must be .* got nan'):
+        Machine.load(tmp_path / "nan.toml")
+
+
 def test_a_damaged_baseline_record_is_refused(tmp_path):
     m = _machine()
     m.save(tmp_path / "m.toml")
