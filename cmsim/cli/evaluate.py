@@ -108,7 +108,7 @@ def _check_answered(ev, args, out):
 
 def _syn2real(args):
     from cmsim.datasets import load
-    from cmsim.diagnostics.syn2real import evaluate_syn2real, measured_windows
+    from cmsim.diagnostics.syn2real import evaluate_syn2real, measured_windows, training_channel
 
     if args.dir is not None or args.algorithm is not None:
         raise CLIError("--train: give either DIR --algorithm NAME or --train DIR --test FOLDER "
@@ -126,6 +126,10 @@ def _syn2real(args):
             raise CLIError(f"--train {exc}", option="--train") from None
         if len(ds) == 0:
             raise CLIError(f"--train {d}: the dataset has no ok record", option="--train")
+        try:
+            training_channel(ds)
+        except ParameterError as exc:
+            raise CLIError(f"--train {d}: {exc}", option="--train") from None
     try:
         test = measured_windows(args.test, window=args.window,
                                 max_windows=args.max_test_windows,

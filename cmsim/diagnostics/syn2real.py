@@ -60,7 +60,8 @@ try:                                    # optional: pip install cmsim[ml]
 except ImportError:                     # pragma: no cover
     RandomForestClassifier = None
 
-__all__ = ["WindowSet", "synthetic_windows", "measured_windows", "envelope_features",
+__all__ = ["WindowSet", "synthetic_windows", "training_channel", "measured_windows",
+           "envelope_features",
            "FEATURE_LINES", "CLASSIFIERS", "make_classifier", "EnvelopeRule",
            "score_windows", "check_disjoint", "evaluate_syn2real", "DEFAULT_WINDOW"]
 
@@ -134,6 +135,32 @@ def _assemble(parts, fs_hz, skipped=None):
                      dict(skipped or {}))
 
 
+def training_channel(ds):
+    """The channel a classifier trains on in a generated dataset: its machine's, else its
+    first housing accelerometer (``accel_*``).
+
+    Parameters
+    ----------
+    ds : cmsim.datasets.Dataset
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ParameterError
+        The dataset has no such channel.
+    """
+    machine = (ds.spec.get("machine") or {}).get("machine", {}).get("channel")
+    accel = [machine] if machine else [c for c in ds.channels if c.startswith("accel_")]
+    if not accel:
+        raise ParameterError(f"the dataset has no accel_* channel to train on (only states "
+                             f"and forces, {len(ds.channels)} channels; a spec makes one with "
+                             f"[sensor] channels = [\"accel_1b1_y\"])", param="channel")
+    return accel[0]
+
+
 def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None,
                       max_records=None):
     """Windows of a generated cmsim dataset (:func:`cmsim.datasets.load`).
@@ -159,12 +186,7 @@ def synthetic_windows(dataset, channel=None, window=None, hop=None, bearing=None
     """
     ds = load(dataset) if isinstance(dataset, (str, Path)) else dataset
     if channel is None:
-        machine = (ds.spec.get("machine") or {}).get("machine", {}).get("channel")
-        accel = [machine] if machine else [c for c in ds.channels if c.startswith("accel_")]
-        if not accel:
-            raise ParameterError("channel: the dataset has no accel_* channel",
-                                 param="channel")
-        channel = accel[0]
+        channel = training_channel(ds)
     if channel not in ds.channels:
         raise ParameterError(f"channel: {channel!r} is not in the dataset "
                              f"{list(ds.channels)}", param="channel")

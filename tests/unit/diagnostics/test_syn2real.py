@@ -213,3 +213,20 @@ def test_a_refused_test_record_is_skipped_and_counted(cwru_small, tmp_path, caps
     assert any("1 of 7 records could not be read" in w for w in out["warnings"]), out
     assert main(argv + ["--trust-metadata"]) == 2        # read: its rate is not the others'
     assert "different sample rates" in json.loads(capsys.readouterr().out)["error"]
+
+
+def test_a_dataset_without_an_accelerometer_is_refused_with_what_makes_one():
+    """A training set of states and forces only (a sweep's, a spec without [sensor]) is
+    refused before anything is windowed, saying how a spec makes an accelerometer; a
+    machine's channel, or the first accel_*, is the one trained on."""
+    from types import SimpleNamespace
+
+    from cmsim.diagnostics.syn2real import training_channel
+
+    bare = SimpleNamespace(spec={}, channels=["x_1b1", "F_1b1_x", "dte"])
+    with pytest.raises(ParameterError, match=r"no accel_\* channel.*\[sensor\] channels"):
+        training_channel(bare)
+    assert training_channel(SimpleNamespace(spec={}, channels=["dte", "accel_1b1_y",
+                                                               "accel_2b1_y"])) == "accel_1b1_y"
+    assert training_channel(SimpleNamespace(spec={"machine": {"machine": {"channel": "DE"}}},
+                                            channels=["DE"])) == "DE"
