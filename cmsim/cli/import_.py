@@ -50,7 +50,9 @@ def run(args):
                        f"channel documented twice could never be told from its namesake",
                        option="--channel")
     if out.exists() and not args.force:
-        raise CLIError(f"--out {out}: exists; give --force to overwrite it", option="--out")
+        raise CLIError(f"--out {out}: exists; give --force to overwrite it"
+                       + ("" if args.out else " (or --out FILE.json: this is its default, "
+                          "DIR/metadata.json)"), option="--out")
     values = recording_values(args)
     values.pop("trust_metadata")
     keep = None
