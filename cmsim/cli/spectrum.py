@@ -97,7 +97,7 @@ def run(args):
 
 
 #: Parameters of :func:`cmsim.measured.read_run` whose errors name their own option.
-_RECORDING_PARAMS = ("record", "rig", "fs_hz", "speed_rpm", "unit", "calibration")
+_RECORDING_PARAMS = ("record", "rig", "fs_hz", "speed_rpm", "unit", "calibration", "--channel")
 
 
 def _read(args):
@@ -109,7 +109,7 @@ def _read(args):
     path = args.record
     rig = load_file("--rig", args.rig, Rig.load, "a rig TOML file") if args.rig else None
     try:
-        return read_run(path, rig=rig, **recording_values(args))
+        return read_run(path, rig=rig, channel=args.channel, **recording_values(args))
     except ParameterError as exc:
         if exc.param in _RECORDING_PARAMS:
             raise

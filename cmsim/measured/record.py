@@ -178,13 +178,24 @@ class MeasuredRecord:
 
 def _channel(signals, sensors, bearings, channel, name):
     if channel is None:
+        # the first near a documented bearing, else the first by name; never a time base
+        # (a LabVIEW "X_Value", a "Time" channel, a matrix's time column): samples that rise
+        # at every step are a clock, not a vibration
         near_bearing = [c for c in signals if (sensors.get(c) or {}).get("near") in bearings]
-        channel = near_bearing[0] if near_bearing else sorted(signals)[0]
+        candidates = near_bearing or sorted(signals)
+        channel = next((c for c in candidates if not _rises_throughout(signals[c])),
+                       candidates[0])
     if channel not in signals:
         raise ParameterError(f"channel {channel!r} is not in {name}; available: "
                              f"{sorted(signals)}", param="--channel",
                              allowed=", ".join(sorted(signals)))
     return channel, _checked_samples(signals[channel], channel, name)
+
+
+def _rises_throughout(x):
+    """Whether every sample of ``x`` is above the one before (a time base or a sample
+    index)."""
+    return x.size > 2 and bool(np.all(np.diff(x) > 0))
 
 
 def _checked_samples(x, channel, name):

@@ -29,11 +29,15 @@ def _csv_dialect(path):
     a tab; a ``;`` file whose numbers carry a decimal comma (European locale) reads them."""
     with open(path, newline="", encoding="utf-8", errors="replace") as fh:
         head = [fh.readline() for _ in range(5)]
+    first, body = head[0].strip().lstrip("\ufeff"), "".join(head[1:])
+    if first and not any(c in first for c in ",;\t") and not _is_number(first, "."):
+        # one column under a one-name header: a comma between digits is a decimal comma,
+        # not a separator (sniffed, it split every number in two)
+        return ("\t" if ";" in body else ";"), ("," if re.search(r"\d,\d", body) else ".")
     try:
         sep = csv.Sniffer().sniff("".join(head), delimiters=",;\t").delimiter
     except csv.Error:
         sep = ","
-    body = "".join(head[1:])
     decimal = "," if sep in ";\t" and re.search(r"\d,\d", body) else "."
     return sep, decimal
 

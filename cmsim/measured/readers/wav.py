@@ -28,36 +28,56 @@ __all__ = []   # read and write: through READERS and WRITERS of the package
 _WAV_TAG = "cmsim "
 
 
-def _wav_comment(path):
-    """The cmsim ``LIST/INFO/ICMT`` comment of a WAV file as a dict (empty without one)."""
+def _chunks(path):
+    """``(id, body, byte order)`` of each chunk of a RIFF/RIFX WAVE file, in order (none
+    where it is not one)."""
     with open(path, "rb") as fh:
         head = fh.read(12)
         if len(head) < 12 or head[:4] not in (b"RIFF", b"RIFX") or head[8:12] != b"WAVE":
-            return {}
+            return
         end = "<" if head[:4] == b"RIFF" else ">"
         while True:
             ck = fh.read(8)
             if len(ck) < 8:
-                return {}
+                return
             cid, size = ck[:4], struct.unpack(end + "I", ck[4:])[0]
-            if cid != b"LIST":
+            if cid in (b"LIST", b"fmt "):
+                yield cid, fh.read(size), end
+                fh.seek(size & 1, 1)
+            else:
                 fh.seek(size + (size & 1), 1)
-                continue
-            body = fh.read(size)
-            if body[:4] != b"INFO":
-                continue
-            i = 4
-            while i + 8 <= len(body):
-                sid, ssize = body[i:i + 4], struct.unpack(end + "I", body[i + 4:i + 8])[0]
-                text = body[i + 8:i + 8 + ssize].rstrip(b"\0").decode("utf-8", "replace")
-                if sid == b"ICMT" and text.startswith(_WAV_TAG):
-                    return json.loads(text[len(_WAV_TAG):])
-                i += 8 + ssize + (ssize & 1)
+
+
+def _wav_comment(path):
+    """The cmsim ``LIST/INFO/ICMT`` comment of a WAV file as a dict (empty without one)."""
+    for cid, body, end in _chunks(path):
+        if cid != b"LIST" or body[:4] != b"INFO":
+            continue
+        i = 4
+        while i + 8 <= len(body):
+            sid, ssize = body[i:i + 4], struct.unpack(end + "I", body[i + 4:i + 8])[0]
+            text = body[i + 8:i + 8 + ssize].rstrip(b"\0").decode("utf-8", "replace")
+            if sid == b"ICMT" and text.startswith(_WAV_TAG):
+                return json.loads(text[len(_WAV_TAG):])
+            i += 8 + ssize + (ssize & 1)
+    return {}
+
+
+def _bits_per_sample(path):
+    """The ``fmt `` chunk's bits per sample (None where there is none)."""
+    for cid, body, end in _chunks(path):
+        if cid == b"fmt " and len(body) >= 16:
+            return struct.unpack(end + "H", body[14:16])[0]
+    return None
 
 
 def read(path, names=None):
     """Channels of a ``.wav`` file and what it states (module docstring)."""
     rate, x = wavfile.read(path)
+    if x.dtype == np.int32 and _bits_per_sample(path) == 24:
+        # scipy gives 24-bit samples left-justified in 32 bits: 256 times the stored value,
+        # which a calibration (units per stored value) is stated for
+        x = x >> 8
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     stated = _wav_comment(path)

@@ -1,0 +1,109 @@
+"""Recordings as labs write them are read right, or refused with what to fix (issue 17).
+
+Test tier: behaviour contracts on files written here. One known signal — a 1.0-g line at
+1234.5 Hz and a 0.3-g shaft line, 2 s at 12 kHz — is written the ways a DAQ program or a
+lab's script writes it (found by a probe of honest lab files, 2026-12-02), and read back
+through :func:`cmsim.measured.read_run`: the channel compared, its rate and its level.
+"""
+
+import struct
+
+import numpy as np
+import pytest
+
+from cmsim.errors import ParameterError
+from cmsim.measured import read_run
+
+FS, N = 12_000, 24_000
+T = np.arange(N) / FS
+X = np.sin(2 * np.pi * 1234.5 * T) + 0.3 * np.sin(2 * np.pi * 29.95 * T)
+
+
+def _line(x, fs=FS, f0=1234.5):
+    """Amplitude of the line at f0 (Hann, coherent gain removed)."""
+    w = np.hanning(x.size)
+    spec = np.abs(np.fft.rfft(x * w)) * 2 / w.sum()
+    f = np.fft.rfftfreq(x.size, 1 / fs)
+    return float(spec[np.abs(f - f0) < 3].max())
+
+
+def _read(path, **kw):
+    run, channel = read_run(path, speed_rpm=1797.0, trust_metadata=True, **kw)
+    return run, channel
+
+
+@pytest.mark.parametrize("name, write", [
+    ("labview.csv", lambda p: p.write_text("X_Value,acc1\n" + "".join(
+        f"{a:.9g},{b:.9g}\n" for a, b in zip(T, X)))),
+    ("time_channel.npz", lambda p: np.savez(p, time=T, vib=X, fs_hz=np.float64(FS))),
+    ("time_column.mat", lambda p: __import__("scipy.io").io.savemat(
+        p, {"data": np.column_stack([T, X])})),
+])
+def test_a_time_base_is_never_the_channel_compared_by_default(tmp_path, name, write):
+    """A channel that rises at every sample is a clock: the default channel is the
+    vibration beside it (the first by name was LabVIEW's X_Value, a time ramp read as a
+    1.14-Hz line in g)."""
+    path = tmp_path / name
+    write(path)
+    run, channel = _read(path, fs_hz=FS, unit="g")
+    assert channel in ("acc1", "vib", "data_1")
+    assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+
+
+def test_spectrum_s_channel_reaches_the_reader(tmp_path, capsys):
+    """``cmsim spectrum --channel`` chooses the channel every check runs on: a dead channel
+    beside it (a constant AI0) no longer refuses the file."""
+    import json
+
+    from cmsim.cli import main
+
+    path = tmp_path / "daq.csv"
+    path.write_text("time [s],AI0 [V],AI1 [g]\n" + "".join(
+        f"{a:.9g},0,{b:.9g}\n" for a, b in zip(T, X)))
+    status = main(["spectrum", str(path), "--speed-rpm", "1797", "--channel", "AI1",
+                   "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert status == 0, out
+    assert out["signal"] == "AI1" and out["unit"] == "g"
+    assert out["peaks"][0]["frequency_hz"] == pytest.approx(1234.5, abs=0.5)
+
+
+def test_an_npz_states_its_rate_in_a_one_value_array_of_a_rate_name(tmp_path):
+    """``fs_hz`` of shape (1,) is the rate (it was ignored, so a contradicting --fs-hz was
+    taken); ``fs`` is a rate too (it was refused as a channel of shape ()); a plain-text
+    ``units`` is every channel's unit (it was refused as damaged JSON)."""
+    np.savez(tmp_path / "a.npz", acc=X, fs_hz=np.array([float(FS)]))
+    with pytest.raises(ParameterError, match="fs_hz\" array says sample rate 12000 Hz but fs_hz says 25600 Hz"):
+        _read(tmp_path / "a.npz", fs_hz=25_600.0)
+    np.savez(tmp_path / "b.npz", acc=X, fs=np.float64(FS), units=np.array("g"))
+    run, channel = _read(tmp_path / "b.npz")
+    assert channel == "acc" and run.fs_hz == FS
+    assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+
+
+def _wav24(path, counts):
+    """A 24-bit PCM WAV of one channel (what a DAQ's recorder writes)."""
+    data = counts.astype("<i4").view(np.uint8).reshape(-1, 4)[:, :3].tobytes()
+    fmt = struct.pack("<HHIIHH", 1, 1, FS, FS * 3, 3, 24)
+    body = (b"WAVE" + b"fmt " + struct.pack("<I", len(fmt)) + fmt + b"data"
+            + struct.pack("<I", len(data)) + data + (b"\0" if len(data) & 1 else b""))
+    path.write_bytes(b"RIFF" + struct.pack("<I", len(body)) + body)
+
+
+def test_a_24_bit_wav_is_read_in_its_stored_counts(tmp_path):
+    """scipy gives 24-bit samples left-justified in 32 bits; a calibration is stated per
+    stored 24-bit count (full scale 2^23), so the level was 256 times too high."""
+    c = 1.05 * np.abs(X).max() / (2 ** 23 - 1)
+    _wav24(tmp_path / "r.wav", np.round(X / c))
+    run, channel = _read(tmp_path / "r.wav", unit="g", calibration=c)
+    assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+
+
+def test_one_column_with_decimal_commas_is_one_channel(tmp_path):
+    """A one-column European CSV: the comma between digits is the decimal comma, not a
+    separator (sniffed as one, it split every number: 1975 Hz at 8e7 g)."""
+    (tmp_path / "r.csv").write_text("acc1 [g]\n" + "".join(
+        f"{v:.9g}\n".replace(".", ",") for v in X))
+    run, channel = _read(tmp_path / "r.csv", fs_hz=FS)
+    assert channel == "acc1" and run[channel].size == N
+    assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
