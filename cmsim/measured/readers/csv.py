@@ -94,14 +94,19 @@ def read(path, names=None):
 
 def _read_headerless(path, sep, decimal, names):
     """A CSV without a header row: every row is data. A first column rising in even steps
-    (with others beside it) is the time base, in seconds; the channels are named by
+    (with others beside it) is the time base, in seconds, or where it counts 1, 2, 3 ... the
+    samples' index (no rate); the channels are named by
     ``names`` (the entry's ``channels``) when they match in number, else ``ch0``,
     ``ch1``, ... as a WAV's are."""
     import pandas as pd
     data = pd.read_csv(path, sep=sep, decimal=decimal, header=None).to_numpy(dtype=float)
     rate = None
     if data.shape[1] > 1 and data.shape[0] > 1 and _evenly_rising(data[:, 0]):
-        rate = time_rate(path, "column 1", data[:, 0])
+        first = data[:, 0]
+        if not np.array_equal(np.diff(first), np.ones(first.size - 1)):
+            rate = time_rate(path, "column 1", first)
+        # else the samples' numbers 0, 1, 2, ... (or 1, 2, 3, ...): an index, no rate (it
+        # read as time in s, 1 Hz, which refused the rate --fs-hz stated)
         data = data[:, 1:]
     names = list(names or [])
     if len(names) != data.shape[1]:

@@ -107,3 +107,15 @@ def test_one_column_with_decimal_commas_is_one_channel(tmp_path):
     run, channel = _read(tmp_path / "r.csv", fs_hz=FS)
     assert channel == "acc1" and run[channel].size == N
     assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+
+
+def test_a_header_less_sample_index_column_states_no_rate(tmp_path):
+    """A first column counting the samples (0, 1, 2, ...) is their index, not a time in
+    seconds: it read as a 1-Hz rate and refused the --fs-hz the user stated."""
+    (tmp_path / "r.csv").write_text("".join(f"{i},{v:.9g}\n" for i, v in enumerate(X)))
+    run, channel = _read(tmp_path / "r.csv", fs_hz=FS, unit="g")
+    assert run.fs_hz == FS and run[channel].size == N
+    assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+    (tmp_path / "t.csv").write_text("".join(f"{a:.9g},{v:.9g}\n" for a, v in zip(T, X)))
+    run, channel = _read(tmp_path / "t.csv", unit="g")       # a time in s still states it
+    assert run.fs_hz == pytest.approx(FS, rel=1e-6)
