@@ -91,10 +91,14 @@ def rate_of_step(step, digits=None):
     return rate
 
 
-#: A CSV time column's name (``t``, ``time``, ``time_s``, ``Time (s)``, ``time [ms]``, any
-#: case) → group 1 the unit (``s`` when none is written).
-TIME_NAME = re.compile(r"^(?:t|time)(?:_(s|ms)|\s*\[\s*(s|ms)\s*\]|\s*\(\s*(s|ms)\s*\))?$",
-                       re.IGNORECASE)
+#: A CSV time column's name (``t``, ``time``, ``zeit``, ``time_s``, ``Time (s)``,
+#: ``time [ms]``, ``Time [sec]``, ``time [us]``, any case) → its groups the unit (``s`` when
+#: none is written; :data:`TIME_UNITS`).
+TIME_NAME = re.compile(r"^(?:t|time|zeit)(?:_(s|sec|ms|us|µs)|\s*\[\s*(s|sec|ms|us|µs)\s*\]"
+                       r"|\s*\(\s*(s|sec|ms|us|µs)\s*\))?$", re.IGNORECASE)
+
+#: A time column's unit → seconds.
+TIME_UNITS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 
 #: Largest relative departure of one time step of a CSV from the mean step that still
 #: counts as evenly spaced (time stamps printed to 2 significant digits of the step).
@@ -102,10 +106,10 @@ TIME_STEP_TOLERANCE = 0.1
 
 
 def time_rate(path, name, t, unit="s"):
-    """The sample rate of a time column or vector ``t`` (unit ``s`` or ``ms``; a CSV's time
+    """The sample rate of a time column or vector ``t`` (a unit of :data:`TIME_UNITS`; a CSV's time
     column, a ``.mat`` file's ``t``), checked for even steps: a gap or a jump back is
     refused, naming where."""
-    t = np.asarray(t, dtype=float) * (1e-3 if unit.lower() == "ms" else 1.0)
+    t = np.asarray(t, dtype=float) * TIME_UNITS[unit.lower()]
     steps = np.diff(t)
     step = (t[-1] - t[0]) / (t.size - 1)
     bad = np.flatnonzero(~(np.abs(steps - step) <= TIME_STEP_TOLERANCE * abs(step)))

@@ -1,16 +1,22 @@
 """``.csv`` — one column per channel, a header row of channel names, separated by ``,``, ``;``
 or tabs (sniffed; a ``;`` file may use decimal commas); a header ``name [unit]`` or
-``name (unit)`` states the unit; a first column named ``t`` or ``time``, bare or with its
-unit (``time_s``, ``Time (s)``, ``time [ms]``; any case) is the time axis, not a channel:
-its steps must be even (within :data:`~cmsim.measured.readers._common.TIME_STEP_TOLERANCE`),
-and give the rate. A file whose first line is all numbers has no header: every row is data,
-the channels are named as a WAV's (``names``, else ``ch0``, ...) and a first column rising
-in even steps is the time in seconds."""
+``name (unit)`` states the unit, and so does a row of units under the header (``s,g,g``);
+a first column named ``t``, ``time`` or ``zeit``, bare or with its unit (``time_s``,
+``Time (s)``, ``time [ms]``, ``Time [sec]``, ``time [us]``; any case) is the time axis, not
+a channel: its steps must be even (within
+:data:`~cmsim.measured.readers._common.TIME_STEP_TOLERANCE`), and give the rate. Lines
+starting with ``#`` before the table (a DAQ program's notes) are skipped, a file that is not
+UTF-8 is read as Windows-1252, and an empty column without a name (a separator ending every
+line) is no channel. A file whose first line is all numbers has no header: every row is
+data, the channels are named as a WAV's (``names``, else ``ch0``, ...) and a first column
+rising in even steps is the time in seconds, or, counting 0, 1, 2, ..., the samples'
+index."""
 
 from __future__ import annotations
 
 import csv
 import re
+from pathlib import Path
 
 import numpy as np
 
@@ -24,11 +30,35 @@ __all__ = []   # read and write: through READERS and WRITERS of the package
 _CSV_UNIT = re.compile(r"^(.*\S)\s*(?:\[([^\]]*)\]|\(([^)]*)\))$")
 
 
-def _csv_dialect(path):
-    """``(delimiter, decimal)`` of a CSV, sniffed from its first lines: ``,``, ``;`` or
-    a tab; a ``;`` file whose numbers carry a decimal comma (European locale) reads them."""
-    with open(path, newline="", encoding="utf-8", errors="replace") as fh:
-        head = [fh.readline() for _ in range(5)]
+def _layout(path):
+    """``(encoding, preamble)`` of a CSV: UTF-8 where its bytes are (a BOM included), else
+    Windows-1252 (a file a Windows DAQ program wrote, ``m/s²`` in one byte); and how many
+    lines starting with ``#`` precede its table (a DAQ program's notes on the device)."""
+    raw = Path(path).read_bytes()
+    try:
+        raw.decode("utf-8")
+        encoding = "utf-8-sig"
+    except UnicodeDecodeError:
+        encoding = "cp1252"
+    preamble = 0
+    for line in raw.decode(encoding, errors="replace").lstrip("\ufeff").splitlines():
+        if not line.lstrip().startswith("#"):
+            break
+        preamble += 1
+    return encoding, preamble
+
+
+def _head(path, encoding, preamble, n=5):
+    """The first ``n`` lines of a CSV's table (after its preamble)."""
+    with open(path, newline="", encoding=encoding, errors="replace") as fh:
+        lines = [fh.readline() for _ in range(preamble + n)]
+    return lines[preamble:]
+
+
+def _csv_dialect(head):
+    """``(delimiter, decimal)`` of a CSV, sniffed from its first lines (``head``): ``,``,
+    ``;`` or a tab; a ``;`` file whose numbers carry a decimal comma (European locale) reads
+    them."""
     first, body = head[0].strip().lstrip("\ufeff"), "".join(head[1:])
     if first and not any(c in first for c in ",;\t") and not _is_number(first, "."):
         # one column under a one-name header: a comma between digits is a decimal comma,
@@ -50,12 +80,24 @@ def _is_number(text, decimal):
     return True
 
 
-def _csv_has_header(path, sep, decimal):
+def _fields(line, sep):
+    return next(csv.reader([line], delimiter=sep), [])
+
+
+def _csv_has_header(head, sep, decimal):
     """False when every field of the first line is a number: a CSV written without a header
     row (its first row is data, not channel names)."""
-    with open(path, newline="", encoding="utf-8", errors="replace") as fh:
-        first = next(csv.reader(fh, delimiter=sep), [])
+    first = _fields(head[0], sep)
     return not (first and all(_is_number(c, decimal) for c in first if c.strip()))
+
+
+def _units_row(head, sep, decimal):
+    """The fields of a row of units under the header (``s,g,g``), or None: a second line
+    none of whose fields is a number."""
+    second = [c.strip() for c in _fields(head[1], sep)] if len(head) > 1 else []
+    if second and any(second) and not any(_is_number(c, decimal) for c in second if c):
+        return second
+    return None
 
 
 def _evenly_rising(t):
@@ -69,11 +111,22 @@ def _evenly_rising(t):
 def read(path, names=None):
     """Channels of a ``.csv`` file and what it states (module docstring)."""
     import pandas as pd
-    sep, decimal = _csv_dialect(path)
-    if not _csv_has_header(path, sep, decimal):
-        return _read_headerless(path, sep, decimal, names)
-    df = pd.read_csv(path, sep=sep, decimal=decimal)
+    encoding, preamble = _layout(path)
+    head = _head(path, encoding, preamble)
+    sep, decimal = _csv_dialect(head)
+    if not _csv_has_header(head, sep, decimal):
+        return _read_headerless(path, sep, decimal, names, encoding, preamble)
+    unit_row = _units_row(head, sep, decimal)
+    df = pd.read_csv(path, sep=sep, decimal=decimal, encoding=encoding,
+                     skiprows=list(range(preamble)) + ([preamble + 1] if unit_row else []))
+    # a separator at the end of every line (as a spreadsheet exports) makes an empty column
+    # without a name: no channel
+    df = df[[c for c in df.columns
+             if not (str(c).startswith("Unnamed: ") and df[c].isna().all())]]
     cols = [str(c) for c in df.columns]
+    if unit_row:                    # a units row: each column's unit, as "name [unit]" does
+        cols = [f"{c} [{u}]" if u and not _CSV_UNIT.match(c) else c
+                for c, u in zip(cols, unit_row + [""] * len(cols))]
     rate = None
     m = TIME_NAME.match(cols[0].strip()) if cols else None
     if m and len(df) > 1:
@@ -92,14 +145,15 @@ def read(path, names=None):
     return SignalFile(signals, rate, units, rate_from="its time column")
 
 
-def _read_headerless(path, sep, decimal, names):
+def _read_headerless(path, sep, decimal, names, encoding="utf-8-sig", preamble=0):
     """A CSV without a header row: every row is data. A first column rising in even steps
     (with others beside it) is the time base, in seconds, or where it counts 1, 2, 3 ... the
     samples' index (no rate); the channels are named by
     ``names`` (the entry's ``channels``) when they match in number, else ``ch0``,
     ``ch1``, ... as a WAV's are."""
     import pandas as pd
-    data = pd.read_csv(path, sep=sep, decimal=decimal, header=None).to_numpy(dtype=float)
+    data = pd.read_csv(path, sep=sep, decimal=decimal, header=None, encoding=encoding,
+                       skiprows=preamble).to_numpy(dtype=float)
     rate = None
     if data.shape[1] > 1 and data.shape[0] > 1 and _evenly_rising(data[:, 0]):
         first = data[:, 0]

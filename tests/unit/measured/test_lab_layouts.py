@@ -119,3 +119,27 @@ def test_a_header_less_sample_index_column_states_no_rate(tmp_path):
     (tmp_path / "t.csv").write_text("".join(f"{a:.9g},{v:.9g}\n" for a, v in zip(T, X)))
     run, channel = _read(tmp_path / "t.csv", unit="g")       # a time in s still states it
     assert run.fs_hz == pytest.approx(FS, rel=1e-6)
+
+
+@pytest.mark.parametrize("name, text, encoding", [
+    ("units_row.csv", "time,acc1\ns,g\n" + "".join(f"{a:.9g},{b:.9g}\n" for a, b in zip(T, X)),
+     "utf-8"),
+    ("preamble.csv", "# Device: NI 9234\n# Sample rate: 12000 Hz\ntime [s],acc1 [g]\n"
+     + "".join(f"{a:.9g},{b:.9g}\n" for a, b in zip(T, X)), "utf-8"),
+    ("windows.csv", "time [s];acc1 [m/s²]\n" + "".join(
+        f"{a:.9g};{9.80665 * b:.9g}\n".replace(".", ",") for a, b in zip(T, X)), "cp1252"),
+    ("trailing.csv", "Time [sec],acc1 [g],\n" + "".join(
+        f"{a:.9g},{b:.9g},\n" for a, b in zip(T, X)), "utf-8"),
+    ("micro.csv", "time [us],acc1 [g]\n" + "".join(
+        f"{1e6 * a:.9g},{b:.9g}\n" for a, b in zip(T, X)), "utf-8"),
+])
+def test_a_daq_program_s_csv_layouts_are_read(tmp_path, name, text, encoding):
+    """A units row under the header, a preamble of # lines, a Windows-1252 file (m/s² in
+    one byte) with decimal commas, a separator ending every line, time in sec or µs: each
+    was refused (as damaged, or its time column as a channel in an unknown unit)."""
+    (tmp_path / name).write_bytes(text.encode(encoding))
+    run, channel = _read(tmp_path / name)
+    assert channel == "acc1" and run.fs_hz == pytest.approx(FS, rel=1e-6)
+    level = 9.80665 if name == "windows.csv" else 1.0        # m/s² there, g elsewhere
+    assert _line(run[channel]) == pytest.approx(level, rel=0.01)
+    assert list(run.signals) == ["acc1"]
