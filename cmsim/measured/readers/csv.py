@@ -41,7 +41,7 @@ def _layout(path):
     except UnicodeDecodeError:
         encoding = "cp1252"
     preamble = 0
-    for line in raw.decode(encoding, errors="replace").lstrip("\ufeff").splitlines():
+    for line in raw[:1 << 16].decode(encoding, errors="replace").lstrip("\ufeff").splitlines():
         if not line.lstrip().startswith("#"):
             break
         preamble += 1
