@@ -438,6 +438,14 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
     inferred, notes, doubts = {}, [], []
+    if scale is None and channel in f.counts and sensor_unit is not None:
+        text = (f"record {p}: channel {channel!r} holds integer counts of a converter and no "
+                f"calibration states their units: each count is read as 1 {sensor_unit} "
+                f"(state the {sensor_unit} per count, in metadata.json \"calibration\" or "
+                f"as the command's calibration, where it is not 1)")
+        notes.append(text)
+        doubts.append(text)
+        warnings.warn(text, RecordWarning, stacklevel=2)
     speed, speed_from = _stated_speed(p, f.speed_rpm, entry, speed_rpm, notes, doubts)
     fs, fs_from = agreed(p, "sample rate", [
         (f.rate_from, "record", f.rate_hz),

@@ -34,6 +34,9 @@ class SignalFile(NamedTuple):
         Factor the reader applied to the stored samples (a WAV's stated calibration).
     rate_from : str
         Where the rate is stated, for messages (``"the WAV header"``).
+    counts : frozenset of str
+        Channels stored as integers and not scaled by the reader: counts of a converter,
+        which need a calibration to be a physical quantity.
     """
 
     signals: dict
@@ -42,6 +45,7 @@ class SignalFile(NamedTuple):
     speed_rpm: float | None = None
     calibration: float | None = None
     rate_from: str = "the file header"
+    counts: frozenset = frozenset()
 
 
 def channel_1d(path, name, a):

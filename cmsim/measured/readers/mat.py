@@ -45,7 +45,7 @@ def read(path, names=None):
         variables = loadmat(path, squeeze_me=True, simplify_cells=True)
     except NotImplementedError:            # a v7.3 file: HDF5 inside
         variables = _read_mat73(path)
-    signals, rates, speeds, units, time = {}, {}, {}, {}, None
+    signals, rates, speeds, units, time, counts = {}, {}, {}, {}, None, set()
     for name, value in variables.items():
         if name.startswith("__"):
             continue
@@ -67,7 +67,10 @@ def read(path, names=None):
             rates[name] = time_rate(path, name, a.reshape(-1),
                                      next((g for g in m.groups() if g), "s"))
             continue
-        signals.update(_mat_channels(path, name, a))
+        channels = _mat_channels(path, name, a)
+        signals.update(channels)
+        if a.dtype.kind in "iu":
+            counts.update(channels)
     if len(set(speeds.values())) > 1:
         raise ParameterError(f"record {path}: the speed is ambiguous: "
                              + ", ".join(f"{k} = {v:g}" for k, v in speeds.items())
@@ -77,7 +80,7 @@ def read(path, names=None):
     rate = one_rate(path, rates, 1e-3)
     return SignalFile(signals, rate, units, next(iter(speeds.values()), None),
                       rate_from=(f"its time vector {time!r}" if time
-                                 else "its sample-rate variable"))
+                                 else "its sample-rate variable"), counts=frozenset(counts))
 
 
 def _read_mat73(path):

@@ -47,7 +47,8 @@ def read(path, names=None):
             units = {k: str(units) for k in signals}
     key = next(iter(rates), None)
     return SignalFile(signals, one_rate(path, rates) if rates else None, units,
-                      rate_from=f"its \"{key}\" array")
+                      rate_from=f"its \"{key}\" array",
+                      counts=frozenset(k for k in signals if arrays[k].dtype.kind in "iu"))
 
 
 def write(path, signals, rate_hz, units):

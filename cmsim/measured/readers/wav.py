@@ -78,6 +78,7 @@ def read(path, names=None):
         # scipy gives 24-bit samples left-justified in 32 bits: 256 times the stored value,
         # which a calibration (units per stored value) is stated for
         x = x >> 8
+    integer = x.dtype.kind in "iu"
     x = np.asarray(x, dtype=float)
     x = x[:, None] if x.ndim == 1 else x
     stated = _wav_comment(path)
@@ -90,7 +91,8 @@ def read(path, names=None):
     units = {n: u for n, u in zip(names, stated.get("units") or []) if u}
     return SignalFile({n: x[:, i] for i, n in enumerate(names)}, float(rate), units,
                       calibration=None if calibration is None else float(calibration),
-                      rate_from="the WAV header")
+                      rate_from="the WAV header",
+                      counts=frozenset(names if integer and calibration is None else ()))
 
 
 def write(path, signals, rate_hz, units):

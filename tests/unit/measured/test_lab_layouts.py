@@ -143,3 +143,20 @@ def test_a_daq_program_s_csv_layouts_are_read(tmp_path, name, text, encoding):
     level = 9.80665 if name == "windows.csv" else 1.0        # m/s² there, g elsewhere
     assert _line(run[channel]) == pytest.approx(level, rel=0.01)
     assert list(run.signals) == ["acc1"]
+
+
+def test_integer_counts_without_a_calibration_are_read_with_a_warning(tmp_path):
+    """A converter's int16 counts stated in g with no calibration read as 1 g a count
+    (15 780 "g" for this signal): said, not silent; with the calibration, not said."""
+    import warnings
+
+    from cmsim.errors import RecordWarning
+
+    c = 1.05 * np.abs(X).max() / 32767
+    np.savez(tmp_path / "r.npz", acc=np.round(X / c).astype(np.int16), fs_hz=np.float64(FS))
+    with pytest.warns(RecordWarning, match="'acc' holds integer counts .* 1 g"):
+        _read(tmp_path / "r.npz", unit="g")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RecordWarning)
+        run, channel = _read(tmp_path / "r.npz", unit="g", calibration=c)
+    assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
