@@ -73,7 +73,8 @@ def test_an_npz_states_its_rate_in_a_one_value_array_of_a_rate_name(tmp_path):
     taken); ``fs`` is a rate too (it was refused as a channel of shape ()); a plain-text
     ``units`` is every channel's unit (it was refused as damaged JSON)."""
     np.savez(tmp_path / "a.npz", acc=X, fs_hz=np.array([float(FS)]))
-    with pytest.raises(ParameterError, match="fs_hz\" array says sample rate 12000 Hz but fs_hz says 25600 Hz"):
+    with pytest.raises(ParameterError,
+                       match="fs_hz\" array says sample rate 12000 Hz but fs_hz says 25600 Hz"):
         _read(tmp_path / "a.npz", fs_hz=25_600.0)
     np.savez(tmp_path / "b.npz", acc=X, fs=np.float64(FS), units=np.array("g"))
     run, channel = _read(tmp_path / "b.npz")
