@@ -21,7 +21,7 @@ from cmsim.discrepancy.compare import DEFAULT_BUDGET
 from cmsim.discrepancy.ranking import MIN_SIGNATURE_DELTA_CHI2
 from cmsim.measured import RECORDING_KEYS, data_root, estimate_shaft_hz, read_record
 from cmsim.discrepancy.synthetic import cwru_like_rig, hidden_effect_record
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, RecordWarning
 from cmsim.features import relative_features
 from cmsim.frequencies import rig_frequencies
 
@@ -154,7 +154,8 @@ def test_reader_csv_wav_and_errors(tmp_path, monkeypatch):
         w.writeframes((x / np.abs(x).max() * 30000).astype("<i2").tobytes())
     a = read_record(folder / "rec.csv").signal
     assert np.allclose(a, x - x.mean(), atol=1e-6)
-    w = read_record(folder / "rec.wav", channel="DE")
+    with pytest.warns(RecordWarning, match="integer counts"):   # int16, no calibration
+        w = read_record(folder / "rec.wav", channel="DE")
     assert w.fs_hz == pytest.approx(fs) and w.signal.size == x.size
     monkeypatch.setenv("CMSIM_DATA", str(tmp_path))
     assert read_record("f/rec.npz").fs_hz == pytest.approx(fs)
