@@ -73,10 +73,8 @@ def run(args):
         # the channel named by the old option: the message names the option as typed
         if args.signal_alias is None or exc.param not in ("signal", "channel", "--channel"):
             raise
-        text = " ".join(str(exc).split())
-        head, _, rest = text.partition(" ")
-        raise CLIError(f"--signal {rest}" if head in (exc.param, "--channel")
-                       else f"--signal {args.signal_alias}: {text}", option="--signal") from None
+        raise CLIError(f"--signal {args.signal_alias}: {' '.join(str(exc).split())}",
+                       option="--signal") from None
     out = {"run": str(args.record), "signal": spec.signal, "kind": spec.kind, "unit": spec.unit,
            "resolution_hz": spec.resolution_hz, "bearing": spec.bearing,
            "families": spec.families, "band_hz": list(spec.band_hz) if spec.band_hz else None,

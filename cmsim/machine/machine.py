@@ -35,7 +35,7 @@ from cmsim.machine.baseline import Baseline
 from cmsim.machine.change import Change, apply_change
 from cmsim.machine.library import SignatureLibrary
 from cmsim.machine.path import TransferPath
-from cmsim.rig import OperatingPoint, Rig
+from cmsim.rig import RANGES, OperatingPoint, Rig
 from cmsim.rig.codec import drop_none
 from cmsim.run import signal_info
 
@@ -465,9 +465,10 @@ class Machine:
             _same_segments(data)
         try:
             m, o, p, b = data["machine"], data["operating"], data["path"], data["background"]
-            for key, hi in (("fs_hz", 1e7), ("segment_s", 60.0)):   # edited by hand?
-                if key in m:
-                    check_range(f'[machine] "{key}"', m[key], 0.0, hi, lo_open=True)
+            if "fs_hz" in m:                        # values edited by hand: checked
+                RANGES["fs_hz"].check('[machine] "fs_hz"', m["fs_hz"])
+            if "segment_s" in m:
+                check_range('[machine] "segment_s"', m["segment_s"], 0.0, 60.0, lo_open=True)
             scale = float(m["unit_scale"])
             wobble = float(m.get("speed_wobble", -1.0))
             return cls(
