@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import csv
 import re
-from pathlib import Path
 
 import numpy as np
 
@@ -31,21 +30,33 @@ _CSV_UNIT = re.compile(r"^(.*\S)\s*(?:\[([^\]]*)\]|\(([^)]*)\))$")
 
 
 def _layout(path):
-    """``(encoding, preamble)`` of a CSV: UTF-8 where its bytes are (a BOM included), else
-    Windows-1252 (a file a Windows DAQ program wrote, ``m/s²`` in one byte); and how many
-    lines starting with ``#`` precede its table (a DAQ program's notes on the device)."""
-    raw = Path(path).read_bytes()
+    """``(encoding, preamble)`` of a CSV, read from its first 64 KiB: UTF-8 where its bytes
+    are (a BOM included), else Windows-1252 (a file a Windows DAQ program wrote, ``m/s²`` in
+    one byte; :func:`_table` reads it so where a later byte says so); and how many lines
+    starting with ``#`` precede its table (a DAQ program's notes on the device)."""
+    with open(path, "rb") as fh:
+        raw = fh.read(1 << 16)
     try:
         raw.decode("utf-8")
         encoding = "utf-8-sig"
-    except UnicodeDecodeError:
-        encoding = "cp1252"
+    except UnicodeDecodeError as exc:       # a character cut at the end of the 64 KiB is not
+        encoding = "utf-8-sig" if exc.start >= len(raw) - 3 else "cp1252"
     preamble = 0
-    for line in raw[:1 << 16].decode(encoding, errors="replace").lstrip("\ufeff").splitlines():
+    for line in raw.decode(encoding, errors="replace").lstrip("\ufeff").splitlines():
         if not line.lstrip().startswith("#"):
             break
         preamble += 1
     return encoding, preamble
+
+
+def _table(path, encoding, **kwargs):
+    """``pandas.read_csv`` of the file in ``encoding``, in Windows-1252 where it is not
+    UTF-8 after all."""
+    import pandas as pd
+    try:
+        return pd.read_csv(path, encoding=encoding, **kwargs)
+    except UnicodeDecodeError:
+        return pd.read_csv(path, encoding="cp1252", **kwargs)
 
 
 def _head(path, encoding, preamble, n=5):
@@ -110,15 +121,14 @@ def _evenly_rising(t):
 
 def read(path, names=None):
     """Channels of a ``.csv`` file and what it states (module docstring)."""
-    import pandas as pd
     encoding, preamble = _layout(path)
     head = _head(path, encoding, preamble)
     sep, decimal = _csv_dialect(head)
     if not _csv_has_header(head, sep, decimal):
         return _read_headerless(path, sep, decimal, names, encoding, preamble)
     unit_row = _units_row(head, sep, decimal)
-    df = pd.read_csv(path, sep=sep, decimal=decimal, encoding=encoding,
-                     skiprows=list(range(preamble)) + ([preamble + 1] if unit_row else []))
+    df = _table(path, encoding, sep=sep, decimal=decimal,
+                skiprows=list(range(preamble)) + ([preamble + 1] if unit_row else []))
     # a separator at the end of every line (as a spreadsheet exports) makes an empty column
     # without a name: no channel
     df = df[[c for c in df.columns
@@ -151,9 +161,8 @@ def _read_headerless(path, sep, decimal, names, encoding="utf-8-sig", preamble=0
     samples' index (no rate); the channels are named by
     ``names`` (the entry's ``channels``) when they match in number, else ``ch0``,
     ``ch1``, ... as a WAV's are."""
-    import pandas as pd
-    data = pd.read_csv(path, sep=sep, decimal=decimal, header=None, encoding=encoding,
-                       skiprows=preamble).to_numpy(dtype=float)
+    data = _table(path, encoding, sep=sep, decimal=decimal, header=None,
+                  skiprows=preamble).to_numpy(dtype=float)
     rate = None
     if data.shape[1] > 1 and data.shape[0] > 1 and _evenly_rising(data[:, 0]):
         first = data[:, 0]
