@@ -179,8 +179,8 @@ class MeasuredRecord:
 def _channel(signals, sensors, bearings, channel, name):
     if channel is None:
         # the first near a documented bearing, else the first by name; never a time base
-        # (a LabVIEW "X_Value", a "Time" channel, a matrix's time column): samples that rise
-        # at every step are a clock, not a vibration
+        # (a LabVIEW "X_Value", a "Time" channel, a matrix's time column): samples that
+        # never fall and end higher are a clock, not a vibration
         near_bearing = [c for c in signals if (sensors.get(c) or {}).get("near") in bearings]
         candidates = near_bearing or sorted(signals)
         channel = next((c for c in candidates if not _rises_throughout(signals[c])),
@@ -193,9 +193,9 @@ def _channel(signals, sensors, bearings, channel, name):
 
 
 def _rises_throughout(x):
-    """Whether every sample of ``x`` is above the one before (a time base or a sample
-    index)."""
-    return x.size > 2 and bool(np.all(np.diff(x) > 0))
+    """Whether no sample of ``x`` is below the one before and the last is above the first (a
+    time base, one printed coarser than its step included, or a sample index)."""
+    return x.size > 2 and x[-1] > x[0] and bool(np.all(np.diff(x) >= 0))
 
 
 def _checked_samples(x, channel, name):
@@ -437,7 +437,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                                       + next((w for w, _, u in stated_units if u), "") + ")")
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
-    inferred, notes, doubts = {}, [], []
+    inferred, notes, doubts = {}, list(f.said), list(f.said)   # read_file warned them
     if scale is None and channel in f.counts and sensor_unit is not None:
         text = (f"record {p}: channel {channel!r} holds integer counts of a converter and no "
                 f"calibration states their units: each count is read as 1 {sensor_unit} "

@@ -31,11 +31,12 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, RecordWarning
 from cmsim.measured.readers import csv, mat, npz, tdms, uff, wav
 from cmsim.measured.readers._common import SignalFile
 from cmsim.measured.readers.npz import npz_names
@@ -111,6 +112,11 @@ def read_file(path, names=None):
     -------
     SignalFile
 
+    Warns
+    -----
+    RecordWarning
+        Each correction the reader made (:attr:`SignalFile.said`).
+
     Raises
     ------
     ParameterError
@@ -137,7 +143,10 @@ def read_file(path, names=None):
                              f"({type(exc).__name__}: {detail}); the file is truncated or "
                              f"damaged: copy or export it again", param="record",
                              allowed=f"a readable {path.suffix} file") from None
-    return out if isinstance(out, SignalFile) else SignalFile(*out)
+    out = out if isinstance(out, SignalFile) else SignalFile(*out)
+    for text in out.said:
+        warnings.warn(text, RecordWarning, stacklevel=2)
+    return out
 
 
 def read_signals(path, names=None):

@@ -14,7 +14,7 @@ import numpy as np
 from cmsim.errors import ParameterError
 
 __all__ = ["SignalFile", "channel_1d", "optional_module", "rate_of_step", "time_rate",
-           "one_rate", "TIME_NAME", "TIME_STEP_TOLERANCE"]
+           "even_time", "rate_within", "one_rate", "TIME_NAME", "TIME_STEP_TOLERANCE"]
 
 
 class SignalFile(NamedTuple):
@@ -37,6 +37,10 @@ class SignalFile(NamedTuple):
     counts : frozenset of str
         Channels stored as integers and not scaled by the reader: counts of a converter,
         which need a calibration to be a physical quantity.
+    said : tuple of str
+        Corrections the reader made to what the file states, each one line for the user
+        (:func:`~cmsim.measured.readers.read_file` warns them): a header-less time column
+        read in ms.
     """
 
     signals: dict
@@ -46,6 +50,7 @@ class SignalFile(NamedTuple):
     calibration: float | None = None
     rate_from: str = "the file header"
     counts: frozenset = frozenset()
+    said: tuple = ()
 
 
 def channel_1d(path, name, a):
@@ -88,11 +93,7 @@ def rate_of_step(step, digits=None):
     if digits is None:
         return rate
     ulp = 10.0 ** (math.floor(math.log10(abs(step))) - digits + 1)
-    for k in range(1, 16):
-        r = float(f"{rate:.{k}g}")
-        if abs(1.0 / r - step) <= 0.5000001 * ulp:
-            return r
-    return rate
+    return rate_within(step, 0.5000001 * ulp)
 
 
 #: A CSV time column's name (``t``, ``time``, ``zeit``, ``time_s``, ``Time (s)``,
@@ -108,23 +109,94 @@ TIME_UNITS = {"s": 1.0, "sec": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
 #: counts as evenly spaced (time stamps printed to 2 significant digits of the step).
 TIME_STEP_TOLERANCE = 0.1
 
+#: Coarsest print resolution of a time base, in sample steps, that still gives its rate:
+#: stamps printed to a resolution q sit within q/2 of the even instants, so repeated or
+#: skipped stamps (0.0001 s printed at 12 kHz: steps of 0 and 0.0001) are rounding, not a
+#: gap; coarser than two steps, the rate would rest on the first and last stamps alone.
+TIME_MAX_RESOLUTION_STEPS = 2.0
+
+
+def _print_resolutions(t):
+    """The decimal resolution each value of ``t`` was printed to — the coarsest power of ten
+    it is a multiple of (1e-4 for 0.0123; four decimals, or six significant digits, print
+    that way) — or None where a value lies on no decimal grid coarser than 1e-12 of the
+    largest (binary floats, never printed)."""
+    scale = max(float(np.max(np.abs(t))), 1e-300)
+    res = np.full(t.shape, np.nan)
+    for d in range(-3, 16):
+        q = 10.0 ** -d
+        if q < 1e-12 * scale:
+            break
+        k = t / q
+        res[np.isnan(res) & (np.abs(k - np.round(k)) <= 1e-6)] = q
+    return None if np.isnan(res).any() else res
+
+
+def even_time(t):
+    """The step of a time base ``t`` (any unit) and how far its stamps lie from the even
+    instants, or None where it is no time base: at least 8 values rising in even steps —
+    within :data:`TIME_STEP_TOLERANCE` of the mean step, or, for stamps printed to a
+    decimal resolution (their median) of at most :data:`TIME_MAX_RESOLUTION_STEPS` steps,
+    each within half its own resolution of the even instants (the rounding: a repeated
+    stamp is no gap) — what no vibration channel does.
+
+    Returns
+    -------
+    (step, spread) : tuple of float, or None
+        The step (the straight line through the stamps) and the stamps' largest distance
+        from that line: their printing's rounding, or a clock's jitter.
+    """
+    t = np.asarray(t, dtype=float)
+    if t.size < 8 or not np.all(np.isfinite(t)):
+        return None
+    steps = np.diff(t)
+    step = (t[-1] - t[0]) / (t.size - 1)
+    if not step > 0:
+        return None
+    i = np.arange(t.size) - 0.5 * (t.size - 1)
+    slope = float(np.dot(i, t - t.mean()) / np.dot(i, i))
+    spread = float(np.max(np.abs(t - t.mean() - slope * i)))
+    if np.all(np.abs(steps - step) <= TIME_STEP_TOLERANCE * step):
+        return slope, spread
+    q = _print_resolutions(t)
+    if q is None or np.median(q) > TIME_MAX_RESOLUTION_STEPS * step or np.any(steps < 0) \
+            or np.any(np.abs(t - t.mean() - slope * i) > 0.6 * q):
+        return None
+    return slope, spread
+
 
 def time_rate(path, name, t, unit="s"):
     """The sample rate of a time column or vector ``t`` (a unit of :data:`TIME_UNITS`; a CSV's time
-    column, a ``.mat`` file's ``t``), checked for even steps: a gap or a jump back is
-    refused, naming where."""
+    column, a ``.mat`` file's ``t``), checked for even steps (:func:`even_time`: stamps
+    printed coarser than a step are read through their rounding): a gap or a jump back is
+    refused, naming the step farthest from the mean. The rate is the one with the fewest digits whose step the stamps
+    allow (12 kHz from stamps printed to 0.1 ms, not 11999.7 Hz)."""
     t = np.asarray(t, dtype=float) * TIME_UNITS[unit.lower()]
-    steps = np.diff(t)
-    step = (t[-1] - t[0]) / (t.size - 1)
-    bad = np.flatnonzero(~(np.abs(steps - step) <= TIME_STEP_TOLERANCE * abs(step)))
-    if step <= 0 or not np.isfinite(step) or bad.size:
-        i = int(bad[0]) if bad.size else 0
+    found = even_time(t)
+    if found is None:
+        steps = np.diff(t)
+        step = (t[-1] - t[0]) / (t.size - 1)
+        off = np.abs(steps - step)
+        i = int(np.argmax(np.where(np.isfinite(off), off, np.inf))) if steps.size else 0
         raise ParameterError(
             f"record {path}: time {name!r} is not evenly spaced (step {i} from "
             f"{t[i]:.9g} s to {t[i + 1]:.9g} s, the mean step is {step:.6g} s); cmsim reads "
             f"evenly sampled records: export without gaps, or cut the record at the gap",
             param="record", allowed="evenly spaced time stamps")
-    return rate_of_step(step, digits=12)
+    step, spread = found
+    # stamps within ±spread of a line pin its step to within 2·spread over the record
+    return rate_within(step, max(2.0 * spread / (t.size - 1), 1e-12 * step))
+
+
+def rate_within(step, tolerance):
+    """The sample rate with the fewest significant digits whose step lies within
+    ``tolerance`` (s) of ``step``."""
+    rate = 1.0 / float(step)
+    for k in range(1, 16):
+        r = float(f"{rate:.{k}g}")
+        if abs(1.0 / r - step) <= tolerance:
+            return r
+    return rate
 
 
 def one_rate(path, rates, tolerance=0.0):

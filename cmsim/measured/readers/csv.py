@@ -9,8 +9,9 @@ starting with ``#`` before the table (a DAQ program's notes) are skipped, a file
 UTF-8 is read as Windows-1252, and an empty column without a name (a separator ending every
 line) is no channel. A file whose first line is all numbers has no header: every row is
 data, the channels are named as a WAV's (``names``, else ``ch0``, ...) and a first column
-rising in even steps is the time in seconds, or, counting 0, 1, 2, ..., the samples'
-index."""
+rising in even steps is the time in seconds (in ms or µs, said, where seconds would sample
+slower than a vibration record is), or, counting 0, 1, 2, ..., the samples' index. Time
+stamps printed coarser than a step (0.1 ms at 12 kHz) are read through their rounding."""
 
 from __future__ import annotations
 
@@ -20,11 +21,19 @@ import re
 import numpy as np
 
 from cmsim._io import atomic_write_text
-from cmsim.measured.readers._common import (TIME_NAME, TIME_STEP_TOLERANCE, SignalFile,
+from cmsim.measured.readers._common import (TIME_NAME, TIME_UNITS, SignalFile, even_time,
                                             time_rate)
+from cmsim.rig.ranges import RANGES
 
 __all__ = []   # read and write: through READERS and WRITERS of the package
 
+
+#: Least sample rate of a vibration record, Hz (the model's, :data:`~cmsim.rig.ranges.RANGES`):
+#: a header-less time column that would sample slower in seconds is in ms or µs.
+MIN_VIBRATION_RATE_HZ = RANGES["fs_hz"].lo
+
+#: A header-less time column's candidate units → samples per second per unit of rate.
+_PER_SECOND = {u: 1.0 / TIME_UNITS[u] for u in ("s", "ms", "µs")}
 
 _CSV_UNIT = re.compile(r"^(.*\S)\s*(?:\[([^\]]*)\]|\(([^)]*)\))$")
 
@@ -111,14 +120,6 @@ def _units_row(head, sep, decimal):
     return None
 
 
-def _evenly_rising(t):
-    """Whether a column is a time base: at least 8 values rising in even steps (within
-    :data:`TIME_STEP_TOLERANCE`), what no vibration channel does."""
-    steps = np.diff(np.asarray(t, dtype=float))
-    step = steps.mean() if steps.size >= 7 else 0.0
-    return bool(step > 0 and np.all(np.abs(steps - step) <= TIME_STEP_TOLERANCE * step))
-
-
 def read(path, names=None):
     """Channels of a ``.csv`` file and what it states (module docstring)."""
     encoding, preamble = _layout(path)
@@ -157,17 +158,30 @@ def read(path, names=None):
 
 def _read_headerless(path, sep, decimal, names, encoding="utf-8-sig", preamble=0):
     """A CSV without a header row: every row is data. A first column rising in even steps
-    (with others beside it) is the time base, in seconds, or where it counts 1, 2, 3 ... the
-    samples' index (no rate); the channels are named by
-    ``names`` (the entry's ``channels``) when they match in number, else ``ch0``,
+    (:func:`~cmsim.measured.readers._common.even_time`, with others beside it) is the time
+    base — in seconds, or, where seconds would give a rate under the least a vibration
+    record is sampled at (:data:`MIN_VIBRATION_RATE_HZ`), in ms or µs, said as a correction
+    — or, where it counts 1, 2, 3 ... the samples' index (no rate); the channels are named
+    by ``names`` (the entry's ``channels``) when they match in number, else ``ch0``,
     ``ch1``, ... as a WAV's are."""
     data = _table(path, encoding, sep=sep, decimal=decimal, header=None,
                   skiprows=preamble).to_numpy(dtype=float)
-    rate = None
-    if data.shape[1] > 1 and data.shape[0] > 1 and _evenly_rising(data[:, 0]):
+    rate, rate_from, said = None, "its first column (rising evenly: the time, in s)", ()
+    if data.shape[1] > 1 and data.shape[0] > 1 and even_time(data[:, 0]) is not None:
         first = data[:, 0]
         if not np.array_equal(np.diff(first), np.ones(first.size - 1)):
             rate = time_rate(path, "column 1", first)
+            unit = next((u for u in ("s", "ms", "µs") if rate * _PER_SECOND[u]
+                         >= MIN_VIBRATION_RATE_HZ), "s")
+            if unit != "s":
+                rate_from = (f"its first column (rising evenly, read as the time in {unit}: "
+                             f"in s it would be {rate:.6g} Hz)")
+                said = ((f"record {path}: its first column has no header and rises evenly; in "
+                         f"seconds it would sample at {rate:.6g} Hz, under the "
+                         f"{MIN_VIBRATION_RATE_HZ:g} Hz a vibration record is sampled at, so "
+                         f"it is read as the time in {unit}: {rate * _PER_SECOND[unit]:.6g} Hz "
+                         f"(write a header such as 'time [s]' to state the unit)"),)
+                rate *= _PER_SECOND[unit]
         # else the samples' numbers 0, 1, 2, ... (or 1, 2, 3, ...): an index, no rate (it
         # read as time in s, 1 Hz, which refused the rate --fs-hz stated)
         data = data[:, 1:]
@@ -175,7 +189,7 @@ def _read_headerless(path, sep, decimal, names, encoding="utf-8-sig", preamble=0
     if len(names) != data.shape[1]:
         names = [f"ch{i}" for i in range(data.shape[1])]
     return SignalFile({n: data[:, i] for i, n in enumerate(names)}, rate, {},
-                      rate_from="its first column (rising evenly: the time, in s)")
+                      rate_from=rate_from, said=said)
 
 
 def write(path, signals, rate_hz, units):

@@ -161,3 +161,44 @@ def test_integer_counts_without_a_calibration_are_read_with_a_warning(tmp_path):
         warnings.simplefilter("error", RecordWarning)
         run, channel = _read(tmp_path / "r.npz", unit="g", calibration=c)
     assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+
+
+@pytest.mark.parametrize("decimals", [4, 5])
+def test_time_stamps_printed_coarser_than_a_step_give_the_rate(tmp_path, decimals):
+    """Time stamps printed to 0.1 ms at 12 kHz (steps of 0 and 0.0001 s) are rounding, not a
+    gap: they were refused as "not evenly spaced"; the rate is the one the stamps pin
+    (12 kHz, not 11999.7). A dropped sample among them is still refused, naming it."""
+    fmt = f"{{:.{decimals}f}},{{:.9g}}\n"
+    (tmp_path / "r.csv").write_text("time,acc1 [g]\n" + "".join(
+        fmt.format(a, b) for a, b in zip(T, X)))
+    run, channel = _read(tmp_path / "r.csv")
+    assert run.fs_hz == FS and _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+    gap = np.delete(np.arange(N + 1) / FS, 5000)
+    (tmp_path / "gap.csv").write_text("time,acc1 [g]\n" + "".join(
+        fmt.format(a, b) for a, b in zip(gap, X)))
+    with pytest.raises(ParameterError, match="not evenly spaced .step 4999 from 0.416"):
+        _read(tmp_path / "gap.csv")
+
+
+def test_a_coarsely_printed_clock_is_never_the_channel_compared(tmp_path):
+    """LabVIEW's X_Value printed to 0.1 ms repeats a stamp now and then: it was taken for
+    the vibration (not rising at every sample) and its ramp read as the record."""
+    (tmp_path / "r.csv").write_text("X_Value,acc1\n" + "".join(
+        f"{a:.4f},{b:.9g}\n" for a, b in zip(T, X)))
+    run, channel = _read(tmp_path / "r.csv", fs_hz=FS, unit="g")
+    assert channel == "acc1" and _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+
+
+@pytest.mark.parametrize("unit, factor", [("ms", 1e3), ("µs", 1e6)])
+def test_a_header_less_time_column_in_ms_is_said_not_read_as_seconds(tmp_path, unit, factor):
+    """A header-less first column of the time in ms read as seconds: a 12-Hz record, its
+    1234.5-Hz line at 1.2 Hz, silently. Under the least rate of a vibration record it is
+    read in ms (or µs), and the correction is said."""
+    from cmsim.errors import RecordWarning
+
+    (tmp_path / "r.csv").write_text("".join(
+        f"{factor * a:.6f},{b:.9g}\n" for a, b in zip(T, X)))
+    with pytest.warns(RecordWarning, match=f"read as the time in {unit}: 12000 Hz"):
+        run, channel = _read(tmp_path / "r.csv", unit="g")
+    assert run.fs_hz == FS and _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+    assert any(f"time in {unit}" in w for w in run.meta["warnings"])
