@@ -413,9 +413,10 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     geometry = meta.get("geometry") or {}
     f = read_file(p, entry.get("channels"))
     if full is None and f.rate_hz is None and fs_hz is None:
+        why = "".join(f" ({text.removeprefix(f'record {p}: ')})" for text in f.said)
         raise ParameterError(f"record {p}: no metadata.json in {p.parent} and the file states "
-                             f"no sample rate: give fs_hz (and speed_rpm, rig), or write the "
-                             f"metadata with cmsim import (the record format is the "
+                             f"no sample rate{why}: give fs_hz (and speed_rpm, rig), or write "
+                             f"the metadata with cmsim import (the record format is the "
                              f"metadata.json schema of the datasets README)", param="record",
                              allowed="a file in a folder with metadata.json, or fs_hz")
     signals = dict(f.signals)

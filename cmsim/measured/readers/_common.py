@@ -159,33 +159,54 @@ def even_time(t):
     if np.all(np.abs(steps - step) <= TIME_STEP_TOLERANCE * step):
         return slope, spread
     q = _print_resolutions(t)
-    if q is None or np.median(q) > TIME_MAX_RESOLUTION_STEPS * step or np.any(steps < 0) \
-            or np.any(np.abs(t - t.mean() - slope * i) > 0.6 * q):
+    if q is None or np.any(steps < 0) or np.median(q) > TIME_MAX_RESOLUTION_STEPS * step:
         return None
-    return slope, spread
+    per = step / float(np.median(q))   # steps per resolution, known to per/(n-1)
+    if abs(per - round(per)) <= 2.0 * per / (t.size - 1):
+        return None      # the even instants print exactly at this resolution: no rounding
+    # the line through the stamps, each weighted by its resolution (six significant digits
+    # print the first second finer than the next)
+    w = q ** -2.0
+    tm, im = np.average(t, weights=w), np.average(i, weights=w)
+    slope = float(np.sum(w * (i - im) * (t - tm)) / np.sum(w * (i - im) ** 2))
+    off = np.abs(t - tm - slope * (i - im))
+    if np.any(off > 0.6 * q):
+        return None
+    return slope, float(np.max(off))
 
 
-def time_rate(path, name, t, unit="s"):
-    """The sample rate of a time column or vector ``t`` (a unit of :data:`TIME_UNITS`; a CSV's time
-    column, a ``.mat`` file's ``t``), checked for even steps (:func:`even_time`: stamps
-    printed coarser than a step are read through their rounding): a gap or a jump back is
-    refused, naming the step farthest from the mean. The rate is the one with the fewest digits whose step the stamps
-    allow (12 kHz from stamps printed to 0.1 ms, not 11999.7 Hz)."""
+def time_rate(path, name, t, unit="s", said=None):
+    """The sample rate of a time column or vector ``t`` (a unit of :data:`TIME_UNITS`; a
+    CSV's time column, a ``.mat`` file's ``t``), checked for even steps (:func:`even_time`:
+    stamps printed coarser than a step are read through their rounding): a gap or a jump
+    back is refused, naming the step farthest from the mean. The rate is the one with the
+    fewest digits whose step the stamps allow (12 kHz from stamps printed to 0.1 ms, not
+    11999.7 Hz). Stamps printed coarser than :data:`TIME_MAX_RESOLUTION_STEPS` steps (1 ms
+    at 12 kHz) but even within their rounding give no rate: None, and why is appended to
+    ``said`` (the rate must then be stated another way)."""
     t = np.asarray(t, dtype=float) * TIME_UNITS[unit.lower()]
     found = even_time(t)
-    if found is None:
-        steps = np.diff(t)
-        step = (t[-1] - t[0]) / (t.size - 1)
-        off = np.abs(steps - step)
-        i = int(np.argmax(np.where(np.isfinite(off), off, np.inf))) if steps.size else 0
-        raise ParameterError(
-            f"record {path}: time {name!r} is not evenly spaced (step {i} from "
-            f"{t[i]:.9g} s to {t[i + 1]:.9g} s, the mean step is {step:.6g} s); cmsim reads "
-            f"evenly sampled records: export without gaps, or cut the record at the gap",
-            param="record", allowed="evenly spaced time stamps")
-    step, spread = found
-    # stamps within ±spread of a line pin its step to within 2·spread over the record
-    return rate_within(step, max(2.0 * spread / (t.size - 1), 1e-12 * step))
+    if found is not None:
+        step, spread = found
+        # stamps within ±spread of a line pin its step to within 2·spread over the record
+        return rate_within(step, max(2.0 * spread / (t.size - 1), 1e-12 * step))
+    steps = np.diff(t)
+    step = (t[-1] - t[0]) / (t.size - 1)
+    q = _print_resolutions(t) if t.size >= 8 and np.all(np.isfinite(t)) else None
+    if said is not None and q is not None and step > 0 and np.all(steps >= 0) \
+            and np.median(q) > TIME_MAX_RESOLUTION_STEPS * step \
+            and np.all(np.abs(t - t[0] - step * np.arange(t.size)) <= 1.1 * q):
+        said.append(f"record {path}: time {name!r} is printed to {np.median(q):.3g} s, "
+                    f"coarser than two samples ({step:.3g} s apart): it gives no sample rate "
+                    f"and cannot show a gap; the rate is taken from where else it is stated")
+        return None
+    off = np.abs(steps - step)
+    i = int(np.argmax(np.where(np.isfinite(off), off, np.inf))) if steps.size else 0
+    raise ParameterError(
+        f"record {path}: time {name!r} is not evenly spaced (step {i} from "
+        f"{t[i]:.9g} s to {t[i + 1]:.9g} s, the mean step is {step:.6g} s); cmsim reads "
+        f"evenly sampled records: export without gaps, or cut the record at the gap",
+        param="record", allowed="evenly spaced time stamps")
 
 
 def rate_within(step, tolerance):

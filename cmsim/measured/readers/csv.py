@@ -138,11 +138,11 @@ def read(path, names=None):
     if unit_row:                    # a units row: each column's unit, as "name [unit]" does
         cols = [f"{c} [{u}]" if u and not _CSV_UNIT.match(c) else c
                 for c, u in zip(cols, unit_row + [""] * len(cols))]
-    rate = None
+    rate, said = None, []
     m = TIME_NAME.match(cols[0].strip()) if cols else None
     if m and len(df) > 1:
         unit = next((g for g in m.groups() if g), "s")
-        rate = time_rate(path, cols[0], df[df.columns[0]].to_numpy(dtype=float), unit)
+        rate = time_rate(path, cols[0], df[df.columns[0]].to_numpy(dtype=float), unit, said)
         df, cols = df.iloc[:, 1:], cols[1:]
     signals, units = {}, {}
     for c, col in zip(cols, df.columns):
@@ -153,7 +153,7 @@ def read(path, names=None):
         if unit:
             units[name] = unit
         signals[name] = df[col].to_numpy(dtype=float)
-    return SignalFile(signals, rate, units, rate_from="its time column")
+    return SignalFile(signals, rate, units, rate_from="its time column", said=tuple(said))
 
 
 def _read_headerless(path, sep, decimal, names, encoding="utf-8-sig", preamble=0):

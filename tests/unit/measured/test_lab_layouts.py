@@ -202,3 +202,19 @@ def test_a_header_less_time_column_in_ms_is_said_not_read_as_seconds(tmp_path, u
         run, channel = _read(tmp_path / "r.csv", unit="g")
     assert run.fs_hz == FS and _line(run[channel]) == pytest.approx(1.0, abs=0.01)
     assert any(f"time in {unit}" in w for w in run.meta["warnings"])
+
+
+def test_time_stamps_printed_coarser_than_two_samples_leave_the_rate_to_be_stated(tmp_path):
+    """Stamps printed to 1 ms at 12 kHz cannot give the rate nor show a gap: the file was
+    refused whatever rate the user gave; now it states none, says why, and reads at the
+    rate given (refused without one, the reason in the message)."""
+    from cmsim.errors import RecordWarning
+
+    (tmp_path / "r.csv").write_text("time,acc1 [g]\n" + "".join(
+        f"{a:.3f},{b:.9g}\n" for a, b in zip(T, X)))
+    with pytest.warns(RecordWarning, match="printed to 0.001 s, coarser than two samples"):
+        run, channel = _read(tmp_path / "r.csv", fs_hz=FS)
+    assert run.fs_hz == FS and _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+    with pytest.raises(ParameterError, match="states no sample rate .time 'time' is printed"), \
+            pytest.warns(RecordWarning):
+        _read(tmp_path / "r.csv")
