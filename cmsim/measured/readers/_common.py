@@ -194,7 +194,7 @@ def time_rate(path, name, t, unit="s", said=None):
     step = (t[-1] - t[0]) / (t.size - 1)
     q = _print_resolutions(t) if t.size >= 8 and np.all(np.isfinite(t)) else None
     if said is not None and q is not None and step > 0 and np.all(steps >= 0) \
-            and np.median(q) > TIME_MAX_RESOLUTION_STEPS * step \
+            and np.median(q) >= (1.0 - 1e-9) * TIME_MAX_RESOLUTION_STEPS * step \
             and np.all(np.abs(t - t[0] - step * np.arange(t.size)) <= 1.1 * q):
         said.append(f"record {path}: time {name!r} is printed to {np.median(q):.3g} s, "
                     f"coarser than two samples ({step:.3g} s apart): it gives no sample rate "
