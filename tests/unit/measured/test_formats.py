@@ -193,7 +193,7 @@ def test_compare_and_spectrum_on_options_only(tmp_path, capsys, kind):
 
 
 @needs_cwru
-def test_calibrate_on_options_only(tmp_path, capsys):
+def test_calibrate_on_options_only(tmp_path, capsys, monkeypatch):
     """A machine from a CWRU ``.mat`` that states neither rate nor unit: the options give
     them. (Calibrate reads a record as compare does, by ``read_record``: the UFF case above
     covers the reader; a second calibration would only build the same library again.)"""
@@ -205,6 +205,19 @@ def test_calibrate_on_options_only(tmp_path, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["fs_hz"] == 12000.0 and out["channel"] == "X097_DE_time"
     assert machine.is_file() and not (tmp_path / "metadata.json").exists()
+    # against it, the model runs only to refine a named cause: with the kernels cached the
+    # command does not load them up front (0.4 s of a 2-s comparison with no finding)
+    import cmsim.cli.app as app
+    import cmsim.dynamics.simulation as simulation
+
+    asked = []
+    monkeypatch.setattr(simulation, "kernels_cached", lambda: True)
+    monkeypatch.setattr(app, "_notice_compile", lambda args, integrates=True: asked.append(
+        integrates))
+    assert main(["compare", str(path), "--machine", str(machine), "--fs-hz", "12000",
+                 "--speed-rpm", "1797", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["mode"] == "machine" and asked == [False]
 
 
 # ---------------------------------------------------------------------- bad inputs
