@@ -5,8 +5,9 @@ a vector ``t`` or ``time`` (``time_s``, ``t_ms``) is the time base, not a channe
 must be even, and give the rate; a scalar whose name ends in ``RPM`` (``X097RPM``) is the
 shaft speed (several of different values are refused as ambiguous), a scalar ``fs``,
 ``Fs``, ``fs_hz`` or ``sample_rate`` the sample rate (it must agree with a time vector), a
-struct ``units`` (channel → text) the units; other scalars, strings and structs are
-skipped. A v7.3 file (HDF5) is read with h5py when it is installed, else refused with what
+struct ``units`` (channel → text) the units; the fields of a struct are read the same way,
+named ``struct.field`` (``rec.acc`` at the rate ``rec.fs``; two levels deep); other
+scalars, strings and cells are skipped. A v7.3 file (HDF5) is read with h5py when it is installed, else refused with what
 to do."""
 
 from __future__ import annotations
@@ -28,6 +29,24 @@ __all__ = []   # read and write: through READERS and WRITERS of the package
 _MAT_RATE_NAMES = ("fs", "fs_hz", "sample_rate", "samplerate", "sampling_rate")
 
 
+#: Levels of nested structs whose fields are read (a struct ``rec`` with fields ``acc`` and
+#: ``fs`` is the channel ``rec.acc`` at the rate ``rec.fs``).
+STRUCT_DEPTH = 2
+
+
+def _flattened(variables, prefix="", depth=0):
+    """``(name, value)`` of every top-level variable and, down to :data:`STRUCT_DEPTH`
+    levels, of every field of a struct (``rec.acc``); a struct's ``units`` stays whole."""
+    for name, value in variables.items():
+        if not prefix and name.startswith("__"):
+            continue
+        full = prefix + str(name)
+        if isinstance(value, dict) and name != "units" and depth < STRUCT_DEPTH:
+            yield from _flattened(value, full + ".", depth + 1)
+        else:
+            yield full, value
+
+
 def _mat_channels(path, name, a):
     """The channels of one ``.mat`` variable: a vector is one channel; an n × k matrix (a
     DAQ export's ``data``) is k channels ``name_0`` ... ``name_{k-1}`` — its columns when
@@ -46,22 +65,24 @@ def read(path, names=None):
     except NotImplementedError:            # a v7.3 file: HDF5 inside
         variables = _read_mat73(path)
     signals, rates, speeds, units, time, counts = {}, {}, {}, {}, None, set()
-    for name, value in variables.items():
-        if name.startswith("__"):
+    for name, value in _flattened(variables):
+        leaf = name.rsplit(".", 1)[-1]
+        if leaf == "units" and isinstance(value, dict):
+            prefix = name[:-len(leaf)]
+            units.update({prefix + str(k): str(v) for k, v in value.items()})
             continue
-        if name == "units" and isinstance(value, dict):
-            units = {str(k): str(v) for k, v in value.items()}
-            continue
+        if isinstance(value, dict):
+            continue                       # a struct nested deeper than STRUCT_DEPTH
         a = np.asarray(value)
         if a.dtype.kind not in "iuf":
-            continue                       # strings, structs, cells, logicals, complex
+            continue                       # strings, cells, logicals, complex
         if a.size == 1:
-            if name.lower().endswith("rpm"):
+            if leaf.lower().endswith("rpm"):
                 speeds[name] = float(a.reshape(-1)[0])
-            elif name.lower() in _MAT_RATE_NAMES:
+            elif leaf.lower() in _MAT_RATE_NAMES:
                 rates[name] = float(a.reshape(-1)[0])
             continue
-        m = TIME_NAME.match(name)
+        m = TIME_NAME.match(leaf)
         if m and (a.ndim == 1 or 1 in a.shape) and a.size > 1:
             time = name
             rates[name] = time_rate(path, name, a.reshape(-1),

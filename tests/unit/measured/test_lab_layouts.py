@@ -218,3 +218,18 @@ def test_time_stamps_printed_coarser_than_two_samples_leave_the_rate_to_be_state
     with pytest.raises(ParameterError, match="states no sample rate .time 'time' is printed"), \
             pytest.warns(RecordWarning):
         _read(tmp_path / "r.csv")
+
+
+def test_a_mat_struct_s_fields_are_channels_and_its_rate(tmp_path):
+    """A lab script's ``rec.acc`` with ``rec.fs`` (and ``rec.units``), or a struct per
+    channel beside a top-level ``fs``: the fields were skipped ("states no sample rate", then
+    no channel); they are read as ``struct.field``."""
+    from scipy.io import savemat
+
+    savemat(tmp_path / "a.mat", {"rec": {"acc": X, "fs": float(FS), "units": {"acc": "g"}}})
+    run, channel = _read(tmp_path / "a.mat")
+    assert channel == "rec.acc" and run.fs_hz == FS
+    assert _line(run[channel]) == pytest.approx(1.0, abs=0.01)
+    savemat(tmp_path / "b.mat", {"ch1": {"y": 2 * X}, "ch2": {"y": X}, "fs": float(FS)})
+    run, channel = _read(tmp_path / "b.mat", channel="ch2.y", unit="g")
+    assert run.fs_hz == FS and _line(run[channel]) == pytest.approx(1.0, abs=0.01)
