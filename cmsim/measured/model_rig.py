@@ -22,7 +22,7 @@ from cmsim.frequencies import RigFrequencies, bearing_frequencies
 from cmsim.measured.schema import STANDARD_GRAVITY_M_S2, documented_radial_load_n
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
 
-__all__ = ["model_rig", "documented_frequencies", "model_operating_point", "NO_GEOMETRY",
+__all__ = ["model_rig", "documented_frequencies", "documented_geometry", "BEARING_NUMBERS", "model_operating_point", "NO_GEOMETRY",
            "documented_operating_point", "DEFAULT_ROTOR_MASS_KG", "DEFAULT_CLEARANCE_M"]
 
 #: Rotor mass assumed for a bearing rig whose rotor is not documented, kg.
@@ -30,6 +30,87 @@ DEFAULT_ROTOR_MASS_KG = 10.0
 
 #: Radial clearance assumed for a documented bearing (not documented in the records), m.
 DEFAULT_CLEARANCE_M = 5e-6
+
+
+#: The numbers of a documented bearing's geometry (all three, or none: undocumented).
+BEARING_NUMBERS = ("n_balls", "ball_diameter_mm", "pitch_diameter_mm")
+
+
+def _whole(value, where):
+    """A count written as a JSON number or a number in quotes (``25``, ``25.0``, ``"25"``),
+    as an int >= 1; anything else one error naming where it is."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = math.nan
+    if isinstance(value, bool) or not (v >= 1 and v == int(v)):
+        raise ParameterError(f"metadata.json {where} must be a whole number >= 1, got "
+                             f"{value!r}", param="geometry", allowed="a whole number >= 1")
+    return int(v)
+
+
+def _shaft(value, where):
+    """``input`` or ``output`` from a bearing's ``shaft`` (default ``input``): a text that
+    names one of them and not the other (``"input shaft (pinion)"``) is that one; any other
+    text is refused — a bearing put on the wrong shaft turns at the wrong rate."""
+    if value is None:
+        return "input"
+    text = str(value).lower()
+    found = [w for w in ("input", "output") if w in text]
+    if len(found) != 1:
+        raise ParameterError(f"metadata.json {where} {value!r}: say which shaft the bearing "
+                             f"is on, input or output (the gear stage's input_teeth or "
+                             f"output_teeth side)", param="geometry", allowed="input, output")
+    return found[0]
+
+
+def documented_geometry(geometry):
+    """The ``geometry`` of ``metadata.json`` as the model reads it, and what was assumed.
+
+    Tooth counts and ball counts may be written in quotes (``"25"``); a bearing whose
+    ball count and diameters are all ``null`` (known by its designation only) is
+    undocumented, as one not listed is; one that gives some of them and not all is
+    refused, naming it; a bearing's ``shaft`` is ``input`` or ``output`` (a text naming
+    one of them, ``"input shaft (pinion)"``, is that one).
+
+    Parameters
+    ----------
+    geometry : dict or None
+
+    Returns
+    -------
+    geometry : dict
+        ``gears`` (stages with both tooth counts, as ints) and ``bearings`` (each with its
+        three numbers and its ``shaft``).
+    notes : list of str
+    """
+    geometry = geometry or {}
+    gears = []
+    for i, stage in enumerate(geometry.get("gears") or []):
+        if not isinstance(stage, dict) or stage.get("input_teeth") is None \
+                or stage.get("output_teeth") is None:
+            continue
+        gears.append({**stage, **{k: _whole(stage[k], f"geometry.gears[{i}].{k}")
+                                  for k in ("input_teeth", "output_teeth")}})
+    bearings, notes = {}, []
+    for key, b in (geometry.get("bearings") or {}).items():
+        b = b if isinstance(b, dict) else {}
+        given = [k for k in BEARING_NUMBERS if b.get(k) is not None]
+        if not given:
+            notes.append(f"bearing {key}: its ball count and diameters are not documented"
+                         + (f" ({b['model']})" if b.get("model") else "")
+                         + ": read as undocumented")
+            continue
+        where = f"geometry.bearings.{key}"
+        if len(given) < len(BEARING_NUMBERS):
+            missing = [k for k in BEARING_NUMBERS if k not in given]
+            raise ParameterError(f"metadata.json {where} gives {', '.join(given)} but not "
+                                 f"{', '.join(missing)}: give all three (the bearing's "
+                                 f"catalogue values) or null them all", param="geometry",
+                                 allowed=", ".join(BEARING_NUMBERS))
+        bearings[key] = {**b, "n_balls": _whole(b["n_balls"], f"{where}.n_balls"),
+                         "shaft": _shaft(b.get("shaft"), f"{where}.shaft")}
+    return {**geometry, "gears": gears, "bearings": bearings}, notes
 
 
 def _bearing(geom, like=None):
@@ -50,11 +131,6 @@ def _bearing(geom, like=None):
         "inner_groove_radius_m", "outer_groove_radius_m")})
 
 
-def _gear_stages(geometry):
-    return [s for s in ((geometry or {}).get("gears") or [])
-            if s.get("input_teeth") and s.get("output_teeth")]
-
-
 def _gear_rig(stage, bearings, near):
     """Paper rig with the documented tooth counts (other gear data undocumented) and the
     documented bearings: on each shaft (``shaft``: ``input``, the default, or ``output``)
@@ -68,7 +144,7 @@ def _gear_rig(stage, bearings, near):
     keys = sorted(bearings, key=lambda k: k != near)
     shafts, names = [], {}
     for i, (shaft, which) in enumerate(zip(base.shafts, ("input", "output"))):
-        on = [k for k in keys if (bearings[k] or {}).get("shaft", "input") == which]
+        on = [k for k in keys if bearings[k]["shaft"] == which]
         if len(on) > 2:
             raise ParameterError(f"metadata.json documents {len(on)} bearings on the {which} "
                                  f"shaft ({', '.join(on)}); a gear rig's shaft has two",
@@ -110,14 +186,14 @@ def model_rig(geometry, near=None):
     ParameterError
         Neither bearing geometry nor gear tooth counts.
     """
-    geometry = geometry or {}
-    bearings = geometry.get("bearings") or {}
-    gears = _gear_stages(geometry)
+    geometry, notes = documented_geometry(geometry)
+    bearings = geometry["bearings"]
+    gears = geometry["gears"]
     if gears:
         rig, names = _gear_rig(gears[0], bearings, near)
         kept = [n for n in rig.bearing_names if n not in names]
-        notes = ["gear data beyond tooth counts undocumented: the paper rig's gears with the "
-                 "documented tooth counts"]
+        notes.append("gear data beyond tooth counts undocumented: the paper rig's gears with "
+                     "the documented tooth counts")
         if kept:
             notes.append(f"bearing{'s' if len(kept) > 1 else ''} {', '.join(kept)} "
                          "undocumented: the paper rig's 209")
@@ -132,7 +208,7 @@ def model_rig(geometry, near=None):
     rig = Rig.rotor_on_bearings(_bearing(bearings[first]),
                                 Rotor(mass_kg=DEFAULT_ROTOR_MASS_KG, inertia_kg_m2=0.02),
                                 bearing_2=_bearing(bearings[other]))
-    return rig, {"1b1": first, "1b2": other}, [
+    return rig, {"1b1": first, "1b2": other}, notes + [
         f"rotor {DEFAULT_ROTOR_MASS_KG:g} kg assumed (undocumented)"]
 
 
@@ -152,13 +228,14 @@ def documented_frequencies(geometry, shaft_hz):
         Shaft rates and GMF of the first stage with tooth counts; bearings by their metadata
         keys (a bearing on the ``output`` shaft turns at the output rate).
     """
-    gears = _gear_stages(geometry)
+    geometry = documented_geometry(geometry)[0]
+    gears = geometry["gears"]
     fr2 = gmf = None
     if gears:
         z1, z2 = gears[0]["input_teeth"], gears[0]["output_teeth"]
         fr2, gmf = shaft_hz * z1 / z2, shaft_hz * z1
     out = {}
-    for name, b in ((geometry or {}).get("bearings") or {}).items():
+    for name, b in geometry["bearings"].items():
         rate = fr2 if b.get("shaft") == "output" and fr2 is not None else shaft_hz
         out[name] = bearing_frequencies(
             rate, int(b["n_balls"]), 1e-3 * float(b["ball_diameter_mm"]),

@@ -61,3 +61,47 @@ def test_three_bearings_on_one_shaft_of_a_gear_rig_is_bad_metadata():
                 "bearings": {"a": b, "b": b, "c": b}}
     with pytest.raises(ParameterError, match="3 bearings on the input shaft"):
         model_rig(geometry)
+
+
+def _ball_bearing(**kw):
+    return {"n_balls": 9, "ball_diameter_mm": 7.94, "pitch_diameter_mm": 39.04, **kw}
+
+
+def test_lab_spellings_of_a_gearbox_s_geometry_are_read_as_documented():
+    """What a lab writes for the same gearbox (found by a probe of documentation variants,
+    2026-12-02): tooth counts in quotes crashed the command ("internal error"); a bearing
+    known by its designation alone (numbers null) refused the record; a ``shaft`` that
+    names its shaft in words dropped the documented bearings for the paper's silently."""
+    words = {"gears": [{"stage": 1, "input_teeth": "25", "output_teeth": 55.0}],
+             "bearings": {"de": _ball_bearing(shaft="input shaft (pinion)"),
+                          "nde": {"model": "6205", "n_balls": None,
+                                  "ball_diameter_mm": None, "pitch_diameter_mm": None},
+                          "out": _ball_bearing(shaft="Output")}}
+    rig, components, notes = model_rig(words, near="de")
+    assert (rig.gears.driving.n_teeth, rig.gears.driven.n_teeth) == (25, 55)
+    assert components["1b1"] == "de" and components["2b1"] == "out"
+    assert "nde" not in components.values()
+    assert any("nde" in n and "6205" in n and "undocumented" in n for n in notes)
+    plain = {"gears": [{"stage": 1, "input_teeth": 25, "output_teeth": 55}],
+             "bearings": {"de": _ball_bearing(shaft="input"),
+                          "out": _ball_bearing(shaft="output")}}
+    same, _, _ = model_rig(plain, near="de")
+    assert rig.shafts[0].bearing_1 == same.shafts[0].bearing_1
+    assert rig.shafts[1].bearing_1 == same.shafts[1].bearing_1
+    assert documented_frequencies(words, 25.0).bearing("out").bpfo_hz == pytest.approx(
+        documented_frequencies(plain, 25.0).bearing("out").bpfo_hz)
+
+
+@pytest.mark.parametrize("change, match", [
+    ({"input_teeth": "25 teeth"}, "input_teeth must be a whole number"),
+    ({"input_teeth": 25.5}, "input_teeth must be a whole number"),
+    ({"shaft": "high-speed"}, "shaft 'high-speed': say which shaft"),
+    ({"ball_diameter_mm": None}, "gives n_balls, pitch_diameter_mm but not ball_diameter_mm"),
+])
+def test_a_gearbox_s_geometry_that_cannot_be_read_is_refused_naming_the_key(change, match):
+    stage = {"stage": 1, "input_teeth": 25, "output_teeth": 55}
+    bearing = _ball_bearing(shaft="input")
+    for k, v in change.items():
+        (stage if k in stage else bearing)[k] = v
+    with pytest.raises(ParameterError, match=match):
+        model_rig({"gears": [stage], "bearings": {"de": bearing}}, near="de")
