@@ -11,6 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from cmsim.discrepancy.signatures import operating_shift
+from cmsim.measured.schema import RADIAL_KEYS, TORQUE_KEYS
 
 __all__ = ["record_load", "at_operating_point", "LOAD_TOLERANCE",
            "OPERATING_SHIFT_UNCERTAINTY", "TORQUE_KEYS", "RADIAL_KEYS"]
@@ -28,11 +29,6 @@ LOAD_TOLERANCE = 0.1
 #: broadband 11 dB, so a shift taken as exact named a tooth fault on a healthy record; the
 #: CWRU records across loads (0 → 1 hp) move their defect families far beyond their shift.
 OPERATING_SHIFT_UNCERTAINTY = 1.0
-
-
-#: Keys of a recording entry that document its torque (a gear rig's) and its radial load.
-TORQUE_KEYS = ("torque_nm", "load_percent")
-RADIAL_KEYS = ("radial_load_n", "radial_load_lbs")
 
 
 def record_load(record, machine):
@@ -57,19 +53,32 @@ def record_load(record, machine):
     if not record.path:
         return op, ""
     entry = record.meta.get("recording") or {}
-    taken = []
-    if record.rig is not None and record.rig.gears is not None \
-            and not any(entry.get(k) is not None for k in TORQUE_KEYS):
-        op = replace(op, torque_nm=machine.op.torque_nm)
-        taken.append(f"torque {machine.op.torque_nm:g} N m")
-    if not any(entry.get(k) is not None for k in RADIAL_KEYS) \
-            and op.radial_load_n != machine.op.radial_load_n:
-        op = replace(op, radial_load_n=machine.op.radial_load_n)
-        taken.append(f"radial load {machine.op.radial_load_n:g} N")
-    if not taken:
-        return op, ""
-    return op, ("the record documents no load: read at the machine's ("
-                + ", ".join(taken) + ")")
+    taken, unknown = [], []
+    for field, keys, gears, what in (
+            ("torque_nm", TORQUE_KEYS, True, f"torque {machine.op.torque_nm:g} N m"),
+            ("radial_load_n", RADIAL_KEYS, False,
+             f"radial load {machine.op.radial_load_n:g} N")):
+        if gears and (record.rig is None or record.rig.gears is None):
+            continue
+        if getattr(op, field) == getattr(machine.op, field):
+            continue
+        if not any(entry.get(k) is not None for k in keys):
+            taken.append(what)
+        elif field in machine.assumed_load:
+            unknown.append(what)
+        else:
+            continue
+        op = replace(op, **{field: getattr(machine.op, field)})
+    notes = []
+    if taken:
+        notes.append("the record documents no load: read at the machine's ("
+                     + ", ".join(taken) + ")")
+    if unknown:
+        notes.append("the machine's baseline documented no load (its "
+                     + ", ".join(unknown) + " was assumed at calibration): the record's "
+                     "documented load is not compared with it, and the record is read at the "
+                     "machine's")
+    return op, "; ".join(notes)
 
 
 def at_operating_point(machine, lib, op):

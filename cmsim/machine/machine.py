@@ -206,6 +206,10 @@ class Machine:
         The baseline records and the segments used.
     notes : tuple of str
         What was assumed (an unidentified path gain, an undocumented load ...).
+    assumed_load : tuple of str
+        The loads of :attr:`op` (``torque_nm``, ``radial_load_n``) its baseline did not
+        document: the model's assumption, no measurement a record's documented load can be
+        compared with (:func:`cmsim.discrepancy.operating_point.record_load`).
     baseline : Baseline or None
         The healthy record(s) it was calibrated on: the healthy prediction of every
         comparison and the healthy stretches of its dataset records (None: a version-1
@@ -232,6 +236,7 @@ class Machine:
     fit_quality: dict = field(default_factory=dict)
     calibrated_on: tuple = ()
     notes: tuple = ()
+    assumed_load: tuple = ()
     baseline: Baseline | None = None
     library: SignatureLibrary | None = None
 
@@ -425,7 +430,8 @@ class Machine:
                         "speed_wobble": -1.0 if self.speed_wobble is None else self.speed_wobble,
                         "components": dict(self.components),
                         "shaft_gain": {str(k): float(v) for k, v in self.shaft_gain.items()},
-                        "calibrated_on": list(self.calibrated_on), "notes": list(self.notes)},
+                        "calibrated_on": list(self.calibrated_on), "notes": list(self.notes),
+                        "assumed_load": list(self.assumed_load)},
             "operating": {"speed_rpm": self.op.speed_rpm, "torque_nm": self.op.torque_nm,
                           "radial_load_n": self.op.radial_load_n,
                           "radial_load_angle_rad": self.op.radial_load_angle_rad},
@@ -488,6 +494,8 @@ class Machine:
                 spread={k: (float(v[0]), float(v[1])) for k, v in data.get("spread", {}).items()},
                 fit_quality=dict(data.get("fit_quality", {})),
                 calibrated_on=tuple(m.get("calibrated_on", ())), notes=tuple(m.get("notes", ())),
+                assumed_load=tuple(str(k) for k in m.get("assumed_load", ())
+                                   if k in ("torque_nm", "radial_load_n")),
                 baseline=Baseline.from_dict(data["baseline"]) if "baseline" in data else None,
                 library=(SignatureLibrary.from_dict(data["library"]) if "library" in data
                          else None))

@@ -26,7 +26,7 @@ __all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_
            "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
            "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
            "documented_radial_load_n", "unit_scale_of", "rig_geometry",
-           "documented_speed", "SPEED_KEYS", "checked_unit", "OTHER_UNITS", "VELOCITY_UNITS",
+           "documented_speed", "SPEED_KEYS", "TORQUE_KEYS", "RADIAL_KEYS", "undocumented_load", "checked_unit", "OTHER_UNITS", "VELOCITY_UNITS",
            "DISPLACEMENT_UNITS", "UNKNOWN_UNIT", "known_units", "unit_kind"]
 
 #: Keys of a ``recordings[]`` entry the pipeline reads; everything else is ignored.
@@ -43,6 +43,20 @@ NUMERIC_KEYS = {"fs_hz": "record_fs_hz", "n_samples": "n_samples",
                 "torque_nm": "torque_nm", "motor_load_hp": "motor_load_hp",
                 "radial_load_lbs": "radial_load_lbs", "radial_load_n": "radial_load_n",
                 "load_percent": "load_percent", "calibration": "calibration"}
+
+#: Keys of a recording entry that document its torque (a gear rig's) and its radial load.
+TORQUE_KEYS = ("torque_nm", "load_percent")
+RADIAL_KEYS = ("radial_load_n", "radial_load_lbs")
+
+
+def undocumented_load(entry):
+    """The loads of an operating point (``torque_nm``, ``radial_load_n``) a recording entry
+    documents none of the keys of (:data:`TORQUE_KEYS`, :data:`RADIAL_KEYS`): the model
+    assumes them."""
+    return tuple(field for field, keys in (("torque_nm", TORQUE_KEYS),
+                                           ("radial_load_n", RADIAL_KEYS))
+                 if not any((entry or {}).get(k) is not None for k in keys))
+
 
 #: Folder-level keys the pipeline reads (``fs_note`` only to cross-check an inferred rate).
 FOLDER_KEYS = ("fs_hz", "fs_note", "channels", "sensors", "geometry")

@@ -107,6 +107,7 @@ from cmsim.machine.calibration.path_reading import (BROADBAND_SHARE, FORCE_MODUL
 from cmsim.machine.calibration.quality import (WOBBLE_MIN_SNR, _misfit, _speed_wobble,
                                                feature_rows)
 from cmsim.machine.machine import Machine, model_force
+from cmsim.measured.schema import undocumented_load
 from cmsim.run import signal_info
 from cmsim.spectra.floor import segment_psd
 from cmsim.spectra.line_detector import (FLOOR_HALF_WIDTH_HZ, LINE_MIN_DB, LINE_TOLERANCE,
@@ -335,5 +336,10 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
                    float(np.mean([v * v for v in z_model.values()])) if z_model else 0.0,
                "n_features": len(z), "held_out_segments": len(held),
                "twin_segments": int(twin_rows.shape[0])}
-    return replace(machine, spread=spread, fit_quality=quality,
+    # the loads no baseline file documents are the model's assumption (a run made here
+    # carries its own)
+    files = [r for r in records if r.path]
+    assumed = tuple(f for f in ("torque_nm", "radial_load_n") if files and all(
+        f in undocumented_load(r.meta.get("recording")) for r in files))
+    return replace(machine, spread=spread, fit_quality=quality, assumed_load=assumed,
                    baseline=Baseline(tuple(r.signal for r in records), fs))

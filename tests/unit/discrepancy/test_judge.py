@@ -162,7 +162,7 @@ def test_a_file_that_documents_no_load_is_read_at_the_machine_s():
 
     gears = SimpleNamespace(gears=object())
     machine = SimpleNamespace(op=OperatingPoint(speed_rpm=1000.0, torque_nm=50.0,
-                                                radial_load_n=120.0))
+                                                radial_load_n=120.0), assumed_load=())
     assumed = OperatingPoint(speed_rpm=1000.0, torque_nm=20.0, radial_load_n=0.0)
 
     def record(entry, path="rec.npz", rig=gears):
@@ -179,3 +179,10 @@ def test_a_file_that_documents_no_load_is_read_at_the_machine_s():
     assert op == assumed and note == ""
     op, _ = record_load(record({}, rig=SimpleNamespace(gears=None)), machine)
     assert op.torque_nm == 20.0 and op.radial_load_n == 120.0       # no gears: no torque
+    # a machine whose baseline documented no torque: its 50 N m is the model's assumption,
+    # and a record's documented load is not compared with it (a probe's gear machine named
+    # a tooth fault an outer race where its records stated load_percent and its baseline not)
+    guessed = SimpleNamespace(op=machine.op, assumed_load=("torque_nm",))
+    op, note = record_load(record({"load_percent": 37.5, "radial_load_n": 0.0}), guessed)
+    assert (op.torque_nm, op.radial_load_n) == (50.0, 0.0)
+    assert "baseline documented no load (its torque 50 N m was assumed" in note
