@@ -135,6 +135,10 @@ def refine_speed(x, fs_hz, speed_rpm, teeth=None):
         The speed to use, rpm.
     how : str or None
         How it was inferred, or None when the documented speed is kept.
+    confirmed : bool
+        Whether the shaft comb stands clear (:data:`MIN_COMB_DB`) at the speed returned: a
+        documented speed it confirms within :data:`MIN_SPEED_CHANGE` is kept as the comb
+        read it, and no coarser search moves it.
     """
     if speed_rpm is None:
         f, score = estimate_shaft_hz(x, fs_hz, lo_hz=5.0, hi_hz=min(100.0, fs_hz / 40),
@@ -146,14 +150,15 @@ def refine_speed(x, fs_hz, speed_rpm, teeth=None):
             f *= ratio
             how += (f"; its fundamental is 1/{1 / ratio:g} of the comb's best fit (its lines "
                     f"between stand as high)")
-        return 60.0 * f, how
+        return 60.0 * f, how, score > MIN_COMB_DB
     f0 = float(speed_rpm) / 60.0
     f, score = estimate_shaft_hz(x, fs_hz, lo_hz=(1 - SPEED_SEARCH_FRACTION) * f0,
                                  hi_hz=(1 + SPEED_SEARCH_FRACTION) * f0, teeth=teeth)
-    if score > MIN_COMB_DB and MIN_SPEED_CHANGE < abs(f / f0 - 1) <= SPEED_SEARCH_FRACTION:
+    clear = score > MIN_COMB_DB and abs(f / f0 - 1) <= SPEED_SEARCH_FRACTION
+    if clear and abs(f / f0 - 1) > MIN_SPEED_CHANGE:
         return 60.0 * f, (f"refined from the documented {float(speed_rpm):g} rpm by the "
-                          f"shaft-harmonic comb ({score:.1f} dB)")
-    return float(speed_rpm), None
+                          f"shaft-harmonic comb ({score:.1f} dB)"), True
+    return float(speed_rpm), None, clear
 
 
 def infer_sample_rate(x, shaft_hz, teeth):

@@ -284,11 +284,16 @@ def _to_acceleration(x, fs_hz, quantity, factor):
 
 def _refined_speed(x, fs, speed, teeth, check, uncertainty, inferred):
     """``(speed, its uncertainty)``: refined by the shaft comb where it stands clear
-    (:func:`~cmsim.measured.inference.refine_speed`), else, for a nominal speed, moved to
-    where the check found the rig's lines standing highest within its uncertainty
+    (:func:`~cmsim.measured.inference.refine_speed`; kept where the clear comb confirms it),
+    else, for a nominal speed, moved to where the check found the rig's lines standing
+    highest within its uncertainty, in steps of 1 %
     (:attr:`~cmsim.measured.consistency.RateCheck.speed_scale`); what was refined goes to
     ``inferred``."""
-    refined, how = refine_speed(x, fs, speed, teeth)
+    refined, how, confirmed = refine_speed(x, fs, speed, teeth)
+    if confirmed and how is None:
+        # a nominal 965 rpm that the comb reads at 964.5 was moved 1 % to where the
+        # families' lines stood highest, and the findings with it
+        return speed, min(uncertainty, MEASURED_SPEED_UNCERTAINTY)
     if how is None and check is not None and check.verdict == "agrees" \
             and check.speed_scale != 1.0:
         refined = speed * check.speed_scale

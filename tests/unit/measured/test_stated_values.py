@@ -123,3 +123,29 @@ def test_a_file_key_is_not_read_as_an_option(tmp_path, capsys):
     assert main(["spectrum", str(tmp_path / "r.npz"), "--fs-hz", "48000", "--json"]) == 2
     err = json.loads(capsys.readouterr().out)["error"]
     assert 'its "fs_hz" array says sample rate 12000 Hz but --fs-hz says 48000 Hz' in err, err
+
+
+def test_a_nominal_speed_the_shaft_comb_confirms_is_not_moved_by_the_coarse_search():
+    """A nominal 965 rpm whose shaft comb stands clear at 964.5 rpm (0.05 % off) was moved
+    1 % (955.35 or 974.65 rpm) to where the rig's families' lines stood highest in steps of
+    1 %, and the findings with it (a probe's healthy gear record named a tooth fault). A
+    comb that confirms the speed keeps it; with no clear comb the coarse search still
+    moves it."""
+    from types import SimpleNamespace
+
+    from cmsim.measured.record import _refined_speed
+
+    fs, f = 12_000.0, 964.5 / 60.0
+    t = np.arange(int(10 * fs)) / fs
+    rng = np.random.default_rng(0)
+    comb = sum(np.sin(2 * np.pi * k * f * t + k) for k in (1, 2, 3, 4)) \
+        + 0.05 * rng.standard_normal(t.size)
+    check = SimpleNamespace(verdict="agrees", speed_scale=1.01,
+                            family=SimpleNamespace(family=SimpleNamespace(name="BPFO")))
+    inferred = {}
+    speed, uncertainty = _refined_speed(comb, fs, 965.0, None, check, 0.03, inferred)
+    assert speed == 965.0 and uncertainty < 0.03 and not inferred
+    noise = rng.standard_normal(t.size)
+    speed, _ = _refined_speed(noise, fs, 965.0, None, check, 0.03, inferred)
+    assert speed == pytest.approx(974.65) and "searched within its 3 %" in (
+        inferred["speed_rpm"]["how"])
