@@ -293,7 +293,9 @@ def model_operating_point(entry, rig, speed_rpm, notes):
     else:
         pct = entry.get("load_percent")
         torque = 20.0 if pct is None else 5.0 + 0.4 * float(pct)
-        notes.append(f"output torque {torque:g} N m assumed from load_percent={pct} "
+        notes.append(f"output torque {torque:g} N m assumed (no torque documented)"
+                     if pct is None else
+                     f"output torque {torque:g} N m assumed from load_percent={pct:g} "
                      "(brake capacity undocumented)")
     return OperatingPoint(speed_rpm=float(speed_rpm), torque_nm=torque, radial_load_n=radial,
                           radial_load_angle_rad=-math.pi / 2)

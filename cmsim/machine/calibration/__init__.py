@@ -309,7 +309,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
     if better:
         c, (score, _, machine, twin_rows) = min(better, key=lambda cr: cr[1][0])
         machine = replace(machine, notes=machine.notes + (
-            f"bearing clearance: {_clearance_words(c)} instead of the documented "
+            f"bearing clearance: {_clearance_words(c)} instead of the model rig's "
             f"{', '.join(_clearance_words(d) for d in sorted(documented))}: its twin's "
             f"misfit on the fit segments (chi2 per feature with z capped at {MISFIT_CAP:g}) "
             f"is {score:.2f} against {first[0]:.2f} (the clearance sets the level of a healthy "
@@ -319,7 +319,7 @@ def calibrate(records, *, seg_s=SEGMENT_S, n_seeds=N_SEEDS, seed=0, name=None):
         why = (f"no other clearance's twin nearer the fit segments by {CLEARANCE_EVIDENCE:g}x"
                if tried else "a bearing rig's clearance is not read")
         machine = replace(machine, notes=machine.notes + (
-            f"bearing clearance: the documented "
+            f"bearing clearance: the model rig's "
             f"{', '.join(_clearance_words(d) for d in sorted(documented))} kept ({why})",))
 
     # 6. the twin on the held-out segments

@@ -301,7 +301,7 @@ def test_the_documented_clearance_is_kept_when_the_record_has_it(case, bearing_c
     taken only on 1.5x less misfit): the twin's rig is the record's."""
     for m, documented in ((case[3], 1.5e-5), (bearing_case[3], 5e-6)):
         assert _clearances(m) == {documented}
-        assert any(n.startswith("bearing clearance: the documented") for n in m.notes)
+        assert any(n.startswith("bearing clearance: the model rig's") for n in m.notes)
     assert any("nearer the fit segments by 1.5x" in n for n in case[3].notes)
 
 
@@ -323,7 +323,7 @@ def test_a_preloaded_gearbox_s_clearance_is_read_from_its_baseline():
     record = record_from_run(run, "acc", rig, OP, model_signal="accel_1b1_y")
     m = calibrate([record], seg_s=0.5, seed=5)
     assert max(_clearances(m)) <= 0.0, (_clearances(m), m.notes)
-    assert any(n.startswith("bearing clearance:") and "instead of the documented 15 µm"
+    assert any(n.startswith("bearing clearance:") and "instead of the model rig's 15 µm"
                in n for n in m.notes), m.notes
     # as near the held-out segments as a twin told the true preload
     told = calibrate([record_from_run(run, "acc", rig.with_clearance(-5e-6), OP,
