@@ -2,8 +2,10 @@
 both modes: against a machine calibrated on a healthy baseline, and without one.
 
 Run: ``python benchmarks/validate_real.py [--data DIR] [--workers W] [--out FILE.md]
-[--json FILE] [--render FILE]``. ``--data`` defaults to ``$CMSIM_DATA`` or
-``../shared/datasets``.
+[--json FILE] [--render FILE] [--channel NAME]``. ``--data`` defaults to ``$CMSIM_DATA`` or
+``../shared/datasets``; ``--channel`` reads every record on another sensor than its default
+(``--datasets cwru_bearing_12k_de --channel FE``: the drive-end faults through the fan-end
+accelerometer, calibrated on that sensor's own baseline).
 
 * **Calibrated** (``compare --machine``): in a folder with healthy records, a machine is
   calibrated (:func:`cmsim.machine.calibrate` and its signature library,
@@ -57,12 +59,13 @@ def calibrate_half(job):
     beside the other machine files of this run; with ``reuse``, an earlier run's file of it
     is read instead (the calibration is deterministic: the judge's rules can be iterated on
     without 5 minutes of calibrations each time)."""
-    baseline, reuse = job
+    baseline, reuse, channel = job
     t0 = time.perf_counter()
-    out = MACHINE_DIR / f"{Path(baseline).parent.name}_{Path(baseline).stem}.toml"
+    out = MACHINE_DIR / (f"{Path(baseline).parent.name}_{Path(baseline).stem}"
+                         + (f"_{channel}" if channel else "") + ".toml")
     if reuse and out.is_file():
         return str(baseline), str(out), 0.0
-    machine = calibrate([_half(read_record(baseline), "first")])
+    machine = calibrate([_half(read_record(baseline, channel=channel), "first")])
     machine = machine.with_library(build_library(machine))
     machine.save(out)
     return str(baseline), str(out), time.perf_counter() - t0
@@ -71,8 +74,8 @@ def calibrate_half(job):
 def one(job):
     """Compare one recording (job: mode, path, baseline path or None, whether the record is
     the baseline itself, the baseline's machine file or None)."""
-    mode, path, baseline, is_baseline, machine_file = job
-    rec = read_record(path)
+    mode, path, baseline, is_baseline, channel, machine_file = job
+    rec = read_record(path, channel=channel)
     machine, quality = None, None
     if machine_file is not None:
         machine = Machine.load(machine_file)
@@ -189,6 +192,9 @@ def main(argv=None):
     ap.add_argument("--reuse-machines", action="store_true",
                     help=f"read the machine files an earlier run left in {MACHINE_DIR} "
                          "instead of calibrating again")
+    ap.add_argument("--channel", default=None,
+                    help="read every record on this channel (CWRU's FE: the drive-end faults "
+                         "through the fan-end accelerometer); default each record's own")
     ap.add_argument("--render", type=Path, default=None,
                     help="only re-render the tables from a --json file of an earlier run")
     a = ap.parse_args(argv)
@@ -205,11 +211,12 @@ def main(argv=None):
         with ProcessPoolExecutor(a.workers) as pool:
             baselines = sorted({str(j[2]) for j in jobs if j[2] is not None})
             machines = {}
-            for base, file, wall in pool.map(calibrate_half,
-                                             [(b, a.reuse_machines) for b in baselines]):
+            for base, file, wall in pool.map(calibrate_half, [(b, a.reuse_machines, a.channel)
+                                                              for b in baselines]):
                 machines[base] = file
                 print(f"calibrated {Path(base).name} (first half) in {wall:.1f} s", flush=True)
-            jobs = [(*j, None if j[2] is None else machines[str(j[2])]) for j in jobs]
+            jobs = [(*j, a.channel, None if j[2] is None else machines[str(j[2])])
+                    for j in jobs]
             t1 = time.perf_counter()
             for key, c in pool.map(one, jobs):
                 results[key] = c

@@ -564,3 +564,52 @@ def test_a_near_tie_is_told_apart_on_what_each_fault_adds_not_on_a_family_that_f
     own = {r["name"]: r["delta_chi2"] for r in d["by_signature"]}
     assert own["bearing_outer_race"] > own["tooth_fault"]      # the fall, counted
     assert (d["finding"], d["decided_on"]) == (finding, "whole")
+
+
+RING_NAMES = ("env_bpfi_1b2_h1_db", "env_bpfi_1b2_h2_db", "env_bsf2_1b1_h1_db",
+              "env_bsf2_1b1_h2_db", "raw_bpfo_1b1_db", "raw_bpfo_1b2_db", "raw_fr_h1_db",
+              "raw_fr_h2_db", "shape_b0_db", "shape_b1_db", "shape_b2_db")
+
+
+@pytest.mark.parametrize("bpfi, bsf, finding", [((12.0, 12.0), (7.0, 7.0), "bearing_inner_race"),
+                                                ((12.0, 0.0), (0.0, 0.0), "transfer_path"),
+                                                ((0.0, 0.0), (0.0, 0.0), "transfer_path")])
+def test_a_ringing_fault_seen_through_another_sensor_is_named_beside_a_moved_path(bpfi, bsf,
+                                                                                 finding):
+    """A bearing fault's impacts ring the structure where the baseline showed nothing: the
+    spectrum moves as a moved path moves it (a bearing defect's ``absorbs``), and little
+    else of its modelled change reaches another bearing's sensor (CWRU's drive-end faults
+    on the fan-end accelerometer read as a transfer path, every one). Its family standing
+    12 dB over the path's prediction in two harmonics names it beside the path; of two
+    families that stand out there, the one that stands out farthest (a fan-end ball family
+    7 dB up, caught by the inner race's sidebands, whose whole-record reading is the
+    nearer). One harmonic alone is within what a moved path's refiltering leaves (cmsim's
+    own moved path lifted a ball family's band 7.8 dB over its prediction); with no family
+    risen, the moved path."""
+    m = len(RING_NAMES)
+    moved = np.array([-10.0, -10.0, -10.0, -10.0, 10.0, -10.0, 10.0])   # raw lines, shape
+    path = np.zeros((3, m))
+    path[:, 4:] = np.outer([0.0, 0.5, 1.0], moved)
+    inner = np.zeros((3, m))
+    inner[:, :2] = np.array([[0.0], [0.5], [1.0]])      # the model's change here: small
+    ball = np.zeros((3, m))
+    ball[:, 2:4] = np.array([[0.0], [3.5], [7.0]])
+    lib = _baseline_at_zero(
+        RING_NAMES, np.ones(m),
+        SignatureEntry("transfer_path", None, "documented", "frequency_factor",
+                       (1.0, 1.3, 1.6), path),
+        SignatureEntry("bearing_inner_race", "1b2", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), inner),
+        SignatureEntry("bearing_ball", "1b1", "documented", "size_m",
+                       (3e-5, 3e-4, 3e-3), ball))
+    li = np.arange(m)
+    meas = np.concatenate([bpfi, bsf, moved])
+    names = list(RING_NAMES)
+    d = decide_record(lib, li, names, meas, feature_sigma(lib, li, names, 8), "1b1")
+    assert d["finding"] == finding, [(r["name"], r["component"], r["chi2"]) for r in d["ranked"]]
+    assert d["ranked"][0]["name"] == "transfer_path"          # it reads the record best
+    if finding == "bearing_inner_race":
+        assert (d["top"]["component"], d["decided_on"]) == ("1b2", "beside")
+        assert [r["name"] for r in d["ties"]] == ["transfer_path"]
+        chi = {r["name"]: r["chi2"] for r in d["ranked"]}
+        assert chi["bearing_ball"] < chi["bearing_inner_race"]   # the nearer, not named
