@@ -74,8 +74,10 @@ INCH_M = 0.0254
 STANDARD_GRAVITY_M_S2 = 9.80665
 
 #: Accelerometer units cmsim converts to m/s² (the first word of a metadata ``unit``).
-ACCELERATION_UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0,
-                      "mm/s2": 1e-3, "mm/s^2": 1e-3}
+ACCELERATION_UNITS = {"g": STANDARD_GRAVITY_M_S2, "g's": STANDARD_GRAVITY_M_S2,
+                      "gs": STANDARD_GRAVITY_M_S2, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0,
+                      "m/s/s": 1.0, "mm/s2": 1e-3, "mm/s^2": 1e-3, "mm/s²": 1e-3,
+                      "mm/s/s": 1e-3}
 
 
 def read_metadata(folder, missing_ok=False):

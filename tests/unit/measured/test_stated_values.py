@@ -149,3 +149,12 @@ def test_a_nominal_speed_the_shaft_comb_confirms_is_not_moved_by_the_coarse_sear
     speed, _ = _refined_speed(noise, fs, 965.0, None, check, 0.03, inferred)
     assert speed == pytest.approx(974.65) and "searched within its 3 %" in (
         inferred["speed_rpm"]["how"])
+
+
+@pytest.mark.parametrize("unit, factor", [("g's", 9.80665), ("Gs", 9.80665), ("m/s/s", 1.0),
+                                          ("mm/s/s", 1e-3)])
+def test_lab_spellings_of_an_acceleration_unit_are_read(unit, factor):
+    """``g's``, ``Gs`` and ``m/s/s`` (US lab sheets) were refused as unknown units."""
+    from cmsim.measured.schema import unit_kind
+
+    assert unit_kind(unit) == ("acceleration", pytest.approx(factor))
