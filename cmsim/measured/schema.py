@@ -74,10 +74,11 @@ INCH_M = 0.0254
 STANDARD_GRAVITY_M_S2 = 9.80665
 
 #: Accelerometer units cmsim converts to m/s² (the first word of a metadata ``unit``).
-ACCELERATION_UNITS = {"g": STANDARD_GRAVITY_M_S2, "g's": STANDARD_GRAVITY_M_S2,
-                      "gs": STANDARD_GRAVITY_M_S2, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0,
-                      "m/s/s": 1.0, "mm/s2": 1e-3, "mm/s^2": 1e-3, "mm/s²": 1e-3,
-                      "mm/s/s": 1e-3}
+ACCELERATION_UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0, "m/s^2": 1.0, "m/s²": 1.0,
+                      "mm/s2": 1e-3, "mm/s^2": 1e-3}
+
+#: Other spellings of those units lab sheets write (read as the unit they spell, listed as it).
+UNIT_SPELLINGS = {"g's": "g", "gs": "g", "m/s/s": "m/s2", "mm/s/s": "mm/s2", "mm/s²": "mm/s2"}
 
 
 def read_metadata(folder, missing_ok=False):
@@ -364,6 +365,7 @@ def unit_kind(unit, where="unit"):
     word = text.split()[0] if text else ""
     if not word or word.lower() == UNKNOWN_UNIT:
         return None, None
+    word = UNIT_SPELLINGS.get(word.lower(), word)
     for kind, table in (("acceleration", ACCELERATION_UNITS), ("velocity", VELOCITY_UNITS),
                         ("displacement", DISPLACEMENT_UNITS)):
         found = table.get(word, table.get(word.lower()))
