@@ -207,8 +207,8 @@ def test_calibrate_on_options_only(tmp_path, capsys, monkeypatch):
     assert machine.is_file() and not (tmp_path / "metadata.json").exists()
     # against it, the model runs only to refine a named cause: with the kernels cached the
     # command does not load them up front (0.4 s of a 2-s comparison with no finding)
-    import cmsim.cli.app as app
-    import cmsim.dynamics.simulation as simulation
+    from cmsim.cli import app
+    from cmsim.dynamics import simulation
 
     asked = []
     monkeypatch.setattr(simulation, "kernels_cached", lambda: True)
