@@ -480,9 +480,10 @@ def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_beari
     (:attr:`~cmsim.discrepancy.causes.Cause.either_way`); else None. Of such faults on several
     components, the one on the sensor's shaft (the shaft-order lines that stand out are
     its), and of those the one whose family stands out farthest; a fault whose impacts ring
-    the structure stands out so on :data:`RINGING_FEATURES` of its family's features. Its prediction is ``top``'s with the fault's own change on the features of its
-    family ``top`` does not raise (its size read there, not on a feature that fell), and the
-    row says what it was read beside (``"beside"``). ``sigma`` is the χ²'s, ``gate`` the
+    the structure stands out so on :data:`RINGING_FEATURES` of its family's features. Its
+    prediction is ``top``'s with the fault's own change on the features of its family
+    ``top`` does not raise (its size read there, not on a feature that fell), and the row
+    says what it was read beside (``"beside"``). ``sigma`` is the χ²'s, ``gate`` the
     stand-out gate's."""
     if top["cause"].signature is not None:
         return None

@@ -37,7 +37,10 @@ def record_load(record, machine):
     metadata documents none (reading a file, the model assumes a load it does not know:
     20 N m on a gear rig; against a machine, the baseline's load is the best guess, and a
     shift to an assumed load moved a 50-N m gear machine's whole baseline and named a ball
-    defect for its tooth fault). An in-memory record (a run) carries its own load.
+    defect for its tooth fault). A load the machine's baseline did not document either
+    (:attr:`~cmsim.machine.Machine.assumed_load`) is the model's assumption, not a
+    measurement: a record's documented load is not compared with it, and the record is read
+    at the machine's. An in-memory record (a run) carries its own load.
 
     Parameters
     ----------

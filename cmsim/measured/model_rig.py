@@ -22,8 +22,9 @@ from cmsim.frequencies import RigFrequencies, bearing_frequencies
 from cmsim.measured.schema import STANDARD_GRAVITY_M_S2, documented_radial_load_n
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
 
-__all__ = ["model_rig", "documented_frequencies", "documented_geometry", "BEARING_NUMBERS", "model_operating_point", "NO_GEOMETRY",
-           "documented_operating_point", "DEFAULT_ROTOR_MASS_KG", "DEFAULT_CLEARANCE_M"]
+__all__ = ["model_rig", "documented_frequencies", "documented_geometry", "BEARING_NUMBERS",
+           "model_operating_point", "NO_GEOMETRY", "documented_operating_point",
+           "DEFAULT_ROTOR_MASS_KG", "DEFAULT_CLEARANCE_M"]
 
 #: Rotor mass assumed for a bearing rig whose rotor is not documented, kg.
 DEFAULT_ROTOR_MASS_KG = 10.0

@@ -26,7 +26,8 @@ __all__ = ["RECORDING_KEYS", "NUMERIC_KEYS", "FOLDER_KEYS", "ANSWER_KEYS", "LBF_
            "STANDARD_GRAVITY_M_S2", "ACCELERATION_UNITS", "read_metadata", "recording_entry",
            "is_answer_key", "answer_key", "label_of", "documented_speed_rpm",
            "documented_radial_load_n", "unit_scale_of", "rig_geometry",
-           "documented_speed", "SPEED_KEYS", "TORQUE_KEYS", "RADIAL_KEYS", "undocumented_load", "checked_unit", "OTHER_UNITS", "VELOCITY_UNITS",
+           "documented_speed", "SPEED_KEYS", "TORQUE_KEYS", "RADIAL_KEYS", "undocumented_load",
+           "checked_unit", "OTHER_UNITS", "VELOCITY_UNITS", "UNIT_SPELLINGS",
            "DISPLACEMENT_UNITS", "UNKNOWN_UNIT", "known_units", "unit_kind"]
 
 #: Keys of a ``recordings[]`` entry the pipeline reads; everything else is ignored.

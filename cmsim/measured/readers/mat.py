@@ -7,8 +7,8 @@ shaft speed (several of different values are refused as ambiguous), a scalar ``f
 ``Fs``, ``fs_hz`` or ``sample_rate`` the sample rate (it must agree with a time vector), a
 struct ``units`` (channel → text) the units; the fields of a struct are read the same way,
 named ``struct.field`` (``rec.acc`` at the rate ``rec.fs``; two levels deep); other
-scalars, strings and cells are skipped. A v7.3 file (HDF5) is read with h5py when it is installed, else refused with what
-to do."""
+scalars, strings and cells are skipped. A v7.3 file (HDF5) is read with h5py when it is
+installed, else refused with what to do."""
 
 from __future__ import annotations
 
