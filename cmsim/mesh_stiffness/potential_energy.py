@@ -286,11 +286,14 @@ def sainsot_coefficients(root_half_angle_rad, hf):
     out = {}
     for key, (A, B, C, D, E, F) in SAINSOT_COEFFICIENTS.items():
         out[key] = A / tf ** 2 + B * hf ** 2 + C * hf / tf + D / tf + E * hf + F
-    outside = [f"{k}*={v:.4g} not in {SAINSOT_FITTED_RANGES[k]}" for k, v in out.items()
+    outside = [f"{k}* = {v:.4g}, fitted {SAINSOT_FITTED_RANGES[k][0]:g}-"
+               f"{SAINSOT_FITTED_RANGES[k][1]:g}" for k, v in out.items()
                if not SAINSOT_FITTED_RANGES[k][0] <= v <= SAINSOT_FITTED_RANGES[k][1]]
     if outside:
-        warnings.warn("Sainsot fillet-foundation formula extrapolated (θf = "
-                      f"{tf:.4f} rad, hf = {hf:.3f}): " + "; ".join(outside), ModelWarning,
+        warnings.warn("gear mesh stiffness: the tooth foundation's compliance (Sainsot's "
+                      "fillet-foundation formula) is extrapolated beyond the tooth shapes it "
+                      f"was fitted on (root half-angle θf = {tf:.4f} rad, root over bore "
+                      f"radius hf = {hf:.3f}: " + "; ".join(outside) + ")", ModelWarning,
                       stacklevel=2)
     return out
 
