@@ -17,8 +17,8 @@ and 2·BSF over the envelope spectrum's median, dB, in each band of the fixed ba
 for the defect's bearing (every bearing on a healthy record).
 
 A family **stands out** where its line, in one band, rises over the baseline's mean in
-the same band by the judge's rule (:func:`cmsim.discrepancy.judge.standing_out`:
-:data:`~cmsim.discrepancy.judge.FAMILY_Z` σ and :data:`~cmsim.discrepancy.judge.FAMILY_RISE_DB`
+the same band by the judge's rule (:func:`cmsim.discrepancy.stand_out.standing_out`:
+:data:`~cmsim.discrepancy.stand_out.FAMILY_Z` σ and :data:`~cmsim.discrepancy.stand_out.FAMILY_RISE_DB`
 dB; σ of :func:`~cmsim.discrepancy.columns.sigma_of`: the baseline's segment-to-segment
 spread over both means' segments and the judge's floor, and with ``--realisations N`` the
 spread of the baseline's mean and N other healthy records' of the same machine, as the
@@ -40,7 +40,7 @@ from bench_compare import SEED0, _angle_case, _model_case
 
 from cmsim.discrepancy.angle_domain import draw_machine, write_machine
 from cmsim.discrepancy.columns import sigma_of
-from cmsim.discrepancy.judge import standing_out
+from cmsim.discrepancy.stand_out import standing_out
 from cmsim.discrepancy.synthetic import hidden_effect_record
 from cmsim.features import N_ENVELOPE_BANDS, band_family_columns, segments
 from cmsim.measured import read_record

@@ -228,7 +228,7 @@ def weight(name, signature=False):
     """Weight of a feature in the χ²: the spectral-shape bands share one family's weight of 4;
     a family's fundamental read band by band (:func:`~cmsim.features.band_family_columns`)
     weighs nothing in the χ² of the whole record — whether it stands out over the baseline in
-    a band is evidence (:func:`cmsim.discrepancy.judge.standing_out`), but its prediction in
+    a band is evidence (:func:`cmsim.discrepancy.stand_out.standing_out`), but its prediction in
     each band depends on where the structure rings, which a path calibrated on a healthy
     baseline does not know (counted at 1/6 each on the cached machines of 2026-11-30, cmsim's
     own records read 37 of 45 against 41: a tooth fault, a friction and an eccentricity went

@@ -16,8 +16,9 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    over its segments): z = (record − baseline) / σ, σ² the baseline's segment-to-segment
    spread² over each mean's segments (1/n_fit + 1/n_baseline), + the model's realisation
    spread² (what one healthy run differs from another by, which averaging segments does not
-   remove; the gate of a family that stands out, :func:`standing_out`, reads the model's
-   run spread there instead: :attr:`~cmsim.machine.library.SignatureLibrary.run_spread`)
+   remove; the gate of a family that stands out,
+   :func:`~cmsim.discrepancy.stand_out.standing_out`, reads the model's run spread there
+   instead: :attr:`~cmsim.machine.library.SignatureLibrary.run_spread`)
    + a floor (:data:`~cmsim.discrepancy.columns.FLOOR_SHARE` of
    :func:`~cmsim.discrepancy.evaluator.feature_floor`). χ²₀ is the
    robust χ² of the record against the baseline (:func:`~cmsim.discrepancy.evaluator.chi2`,
@@ -25,11 +26,11 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    :data:`NONE_CHI2_PER_FEATURE` and no feature of which departs by :data:`ALARM_Z` σ is
    ``none``: within the machine's own spread, unless a structure-ringing fault's family
    stands out over the baseline (step 4), in whatever band, or a band of the spectrum's
-   shape moved as far from it, either way (:func:`shape_moved`). A record documented at
-   another load than the machine's is read against the baseline moved by the model's change
-   between the two loads, every prediction with it, and each feature's σ widened by that
-   change's own size (:mod:`cmsim.discrepancy.operating_point`): how a gearbox answers its
-   load is the model's guess, not the machine's measurement.
+   shape moved as far from it, either way (:func:`~cmsim.discrepancy.stand_out.shape_moved`).
+   A record documented at another load than the machine's is read against the baseline
+   moved by the model's change between the two loads, every prediction with it, and each
+   feature's σ widened by that change's own size (:mod:`cmsim.discrepancy.operating_point`):
+   how a gearbox answers its load is the model's guess, not the machine's measurement.
 3. **Matching.** Every entry of the library (a cause on a component, a nuisance variant, a
    grid of sizes) is compared with the record the same way; between two sizes of the grid the
    features are interpolated (:data:`INTERPOLATION_STEPS`, linear in log size), so the size is
@@ -70,8 +71,9 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       calibrated path cannot know), a fault is named on its own signature
       (:func:`~cmsim.discrepancy.ranking.decide`: its evidence on the features it moves, its
       family moved towards the record), provided one feature of its family stands
-      :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB` over the baseline and its change, at the
-      variant and size its signature reads best, reads the record's features nearer than
+      :data:`~cmsim.discrepancy.stand_out.FAMILY_Z` σ and
+      :data:`~cmsim.discrepancy.stand_out.FAMILY_RISE_DB` over the baseline and its change,
+      at the variant and size its signature reads best, reads the record's features nearer than
       the baseline alone over all of them as its signature weighs them (its row's
       ``total``; the path profiled out as below); a fault that rings the structure must
       also stand out so over the prediction of the reshaping cause that reads the record
@@ -90,9 +92,10 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    c. *Within its prediction's own error.* Where neither names a cause, the reshaping cause
       that reads the whole record best of every cause (a fault that cannot be named reading
       it better leaves it unexplained) is named if it removes :data:`MIN_SHARE` of the
-      departure with each feature's σ widened by :data:`PREDICTION_ERROR` of the change it
-      predicts there: the library's change is one run of the model at the grid's sizes, the
-      record's another at its own (a load 3.4 times the baseline's moved cmsim's own bearing
+      departure with each feature's σ widened by
+      :data:`~cmsim.discrepancy.reshaping.PREDICTION_ERROR` of the change it predicts there:
+      the library's change is one run of the model at the grid's sizes, the record's
+      another at its own (a load 3.4 times the baseline's moved cmsim's own bearing
       envelope lines 11-12 dB from the library's prediction, its cages and slip at that
       load), an error the baseline's spread does not hold. The ranking and steps a and b
       read the plain σ.
@@ -126,9 +129,11 @@ from cmsim.discrepancy.evaluator import path_free, rises, weight
 from cmsim.discrepancy.operating_point import at_operating_point, record_load
 from cmsim.discrepancy.ranking import (NEAR_TIE, SEVERITY_DELTA_CHI2, _consistent,
                                        added_evidence, decide)
+from cmsim.discrepancy.reshaping import PREDICTION_ERROR, absorbed_by, within_error
 from cmsim.discrepancy.resolution import buried_family, resolve_line
 from cmsim.discrepancy.shaft_lines import held_lines
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
+from cmsim.discrepancy.stand_out import FAMILY_RISE_DB, FAMILY_Z, shape_moved, standing_out
 from cmsim.errors import ParameterError
 from cmsim.features import segments
 from cmsim.machine.calibration import feature_rows
@@ -156,20 +161,6 @@ MIN_SHARE = 0.5
 #: Points read between two sizes of a library entry (interpolated features).
 INTERPOLATION_STEPS = 4
 
-#: A structure-ringing fault is named only where one feature of its own family (its envelope
-#: lines, its sidebands: the path-free ones) stands out over the baseline: :data:`FAMILY_Z`
-#: of its σ upwards and, for a level in dB, :data:`FAMILY_RISE_DB` over the baseline's own
-#: (the level at which a family stands clearly out). A family that does not stand out names
-#: no spall, whatever else moved (CWRU's 0.007-in ball records: no family of either bearing
-#: above z 2.6, while their broadband rose 20 dB and lowered every raw line over its
-#: median); one that does is never left unexplained for a statistic (an outer-race spall
-#: injected into CWRU's held-out healthy half lifted its family 7 dB, 3.5 σ, and read
-#: unexplained under a 4-σ gate).
-FAMILY_Z = 3.0
-
-#: See :data:`FAMILY_Z`, dB.
-FAMILY_RISE_DB = 6.0
-
 #: A record whose level departs from the baseline's by this many σ tells the direction of
 #: its change: a prediction that moves the level the other way is not a candidate (power
 #: added cannot make a machine quieter, a cause that removes power cannot make it louder).
@@ -177,10 +168,6 @@ FAMILY_RISE_DB = 6.0
 #: spectrum can resemble, named noise on a preloaded machine 19 dB under its baseline.
 LEVEL_DIRECTION_Z = 3.0
 
-#: A cause's prediction misses a feature by about this share of the change it predicts there
-#: (step 4c of the module docstring). A prior, not a measurement: between 0.2 and 1.0 the
-#: compare benchmarks name the same records (2026-11-30); at 0.1, one fewer.
-PREDICTION_ERROR = 0.3
 
 
 def _record_rows(record, machine, seg_s, max_segments):
@@ -194,49 +181,6 @@ def _record_rows(record, machine, seg_s, max_segments):
                                record.model_frequencies(), list(machine.rig.bearing_names),
                                scale, bands=BAND_FAMILIES)
     return names, rows
-
-
-def standing_out(features, meas, reference, sigma, names):
-    """The ``features`` (column indices) on which the record stands out over a reference
-    (the baseline, or a cause's prediction): :data:`FAMILY_Z` of their σ upwards and, for a
-    level in dB, :data:`FAMILY_RISE_DB` over it.
-
-    Parameters
-    ----------
-    features : sequence of int
-        Columns to look at.
-    meas, reference, sigma : numpy.ndarray
-        The record's features, the reference's and their σ.
-    names : sequence of str
-        Feature names (a ``_db`` name is a level in dB).
-
-    Returns
-    -------
-    list of int
-    """
-    return [i for i in features if (meas[i] - reference[i]) / sigma[i] >= FAMILY_Z and (
-        not names[i].endswith("_db") or meas[i] - reference[i] >= FAMILY_RISE_DB)]
-
-
-def shape_moved(meas, reference, sigma, names):
-    """The columns of the spectrum's shape bands (``shape_*``) on which the record moved
-    away from a reference either way by :func:`standing_out`'s gate (:data:`FAMILY_Z` σ
-    and :data:`FAMILY_RISE_DB`): a band halving its power departs as one doubling it does.
-
-    Parameters
-    ----------
-    meas, reference, sigma : numpy.ndarray
-        The record's features, the reference's and their σ.
-    names : sequence of str
-        Feature names.
-
-    Returns
-    -------
-    list of int
-    """
-    shape = [i for i, k in enumerate(names) if k.startswith("shape_")]
-    return sorted(standing_out(shape, meas, reference, sigma, names)
-                  + standing_out(shape, reference, meas, sigma, names))
 
 
 def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate_sigma=None):
@@ -257,9 +201,11 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
     causes : sequence of str, optional
         The causes considered (default every one of the library).
     gate_sigma : numpy.ndarray, optional
-        The σ of the gate of a family that stands out (:func:`standing_out`,
-        :func:`shape_moved`; default ``sigma``): the baseline's spread with the model's run
-        spread (:func:`~cmsim.discrepancy.columns.feature_sigma`'s ``standing``).
+        The σ of the gate of a family that stands out
+        (:func:`~cmsim.discrepancy.stand_out.standing_out`,
+        :func:`~cmsim.discrepancy.stand_out.shape_moved`; default ``sigma``): the baseline's
+        spread with the model's run spread
+        (:func:`~cmsim.discrepancy.columns.feature_sigma`'s ``standing``).
 
     Returns
     -------
@@ -384,7 +330,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                 new = max(out, key=lambda r: r["family_z"])
                 ties = [r for r in [top] + ties if r is not new]
                 top = new
-            absorbed = _absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, gate,
+            absorbed = absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, gate,
                                     names, sensor_bearing)
             if absorbed is not None:
                 ties, top, how = [top], absorbed, "beside"
@@ -441,107 +387,6 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                                    key=lambda r: (r["cause"].signature is None,
                                                   -r["delta_chi2"])),
             "decided_on": how, "chi2": chi0, "n_eff": n_eff, "z": z0}
-
-
-def within_error(row, meas, base, sigma, names):
-    """The χ² of a cause's row (of ``decide_record``'s ``ranked``) with each feature's σ
-    widened by :data:`PREDICTION_ERROR` of the change its prediction makes there (step 4c).
-
-    Parameters
-    ----------
-    row : dict
-        The cause's best reading (its ``prediction``).
-    meas, base, sigma : numpy.ndarray
-        The record's features, the baseline's and their σ.
-    names : sequence of str
-        Feature names.
-
-    Returns
-    -------
-    float
-    """
-    pred = row["prediction"]
-    widened = np.hypot(sigma, PREDICTION_ERROR * np.nan_to_num(pred - base))
-    return float(chi2_rows(meas, pred[None, :], widened, names)[0][0])
-
-
-#: Features of its family (harmonics, bands) a fault whose impacts ring the structure must
-#: stand out on over a reshaping cause's prediction to be named beside it (:func:`_absorbed_by`).
-RINGING_FEATURES = 2
-
-
-def _absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearing):
-    """The fault whose own change holds the reshaping cause ``top``'s
-    (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`) and whose family stands out where
-    ``top``'s prediction leaves the record — :data:`FAMILY_Z` σ and :data:`FAMILY_RISE_DB`
-    over it, on a feature ``top`` does not raise, or under the least ``top`` leaves at any
-    size that reads the record as well (its ``range``), on a feature where the fault adds to
-    what the machine has at its own phase
-    (:attr:`~cmsim.discrepancy.causes.Cause.either_way`); else None. Of such faults on several
-    components, the one on the sensor's shaft (the shaft-order lines that stand out are
-    its), and of those the one whose family stands out farthest; a fault whose impacts ring
-    the structure stands out so on :data:`RINGING_FEATURES` of its family's features. Its
-    prediction is ``top``'s with the fault's own change on the features of its family
-    ``top`` does not raise (its size read there, not on a feature that fell), and the row
-    says what it was read beside (``"beside"``). ``sigma`` is the χ²'s, ``gate`` the
-    stand-out gate's."""
-    if top["cause"].signature is not None:
-        return None
-    pred = top["prediction"]
-    raised = pred - base
-    # the least ``top`` leaves on each feature at the sizes that read the record as well as
-    # its best (within SEVERITY_DELTA_CHI2: its ``range``)
-    lo, hi = top["range"]
-    lowest = np.min([pred] + [table[(values >= lo) & (values <= hi)].min(axis=0, initial=np.inf)
-                              for _, values, table in
-                              tables.get((top["name"], top["component"]), [])], axis=0)
-    found = []
-    for r in rows:
-        if top["name"] not in r["cause"].absorbs:
-            continue
-        out = [i for i in standing_out([names.index(k) for k in r["family"]], meas, pred,
-                                       gate, names) if raised[i] <= 0.0]
-        if r["cause"].rings_structure and len(out) < RINGING_FEATURES:
-            # impacts that ring the structure light their family in several harmonics or
-            # bands; one band alone over a moved path's prediction is within what refiltering
-            # leaves (cmsim's own moved path, seed 0: a ball family's band 1, 7.8 dB, 3.7 σ)
-            out = []
-        # where its change adds to a component the machine has at its own phase, the record
-        # departs downwards too: below the least ``top`` leaves there at any size that reads
-        # the record as well
-        fell = standing_out([names.index(k) for k in r["family"]
-                             if k in r["cause"].either_way], lowest, meas, gate, names)
-        if out or fell:     # a component's name starts with its shaft's number ("1G1", "1b1")
-            # the family that stands out farthest: seen through a ringing structure, other
-            # families' windows catch the sidebands of the one that rose (CWRU's drive-end
-            # inner race on the fan-end sensor: its own lines 21 sigma over a moved path's
-            # prediction, a fan-end ball's 5)
-            far = max(abs(meas[i] - pred[i]) / gate[i] for i in out + fell)
-            found.append((r["component"] is None or r["component"][0] != sensor_bearing[0],
-                          -far, r, out + fell, fell))
-    if not found:
-        return None
-    _, _, r, out, fell = min(found, key=lambda f: f[:2])
-    # the fault's change on its family where the reshaping cause does not raise it, the
-    # reshaping cause's elsewhere (its size read there; not on a feature that fell, which
-    # the fault's change, adding at an unknown phase, is no reading of)
-    own = np.array([k in r["family"] and raised[i] <= 0.0 and i not in fell
-                    for i, k in enumerate(names)])
-    best = None
-    for e, values, table in tables[(r["name"], r["component"])]:
-        both = pred[None, :] + np.where(own, table - base[None, :], 0.0)
-        chi = chi2_rows(meas, both, sigma, names)[1][:, own].sum(axis=1)
-        k = int(np.argmin(chi))
-        if best is None or chi[k] < best["score"]:
-            within = values[chi <= chi[k] + SEVERITY_DELTA_CHI2]
-            best = {**r, "variant": e.variant, "value": float(values[k]),
-                    "range": (float(within.min()), float(within.max())),
-                    "chi2": float(chi2_rows(meas, both[k:k + 1], sigma, names)[0][0]),
-                    "score": float(chi[k]), "prediction": both[k],
-                    "out": out, "stands_out": True,
-                    "beside": {"name": top["name"], "parameter": top["parameter"],
-                               "value": top["value"]}}
-    return best
 
 
 def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,

@@ -15,7 +15,7 @@ resolution falls to its floor.
 
 So when the judge names a bearing fault, every other bearing fault whose fundamental's window
 overlaps the named one's at segment resolution, and whose fundamental stands out over the
-baseline there (:func:`~cmsim.discrepancy.judge.standing_out`), is read again with the named
+baseline there (:func:`~cmsim.discrepancy.stand_out.standing_out`), is read again with the named
 one over the whole record (its middle :data:`FULL_RESOLUTION_MAX_S` at most;
 :func:`~cmsim.features.relative.envelope_columns`: the same lines, floor and band rule as the
 segments). The rival whose fundamental then stands

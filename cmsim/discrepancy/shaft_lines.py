@@ -41,7 +41,7 @@ FLOOR_BORNE_SHARE = 0.5
 #: Least rise of a shaft line in absolute level over the baseline's for a cause named on
 #: it, dB: about 3 times the spread of a 0.5-s segment's line (0.9-1.1 dB on SpectraQuest's
 #: healthy input shaft at no load), and half the judge's
-#: :data:`~cmsim.discrepancy.judge.FAMILY_RISE_DB`.
+#: :data:`~cmsim.discrepancy.stand_out.FAMILY_RISE_DB`.
 LINE_RISE_DB = 3.0
 
 #: Segments of a record or a baseline the floor is averaged over.
