@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from cmsim.discrepancy.signatures import operating_shift
-from cmsim.measured.schema import RADIAL_KEYS, TORQUE_KEYS
+from cmsim.measured.schema import RADIAL_KEYS, TORQUE_KEYS, undocumented_load
 
 __all__ = ["record_load", "at_operating_point", "LOAD_TOLERANCE",
            "OPERATING_SHIFT_UNCERTAINTY", "TORQUE_KEYS", "RADIAL_KEYS"]
@@ -55,17 +55,16 @@ def record_load(record, machine):
     op = record.op
     if not record.path:
         return op, ""
-    entry = record.meta.get("recording") or {}
+    undocumented = undocumented_load(record.meta.get("recording"))
     taken, unknown = [], []
-    for field, keys, gears, what in (
-            ("torque_nm", TORQUE_KEYS, True, f"torque {machine.op.torque_nm:g} N m"),
-            ("radial_load_n", RADIAL_KEYS, False,
-             f"radial load {machine.op.radial_load_n:g} N")):
+    for field, gears, what in (
+            ("torque_nm", True, f"torque {machine.op.torque_nm:g} N m"),
+            ("radial_load_n", False, f"radial load {machine.op.radial_load_n:g} N")):
         if gears and (record.rig is None or record.rig.gears is None):
             continue
         if getattr(op, field) == getattr(machine.op, field):
             continue
-        if not any(entry.get(k) is not None for k in keys):
+        if field in undocumented:
             taken.append(what)
         elif field in machine.assumed_load:
             unknown.append(what)
