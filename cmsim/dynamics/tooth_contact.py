@@ -47,19 +47,23 @@ from __future__ import annotations
 
 import functools
 import sys
+import threading
+import warnings
+from dataclasses import replace
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
 from cmsim.dynamics import torque_tables as table_builder
-from cmsim.errors import ParameterError, check_range
+from cmsim.errors import ModelWarning, ParameterError, check_range
 from cmsim.mesh_stiffness import cache
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.mesh_cycle import hybrid_mesh_table
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.mesh_stiffness.table_set import MeshTableSet
 from cmsim.rig import Rig
+from cmsim.rig.codec import to_plain
 
 __all__ = ["resolve_mesh", "hybrid_table_set", "tables_key", "default_mesh_table",
            "build_paper_tables", "MESH_CHOICES", "TORQUE_GRID_NM", "PAPER_TABLES_FILE"]
@@ -79,12 +83,16 @@ BUILD_SETTINGS = {"method": "hybrid", "speed_rpm": 1000.0, "n_orbit": 24, "n_ste
 #: Bump when the tables' contents change for the same inputs (invalidates cached sets).
 TABLES_VERSION = 1
 
+#: Bump when the potential-energy table's contents change for the same gear pair.
+PE_TABLE_VERSION = 1
+
 #: Package data file with the paper rig's set (relative to the ``cmsim`` package).
 PAPER_TABLES_FILE = "data/paper_2016_hybrid_tables.npz"
 
 _SETS = {}
 _ABOVE = {}
 _PE_CACHE = {}
+_PE_LOCK = threading.Lock()
 
 
 @functools.lru_cache(maxsize=64)
@@ -111,10 +119,47 @@ def tables_key(rig):
 
 
 def default_mesh_table(pair):
-    """Potential-energy table of ``pair`` (paper 004; cached per gear pair)."""
+    """Potential-energy table of ``pair`` (paper 004), memoised per gear pair and cached on
+    disk: its corner zones take 0.4 s to find, which every process simulating a machine's
+    twin (:func:`cmsim.machine.twin_mesh`) paid, a comparison's refining run included. The
+    warnings of its build (a formula used beyond its fit) are stored with it and said again
+    once a process, as when it was built."""
+    with _PE_LOCK:      # a healthy and a changed run may ask at once (two threads)
+        return _potential_energy_table(pair)
+
+
+def _potential_energy_table(pair):
     if pair not in _PE_CACHE:
-        _PE_CACHE[pair] = MeshStiffnessTable.potential_energy(pair)
+        key = cache.cache_key("potential-energy", {"pair": to_plain(pair),
+                                                   "version": PE_TABLE_VERSION})
+        path = cache.cache_path("potential-energy", key)
+        table = _load_table(path)
+        if table is None:
+            with warnings.catch_warnings(record=True) as said:
+                warnings.simplefilter("always")
+                table = MeshStiffnessTable.potential_energy(pair)
+            kept = [w for w in said if w.category in (ModelWarning, UserWarning)]
+            for w in said:
+                if w not in kept:       # not the table's own: said now, not stored
+                    warnings.warn(w.message, w.category, stacklevel=2)
+            table = replace(table, meta={**table.meta, "warnings": [
+                [w.category.__name__, str(w.message)] for w in kept]})
+            table.save(path)
+        for category, message in table.meta.get("warnings", ()):
+            warnings.warn(message, ModelWarning if category == "ModelWarning" else UserWarning,
+                          stacklevel=2)
+        _PE_CACHE[pair] = table
     return _PE_CACHE[pair]
+
+
+def _load_table(path):
+    """The table cached at ``path``, or None (absent or unreadable: built again)."""
+    if not path.is_file():
+        return None
+    try:
+        return MeshStiffnessTable.load(path)
+    except (OSError, ValueError, KeyError):
+        return None
 
 
 def _bar_progress(progress, n, what):
@@ -209,12 +254,7 @@ def _table_at(rig, torque_nm, progress):
     if key in _ABOVE:
         return _ABOVE[key]
     path = cache.cache_path("hybrid-table", key)
-    table = None
-    if path.is_file():
-        try:
-            table = MeshStiffnessTable.load(path)
-        except (OSError, ValueError, KeyError):
-            table = None
+    table = _load_table(path)
     if table is None:
         step, close = _bar_progress(progress, 1, f"cmsim: mesh table at {torque_nm:g} N m")
         try:

@@ -12,6 +12,7 @@ Tier: regression and structure. Checks that
 * bad ``mesh`` values are refused with an error naming ``mesh``.
 """
 
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -21,7 +22,7 @@ from cmsim.dynamics import tooth_contact
 from cmsim.dynamics.tooth_contact import (MESH_CHOICES, TORQUE_GRID_NM, hybrid_table_set,
                                           resolve_mesh, tables_key)
 from cmsim.dynamics.torque_tables import torque_tables
-from cmsim.errors import ParameterError
+from cmsim.errors import ModelWarning, ParameterError
 from cmsim.mesh_stiffness import influence
 from cmsim.mesh_stiffness.hybrid import HybridMeshModel
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
@@ -146,6 +147,35 @@ def test_explicit_meshes_and_potential_energy():
     assert resolve_mesh(RIG, own, 50.0) == (own, None)
     tables = hybrid_table_set(RIG)
     assert resolve_mesh(RIG, tables, 100.0)[0] is tables.at(100.0)
+
+
+def test_potential_energy_table_is_cached_with_its_warnings(fresh, monkeypatch):
+    """The potential-energy table (every machine's twin mesh) is built once per gear pair
+    and read from the disk cache by a later process, equal to the bit; a build that warned
+    (Sainsot's fillet-foundation formula beyond its fit: a 60-tooth pinion on a 20-mm bore)
+    warns again when a later process reads it, once, and another pair gets its own entry."""
+    monkeypatch.setattr(tooth_contact, "_PE_CACHE", {})
+    pair = replace(RIG.gears, driving=replace(RIG.gears.driving, n_teeth=60))
+    with pytest.warns(ModelWarning, match="tooth foundation") as built:
+        table = tooth_contact.default_mesh_table(pair)
+    assert len(list(fresh.glob("potential-energy-*.npz"))) == 1
+    monkeypatch.setattr(tooth_contact, "_PE_CACHE", {})      # a later process
+    builds = []
+    monkeypatch.setattr(MeshStiffnessTable, "potential_energy",
+                        classmethod(lambda cls, p, n_points=257: builds.append(p)))
+    with pytest.warns(ModelWarning) as read:
+        again = tooth_contact.default_mesh_table(pair)
+    assert not builds and [str(w.message) for w in read] == [str(w.message) for w in built]
+    assert np.array_equal(again.stiffness_n_per_m, table.stiffness_n_per_m)
+    assert np.array_equal(again.position_m, table.position_m)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                       # memoised: said once
+        assert tooth_contact.default_mesh_table(pair) is again
+    monkeypatch.undo()
+    monkeypatch.setattr(tooth_contact, "_PE_CACHE", {})
+    monkeypatch.setenv("CMSIM_CACHE_DIR", str(fresh))
+    tooth_contact.default_mesh_table(RIG.gears)
+    assert len(list(fresh.glob("potential-energy-*.npz"))) == 2
 
 
 def test_gearless_rigs_and_bad_values():
