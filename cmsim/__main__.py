@@ -1,8 +1,6 @@
 """``python -m cmsim``: the ``cmsim`` command (the same as ``python -m cmsim.cli``)."""
 
-import sys
-
-from cmsim.cli.app import main
+from cmsim.cli.app import console
 
 if __name__ == "__main__":
-    sys.exit(main())
+    console()

@@ -1,6 +1,7 @@
 """The ``cmsim`` command line: ``main(argv)``, one module per command, thin over the library.
 
 * :mod:`~cmsim.cli.app` — :func:`main`, :func:`build_parser`: parse, run, print;
+  :func:`console`, the console script: :func:`main`, then an exit without teardown;
 * :mod:`~cmsim.cli.contract` — the one way the command line validates, names options in
   messages and reports errors (exit 2 bad input, 3 diverged, one line, ``--json``);
 * :mod:`~cmsim.cli.options` — the option groups several commands share (rig, the one sampling
@@ -14,6 +15,6 @@
   ``run(args)`` and ``text(result)``.
 """
 
-from cmsim.cli.app import build_parser, main
+from cmsim.cli.app import build_parser, console, main
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "console", "build_parser"]

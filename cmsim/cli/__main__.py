@@ -1,7 +1,5 @@
 """``python -m cmsim.cli``: the ``cmsim`` command."""
 
-import sys
+from cmsim.cli.app import console
 
-from cmsim.cli.app import main
-
-sys.exit(main())
+console()
