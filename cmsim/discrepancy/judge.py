@@ -409,7 +409,8 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
         alone); each lays the cause at its fitted size on the baseline anew, and is kept
         when it reads the record better.
     workers : int
-        Processes that build a missing library.
+        Processes that build a missing library; with 2 or more, the model's two runs of a
+        refinement or a load change go side by side on two threads.
     library_progress : callable, optional
         Progress of a library built here.
 
@@ -435,7 +436,7 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     if record.unit_scale is None and machine.unit_scale is not None:
         notes.append("the record's unit is unknown: its absolute level is not compared")
     op, load_note = record_load(record, machine)
-    lib, shift_note = at_operating_point(machine, lib, op)
+    lib, shift_note = at_operating_point(machine, lib, op, threads=min(2, workers))
     notes.extend(n for n in (load_note, shift_note) if n)
     names, rows = _record_rows(record, machine, lib.segment_s, max_segments)
     fit, held = rows[0::2], rows[1::2]
@@ -472,7 +473,7 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     fitted, simulations = None, 0
     if top is not None and refine > 0 and top["name"] in CAUSES and "beside" not in top:
         got = simulate_entry(machine, lib, CAUSES[top["name"]](), top["component"],
-                             top["variant"], top["value"])
+                             top["variant"], top["value"], threads=min(2, workers))
         simulations = 1
         if got is not None and list(got[0]) == list(lib.names):
             pred = got[1][li]

@@ -83,7 +83,7 @@ def record_load(record, machine):
     return op, "; ".join(notes)
 
 
-def at_operating_point(machine, lib, op):
+def at_operating_point(machine, lib, op, *, threads=1):
     """(library, note): the library with every reference and prediction moved by the model's
     change from the machine's documented load to the record's, where they differ by more than
     :data:`LOAD_TOLERANCE` (the baseline at 0 % load, a record at 50 %), each feature's
@@ -97,6 +97,8 @@ def at_operating_point(machine, lib, op):
         Its library.
     op : cmsim.rig.OperatingPoint
         The record's (:func:`record_load`).
+    threads : int
+        Threads of the model's two runs (:func:`~cmsim.discrepancy.signatures.change_of`).
 
     Returns
     -------
@@ -108,7 +110,7 @@ def at_operating_point(machine, lib, op):
     if not (differs(op.torque_nm, machine.op.torque_nm)
             or differs(op.radial_load_n, machine.op.radial_load_n)):
         return lib, ""
-    shift = operating_shift(machine, lib, op)
+    shift = operating_shift(machine, lib, op, threads=threads)
     if shift is None:
         return lib, ("the record's documented load differs from the machine's, and the model "
                      "at it diverged: read against the baseline as it is")

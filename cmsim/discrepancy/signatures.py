@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import time
 import warnings
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
 import numpy as np
@@ -169,7 +170,7 @@ def _nanmean(rows):
         return np.nanmean(rows, axis=0)
 
 
-def change_of(setup, healthy, force_of, fs_hz, seed):
+def change_of(setup, healthy, force_of, fs_hz, seed, *, threads=1):
     """The :class:`~cmsim.machine.change.Change` a setup makes relative to a healthy one.
 
     Parameters
@@ -183,6 +184,10 @@ def change_of(setup, healthy, force_of, fs_hz, seed):
         Sample rate, Hz.
     seed : int
         Seed of the shaft forces' phase.
+    threads : int
+        Threads the healthy and the changed run go side by side on (the integrator releases
+        the GIL): 2 where nothing else uses the other core (a comparison's refining run), 1
+        in a pool's worker.
 
     Returns
     -------
@@ -199,8 +204,8 @@ def change_of(setup, healthy, force_of, fs_hz, seed):
     edge, rotating = 0, ()
     moved = dyn.dynamics_key() != healthy.dynamics_key()
     if moved or setup.shaft_forces:
-        h = force_of(healthy)
-        c = force_of(dyn) if moved else h
+        runs = _side_by_side(force_of, (healthy, dyn) if moved else (healthy,), threads)
+        h, c = runs[0], runs[-1]
         if h is None or c is None:
             return None
         base, edge = h[0], h[1]
@@ -214,6 +219,14 @@ def change_of(setup, healthy, force_of, fs_hz, seed):
                   white_noise=setup.white_noise,
                   background_gain=max(1.0, setup.background_gain * setup.background_level),
                   speed_fluctuation=fluct, pin_hz=_mesh_harmonics(freqs, fs_hz))
+
+
+def _side_by_side(force_of, setups, threads):
+    """``force_of`` of each setup, on up to ``threads`` threads."""
+    if threads < 2 or len(setups) < 2:
+        return [force_of(s) for s in setups]
+    with ThreadPoolExecutor(min(threads, len(setups))) as pool:
+        return list(pool.map(force_of, setups))
 
 
 def _mesh_harmonics(freqs, fs_hz):
@@ -467,7 +480,7 @@ def _run(lib, jobs, workers, progress):
     return out
 
 
-def simulate_entry(machine, library, cause, component, variant, value):
+def simulate_entry(machine, library, cause, component, variant, value, *, threads=1):
     """One prediction of the library's kind, simulated anew: the machine's baseline segments
     (those the library was computed on) with ``cause`` at ``value`` on ``component`` under the
     nuisance ``variant`` — what refines a leading cause's size between the grid's points.
@@ -486,6 +499,8 @@ def simulate_entry(machine, library, cause, component, variant, value):
         A nuisance variant's label (of the library's entries).
     value : float
         The cause's first parameter.
+    threads : int
+        Threads of its healthy and changed runs (:func:`change_of`).
 
     Returns
     -------
@@ -505,14 +520,14 @@ def simulate_entry(machine, library, cause, component, variant, value):
                              component)
     except ParameterError:
         return None
-    change = change_of(setup, healthy, lib.force, lib.fs, lib.seed)
+    change = change_of(setup, healthy, lib.force, lib.fs, lib.seed, threads=threads)
     if change is None:
         return None
     return lib.features(replace(change, path_gain=gain), [library.seed, 424_242],
                         signals=True)
 
 
-def operating_shift(machine, library, op):
+def operating_shift(machine, library, op, *, threads=1):
     """What the model says another operating point changes on the baseline's features: the
     healthy model at ``op`` against the healthy model at the machine's (the same seed) laid
     on the library's segments, less the library's reference — the shift of every feature a
@@ -525,6 +540,8 @@ def operating_shift(machine, library, op):
     library : SignatureLibrary
     op : OperatingPoint
         The record's documented operating point.
+    threads : int
+        Threads of its two runs (:func:`change_of`).
 
     Returns
     -------
@@ -535,7 +552,7 @@ def operating_shift(machine, library, op):
     lib = _Library(machine, segs, library.seed)
     nominal = ModelSetup(rig=machine.rig, op=machine.op, machine=machine)
     moved = replace(nominal, op=replace(op, speed_rpm=machine.op.speed_rpm))
-    change = change_of(moved, nominal, lib.force, lib.fs, lib.seed)
+    change = change_of(moved, nominal, lib.force, lib.fs, lib.seed, threads=threads)
     if change is None:
         return None
     names, mean = lib.features(change, [library.seed, 31_337])

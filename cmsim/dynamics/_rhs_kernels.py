@@ -20,7 +20,8 @@ mesh forces, right-hand side and integrator): they share the numba convention â€
 numbers; hot-path code never slices arrays and never takes arrays out of tuples inside loops
 (numba takes an atomic reference count for each); the force and integrator kernels are compiled
 without numba's reference-counting runtime (``_nrt=False``: they allocate nothing, the caller
-passes every buffer); small kernels are inlined at numba-IR level (``inline="always"``: a call
+passes every buffer); the integrator releases the GIL (``nogil=True``: a healthy and a
+changed run go side by side on two threads); small kernels are inlined at numba-IR level (``inline="always"``: a call
 with array arguments costs about 25 ns). """
 
 from __future__ import annotations
@@ -413,7 +414,7 @@ def _propagate_jit(X, which, x):
             x[X.idx[b, i]] = acc
 
 
-@njit(cache=True, error_model="numpy", _nrt=False)
+@njit(cache=True, error_model="numpy", _nrt=False, nogil=True)
 def integrate_jit(y0, t0, h, n_out, substeps, m_offset, rk_a, rk_b, rk_c, X, P, W, B, out_y,
                   out_diag, max_disp, max_rot, trans_mask):
     """Fixed-step explicit Runge-Kutta with output every ``substeps`` steps.

@@ -95,3 +95,36 @@ def test_a_dead_helper_leaves_its_runs_to_this_process(monkeypatch):
     with Evaluator(record, 0.25, 0, 10, workers=2) as ev:
         assert ev.rows(setup, ev.seeds(2)) == expected
         assert ev.workers == 1 and ev._helpers is None and ev.count == 2
+
+
+@pytest.mark.slow
+def test_a_machine_comparison_refines_on_two_threads_as_on_one(monkeypatch):
+    """Against a machine, the refining runs (the healthy and the changed model) go side by
+    side on two threads where the comparison has two workers: the same comparison, number for
+    number, as one thread makes, and the runs were made on two threads."""
+    import threading
+
+    from cmsim.discrepancy import CAUSES, signatures
+    from cmsim.discrepancy.signatures import build_library
+
+    baseline = hidden_effect_record(None, 4, sim_seed=9, duration_s=2.0).record
+    machine = calibrate([baseline], seed=4)
+    machine = machine.with_library(build_library(
+        machine, causes=[CAUSES[c]() for c in ("bearing_outer_race", "unbalance")], n_sizes=3,
+        seed=2, workers=1))
+    record = hidden_effect_record("bearing_outer_race", 5, duration_s=2.0).record
+    threads = []
+    force = signatures.model_force
+
+    def counted(*args, **kwargs):
+        threads.append(threading.get_ident())
+        return force(*args, **kwargs)
+
+    monkeypatch.setattr(signatures, "model_force", counted)
+    one = compare(record, machine=machine, workers=1)
+    assert one.finding == "bearing_outer_race" and one.simulations == 1
+    assert len(threads) == 2 and len(set(threads)) == 1
+    threads.clear()
+    two = compare(record, machine=machine, workers=2)
+    assert len(threads) == 2 and len(set(threads)) == 2
+    _same(one, two)
