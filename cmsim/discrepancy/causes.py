@@ -152,7 +152,8 @@ class Cause:
     #: False: judged at its probes, fitted only if named.
     refined: typing.ClassVar[bool] = True
     #: Prefixes of the features the cause is judged on (its families, sidebands, bands;
-    #: ``{b}`` stands for its bearing); None: it reshapes the spectrum and is judged on all.
+    #: ``{b}`` stands for its bearing, ``{fr}`` for its gear's shaft rate, ``fr1`` or
+    #: ``fr2``); None: it reshapes the spectrum and is judged on all.
     signature: typing.ClassVar[tuple | None] = None
     #: Its change is impacts ringing the machine's structure (a spall, a broken tooth): where
     #: they ring depends on the structure's response at frequencies a healthy baseline may
@@ -200,7 +201,8 @@ class Cause:
         """
         if self.signature is None:
             return list(names)
-        pre = tuple(p.format(b=component) for p in self.signature)
+        pre = tuple(p.format(b=component, fr=f"fr{_gear_index(component)}")
+                    for p in self.signature)
         return [k for k in names if k.startswith(pre)]
 
     def family(self, names, component):
@@ -316,7 +318,9 @@ class EccentricityCause(Cause):
     probes = (1e-5, 5e-5)
     kind = "gear"
     needs_gears = True
-    signature = ("sb1_", "raw_fr_h1_db", "env_fr_h1_db", "gmf")
+    #: The mesh's sidebands at its own shaft's rate: a gear on the input shaft modulates the
+    #: mesh at the input's rate, not the output's.
+    signature = ("sb1_{fr}_", "raw_fr_h1_db", "env_fr_h1_db", "gmf")
     #: Its run-out modulates the mesh once per revolution; how much depends on the gears'
     #: stiffness and the load's inertia, which a calibrated machine does not know (the
     #: model's own modulation, through the contact geometry of a light output, lifts the
@@ -340,8 +344,9 @@ class ToothFaultCause(Cause):
     probes = (5e-4, 2e-3)
     kind = "gear"
     needs_gears = True
-    signature = ("sb1_", "sb23_", "tsa_residual_kurtosis_log", "kurtosis_log", "crest_log",
-                 "gmf")
+    #: The sidebands at its own shaft's rate (its event recurs once per turn of its gear).
+    signature = ("sb1_{fr}_", "sb23_{fr}_", "tsa_residual_kurtosis_log", "kurtosis_log",
+                 "crest_log", "gmf")
     rings_structure = True
 
     def apply(self, setup, value, component):
