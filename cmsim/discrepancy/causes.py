@@ -152,8 +152,9 @@ class Cause:
     #: False: judged at its probes, fitted only if named.
     refined: typing.ClassVar[bool] = True
     #: Prefixes of the features the cause is judged on (its families, sidebands, bands;
-    #: ``{b}`` stands for its bearing, ``{fr}`` for its gear's shaft rate, ``fr1`` or
-    #: ``fr2``); None: it reshapes the spectrum and is judged on all.
+    #: ``{b}`` stands for its bearing, ``{fr}`` for the rate of the shaft it turns with,
+    #: ``fr1`` or ``fr2``: its gear's, or the sensor's for a rotating force);
+    #: None: it reshapes the spectrum and is judged on all.
     signature: typing.ClassVar[tuple | None] = None
     #: Its change is impacts ringing the machine's structure (a spall, a broken tooth): where
     #: they ring depends on the structure's response at frequencies a healthy baseline may
@@ -185,7 +186,7 @@ class Cause:
     #: (:data:`~cmsim.discrepancy.signatures.SHAFT_MODULATIONS`).
     rotates: typing.ClassVar[bool] = False
 
-    def judged_on(self, names, component):
+    def judged_on(self, names, component, shaft=None):
         """The features of ``names`` this cause is judged on (its :attr:`signature`).
 
         Parameters
@@ -193,7 +194,11 @@ class Cause:
         names : sequence of str
             Feature names.
         component : str or None
-            The component it sits on (fills ``{b}``).
+            The component it sits on (fills ``{b}``; a gear's fills ``{fr}``).
+        shaft : int, optional
+            The shaft the sensor's bearing sits on (1 the input, 2 the output): the mesh
+            sidebands of a cause whose component names no shaft (a rotating force laid on the
+            sensor's bearing) are that shaft's; None: either shaft's.
 
         Returns
         -------
@@ -201,11 +206,12 @@ class Cause:
         """
         if self.signature is None:
             return list(names)
-        pre = tuple(p.format(b=component, fr=f"fr{_gear_index(component)}")
-                    for p in self.signature)
+        rate = (f"fr{_gear_index(component)}" if self.kind == "gear"
+                else f"fr{shaft}" if shaft else "fr")
+        pre = tuple(p.format(b=component, fr=rate) for p in self.signature)
         return [k for k in names if k.startswith(pre)]
 
-    def family(self, names, component):
+    def family(self, names, component, shaft=None):
         """The features of ``names`` that tell this cause from the other faults: its signature
         without the shared :data:`STATISTICS` (empty for a cause that reshapes the spectrum).
 
@@ -215,6 +221,8 @@ class Cause:
             Feature names.
         component : str or None
             The component it sits on (fills ``{b}``).
+        shaft : int, optional
+            The sensor's shaft (:meth:`judged_on`).
 
         Returns
         -------
@@ -222,7 +230,7 @@ class Cause:
         """
         if self.signature is None:
             return []
-        return [k for k in self.judged_on(names, component) if k not in STATISTICS]
+        return [k for k in self.judged_on(names, component, shaft) if k not in STATISTICS]
 
     @property
     def params(self):
@@ -434,7 +442,8 @@ class _ShaftForce(Cause):
     heavier-tailed than the same signal unmodulated (a modulation of depth a raises a
     Gaussian signal's kurtosis from 3 to 3·(1 + 3a² + 3a⁴/8)/(1 + a²/2)², 4.8 at a = 0.66).
     As for a fault, the statistics add to its evidence but never name it alone: its family
-    (the shaft lines and sidebands) must move towards the record."""
+    (the shaft lines and the mesh's sidebands at the rate of the sensor's shaft, which the
+    force is laid on) must move towards the record."""
     parameter = "relative_amplitude"
     bounds = (0.02, 2.0)
     probes = (0.1, 0.5)
@@ -453,7 +462,7 @@ class UnbalanceCause(_ShaftForce):
     bearing load: the 1× line and a once-per-revolution load modulation."""
     name = "unbalance"
     orders = ((1, 1.0),)
-    signature = ("raw_fr_h1_db", "env_fr_h1_db", "sb1_") + STATISTICS
+    signature = ("raw_fr_h1_db", "env_fr_h1_db", "sb1_{fr}") + STATISTICS
 
 
 @register_cause
@@ -463,7 +472,7 @@ class MisalignmentCause(_ShaftForce):
     line and a twice-per-revolution load modulation."""
     name = "misalignment"
     orders = ((2, 1.0), (1, 0.5))
-    signature = ("raw_fr_h2_db", "raw_fr_h1_db", "sb23_", "sb1_") + STATISTICS
+    signature = ("raw_fr_h2_db", "raw_fr_h1_db", "sb23_{fr}", "sb1_{fr}") + STATISTICS
 
 
 # ---------------------------------------------------------------------- uncertain parameters

@@ -234,6 +234,8 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
     direction = 0.0
     if level is not None and abs(z0[level]) >= LEVEL_DIRECTION_Z:
         direction = math.copysign(1.0, z0[level])
+    # the shaft the sensor's bearing turns with ("<shaft>b<k>"): a rotating force's sidebands
+    shaft = int(sensor_bearing.split("b")[0]) if sensor_bearing[:1].isdigit() else None
     ranked, by_signature, tables = {}, {}, {}
     for e in lib.entries:
         if causes is not None and e.cause not in causes:
@@ -252,7 +254,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
         per_prof = per_sig
         if cause.rings_structure and np.any(path_dep):
             per_prof = np.where(path_dep, per0s[0], per_sig)
-        judged = cause.judged_on(names, e.component)
+        judged = cause.judged_on(names, e.component, shaft)
         sel = np.array([k in judged for k in names], dtype=bool)
         for store, per, p0, score in (
                 (ranked, per_full, per0, np.where(ok, chi, np.inf)),
@@ -270,7 +272,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                           "range": (float(within.min()), float(within.max())),
                           "chi2": float(per[b].sum()), "score": float(score[b]),
                           "prediction": table[b], "judged_on": judged,
-                          "family": cause.family(names, e.component),
+                          "family": cause.family(names, e.component, shaft),
                           "per_feature": dict(zip(names, delta.tolist())),
                           "total": float(delta.sum()), "delta_chi2": float(delta[sel].sum()),
                           "evidence": float(chi0 - per[b].sum())}

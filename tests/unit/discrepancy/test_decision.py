@@ -622,8 +622,9 @@ def test_a_gear_s_family_is_its_own_shaft_s_sidebands():
     injected into SpectraQuest's held-out half whose model run lifted the output shaft's
     first sideband 7-13 dB at every size (a run-to-run difference of the light mesh, not the
     run-out's change) was read as an input-gear tooth fault, its family standing out on that
-    sideband. A record whose one departure is that sideband is never a fault of the input
-    gear."""
+    sideband. A rotating force (unbalance, misalignment) is laid on the sensor's bearing:
+    its sidebands are the sensor's shaft's. A record whose one departure is the output
+    shaft's sideband is never a fault of the input gear."""
     from cmsim.discrepancy import CAUSES
 
     names = ("sb1_fr1_k1_db", "sb23_fr1_k1_db", "sb1_fr2_k1_db", "sb23_fr2_k1_db",
@@ -633,6 +634,12 @@ def test_a_gear_s_family_is_its_own_shaft_s_sidebands():
         for gear, fr in (("1G1", "fr1"), ("2G1", "fr2")):
             family = CAUSES[cause]().family(names, gear)
             assert [k for k in family if k.startswith("sb")] == [p.format(fr) for p in own]
+    # a rotating force is laid on the sensor's bearing: its sidebands are that shaft's
+    for shaft, fr in ((1, "fr1"), (2, "fr2")):
+        family = CAUSES["misalignment"]().family(names, None, shaft)
+        assert [k for k in family if k.startswith("sb")] == [f"sb1_{fr}_k1_db",
+                                                              f"sb23_{fr}_k1_db"]
+    assert len([k for k in CAUSES["unbalance"]().family(names, None) if k.startswith("sb")]) == 2
     m = len(names)
     entries = []
     for gear, cols in (("1G1", [0, 1]), ("2G1", [2, 3])):
