@@ -21,8 +21,8 @@ numbers; hot-path code never slices arrays and never takes arrays out of tuples 
 (numba takes an atomic reference count for each); the force and integrator kernels are compiled
 without numba's reference-counting runtime (``_nrt=False``: they allocate nothing, the caller
 passes every buffer); the integrator releases the GIL (``nogil=True``: a healthy and a
-changed run go side by side on two threads); small kernels are inlined at numba-IR level (``inline="always"``: a call
-with array arguments costs about 25 ns). """
+changed run go side by side on two threads); small kernels are inlined at numba-IR level
+(``inline="always"``: a call with array arguments costs about 25 ns). """
 
 from __future__ import annotations
 

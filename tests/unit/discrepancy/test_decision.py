@@ -280,7 +280,8 @@ def _across_loads(monkeypatch, shift):
     import cmsim.discrepancy.operating_point as operating_point
     from cmsim.rig import OperatingPoint
 
-    monkeypatch.setattr(operating_point, "operating_shift", lambda machine, lib, op, threads=1: shift)
+    monkeypatch.setattr(operating_point, "operating_shift",
+                        lambda machine, lib, op, threads=1: shift)
     machine = SimpleNamespace(op=OperatingPoint(speed_rpm=1797.0, torque_nm=0.0,
                                                 radial_load_n=98.0))
     moved, note = operating_point.at_operating_point(
