@@ -105,7 +105,11 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
    the record is decided again without it (:mod:`cmsim.discrepancy.shaft_lines`). A record
    that departs and that no step explains is ``unexplained``, with where it departs.
 5. **Which bearing's line.** A named bearing fault whose fundamental shares its line, at the
-   segments' resolution, with another bearing fault's that stands out as far yields to it
+   segments' resolution, with a harmonic of a shaft whose envelope comb rose over the
+   baseline's, while its window beside that harmonic did not, is not named: the line is the
+   shaft's once-per-revolution event (a broken tooth's impacts), and the record is decided
+   again without that fault on that bearing. A named bearing fault whose fundamental shares
+   its line with another bearing fault's that stands out as far yields to it
    where the whole record, read at its full resolution, puts the line in the other's window
    alone (``decided_on`` ``"full resolution"``), and one whose fundamental stands out in no
    band, only a harmonic, to one whose fundamental does (``"fundamental"``). Where nothing
@@ -130,7 +134,8 @@ from cmsim.discrepancy.operating_point import at_operating_point, record_load
 from cmsim.discrepancy.ranking import (NEAR_TIE, SEVERITY_DELTA_CHI2, _consistent,
                                        added_evidence, decide)
 from cmsim.discrepancy.reshaping import PREDICTION_ERROR, absorbed_by, within_error
-from cmsim.discrepancy.resolution import buried_family, resolve_line
+from cmsim.discrepancy.resolution import (FUNDAMENTALS, buried_family, resolve_line,
+                                          shaft_comb)
 from cmsim.discrepancy.shaft_lines import held_lines
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
 from cmsim.discrepancy.stand_out import FAMILY_RISE_DB, FAMILY_Z, shape_moved, standing_out
@@ -183,7 +188,8 @@ def _record_rows(record, machine, seg_s, max_segments):
     return names, rows
 
 
-def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate_sigma=None):
+def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate_sigma=None,
+                  excluded=()):
     """Steps 2-4 of the module docstring on a record's mean features.
 
     Parameters
@@ -206,6 +212,8 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
         :func:`~cmsim.discrepancy.stand_out.shape_moved`; default ``sigma``): the baseline's
         spread with the model's run spread
         (:func:`~cmsim.discrepancy.columns.feature_sigma`'s ``standing``).
+    excluded : collection of (str, str or None)
+        (cause, component) pairs not considered.
 
     Returns
     -------
@@ -238,7 +246,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
     shaft = int(sensor_bearing.split("b")[0]) if sensor_bearing[:1].isdigit() else None
     ranked, by_signature, tables = {}, {}, {}
     for e in lib.entries:
-        if causes is not None and e.cause not in causes:
+        if (causes is not None and e.cause not in causes) or (e.cause, e.component) in excluded:
             continue
         cause = CAUSES[e.cause]()
         values, table = interpolated(e.values, e.features[:, li], INTERPOLATION_STEPS)
@@ -450,15 +458,28 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     sigma = feature_sigma(lib, li, cnames, n_fit)
     sensor = signal_info(machine.model_signal).component
     gate = feature_sigma(lib, li, cnames, n_fit, standing=True)
-    d = decide_record(lib, li, cnames, meas, sigma, sensor, causes, gate_sigma=gate)
-    d, why = held_lines(record, machine, d, cnames, meas, lib.mean[li], lib.segment_s,
-                        lambda out: decide_record(lib, li, cnames, meas, sigma, sensor, [
-                            c for c in causes or {e.cause for e in lib.entries}
-                            if c not in out], gate_sigma=gate))
+    held, combed = set(), set()
+
+    def decide(out=(), pairs=()):
+        held.update(out)
+        combed.update(pairs)
+        return decide_record(lib, li, cnames, meas, sigma, sensor, causes if not held else [
+            c for c in causes or {e.cause for e in lib.entries} if c not in held],
+            gate_sigma=gate, excluded=combed)
+
+    d = decide()
+    d, why = held_lines(record, machine, d, cnames, meas, lib.mean[li], lib.segment_s, decide)
     notes.extend(why)
+    baseline = machine.baseline.records if machine.baseline else ()
+    for _ in range(len(machine.rig.bearing_names) * len(FUNDAMENTALS)):
+        got = shaft_comb(record, baseline, machine.op.speed_rpm, lib.segment_s, d)
+        if got is None:
+            break
+        d = decide(pairs=[(got[0]["name"], got[0]["component"])])
+        notes.append(got[1])
     resolved = resolve_line(record, lib.segment_s, d, cnames, meas, lambda cols: standing_out(
         cols, meas, lib.mean[li], gate, cnames)) or buried_family(
-            record, machine.baseline.records if machine.baseline else (), machine.op.speed_rpm, d)
+            record, baseline, machine.op.speed_rpm, d)
     if resolved is not None:
         new, how, why = resolved
         d["ties"] = [r for r in [d["top"]] + d["ties"] if r is not new and r is not None]

@@ -38,6 +38,21 @@ SpectraQuest's healthy half (their family 1.6-5.7 dB up, standing out nowhere) w
 otherwise named outer races on a BPFO line standing out in one or two of the bank's bands
 of that impulsive baseline (one of them not even its own: −0.2 dB over the whole record).
 
+A once-per-revolution event — a broken tooth's impacts — lights the whole comb of its shaft's
+harmonics in the envelope, and at the segments' resolution a bearing's fundamental falls in
+the window of one of them more often than not (2 % slip and 1.5 bins of 2 Hz either side:
+± 5.4 Hz at 120 Hz, against a 25-30 Hz comb). The angle-domain generator's gear machines
+named three of eight tooth faults a ball or an outer-race defect of a bearing whose
+fundamental lay 0.1-4.4 Hz from the input shaft's 3rd or 4th harmonic. So a named bearing
+fault whose fundamental shares its segment window with a shaft's harmonic
+(:func:`shaft_comb`) is read over the whole record beside the baseline's (as a buried family
+is): where the shaft's comb, the median over its first :data:`COMB_HARMONICS` harmonics, rose
+:data:`COMB_RISE_DB` over the baseline's, and the fundamental's window outside the
+harmonic's own bins did not rise :data:`~cmsim.discrepancy.stand_out.FAMILY_RISE_DB`, the
+line is the shaft's and the fault is not named there. A bearing defect's line slips off the
+harmonic (a window's width at full resolution), and an inner race, whose load zone turns
+with its shaft and lights the comb too, keeps its own line beside it.
+
 Where the segments name nothing (``none`` or ``unexplained``), a bearing's family may still
 stand over the whole record: under a gear mesh, a race's impacts fill no band of a 0.5-s
 segment, but their steady lines gain with the resolution as the floor does not. The record and
@@ -57,13 +72,14 @@ import numpy as np
 
 from cmsim.discrepancy.causes import CAUSE_WORDS
 from cmsim.features.envelope import envelope_lines
-from cmsim.features.relative import envelope_columns
-from cmsim.spectra.lines import SLIP_TOLERANCE, line_bins
+from cmsim.discrepancy.stand_out import FAMILY_RISE_DB
+from cmsim.features.relative import envelope_columns, envelope_over_floor
+from cmsim.spectra.lines import SLIP_TOLERANCE, line_amplitude, line_bins
 
 __all__ = ["BURIED_LINE_DB", "BURIED_RISE_DB", "BURIED_SPANS", "BURIED_TIE_DB",
-           "FULL_RESOLUTION_MAX_S",
+           "COMB_HARMONICS", "COMB_RISE_DB", "FULL_RESOLUTION_MAX_S",
            "FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "buried_family", "fundamental_columns",
-           "fundamental_hz", "overlapping", "resolve_line"]
+           "fundamental_hz", "overlapping", "resolve_line", "shaft_comb"]
 
 #: A rival's fundamental, read over the whole record, stands this far over the named fault's
 #: to take the line, dB: a steady line gains 7.8 dB from 0.5-s segments to a 3-s record,
@@ -96,6 +112,15 @@ BURIED_TIE_DB = 3.0
 #: Spans of a long baseline read, each as long as the record: a healthy line's level
 #: wanders from span to span, and the record's rise is taken over their highest.
 BURIED_SPANS = 4
+
+#: A shaft's envelope comb risen this far over the baseline's (the median over its harmonics
+#: that no line of the named fault's family holds), dB: a once-per-revolution event of that
+#: shaft. On the angle-domain generator's machines the input shaft's comb rose 11-18 dB with
+#: a local tooth fault, -3 to +5 dB with a bearing defect (either shaft).
+COMB_RISE_DB = 8.0
+
+#: Harmonics of a shaft's rate that make its comb.
+COMB_HARMONICS = 12
 
 #: The envelope line that defines each bearing fault: its family's fundamental.
 FUNDAMENTALS = {"bearing_outer_race": "bpfo", "bearing_inner_race": "bpfi",
@@ -168,13 +193,17 @@ def _key(row):
     return f"env_{FUNDAMENTALS[row['name']]}_{row['component']}_h1_db"
 
 
+def _middle(x, n):
+    return np.asarray(x[(x.size - n) // 2:(x.size - n) // 2 + n], dtype=float)
+
+
 def _full_resolution(record, freqs, rows, x=None, n=None):
     """The envelope columns of the rows' bearings read over the whole record (its middle
     :data:`FULL_RESOLUTION_MAX_S` of a longer one; or the middle ``n`` samples of ``x``, at
     the record's rate), and that span's resolution, Hz."""
     x = record.signal if x is None else x
     n = min(x.size, int(round(FULL_RESOLUTION_MAX_S * record.fs_hz)), n or x.size)
-    x = np.asarray(x[(x.size - n) // 2:(x.size - n) // 2 + n], dtype=float)
+    x = _middle(x, n)
     bearings = {b: freqs.bearing(b) for b in {r["component"] for r in rows}}
     return envelope_columns(x - x.mean(), record.fs_hz, freqs.fr1_hz, bearings), \
         record.fs_hz / n
@@ -322,3 +351,77 @@ def resolve_line(record, segment_s, decision, names, meas, stands_out):
         f"{f_top:.1f} Hz) share a line in the {segment_s:g}-s segments; read over the whole "
         f"record ({df:.2g} Hz), the line is the first's ({fine[key]:.1f} dB over the "
         f"envelope's floor, the second's {fine[top_key]:.1f} dB)")
+
+
+def _comb_levels(x, fs, shaft_hz, bearings, band, comb_hz, fundamental_hz):
+    """The comb's lines and a fundamental's (outside the comb's bins) over the envelope's
+    floor of ``x``, dB, and the band read."""
+    ef, ratio, band = envelope_over_floor(x - x.mean(), fs, shaft_hz, bearings, band)
+    with np.errstate(divide="ignore"):
+        comb = 20.0 * np.log10([line_amplitude(ef, ratio, f) for f in comb_hz])
+        own = 20.0 * np.log10(line_amplitude(ef, ratio, fundamental_hz, SLIP_TOLERANCE,
+                                             comb_hz))
+    return comb, float(own), band
+
+
+def shaft_comb(record, baseline, baseline_rpm, segment_s, decision):
+    """The named bearing fault, and a note saying why, where its fundamental shares a line
+    with a harmonic of a shaft whose envelope comb rose over the baseline's while the
+    fundamental's window beside the comb did not (module docstring); else None.
+
+    Parameters
+    ----------
+    record : MeasuredRecord
+        The record.
+    baseline : sequence of numpy.ndarray
+        The machine's baseline records (the record's rate).
+    baseline_rpm : float
+        The baseline's input speed, rpm (its shaft rates are read there).
+    segment_s : float
+        Length of the segments the features were read on, s.
+    decision : dict
+        :func:`~cmsim.discrepancy.judge.decide_record`'s result (``top``).
+
+    Returns
+    -------
+    (dict, str) or None
+        The named fault's row and the note.
+    """
+    top = decision["top"]
+    if top is None or top["name"] not in FUNDAMENTALS or not top["component"] or not baseline:
+        return None
+    freqs = record.model_frequencies()
+    ref = record.model_frequencies(speed_rpm=baseline_rpm)
+    f_top = fundamental_hz(freqs, top["name"], top["component"])
+    f_ref = fundamental_hz(ref, top["name"], top["component"])
+    n = min(min(b.size for b in baseline), record.signal.size,
+            int(round(FULL_RESOLUTION_MAX_S * record.fs_hz)))
+    x, fs = _middle(record.signal, n), record.fs_hz
+    for shaft, fr, fr_ref in (("input", freqs.fr1_hz, ref.fr1_hz),
+                              ("output", freqs.fr2_hz, ref.fr2_hz)):
+        k = 0 if not fr else max(1, round(f_top / fr))
+        if not k or not overlapping(f_top, k * fr, 1.0 / segment_s):
+            continue
+        # the comb up to the fundamental's harmonic and beyond: its lines beside the
+        # fundamental's window are the comb's alone
+        js = np.arange(1, max(COMB_HARMONICS, k + 2) + 1)
+        comb, own, band = _comb_levels(x, fs, freqs.fr1_hz, freqs.bearings, None, js * fr,
+                                       f_top)
+        # the baseline read in the same band over spans of the same length, each line at
+        # its highest
+        base_comb, base_own = np.full(js.size, -np.inf), -np.inf
+        for b in baseline:
+            for i in range(min(b.size // n, BURIED_SPANS)):
+                c, o, _ = _comb_levels(np.asarray(b[i * n:(i + 1) * n], dtype=float), fs,
+                                       ref.fr1_hz, ref.bearings, band, js * fr_ref, f_ref)
+                base_comb, base_own = np.fmax(base_comb, c), np.fmax(base_own, o)
+        rise = float(np.nanmedian(comb - base_comb))
+        own_rise = own - base_own
+        if rise >= COMB_RISE_DB and not own_rise >= FAMILY_RISE_DB:
+            return top, (
+                f"{_name(record, top)} not named: its fundamental ({f_top:.1f} Hz) shares a "
+                f"line with the {shaft} shaft's {k}× ({k * fr:.1f} Hz) in the segments; the "
+                f"shaft's envelope comb (its first {js.size} harmonics) rose {rise:.1f} dB "
+                f"over the baseline's, the fundamental's window beside it {own_rise:+.1f} dB, "
+                f"read over the whole record: a once-per-revolution event of that shaft")
+    return None

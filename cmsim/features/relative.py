@@ -27,6 +27,7 @@ from cmsim.spectra._checks import sampling_rate, signal_1d
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["relative_features", "raw_floor", "envelope_columns", "band_family_columns", "band_column",
+           "envelope_over_floor",
            "segment_features", "segments", "N_SHAPE_BANDS", "N_ENVELOPE_BANDS",
            "shape_band_edges", "N_RELATIVE_GMF_HARMONICS"]
 
@@ -220,6 +221,36 @@ def envelope_columns(x, fs_hz, shaft_hz, bearings):
         out[f"env_bpfo_{b}_sb_db"] = _db(_mean(*sb), efloor)
         out[f"env_bpfo_{b}_band_db"] = _db_power(band_excess(ef, ea, bf.bpfo_hz, efloor, tol))
     return out
+
+
+def envelope_over_floor(x, fs_hz, shaft_hz, bearings, band_hz=None):
+    """The envelope spectrum :func:`envelope_columns` reads (its band rule, or a given band)
+    over its floor, for lines read at any frequency (a shaft's harmonics).
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        Signal, mean removed.
+    fs_hz : float
+        Sample rate, Hz.
+    shaft_hz : float
+        Input shaft rate, Hz (the floor's span starts at half of it).
+    bearings : dict of str to cmsim.frequencies.BearingFrequencies
+        The bearings whose families set the band rule's band and the floor's span.
+    band_hz : tuple of float, optional
+        The band demodulated (default the band rule's on ``x``).
+
+    Returns
+    -------
+    freq : numpy.ndarray
+        Bin frequencies, Hz.
+    ratio : numpy.ndarray
+        Amplitude over the floor.
+    band_hz : tuple of float
+        The band demodulated, Hz.
+    """
+    (ef, ea), band = demodulated_spectrum(x, fs_hz, bearings.values(), band_hz)
+    return ef, ea / _envelope_floor(ef, ea, shaft_hz, bearings), band
 
 
 def _envelope_floor(ef, ea, shaft_hz, bearings):

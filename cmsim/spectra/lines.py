@@ -42,6 +42,7 @@ import math
 import numpy as np
 
 __all__ = ["line_window", "line_bins", "line_amplitude", "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE",
+           "AVOID_HALF_WIDTH_BINS",
            "SLIP_TOLERANCE"]
 
 #: Half-width of a line's window beyond its relative tolerance, bins.
@@ -49,6 +50,10 @@ LINE_HALF_WIDTH_BINS = 1.5
 
 #: Relative tolerance of a line whose frequency is known exactly (see the module docstring).
 EXACT_TOLERANCE = 0.0
+
+#: Half width of an avoided line's window (:func:`line_amplitude`'s ``avoid_hz``), bins: a
+#: Hann window's main lobe (2 bins) with the line anywhere in its bin.
+AVOID_HALF_WIDTH_BINS = 2.5
 
 #: Relative tolerance of a line read at a nominal speed: bearing slip and speed error.
 SLIP_TOLERANCE = 0.02
@@ -111,8 +116,9 @@ def line_bins(freq, f_hz, tolerance=EXACT_TOLERANCE, half_width_bins=LINE_HALF_W
     return slice(lo, hi) if hi > lo else None
 
 
-def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE):
-    """Amplitude of the line at ``f_hz``: the largest bin of its window.
+def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE, avoid_hz=()):
+    """Amplitude of the line at ``f_hz``: the largest bin of its window (outside the exact
+    windows of the lines at ``avoid_hz``).
 
     Parameters
     ----------
@@ -124,11 +130,15 @@ def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE):
         Nominal frequency of the line, Hz.
     tolerance : float
         Relative tolerance (:data:`EXACT_TOLERANCE`, :data:`SLIP_TOLERANCE`), >= 0.
+    avoid_hz : sequence of float
+        Lines of another source whose bins (their :data:`EXACT_TOLERANCE` windows,
+        :data:`AVOID_HALF_WIDTH_BINS` wide) the window leaves out: a slipping bearing line
+        read beside a shaft's harmonic, which has no slip.
 
     Returns
     -------
     float or numpy.ndarray of shape amp.shape[:-1]
-        NaN when the line is not in the spectrum.
+        NaN when the line is not in the spectrum (or every bin of its window is avoided).
 
     Examples
     --------
@@ -140,9 +150,18 @@ def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE):
     (0.0, 2.0)
     >>> line_amplitude(f, a, 105.0, SLIP_TOLERANCE)    # 105·(1 ± 0.02) ± 1.5 bins
     2.0
+    >>> line_amplitude(f, a, 105.0, SLIP_TOLERANCE, avoid_hz=[101.0])
+    0.0
     """
     amp = np.asarray(amp)
     sel = line_bins(freq, f_hz, tolerance)
+    if sel is not None and len(avoid_hz):
+        keep = np.ones(sel.stop - sel.start, dtype=bool)
+        for f in avoid_hz:
+            other = line_bins(freq, f, EXACT_TOLERANCE, AVOID_HALF_WIDTH_BINS)
+            if other is not None:
+                keep[max(other.start - sel.start, 0):max(other.stop - sel.start, 0)] = False
+        sel = np.arange(sel.start, sel.stop)[keep] if keep.any() else None
     if sel is None:
         return math.nan if amp.ndim == 1 else np.full(amp.shape[:-1], math.nan)
     peak = amp[..., sel].max(axis=-1)

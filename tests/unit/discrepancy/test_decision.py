@@ -89,6 +89,23 @@ def test_a_cause_whose_prediction_reads_the_whole_record_is_named():
     assert 0.5 < d["top"]["value"] < 2.0
 
 
+def test_a_cause_excluded_at_one_component_is_not_read_there():
+    d = _decide([20.0, 20.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    assert (d["finding"], d["top"]["component"]) == ("bearing_outer_race", "1b1")
+    lib = _library()
+    li = np.arange(len(NAMES))
+    sigma = feature_sigma(lib, li, list(NAMES), 8)
+    meas = np.array([20.0, 20.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    d = decide_record(lib, li, list(NAMES), meas, sigma, "1b1",
+                      excluded={("bearing_outer_race", "1b1")})
+    assert d["finding"] != "bearing_outer_race"
+    assert all(r["name"] != "bearing_outer_race" for r in d["ranked"])
+    # another component's exclusion leaves it
+    d = decide_record(lib, li, list(NAMES), meas, sigma, "1b1",
+                      excluded={("bearing_outer_race", "2b1")})
+    assert d["finding"] == "bearing_outer_race"
+
+
 @pytest.mark.parametrize("lift, finding", [(4.0, "unexplained"), (8.0, "bearing_outer_race")])
 def test_a_fault_named_on_its_family_only_where_the_family_stands_out(lift, finding):
     """The record's envelope lines lifted by ``lift`` dB and its low bands moved far where no

@@ -1,6 +1,7 @@
 """Which bearing's line (cmsim.discrepancy.resolution): a line two families share at the
-segments' resolution is given to the one whose window holds it over the whole record, and a
-family no segment showed is named where the whole record shows it over the baseline."""
+segments' resolution is given to the one whose window holds it over the whole record, a
+family no segment showed is named where the whole record shows it over the baseline, and a
+bearing's line that is a shaft's harmonic is the shaft's where its comb rose."""
 
 from types import SimpleNamespace
 
@@ -10,11 +11,13 @@ import pytest
 from cmsim.discrepancy import resolution
 from cmsim.discrepancy.resolution import (
     BURIED_RISE_DB,
+    COMB_RISE_DB,
     FULL_RESOLUTION_MAX_S,
     RESOLUTION_DB,
     buried_family,
     overlapping,
     resolve_line,
+    shaft_comb,
 )
 from cmsim.frequencies import BearingFrequencies, RigFrequencies
 
@@ -243,3 +246,47 @@ def test_two_bearings_whose_families_share_the_line_name_neither(monkeypatch):
 
 def test_the_rise_asked_lies_above_what_a_healthy_line_wanders_between_records():
     assert BURIED_RISE_DB > 9.5
+
+
+# ------------------------------------------------- a bearing's line on a shaft's harmonic
+
+# the drive end's 2xBSF (120 Hz) on the shaft's 4th harmonic; its BPFO (107 Hz) on none
+COMBED = RigFrequencies(fr1_hz=30.0, bearings={
+    "1b1": BearingFrequencies(30.0, 12.0, 107.0, 163.0, 60.0, 107.0)})
+
+
+def _combed(x):
+    return SimpleNamespace(signal=x, fs_hz=FS, components={"1b1": "drive_end"},
+                           model_frequencies=lambda speed_rpm=1800.0: COMBED)
+
+
+def test_a_bearing_line_that_is_a_risen_shaft_comb_is_the_shaft_s():
+    baseline = [_geared(1)]
+    ball = _row("bearing_ball", "1b1")
+    # a once-per-revolution event: impacts at the shaft rate light its whole comb, 120 Hz too
+    rev = _combed(_geared(2, impacts_hz=30.0))
+    row, why = shaft_comb(rev, baseline, 1800.0, 0.5, _decision(ball))
+    assert row is ball
+    assert "the input shaft's 4× (120.0 Hz)" in why and "once-per-revolution" in why
+    # a ball defect whose line slips 1.5 % below the harmonic: the window beside it rose
+    assert shaft_comb(_combed(_geared(2, impacts_hz=120.0 * 0.985)), baseline, 1800.0, 0.5,
+                      _decision(ball)) is None
+    # both: the shaft's comb and the ball's own line beside it
+    both = _geared(2, impacts_hz=30.0) + _geared(3, impacts_hz=120.0 * 0.985) - _geared(3)
+    assert shaft_comb(_combed(both), baseline, 1800.0, 0.5, _decision(ball)) is None
+    # a healthy record; a fault whose fundamental shares no harmonic's line; no fault named
+    assert shaft_comb(_combed(_geared(3)), baseline, 1800.0, 0.5, _decision(ball)) is None
+    assert shaft_comb(rev, baseline, 1800.0, 0.5,
+                      _decision(_row("bearing_outer_race", "1b1"))) is None
+    assert shaft_comb(rev, baseline, 1800.0, 0.5, _decision(_row("clearance", None))) is None
+    assert shaft_comb(rev, baseline, 1800.0, 0.5, _decision(None)) is None
+    # nor without a baseline to read the comb's rise over
+    assert shaft_comb(rev, [], 1800.0, 0.5, _decision(ball)) is None
+
+
+def test_the_comb_s_rise_is_read_over_the_baseline_s_own():
+    # a machine whose healthy baseline already carries the once-per-revolution comb
+    baseline = [_geared(1, impacts_hz=30.0)]
+    assert shaft_comb(_combed(_geared(2, impacts_hz=30.0)), baseline, 1800.0, 0.5,
+                      _decision(_row("bearing_ball", "1b1"))) is None
+    assert COMB_RISE_DB > 5.2       # a bearing defect lifted a comb by up to 5.2 dB
