@@ -142,6 +142,7 @@ from cmsim.discrepancy.stand_out import FAMILY_RISE_DB, FAMILY_Z, shape_moved, s
 from cmsim.errors import ParameterError
 from cmsim.features import segments
 from cmsim.machine.calibration import feature_rows
+from cmsim.rig import Rig
 from cmsim.run import signal_info
 from cmsim.spectra.misfit import misfit
 
@@ -243,7 +244,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
     if level is not None and abs(z0[level]) >= LEVEL_DIRECTION_Z:
         direction = math.copysign(1.0, z0[level])
     # the shaft the sensor's bearing turns with ("<shaft>b<k>"): a rotating force's sidebands
-    shaft = int(sensor_bearing.split("b")[0]) if sensor_bearing[:1].isdigit() else None
+    shaft = Rig.shaft_of(sensor_bearing)
     ranked, by_signature, tables = {}, {}, {}
     for e in lib.entries:
         if (causes is not None and e.cause not in causes) or (e.cause, e.component) in excluded:

@@ -26,6 +26,7 @@ References
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -151,6 +152,19 @@ class Rig:
             raise ParameterError(f"node must be one of {self.node_names}"
                                  f"{' or 2J2 (theta)' if self.has_gears else ''}, got {node!r}",
                                  param="node") from None
+
+    @staticmethod
+    def shaft_of(node):
+        """The shaft (1, 2, ...) a node of :attr:`node_names` sits on, or None for a name
+        that is not one (a sensor on no node).
+
+        Examples
+        --------
+        >>> Rig.shaft_of("2b1"), Rig.shaft_of("1G1"), Rig.shaft_of("housing")
+        (2, 1, None)
+        """
+        m = re.match(r"(\d+)[A-Za-z]", str(node))
+        return int(m.group(1)) if m else None
 
     @property
     def bearing_names(self):

@@ -11,6 +11,7 @@ import numpy as np
 
 from cmsim.machine.calibration.background_lines import _near
 from cmsim.machine.machine import static_load
+from cmsim.rig import Rig
 
 __all__ = ["BALANCE_GRADE_MM_S", "SHAFT_ORDERS"]
 
@@ -50,7 +51,7 @@ def _shaft_gains(lines, rig, bearing, fr, df, forces):
     the force is a share of is the model force's, the level an unbalance cause's relative
     amplitude refers to.
     """
-    shaft = int(bearing.split("b")[0]) - 1                # node "<shaft>b<k>"
+    shaft = Rig.shaft_of(bearing) - 1
     s = rig.shafts[shaft]
     centre = ((rig.gears.driving if shaft == 0 else rig.gears.driven).mass_kg
               if rig.gears is not None else s.rotor.mass_kg)
