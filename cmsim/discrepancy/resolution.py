@@ -113,9 +113,8 @@ BURIED_TIE_DB = 3.0
 #: wanders from span to span, and the record's rise is taken over their highest.
 BURIED_SPANS = 4
 
-#: A shaft's envelope comb risen this far over the baseline's (the median over its harmonics
-#: that no line of the named fault's family holds), dB: a once-per-revolution event of that
-#: shaft. On the angle-domain generator's machines the input shaft's comb rose 11-18 dB with
+#: A shaft's envelope comb risen this far over the baseline's (the median over its first
+#: :data:`COMB_HARMONICS` harmonics), dB: a once-per-revolution event of that shaft. On the angle-domain generator's machines the input shaft's comb rose 11-18 dB with
 #: a local tooth fault, -3 to +5 dB with a bearing defect (either shaft).
 COMB_RISE_DB = 8.0
 
