@@ -50,7 +50,11 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       :data:`~cmsim.discrepancy.ranking.NEAR_TIE` of the best one's evidence are told apart
       by their evidence on their own signatures, over the features their change lifts above
       the baseline (and the statistics): a family that fell, as the envelope's band moves
-      under any impulsive fault, is no fault's. A fault is a
+      under any impulsive fault, is no fault's. So are two bearing faults whose fundamentals
+      read one line in the segments
+      (:func:`~cmsim.discrepancy.resolution.shares_line`), however far apart their whole
+      readings: the rest of the record, which their sizes and variants read, cannot say
+      whose the line is. A fault is a
       candidate here where its family stands out (below), or where its prediction reads the
       whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`). A reshaping
       cause that reads best yields to a fault whose own change holds it
@@ -75,11 +79,11 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       :data:`~cmsim.discrepancy.stand_out.FAMILY_RISE_DB` over the baseline and its change,
       at the variant and size its signature reads best, reads the record's features nearer than
       the baseline alone over all of them as its signature weighs them (its row's
-      ``total``; the path profiled out as below); a fault that rings the structure must
-      also stand out so over the prediction of the reshaping cause that reads the record
-      best, if one reaches :data:`MIN_EVIDENCE` (a load moves the ball-pass lines too).
-      A cause whose change
-      is impacts ringing the structure
+      ``total``; the path profiled out as below) — that variant and size chosen among those
+      whose change does so, where one does (:data:`INCONSISTENT`); a fault that rings the
+      structure must also stand out so over the prediction of the reshaping cause that
+      reads the record best, if one reaches :data:`MIN_EVIDENCE` (a load moves the
+      ball-pass lines too). A cause whose change is impacts ringing the structure
       (:attr:`~cmsim.discrepancy.causes.Cause.rings_structure`) is judged there with the
       path profiled out: each feature that depends on the transfer path, and the
       kurtosis and crest factor, counts for it what it counts for the baseline, neither for
@@ -135,8 +139,8 @@ from cmsim.discrepancy.ranking import (NEAR_TIE, SEVERITY_DELTA_CHI2, _consisten
                                        added_evidence, decide)
 from cmsim.discrepancy.reshaping import PREDICTION_ERROR, absorbed_by, within_error
 from cmsim.discrepancy.resolution import (FUNDAMENTALS, buried_family, resolve_line,
-                                          shaft_comb)
-from cmsim.discrepancy.shaft_lines import held_lines
+                                          shaft_comb, shares_line)
+from cmsim.discrepancy.shaft_lines import floor_change_db, held_lines
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
 from cmsim.discrepancy.stand_out import FAMILY_RISE_DB, FAMILY_Z, shape_moved, standing_out
 from cmsim.errors import ParameterError
@@ -148,7 +152,7 @@ from cmsim.spectra.misfit import misfit
 
 __all__ = ["judge", "decide_record", "standing_out", "shape_moved", "NONE_CHI2_PER_FEATURE",
            "ALARM_Z", "MIN_EVIDENCE", "MIN_SHARE", "INTERPOLATION_STEPS", "FAMILY_Z",
-           "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z",
+           "FAMILY_RISE_DB", "LEVEL_DIRECTION_Z", "INCONSISTENT",
            "PREDICTION_ERROR", "within_error"]
 
 #: χ² per feature against the baseline within which a record reads ``none``.
@@ -174,6 +178,10 @@ INTERPOLATION_STEPS = 4
 #: spectrum can resemble, named noise on a preloaded machine 19 dB under its baseline.
 LEVEL_DIRECTION_Z = 3.0
 
+#: Added, in the choice of a fault's variant and size on its own signature, to one whose
+#: change takes the record's features further from it than the baseline alone: any that
+#: does not is read first, and one that does only where no other is left.
+INCONSISTENT = 1e9
 
 
 def _record_rows(record, machine, seg_s, max_segments):
@@ -190,7 +198,7 @@ def _record_rows(record, machine, seg_s, max_segments):
 
 
 def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate_sigma=None,
-                  excluded=()):
+                  excluded=(), floor_db=None):
     """Steps 2-4 of the module docstring on a record's mean features.
 
     Parameters
@@ -215,6 +223,11 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
         (:func:`~cmsim.discrepancy.columns.feature_sigma`'s ``standing``).
     excluded : collection of (str, str or None)
         (cause, component) pairs not considered.
+    floor_db : float, optional
+        The record's raw floor over the baseline's, dB
+        (:func:`~cmsim.discrepancy.shaft_lines.floor_change_db`): a shaft line read fallen
+        over its floor is fallen only where it fell in absolute level
+        (:func:`~cmsim.discrepancy.reshaping.absorbed_by`).
 
     Returns
     -------
@@ -265,13 +278,20 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
             per_prof = np.where(path_dep, per0s[0], per_sig)
         judged = cause.judged_on(names, e.component, shaft)
         sel = np.array([k in judged for k in names], dtype=bool)
-        for store, per, p0, score in (
-                (ranked, per_full, per0, np.where(ok, chi, np.inf)),
+        # a fault's own signature is read at the variant and size that reads its family
+        # best of those whose change does not take the record's features, all of them as
+        # the signature weighs them, further from it than the baseline alone: a variant
+        # that reads the family but lifts what the record did not move is not its change
+        # (an outer race's family read by a 3x path's change that lifted the mesh's
+        # sidebands 38 dB, where the record's had not moved, was no candidate at all)
+        apart = np.where((per0s[0] - per_prof).sum(axis=1) > 0.0, 0.0, INCONSISTENT)
+        for store, per, p0, score, order in (
+                (ranked, per_full, per0, np.where(ok, chi, np.inf), np.zeros(chi.size)),
                 (by_signature, per_prof, per0s,
-                 np.where(ok, per_prof[:, sel].sum(axis=1), np.inf))):
-            b = int(np.argmin(score))
+                 np.where(ok, per_prof[:, sel].sum(axis=1), np.inf), apart)):
+            b = int(np.argmin(score + order))
             key = (e.cause, e.component)
-            if key in store and score[b] >= store[key]["score"]:
+            if key in store and score[b] + order[b] >= store[key]["order"]:
                 continue
             within = values[score <= score[b] + SEVERITY_DELTA_CHI2]
             delta = p0[0] - per[b]
@@ -280,6 +300,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                           "value": float(values[b]),
                           "range": (float(within.min()), float(within.max())),
                           "chi2": float(per[b].sum()), "score": float(score[b]),
+                          "order": float(score[b] + order[b]),
                           "prediction": table[b], "judged_on": judged,
                           "family": cause.family(names, e.component, shaft),
                           "per_feature": dict(zip(names, delta.tolist())),
@@ -324,7 +345,10 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
     if departs:
         if cands and explains(cands[0]):
             top, how = cands[0], "whole"
-            ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]]
+            # two bearing faults whose fundamentals read one line in the segments tie however
+            # far apart the whole record's readings (their sizes and variants read the rest)
+            ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]
+                    or shares_line(top, r, names, meas)]
             # a fault whose own family stands clearly out where the winner's prediction
             # leaves it wins a near tie on the whole record against a cause whose family
             # does not (an outer race that lifted its envelope lines 19 dB tied a torque
@@ -342,7 +366,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                 ties = [r for r in [top] + ties if r is not new]
                 top = new
             absorbed = absorbed_by(top, rows_out, tables, lib.mean[li], meas, sigma, gate,
-                                    names, sensor_bearing)
+                                    names, sensor_bearing, floor_db)
             if absorbed is not None:
                 ties, top, how = [top], absorbed, "beside"
             elif top["cause"].signature is not None:
@@ -460,13 +484,14 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
     sensor = signal_info(machine.model_signal).component
     gate = feature_sigma(lib, li, cnames, n_fit, standing=True)
     held, combed = set(), set()
+    floor_db = floor_change_db(record, machine, lib.segment_s)
 
     def decide(out=(), pairs=()):
         held.update(out)
         combed.update(pairs)
         return decide_record(lib, li, cnames, meas, sigma, sensor, causes if not held else [
             c for c in causes or {e.cause for e in lib.entries} if c not in held],
-            gate_sigma=gate, excluded=combed)
+            gate_sigma=gate, excluded=combed, floor_db=floor_db)
 
     d = decide()
     d, why = held_lines(record, machine, d, cnames, meas, lib.mean[li], lib.segment_s, decide)

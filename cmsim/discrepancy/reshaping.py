@@ -10,6 +10,7 @@ import numpy as np
 
 from cmsim.discrepancy.columns import chi2_rows
 from cmsim.discrepancy.ranking import SEVERITY_DELTA_CHI2
+from cmsim.discrepancy.shaft_lines import line_fell
 from cmsim.discrepancy.stand_out import standing_out
 
 __all__ = ["PREDICTION_ERROR", "RINGING_FEATURES", "absorbed_by", "within_error"]
@@ -48,7 +49,8 @@ def within_error(row, meas, base, sigma, names):
 RINGING_FEATURES = 2
 
 
-def absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearing):
+def absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearing,
+                floor_db=None):
     """The fault whose own change holds the reshaping cause ``top``'s
     (:attr:`~cmsim.discrepancy.causes.Cause.absorbs`) and whose family stands out where
     ``top``'s prediction leaves the record — :data:`~cmsim.discrepancy.stand_out.FAMILY_Z` σ
@@ -81,6 +83,11 @@ def absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearin
         Feature names.
     sensor_bearing : str
         The model bearing the sensor sits on (its shaft's faults are preferred).
+    floor_db : float, optional
+        The record's raw floor over the baseline's, dB: a shaft line that fell only over a
+        floor that rose (impacts lift the broadband) fell in no absolute level, and is no
+        reading of a fault adding to it at its own phase
+        (:func:`~cmsim.discrepancy.shaft_lines.line_fell`).
 
     Returns
     -------
@@ -112,8 +119,10 @@ def absorbed_by(top, rows, tables, base, meas, sigma, gate, names, sensor_bearin
         # where its change adds to a component the machine has at its own phase, the record
         # departs downwards too: below the least ``top`` leaves there at any size that reads
         # the record as well
-        fell = standing_out([names.index(k) for k in r["family"]
-                             if k in r["cause"].either_way], lowest, meas, gate, names)
+        fell = [i for i in standing_out([names.index(k) for k in r["family"]
+                                         if k in r["cause"].either_way], lowest, meas, gate,
+                                        names)
+                if line_fell(names[i], meas[i], base[i], floor_db)]
         if out or fell:     # a component's name starts with its shaft's number ("1G1", "1b1")
             # the family that stands out farthest: seen through a ringing structure, other
             # families' windows catch the sidebands of the one that rose (CWRU's drive-end

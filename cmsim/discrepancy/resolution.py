@@ -57,9 +57,10 @@ Where the segments name nothing (``none`` or ``unexplained``), a bearing's famil
 stand over the whole record: under a gear mesh, a race's impacts fill no band of a 0.5-s
 segment, but their steady lines gain with the resolution as the floor does not. The record and
 the machine's baseline are then read over spans of one length at full resolution (each at its
-own speed's family; the baseline's highest of up to :data:`BURIED_SPANS`), and a bearing fault whose fundamental and second harmonic both stand
-:data:`BURIED_RISE_DB` over the baseline's, its fundamental a line :data:`BURIED_LINE_DB` over
-the record's envelope floor, is named (``decided_on`` ``"whole-record family"``) — unless
+own speed's family; the baseline's highest of up to :data:`BURIED_SPANS`), and a bearing
+fault whose fundamental and second harmonic both stand :data:`BURIED_RISE_DB` over the
+baseline's, its fundamental a line :data:`BURIED_LINE_DB` over the record's envelope floor,
+is named (``decided_on`` ``"whole-record family"``) — unless
 another bearing fault's family rises within :data:`BURIED_TIE_DB` of it (one line two
 families share). On the angle-domain generator's 40 healthy records (20 machines) the
 highest such rise was 9.5 dB (a BPFO window of a gear machine, its line 13 dB over the
@@ -79,7 +80,7 @@ from cmsim.spectra.lines import SLIP_TOLERANCE, line_amplitude, line_bins
 __all__ = ["BURIED_LINE_DB", "BURIED_RISE_DB", "BURIED_SPANS", "BURIED_TIE_DB",
            "COMB_HARMONICS", "COMB_RISE_DB", "FULL_RESOLUTION_MAX_S",
            "FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "buried_family", "fundamental_columns",
-           "fundamental_hz", "overlapping", "resolve_line", "shaft_comb"]
+           "fundamental_hz", "overlapping", "resolve_line", "shaft_comb", "shares_line"]
 
 #: A rival's fundamental, read over the whole record, stands this far over the named fault's
 #: to take the line, dB: a steady line gains 7.8 dB from 0.5-s segments to a 3-s record,
@@ -114,8 +115,9 @@ BURIED_TIE_DB = 3.0
 BURIED_SPANS = 4
 
 #: A shaft's envelope comb risen this far over the baseline's (the median over its first
-#: :data:`COMB_HARMONICS` harmonics), dB: a once-per-revolution event of that shaft. On the angle-domain generator's machines the input shaft's comb rose 11-18 dB with
-#: a local tooth fault, -3 to +5 dB with a bearing defect (either shaft).
+#: :data:`COMB_HARMONICS` harmonics), dB: a once-per-revolution event of that shaft. On the
+#: angle-domain generator's machines the input shaft's comb rose 11-18 dB with a local tooth
+#: fault, -3 to +5 dB with a bearing defect (either shaft).
 COMB_RISE_DB = 8.0
 
 #: Harmonics of a shaft's rate that make its comb.
@@ -143,7 +145,8 @@ def fundamental_hz(freqs, cause, bearing):
     float
     """
     first = f"{FUNDAMENTALS[cause]}_1"          # the family's first line, as the features read it
-    return next(ln.frequency_hz for ln in envelope_lines(freqs.bearing(bearing)) if ln.name == first)
+    return next(ln.frequency_hz for ln in envelope_lines(freqs.bearing(bearing))
+                if ln.name == first)
 
 
 def overlapping(f1_hz, f2_hz, df_hz):
@@ -185,6 +188,32 @@ def fundamental_columns(row, names):
     """
     stem = f"env_{FUNDAMENTALS[row['name']]}_{row['component']}_h1_"
     return [i for i in row["out"] if names[i].startswith(stem)]
+
+
+def shares_line(a, b, names, meas):
+    """Whether two bearing faults' fundamentals read one line in the segments: the same peak
+    the highest of both windows, so the same value in the band rule's band (the angle-domain
+    generator's bearing machine 10: a drive-end ball defect's 2×BSF and the same bearing's
+    BPFI, 26.85 dB both, and their second harmonics 23.36 dB both).
+
+    Parameters
+    ----------
+    a, b : dict
+        Rows of :func:`~cmsim.discrepancy.judge.decide_record` (``name``, ``component``).
+    names : sequence of str
+        The compared features' names.
+    meas : numpy.ndarray
+        The record's features.
+
+    Returns
+    -------
+    bool
+    """
+    if not all(r["name"] in FUNDAMENTALS and r["component"] for r in (a, b)):
+        return False
+    ka, kb = _key(a), _key(b)
+    return (ka != kb and ka in names and kb in names
+            and meas[names.index(ka)] == meas[names.index(kb)])
 
 
 def _key(row):

@@ -28,7 +28,7 @@ from cmsim.features.relative import raw_floor, segments
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["FLOOR_BORNE_SHARE", "LINE_RISE_DB", "SHAFT_LINES", "floor_borne",
-           "floor_change_db", "held_lines"]
+           "floor_change_db", "held_lines", "line_fell"]
 
 #: The raw shaft lines, read over :func:`~cmsim.features.relative.raw_floor`, and their
 #: orders in words.
@@ -123,6 +123,30 @@ def floor_borne(row, names, meas, base, floor_db):
         return None
     rises = {k: v + floor_db for k, v in over.items()}
     return None if max(rises.values()) >= LINE_RISE_DB else rises
+
+
+def line_fell(name, meas, base, floor_db):
+    """Whether a feature read fallen over the baseline fell in absolute level too: a shaft
+    line (:data:`SHAFT_LINES`) only where it fell :data:`LINE_RISE_DB` with its floor's
+    change added (an unknown ``floor_db``, None, leaves it as read); any other feature as
+    read.
+
+    Parameters
+    ----------
+    name : str
+        The feature.
+    meas, base : float
+        Its value on the record and on the baseline.
+    floor_db : float or None
+        :func:`floor_change_db`.
+
+    Returns
+    -------
+    bool
+    """
+    if name not in SHAFT_LINES or floor_db is None:
+        return True
+    return meas - base + floor_db <= -LINE_RISE_DB
 
 
 def held_lines(record, machine, decision, names, meas, base, seg_s, redecide):

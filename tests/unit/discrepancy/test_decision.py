@@ -125,14 +125,15 @@ def test_a_fault_is_named_on_its_family_only_where_its_whole_change_reads_the_re
         other, finding):
     """A record whose outer-race family stands 8 dB over the baseline and whose low bands
     moved far where no cause moves them, read by an outer race whose change also lifts the
-    inner race's family by ``other`` dB, which the record kept at the baseline: where the
-    fault's whole change takes the record farther from its prediction than the baseline
-    alone is, its family standing out does not make it the record's fault."""
+    inner race's family by ``other`` dB at every size, which the record kept at the
+    baseline: where the fault's whole change, at every size, takes the record farther from
+    its prediction than the baseline alone is, its family standing out does not make it the
+    record's fault (a size whose change does not is read first: the test below)."""
     names = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "env_bpfi_1b1_h1_db",
              "env_bpfi_1b1_h2_db", "shape_b0_db", "shape_b1_db")
     outer = np.zeros((3, len(names)))
     outer[:, :2] = np.array([[0.0], [5.0], [20.0]])
-    outer[1:, 2:4] = other
+    outer[:, 2:4] = other
     spread = np.ones(len(names))
     spread[:4] = 3.5
     lib = _baseline_at_zero(names, spread,
@@ -146,6 +147,41 @@ def test_a_fault_is_named_on_its_family_only_where_its_whole_change_reads_the_re
     assert row["name"] == "bearing_outer_race" and row["stands_out"]
     assert row["delta_chi2"] > 0.0 and (row["total"] > 0.0) == (other == 0.0)
     assert d["finding"] == finding, (row["delta_chi2"], row["total"])
+
+
+def test_a_fault_s_signature_is_read_at_a_variant_whose_whole_change_reads_the_record():
+    """The same record and outer race as above, its 3x-path variant lifting the inner race's
+    family 10 dB with its own (the model's impacts through a loud path lifted the mesh's
+    sidebands 38 dB where the angle generator's record kept them), and a line-contact variant
+    that lifts the outer race's family alone, less: the family is read at the variant whose
+    whole change takes the record nearer than the baseline alone, and the outer race is
+    named on it; with that variant gone, the loud one is read and nothing is named."""
+    names = ("env_bpfo_1b1_h1_db", "env_bpfo_1b1_h2_db", "env_bpfi_1b1_h1_db",
+             "env_bpfi_1b1_h2_db", "shape_b0_db", "shape_b1_db")
+    sizes = (3e-5, 3e-4, 3e-3)
+    loud, quiet = np.zeros((3, len(names))), np.zeros((3, len(names)))
+    loud[:, :2] = np.array([[0.0], [5.0], [20.0]])
+    loud[:, 2:4] = 10.0
+    quiet[:, :2] = np.array([[0.0], [3.0], [9.0]])
+    spread = np.ones(len(names))
+    spread[:4] = 3.5
+    entries = (SignatureEntry("bearing_outer_race", "1b1", "documented; path x3", "size_m",
+                              sizes, loud),
+               SignatureEntry("bearing_outer_race", "1b1", "line contact", "size_m", sizes,
+                              quiet))
+    li = np.arange(len(names))
+    meas = np.array([8.0, 8.0, 0.0, 0.0, -30.0, -30.0])
+    got = {}
+    for kept in (entries, entries[:1]):
+        lib = _baseline_at_zero(names, spread, *kept)
+        got[len(kept)] = decide_record(lib, li, list(names), meas,
+                                       feature_sigma(lib, li, list(names), 8), "1b1")
+    row = got[2]["by_signature"][0]
+    assert (row["name"], row["variant"]) == ("bearing_outer_race", "line contact")
+    assert row["total"] > 0.0 and row["stands_out"]
+    assert (got[2]["finding"], got[2]["decided_on"]) == ("bearing_outer_race", "family")
+    assert got[1]["by_signature"][0]["total"] < 0.0
+    assert got[1]["finding"] == "unexplained"
 
 
 @pytest.mark.parametrize("env, finding", [(0.0, "bearing_outer_race"), (8.0, "unexplained")])
@@ -488,6 +524,37 @@ def test_a_line_two_families_share_is_read_as_either_where_the_library_tells_the
                                        for e in lib.entries))
     assert compared_columns(list(names), alike, fit, held)[2] == [
         "env_bpfi_1b1_h1_db", "env_bpfi_1b1_sb_db", "kurtosis_log", "crest_log"]
+
+
+@pytest.mark.parametrize("apart, finding", [(0.0, "bearing_ball"),
+                                            (1.0, "bearing_inner_race")])
+def test_two_faults_whose_fundamentals_read_one_line_tie_on_the_whole_record(apart, finding):
+    """The angle generator's bearing machine 10: a ball defect's 2xBSF and the same
+    bearing's BPFI read one line in the segments (26.85 dB both, their second harmonics
+    23.36 dB both). The inner race's change reads the rest of the record better (here: the
+    shaft lines and the level it lifts), 448 against 336, beyond a near tie; its shaft-rate
+    sidebands stayed where they were, the ball's cage line rose. One line in both windows is
+    a tie, told apart on what each fault adds; lines of their own (1 dB apart) are not."""
+    names = ("env_bpfi_1b1_h1_db", "env_bsf2_1b1_h1_db", "env_bpfi_1b1_h2_db",
+             "env_bsf2_1b1_h2_db", "env_bpfi_1b1_sb_db", "env_ftf_1b1_db", "raw_fr_h1_db",
+             "raw_fr_h2_db", "level_db")
+    m, sizes = len(names), (3e-5, 3e-4, 3e-3)
+    inner, ball = np.zeros((3, m)), np.zeros((3, m))
+    inner[:, [0, 2, 4, 6, 7, 8]] = np.array([[0.0], [10.0], [20.0]])
+    ball[:, [1, 3]] = np.array([[0.0], [10.0], [20.0]])
+    ball[:, [5, 8]] = np.array([[0.0], [5.0], [10.0]])        # the cage line, louder
+    lib = _baseline_at_zero(
+        names, np.full(m, 2.0),
+        SignatureEntry("bearing_inner_race", "1b1", "documented", "size_m", sizes, inner),
+        SignatureEntry("bearing_ball", "1b1", "documented", "size_m", sizes, ball))
+    li = np.arange(m)
+    meas = np.array([20.0, 20.0 - apart, 20.0, 20.0, 0.0, 10.0, 20.0, 20.0, 20.0])
+    d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
+                      "1b1")
+    ev = {r["name"]: r["evidence"] for r in d["ranked"]}
+    assert ev["bearing_ball"] < NEAR_TIE * ev["bearing_inner_race"]
+    assert (d["finding"], d["decided_on"]) == (finding, "whole")
+    assert [r["name"] for r in d["ties"]] == (["bearing_inner_race"] if apart == 0.0 else [])
 
 
 def _reshaped_by_a_load(low, high, unnameable_fault=False):

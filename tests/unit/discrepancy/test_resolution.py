@@ -18,6 +18,7 @@ from cmsim.discrepancy.resolution import (
     overlapping,
     resolve_line,
     shaft_comb,
+    shares_line,
 )
 from cmsim.frequencies import BearingFrequencies, RigFrequencies
 
@@ -290,3 +291,21 @@ def test_the_comb_s_rise_is_read_over_the_baseline_s_own():
     assert shaft_comb(_combed(_geared(2, impacts_hz=30.0)), baseline, 1800.0, 0.5,
                       _decision(_row("bearing_ball", "1b1"))) is None
     assert COMB_RISE_DB > 5.2       # a bearing defect lifted a comb by up to 5.2 dB
+
+
+def test_two_bearing_faults_share_a_line_where_their_fundamentals_read_one_value():
+    """One peak the highest of both windows reads the same value in both fundamentals'
+    columns; a line of each its own, or a gear's row, shares nothing."""
+    names = ["env_bpfi_1b1_h1_db", "env_bsf2_1b1_h1_db", "env_bpfo_1b2_h1_db", "gmf1_rel_db"]
+    meas = np.array([26.85, 26.85, 12.0, 3.0])
+    row = {name: {"name": name, "component": c} for name, c in (
+        ("bearing_inner_race", "1b1"), ("bearing_ball", "1b1"),
+        ("bearing_outer_race", "1b2"), ("tooth_fault", "1G1"))}
+    inner, ball, outer = (row[k] for k in ("bearing_inner_race", "bearing_ball",
+                                          "bearing_outer_race"))
+    assert shares_line(inner, ball, names, meas) and shares_line(ball, inner, names, meas)
+    assert not shares_line(inner, outer, names, meas)
+    assert not shares_line(inner, inner, names, meas)            # one family is no pair
+    assert not shares_line(inner, row["tooth_fault"], names, meas)
+    meas[1] = 26.0
+    assert not shares_line(inner, ball, names, meas)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from cmsim.discrepancy.shaft_lines import (FLOOR_BORNE_SHARE, LINE_RISE_DB, floor_borne,
-                                           floor_change_db, held_lines)
+                                           floor_change_db, held_lines, line_fell)
 from cmsim.frequencies import BearingFrequencies, RigFrequencies
 
 FS = 12_000.0
@@ -99,3 +99,20 @@ def test_the_decision_is_taken_again_without_every_cause_the_floor_carries():
     got, notes = held_lines(_record(_noise(3, 1.0)), _machine([quiet]), decision, NAMES, meas,
                             base, 0.5, redecide)
     assert got is decision and notes == [] and len(asked) == 1
+
+
+@pytest.mark.parametrize("over_floor, floor_db, fell", [
+    (-26.1, 24.9, False),       # a broken tooth's impacts lifted the floor 24.9 dB
+    (-28.0, 0.0, True),
+    (-2.0, 0.0, False),         # under a line's rise asked
+    (-8.0, 4.0, True),
+    (-8.0, None, True),         # the floor's change unknown: as read
+])
+def test_a_shaft_line_read_fallen_fell_only_where_it_fell_in_absolute_level(over_floor,
+                                                                           floor_db, fell):
+    """A shaft line read over its floor falls by the floor's rise alone where its level held
+    (the angle generator's tooth fault: the 1x line 26.1 dB down over a floor 24.9 dB up); it
+    fell where the line's change with the floor's reaches LINE_RISE_DB down."""
+    assert line_fell("raw_fr_h1_db", 10.0 + over_floor, 10.0, floor_db) is fell
+    assert line_fell("gmf2_rel_db", 10.0 + over_floor, 10.0, floor_db) is True
+    assert floor_db is None or (over_floor + floor_db <= -LINE_RISE_DB) is fell
