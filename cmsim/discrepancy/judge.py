@@ -184,6 +184,16 @@ LEVEL_DIRECTION_Z = 3.0
 INCONSISTENT = 1e9
 
 
+def _shared_readings(rows, names, meas):
+    """(cause, component) → the features of each row's family whose reading on the record
+    another row's family holds too (the same value: one peak the highest of both windows)."""
+    values = {(r["name"], r["component"]): {meas[names.index(k)] for k in r["family"]
+                                             if k in names} for r in rows}
+    return {key: {k for k in r["family"] if k in names and any(
+                meas[names.index(k)] in v for other, v in values.items() if other != key)}
+            for r in rows for key in [(r["name"], r["component"])]}
+
+
 def _record_rows(record, machine, seg_s, max_segments):
     x = record.signal
     spans = segments(x.size, record.fs_hz, seg_s, max_segments)
@@ -377,7 +387,10 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                         if r["cause"].signature is not None}
                 own = [r for r in by_signature.values() if (r["name"], r["component"]) in tied
                        and r["nameable"]]
-                best = max(own, key=lambda r: added_evidence(r, lib.mean[li]), default=None)
+                # a reading two of them hold (one line in both windows) tells neither
+                shared = _shared_readings(own, names, meas)
+                best = max(own, key=lambda r: added_evidence(
+                    r, lib.mean[li], skip=shared[(r["name"], r["component"])]), default=None)
                 if best is not None and (best["name"], best["component"]) != (
                         top["name"], top["component"]):
                     new = next(r for r in cands if (r["name"], r["component"])

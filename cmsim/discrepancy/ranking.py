@@ -153,7 +153,7 @@ class Nuisances:
         return best
 
 
-def added_evidence(row, base):
+def added_evidence(row, base, skip=()):
     """A fault's evidence on its own signature, over the features its change lifts above the
     baseline and the shared statistics: a fault adds its family, and a family that fell is
     no fault's (every impulsive fault moves the band the envelope is read in, so a healthy
@@ -167,6 +167,8 @@ def added_evidence(row, base):
         (``prediction``, ``per_feature``, ``judged_on``).
     base : numpy.ndarray
         The baseline's features.
+    skip : collection of str
+        Features not counted (a reading another fault's family holds too).
 
     Returns
     -------
@@ -174,7 +176,7 @@ def added_evidence(row, base):
     """
     lifted = row["prediction"] >= base
     return sum(v for i, (k, v) in enumerate(row["per_feature"].items())
-               if k in row["judged_on"] and (k in STATISTICS or lifted[i]))
+               if k in row["judged_on"] and k not in skip and (k in STATISTICS or lifted[i]))
 
 
 def nuisance_params(setup, nominal):

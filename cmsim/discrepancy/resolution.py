@@ -75,7 +75,7 @@ from cmsim.discrepancy.causes import CAUSE_WORDS
 from cmsim.features.envelope import envelope_lines
 from cmsim.discrepancy.stand_out import FAMILY_RISE_DB
 from cmsim.features.relative import envelope_columns, envelope_over_floor
-from cmsim.spectra.lines import SLIP_TOLERANCE, line_amplitude, line_bins
+from cmsim.spectra.lines import SLIP_TOLERANCE, leakage_bins, line_amplitude, line_bins
 
 __all__ = ["BURIED_LINE_DB", "BURIED_RISE_DB", "BURIED_SPANS", "BURIED_TIE_DB",
            "COMB_HARMONICS", "COMB_RISE_DB", "FULL_RESOLUTION_MAX_S",
@@ -381,15 +381,18 @@ def resolve_line(record, segment_s, decision, names, meas, stands_out):
         f"envelope's floor, the second's {fine[top_key]:.1f} dB)")
 
 
-def _comb_levels(x, fs, shaft_hz, bearings, band, comb_hz, fundamental_hz):
-    """The comb's lines and a fundamental's (outside the comb's bins) over the envelope's
-    floor of ``x``, dB, and the band read."""
+def _comb_levels(x, fs, shaft_hz, bearings, band, comb_hz, fundamental_hz, widths=None):
+    """The comb's lines and a fundamental's (outside the comb's bins: out to where each
+    line's leakage falls under the floor, :func:`~cmsim.spectra.lines.leakage_bins`, or
+    ``widths``) over the envelope's floor of ``x``, dB, the band read and the comb's widths,
+    bins."""
     ef, ratio, band = envelope_over_floor(x - x.mean(), fs, shaft_hz, bearings, band)
+    lines = np.array([line_amplitude(ef, ratio, f) for f in comb_hz])
+    widths = leakage_bins(np.nan_to_num(lines)) if widths is None else widths
     with np.errstate(divide="ignore"):
-        comb = 20.0 * np.log10([line_amplitude(ef, ratio, f) for f in comb_hz])
         own = 20.0 * np.log10(line_amplitude(ef, ratio, fundamental_hz, SLIP_TOLERANCE,
-                                             comb_hz))
-    return comb, float(own), band
+                                             comb_hz, widths))
+        return 20.0 * np.log10(lines), float(own), band, widths
 
 
 def shaft_comb(record, baseline, baseline_rpm, segment_s, decision):
@@ -433,15 +436,16 @@ def shaft_comb(record, baseline, baseline_rpm, segment_s, decision):
         # the comb up to the fundamental's harmonic and beyond: its lines beside the
         # fundamental's window are the comb's alone
         js = np.arange(1, max(COMB_HARMONICS, k + 2) + 1)
-        comb, own, band = _comb_levels(x, fs, freqs.fr1_hz, freqs.bearings, None, js * fr,
-                                       f_top)
+        comb, own, band, widths = _comb_levels(x, fs, freqs.fr1_hz, freqs.bearings, None,
+                                               js * fr, f_top)
         # the baseline read in the same band over spans of the same length, each line at
-        # its highest
+        # its highest, its fundamental's window beside the record's comb's bins
         base_comb, base_own = np.full(js.size, -np.inf), -np.inf
         for b in baseline:
             for i in range(min(b.size // n, BURIED_SPANS)):
-                c, o, _ = _comb_levels(np.asarray(b[i * n:(i + 1) * n], dtype=float), fs,
-                                       ref.fr1_hz, ref.bearings, band, js * fr_ref, f_ref)
+                c, o, _, _ = _comb_levels(np.asarray(b[i * n:(i + 1) * n], dtype=float), fs,
+                                          ref.fr1_hz, ref.bearings, band, js * fr_ref, f_ref,
+                                          widths)
                 base_comb, base_own = np.fmax(base_comb, c), np.fmax(base_own, o)
         rise = float(np.nanmedian(comb - base_comb))
         own_rise = own - base_own

@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 __all__ = ["line_window", "line_bins", "line_amplitude", "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE",
-           "AVOID_HALF_WIDTH_BINS",
+           "AVOID_HALF_WIDTH_BINS", "leakage_bins",
            "SLIP_TOLERANCE"]
 
 #: Half-width of a line's window beyond its relative tolerance, bins.
@@ -116,7 +116,39 @@ def line_bins(freq, f_hz, tolerance=EXACT_TOLERANCE, half_width_bins=LINE_HALF_W
     return slice(lo, hi) if hi > lo else None
 
 
-def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE, avoid_hz=()):
+def leakage_bins(level):
+    """Half width, bins, of a line's window in a Hann-windowed spectrum out to where its
+    sidelobes fall under the floor: the kernel's envelope 1/(π·d·(d² − 1)) (d in bins from
+    the tone) times ``level`` reaches 1 at d, and the tone lies anywhere in its bin (half a
+    bin more); never under :data:`AVOID_HALF_WIDTH_BINS` (the main lobe).
+
+    Parameters
+    ----------
+    level : float or numpy.ndarray
+        The line's amplitude over the floor (a ratio, not dB).
+
+    Returns
+    -------
+    float or numpy.ndarray
+
+    Examples
+    --------
+    >>> float(leakage_bins(1.0)), round(float(leakage_bins(10 ** (48 / 20))), 2)
+    (2.5, 4.89)
+    """
+    level = np.asarray(level, dtype=float)
+    # d·(d² − 1) = level/π: its one real root over 1 (Cardano; a level under
+    # 2π/(3√3) leaves the main lobe)
+    q = np.maximum(level, 0.0) / math.pi
+    disc = np.sqrt(np.maximum(q * q / 4.0 - 1.0 / 27.0, 0.0))
+    d = np.where(q * q / 4.0 >= 1.0 / 27.0,
+                 np.cbrt(q / 2.0 + disc) + np.cbrt(q / 2.0 - disc), 0.0)
+    out = np.maximum(d + 0.5, AVOID_HALF_WIDTH_BINS)
+    return float(out) if out.ndim == 0 else out
+
+
+def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE, avoid_hz=(),
+                   avoid_bins=AVOID_HALF_WIDTH_BINS):
     """Amplitude of the line at ``f_hz``: the largest bin of its window (outside the exact
     windows of the lines at ``avoid_hz``).
 
@@ -134,6 +166,9 @@ def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE, avoid_hz=()):
         Lines of another source whose bins (their :data:`EXACT_TOLERANCE` windows,
         :data:`AVOID_HALF_WIDTH_BINS` wide) the window leaves out: a slipping bearing line
         read beside a shaft's harmonic, which has no slip.
+    avoid_bins : float or sequence of float
+        Their windows' half width, bins: one for all, or one each (a strong line's leakage,
+        :func:`leakage_bins`).
 
     Returns
     -------
@@ -157,8 +192,9 @@ def line_amplitude(freq, amp, f_hz, tolerance=EXACT_TOLERANCE, avoid_hz=()):
     sel = line_bins(freq, f_hz, tolerance)
     if sel is not None and len(avoid_hz):
         keep = np.ones(sel.stop - sel.start, dtype=bool)
-        for f in avoid_hz:
-            other = line_bins(freq, f, EXACT_TOLERANCE, AVOID_HALF_WIDTH_BINS)
+        widths = np.broadcast_to(np.asarray(avoid_bins, dtype=float), (len(avoid_hz),))
+        for f, w in zip(avoid_hz, widths):
+            other = line_bins(freq, f, EXACT_TOLERANCE, float(w))
             if other is not None:
                 keep[max(other.start - sel.start, 0):max(other.stop - sel.start, 0)] = False
         sel = np.arange(sel.start, sel.stop)[keep] if keep.any() else None
