@@ -50,11 +50,7 @@ supplies what each cause changes (issue 16; DESIGN.md, "How a machine judges a r
       :data:`~cmsim.discrepancy.ranking.NEAR_TIE` of the best one's evidence are told apart
       by their evidence on their own signatures, over the features their change lifts above
       the baseline (and the statistics): a family that fell, as the envelope's band moves
-      under any impulsive fault, is no fault's. So are two bearing faults whose fundamentals
-      read one line in the segments
-      (:func:`~cmsim.discrepancy.resolution.shares_line`), however far apart their whole
-      readings: the rest of the record, which their sizes and variants read, cannot say
-      whose the line is. A fault is a
+      under any impulsive fault, is no fault's. A fault is a
       candidate here where its family stands out (below), or where its prediction reads the
       whole record within the baseline's spread (:data:`NONE_CHI2_PER_FEATURE`). A reshaping
       cause that reads best yields to a fault whose own change holds it
@@ -139,7 +135,7 @@ from cmsim.discrepancy.ranking import (NEAR_TIE, SEVERITY_DELTA_CHI2, _consisten
                                        added_evidence, decide)
 from cmsim.discrepancy.reshaping import PREDICTION_ERROR, absorbed_by, within_error
 from cmsim.discrepancy.resolution import (FUNDAMENTALS, buried_family, resolve_line,
-                                          shaft_comb, shares_line)
+                                          shaft_comb)
 from cmsim.discrepancy.shaft_lines import floor_change_db, held_lines
 from cmsim.discrepancy.signatures import BAND_FAMILIES, build_library, simulate_entry
 from cmsim.discrepancy.stand_out import FAMILY_RISE_DB, FAMILY_Z, shape_moved, standing_out
@@ -182,16 +178,6 @@ LEVEL_DIRECTION_Z = 3.0
 #: change takes the record's features further from it than the baseline alone: any that
 #: does not is read first, and one that does only where no other is left.
 INCONSISTENT = 1e9
-
-
-def _shared_readings(rows, names, meas):
-    """(cause, component) → the features of each row's family whose reading on the record
-    another row's family holds too (the same value: one peak the highest of both windows)."""
-    values = {(r["name"], r["component"]): {meas[names.index(k)] for k in r["family"]
-                                             if k in names} for r in rows}
-    return {key: {k for k in r["family"] if k in names and any(
-                meas[names.index(k)] in v for other, v in values.items() if other != key)}
-            for r in rows for key in [(r["name"], r["component"])]}
 
 
 def _record_rows(record, machine, seg_s, max_segments):
@@ -355,10 +341,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
     if departs:
         if cands and explains(cands[0]):
             top, how = cands[0], "whole"
-            # two bearing faults whose fundamentals read one line in the segments tie however
-            # far apart the whole record's readings (their sizes and variants read the rest)
-            ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]
-                    or shares_line(top, r, names, meas)]
+            ties = [r for r in cands[1:] if r["evidence"] >= NEAR_TIE * top["evidence"]]
             # a fault whose own family stands clearly out where the winner's prediction
             # leaves it wins a near tie on the whole record against a cause whose family
             # does not (an outer race that lifted its envelope lines 19 dB tied a torque
@@ -387,10 +370,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                         if r["cause"].signature is not None}
                 own = [r for r in by_signature.values() if (r["name"], r["component"]) in tied
                        and r["nameable"]]
-                # a reading two of them hold (one line in both windows) tells neither
-                shared = _shared_readings(own, names, meas)
-                best = max(own, key=lambda r: added_evidence(
-                    r, lib.mean[li], skip=shared[(r["name"], r["component"])]), default=None)
+                best = max(own, key=lambda r: added_evidence(r, lib.mean[li]), default=None)
                 if best is not None and (best["name"], best["component"]) != (
                         top["name"], top["component"]):
                     new = next(r for r in cands if (r["name"], r["component"])

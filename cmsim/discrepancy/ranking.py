@@ -153,7 +153,7 @@ class Nuisances:
         return best
 
 
-def added_evidence(row, base, skip=()):
+def added_evidence(row, base):
     """A fault's evidence on its own signature, over the features its change lifts above the
     baseline and the shared statistics: a fault adds its family, and a family that fell is
     no fault's (every impulsive fault moves the band the envelope is read in, so a healthy
@@ -167,8 +167,6 @@ def added_evidence(row, base, skip=()):
         (``prediction``, ``per_feature``, ``judged_on``).
     base : numpy.ndarray
         The baseline's features.
-    skip : collection of str
-        Features not counted (a reading another fault's family holds too).
 
     Returns
     -------
@@ -176,7 +174,7 @@ def added_evidence(row, base, skip=()):
     """
     lifted = row["prediction"] >= base
     return sum(v for i, (k, v) in enumerate(row["per_feature"].items())
-               if k in row["judged_on"] and k not in skip and (k in STATISTICS or lifted[i]))
+               if k in row["judged_on"] and (k in STATISTICS or lifted[i]))
 
 
 def nuisance_params(setup, nominal):

@@ -80,7 +80,7 @@ from cmsim.spectra.lines import SLIP_TOLERANCE, leakage_bins, line_amplitude, li
 __all__ = ["BURIED_LINE_DB", "BURIED_RISE_DB", "BURIED_SPANS", "BURIED_TIE_DB",
            "COMB_HARMONICS", "COMB_RISE_DB", "FULL_RESOLUTION_MAX_S",
            "FUNDAMENTALS", "HOLD_DB", "RESOLUTION_DB", "buried_family", "fundamental_columns",
-           "fundamental_hz", "overlapping", "resolve_line", "shaft_comb", "shares_line"]
+           "fundamental_hz", "overlapping", "resolve_line", "shaft_comb"]
 
 #: A rival's fundamental, read over the whole record, stands this far over the named fault's
 #: to take the line, dB: a steady line gains 7.8 dB from 0.5-s segments to a 3-s record,
@@ -188,32 +188,6 @@ def fundamental_columns(row, names):
     """
     stem = f"env_{FUNDAMENTALS[row['name']]}_{row['component']}_h1_"
     return [i for i in row["out"] if names[i].startswith(stem)]
-
-
-def shares_line(a, b, names, meas):
-    """Whether two bearing faults' fundamentals read one line in the segments: the same peak
-    the highest of both windows, so the same value in the band rule's band (the angle-domain
-    generator's bearing machine 10: a drive-end ball defect's 2×BSF and the same bearing's
-    BPFI, 26.85 dB both, and their second harmonics 23.36 dB both).
-
-    Parameters
-    ----------
-    a, b : dict
-        Rows of :func:`~cmsim.discrepancy.judge.decide_record` (``name``, ``component``).
-    names : sequence of str
-        The compared features' names.
-    meas : numpy.ndarray
-        The record's features.
-
-    Returns
-    -------
-    bool
-    """
-    if not all(r["name"] in FUNDAMENTALS and r["component"] for r in (a, b)):
-        return False
-    ka, kb = _key(a), _key(b)
-    return (ka != kb and ka in names and kb in names
-            and meas[names.index(ka)] == meas[names.index(kb)])
 
 
 def _key(row):

@@ -526,37 +526,6 @@ def test_a_line_two_families_share_is_read_as_either_where_the_library_tells_the
         "env_bpfi_1b1_h1_db", "env_bpfi_1b1_sb_db", "kurtosis_log", "crest_log"]
 
 
-@pytest.mark.parametrize("apart, finding", [(0.0, "bearing_ball"),
-                                            (1.0, "bearing_inner_race")])
-def test_two_faults_whose_fundamentals_read_one_line_tie_on_the_whole_record(apart, finding):
-    """The angle generator's bearing machine 10: a ball defect's 2xBSF and the same
-    bearing's BPFI read one line in the segments (26.85 dB both, their second harmonics
-    23.36 dB both). The inner race's change reads the rest of the record better (here: the
-    shaft lines and the level it lifts), 448 against 336, beyond a near tie; its shaft-rate
-    sidebands stayed where they were, the ball's cage line rose. One line in both windows is
-    a tie, told apart on what each fault adds; lines of their own (1 dB apart) are not."""
-    names = ("env_bpfi_1b1_h1_db", "env_bsf2_1b1_h1_db", "env_bpfi_1b1_h2_db",
-             "env_bsf2_1b1_h2_db", "env_bpfi_1b1_sb_db", "env_ftf_1b1_db", "raw_fr_h1_db",
-             "raw_fr_h2_db", "level_db")
-    m, sizes = len(names), (3e-5, 3e-4, 3e-3)
-    inner, ball = np.zeros((3, m)), np.zeros((3, m))
-    inner[:, [0, 2, 4, 6, 7, 8]] = np.array([[0.0], [10.0], [20.0]])
-    ball[:, [1, 3]] = np.array([[0.0], [10.0], [20.0]])
-    ball[:, [5, 8]] = np.array([[0.0], [5.0], [10.0]])        # the cage line, louder
-    lib = _baseline_at_zero(
-        names, np.full(m, 2.0),
-        SignatureEntry("bearing_inner_race", "1b1", "documented", "size_m", sizes, inner),
-        SignatureEntry("bearing_ball", "1b1", "documented", "size_m", sizes, ball))
-    li = np.arange(m)
-    meas = np.array([20.0, 20.0 - apart, 20.0, 20.0, 0.0, 10.0, 20.0, 20.0, 20.0])
-    d = decide_record(lib, li, list(names), meas, feature_sigma(lib, li, list(names), 8),
-                      "1b1")
-    ev = {r["name"]: r["evidence"] for r in d["ranked"]}
-    assert ev["bearing_ball"] < NEAR_TIE * ev["bearing_inner_race"]
-    assert (d["finding"], d["decided_on"]) == (finding, "whole")
-    assert [r["name"] for r in d["ties"]] == (["bearing_inner_race"] if apart == 0.0 else [])
-
-
 def _reshaped_by_a_load(low, high, unnameable_fault=False):
     """decide_record on a record whose eight lines a load change moves +10 dB (its library
     entry at the larger of two sizes; spread 1 dB), the record's moved ``low`` dB on half of
