@@ -280,14 +280,15 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
         # that reads the family but lifts what the record did not move is not its change
         # (an outer race's family read by a 3x path's change that lifted the mesh's
         # sidebands 38 dB, where the record's had not moved, was no candidate at all)
-        apart = np.where((per0s[0] - per_prof).sum(axis=1) > 0.0, 0.0, INCONSISTENT)
-        for store, per, p0, score, order in (
-                (ranked, per_full, per0, np.where(ok, chi, np.inf), np.zeros(chi.size)),
+        penalty = np.where((per0s[0] - per_prof).sum(axis=1) > 0.0, 0.0, INCONSISTENT)
+        for store, per, p0, score, rank in (
+                (ranked, per_full, per0, np.where(ok, chi, np.inf), 0.0),
                 (by_signature, per_prof, per0s,
-                 np.where(ok, per_prof[:, sel].sum(axis=1), np.inf), apart)):
-            b = int(np.argmin(score + order))
+                 np.where(ok, per_prof[:, sel].sum(axis=1), np.inf), penalty)):
+            rank = score + rank             # the score, an inconsistent change's after all
+            b = int(np.argmin(rank))
             key = (e.cause, e.component)
-            if key in store and score[b] + order[b] >= store[key]["order"]:
+            if key in store and rank[b] >= store[key]["rank"]:
                 continue
             within = values[score <= score[b] + SEVERITY_DELTA_CHI2]
             delta = p0[0] - per[b]
@@ -296,7 +297,7 @@ def decide_record(lib, li, names, meas, sigma, sensor_bearing, causes=None, gate
                           "value": float(values[b]),
                           "range": (float(within.min()), float(within.max())),
                           "chi2": float(per[b].sum()), "score": float(score[b]),
-                          "order": float(score[b] + order[b]),
+                          "rank": float(rank[b]),
                           "prediction": table[b], "judged_on": judged,
                           "family": cause.family(names, e.component, shaft),
                           "per_feature": dict(zip(names, delta.tolist())),
@@ -487,7 +488,7 @@ def judge(record, machine, *, max_segments=16, causes=None, refine=1, workers=1,
             gate_sigma=gate, excluded=combed, floor_db=floor_db)
 
     d = decide()
-    d, why = held_lines(record, machine, d, cnames, meas, lib.mean[li], lib.segment_s, decide)
+    d, why = held_lines(d, cnames, meas, lib.mean[li], floor_db, decide)
     notes.extend(why)
     baseline = machine.baseline.records if machine.baseline else ()
     for _ in range(len(machine.rig.bearing_names) * len(FUNDAMENTALS)):

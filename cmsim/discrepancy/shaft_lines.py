@@ -149,24 +149,20 @@ def line_fell(name, meas, base, floor_db):
     return meas - base + floor_db <= -LINE_RISE_DB
 
 
-def held_lines(record, machine, decision, names, meas, base, seg_s, redecide):
+def held_lines(decision, names, meas, base, floor_db, redecide):
     """The decision taken again without the causes named on a floor that fell (module
     docstring), and the notes saying why (none where the named cause is not one of them).
 
     Parameters
     ----------
-    record : MeasuredRecord
-        The record.
-    machine : cmsim.machine.Machine
-        Its machine.
     decision : dict
         :func:`~cmsim.discrepancy.judge.decide_record`'s result.
     names : sequence of str
         The compared features.
     meas, base : numpy.ndarray
         The record's features and the baseline's.
-    seg_s : float
-        The library's segment length, s.
+    floor_db : float or None
+        :func:`floor_change_db` (None: unknown, the decision stands).
     redecide : callable
         ``redecide(excluded)``: the decision without the causes named in ``excluded``.
 
@@ -177,7 +173,6 @@ def held_lines(record, machine, decision, names, meas, base, seg_s, redecide):
     top = decision["top"]
     if top is None or not any(k in top["judged_on"] for k in SHAFT_LINES):
         return decision, []
-    floor_db = floor_change_db(record, machine, seg_s)
     lines = None if floor_db is None else floor_borne(top, names, meas, base, floor_db)
     if lines is None:
         return decision, []

@@ -91,13 +91,14 @@ def test_the_decision_is_taken_again_without_every_cause_the_floor_carries():
         asked.append(set(excluded))
         return again
 
-    got, notes = held_lines(_record(loud), _machine([quiet]), decision, NAMES, meas, base,
-                            0.5, redecide)
+    got, notes = held_lines(decision, NAMES, meas, base,
+                            floor_change_db(_record(loud), _machine([quiet]), 0.5), redecide)
     assert got is again and asked == [{"misalignment", "unbalance"}]
     assert "misalignment, unbalance not named" in notes[0]
     # the same lines over a floor that stayed: the decision stands, nothing asked again
-    got, notes = held_lines(_record(_noise(3, 1.0)), _machine([quiet]), decision, NAMES, meas,
-                            base, 0.5, redecide)
+    got, notes = held_lines(decision, NAMES, meas, base,
+                            floor_change_db(_record(_noise(3, 1.0)), _machine([quiet]), 0.5),
+                            redecide)
     assert got is decision and notes == [] and len(asked) == 1
 
 
