@@ -189,7 +189,7 @@ def test_through_a_machine_a_wandering_ball_reads_as_the_real_ball_records(tmp_p
     res = evaluate_syn2real([out], CWRU, "forest", max_test_windows=8)
     recall = {k: v["mean"] for k, v in res["per_class_recall"].items()}
     assert res["n_test_windows"] == 7 * 8
-    assert res["balanced_accuracy"]["mean"] >= 0.85, recall     # 0.98 measured
+    assert res["balanced_accuracy"]["mean"] >= 0.85, recall     # 0.97 measured
     assert recall["ball"] >= 0.5 and min(recall.values()) >= 0.5, recall
 
 
