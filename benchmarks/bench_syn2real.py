@@ -27,6 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from cmsim.datasets import DatasetSpec, generate_dataset         # noqa: E402
+from cmsim.datasets.spec_toml import through_machine                # noqa: E402
 from cmsim.measured import data_root                            # noqa: E402
 from cmsim.diagnostics.syn2real import evaluate_syn2real, measured_windows  # noqa: E402
 
@@ -59,12 +60,8 @@ def _ablate_one(d, variant):
                 t["axis_offset"] = {"distribution": "uniform", "min": -1.0, "max": 1.0}
                 t["wander_s"] = {"distribution": "loguniform", "min": 0.05, "max": 5.0}
     elif variant == "machine":
-        # the housing path and sensor noise are the machine's calibrated path and background
-        d.pop("rig", None)
-        d["machine"] = {"file": str(MACHINE_FILE)}
-        for k in ("housing_mode_hz", "housing_damping", "sensor_noise_m_s2"):
-            d["nuisances"].pop(k, None)
-        d["sensor"]["channels"] = ["DE"]
+        # the housing path, sensor noise and channel are the machine's
+        d = through_machine(d, MACHINE_FILE)
         d["dataset"]["name"] += "_machine"
     elif variant != "full":
         raise ValueError(variant)

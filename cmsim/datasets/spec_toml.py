@@ -44,6 +44,7 @@ Values are :class:`~cmsim.datasets.distribution.Distribution` s: a number (const
 
 from __future__ import annotations
 
+import copy
 import tomllib
 from pathlib import Path
 
@@ -55,7 +56,7 @@ from cmsim.machine import Machine
 from cmsim.rig import PRESETS, RANGES, SAMPLING, Rig
 
 __all__ = ["read_toml", "toml_keywords", "load_rig", "load_machine", "check_channels", "setting_range",
-           "OPERATING_DEFAULTS", "machine_operating"]
+           "OPERATING_DEFAULTS", "machine_operating", "through_machine", "MACHINE_OWNS"]
 
 
 def machine_operating(machine):
@@ -239,6 +240,31 @@ def toml_keywords(data, base_dir=None):
 #: Nuisances a machine's own path and background replace: a spec through a machine that
 #: draws them would draw a housing and a sensor noise its records never go through.
 MACHINE_OWNS = ("housing_mode_hz", "housing_damping", "sensor_noise_m_s2")
+
+
+def through_machine(data, machine_file):
+    """A spec's TOML table made through a machine: ``[rig]`` replaced by ``[machine] file =
+    machine_file``, the nuisances the machine owns (:data:`MACHINE_OWNS`) and the sensor's
+    channels left out (the machine brings its path, background and channel).
+
+    Parameters
+    ----------
+    data : dict
+        A spec's table (:func:`read_toml`); not changed.
+    machine_file : str or Path
+        A machine file (``cmsim calibrate --out``).
+
+    Returns
+    -------
+    dict
+    """
+    out = copy.deepcopy(data)
+    out.pop("rig", None)
+    out["machine"] = {"file": str(machine_file)}
+    for n in MACHINE_OWNS:
+        out.get("nuisances", {}).pop(n, None)
+    out.get("sensor", {}).pop("channels", None)
+    return out
 
 
 def _check_through_machine(machine, channels, nuisances):

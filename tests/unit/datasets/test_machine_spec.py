@@ -6,6 +6,7 @@ the path (the same as ``simulate --machine`` makes of the same run), and the spe
 what contradicts the machine (another rig, another sample rate, a missing file).
 """
 
+import copy
 import dataclasses
 import hashlib
 import json
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 from cmsim.datasets import DatasetSpec, generate_dataset, load
+from cmsim.datasets.spec_toml import through_machine
 from cmsim.diagnostics.syn2real import synthetic_windows
 from cmsim.dynamics import simulate
 from cmsim.errors import ParameterError
@@ -174,6 +176,27 @@ def test_a_machine_spec_refuses_what_the_machine_owns(tmp_path, key, table, valu
     data[table] = {**data.get(table, {}), **value}
     with pytest.raises(ParameterError, match=key.replace("[", r"\[").replace("]", r"\]")):
         DatasetSpec.from_dict(data, base_dir=tmp_path)
+
+
+def test_a_stock_spec_through_a_machine_is_accepted_as_the_machine_owns(tmp_path):
+    """The refusal above, the other way: a stock spec with its rig, housing and sensor
+    nuisances and accelerometer channel, made through a machine by
+    :func:`~cmsim.datasets.spec_toml.through_machine`, is accepted, on the machine's rig and
+    channel; the stock table itself is left as it was."""
+    _machine().save(tmp_path / "m.toml")
+    stock = {**{k: v for k, v in _spec_dict(tmp_path).items() if k != "machine"},
+             "rig": {"builtin": "paper_2016"},
+             "nuisances": {"housing_mode_hz": 3000.0, "sensor_noise_m_s2": 0.1,
+                           "housing_damping": 0.05, "slip": 0.01},
+             "sensor": {"channels": ["accel_1b1_y"], "duration_s": 1.0}}
+    kept = copy.deepcopy(stock)
+    spec = DatasetSpec.from_dict(through_machine(stock, "m.toml"), base_dir=tmp_path)
+    assert spec.channels == ("DE", "tacho") and spec.rig_source == "machine:bench"
+    assert {n for n, _ in spec.nuisances} == {"slip"}
+    assert stock == kept
+    by_hand = {k: v for k, v in stock.items() if k != "rig"} | {"machine": {"file": "m.toml"}}
+    with pytest.raises(ParameterError, match=r"sensor\.channels\[0\]"):
+        DatasetSpec.from_dict(by_hand, base_dir=tmp_path)      # only [rig] swapped: refused
 
 
 def test_a_machine_spec_s_references_run_in_batches_and_keep_the_records_bits(

@@ -22,6 +22,7 @@ import pytest
 from cmsim.cli import main
 from cmsim.datasets import DatasetSpec, generate_dataset, load
 from cmsim.datasets.export import to_bearing_datasets
+from cmsim.datasets.spec_toml import through_machine
 from cmsim.measured import data_root
 from cmsim.diagnostics.syn2real import (WindowSet, check_disjoint, envelope_features,
                                         evaluate_syn2real, measured_windows, score_windows,
@@ -172,12 +173,8 @@ def test_through_a_machine_a_wandering_ball_reads_as_the_real_ball_records(tmp_p
     from cmsim.measured import read_record
     machine = calibrate([read_record(CWRU / "normal_0.npz").span(5.0, 10.0)])
     machine.save(tmp_path / "cwru_de.toml")
-    data = tomllib.loads((ROOT / "datasets" / "cwru_syn2real.toml").read_text())
-    data.pop("rig")
-    data["machine"] = {"file": str(tmp_path / "cwru_de.toml")}
-    for k in ("housing_mode_hz", "housing_damping", "sensor_noise_m_s2"):
-        data["nuisances"].pop(k)
-    data["sensor"]["channels"] = ["DE"]
+    data = through_machine(tomllib.loads((ROOT / "datasets" / "cwru_syn2real.toml")
+                                          .read_text()), tmp_path / "cwru_de.toml")
     data["dataset"]["records"] = N_RECORDS
     ball = next(t for t in data["faults"]["types"] if t["type"] == "ball")
     ball["axis_offset"] = {"distribution": "uniform", "min": -1.0, "max": 1.0}
