@@ -97,7 +97,8 @@ def demodulation_band(x, fs_hz, max_fault_hz):
     fs = float(fs_hz)
     f_max = min(float(max_fault_hz), MAX_FAULT_FRACTION * fs)
     try:
-        lo, hi = residual_kurtogram(x, fs, max_fault_hz=f_max if f_max > 0 else None).band_hz
+        lo, hi = residual_kurtogram(x, fs, max_fault_hz=f_max if f_max > 0 else None,
+                                    narrow_levels=False).band_hz
     except ParameterError:
         return FALLBACK_BAND[0] * fs, FALLBACK_BAND[1] * fs
     if hi - lo < NARROW_BAND_FRACTION * fs:

@@ -136,6 +136,11 @@ def test_kurtogram_min_bandwidth_removes_the_narrow_levels():
     assert kept.kurtosis_max < free.kurtosis_max
     assert kept.best_nperseg < free.best_nperseg
     assert kurtogram(x, FS, min_bandwidth_hz=3.0 * rep).band_hz == kept.band_hz
+    # the band rule's kurtogram skips them: the same band, without their cost
+    lean = kurtogram(x, FS, max_fault_hz=rep, narrow_levels=False)
+    assert lean.band_hz == kept.band_hz and lean.kurtosis_max == kept.kurtosis_max
+    assert lean.nperseg == tuple(n for n in kept.nperseg if 2.0 * FS / n >= 3.0 * rep)
+    assert len(lean.nperseg) < len(kept.nperseg)
 
 
 @pytest.mark.parametrize("band, order", [((2000.0, 4000.0), 4), ((0.0, 1500.0), 4),
