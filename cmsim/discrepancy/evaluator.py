@@ -17,6 +17,7 @@ import math
 import warnings
 from concurrent.futures import CancelledError
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import replace
 
 import numpy as np
 
@@ -55,6 +56,9 @@ LOG_FLOOR = 0.1
 
 #: Reference of ``level_db``, m/s².
 LEVEL_REF = 1.0
+
+#: Path signals an evaluator keeps (:meth:`Evaluator.signal`; the oldest goes first).
+PATH_CACHE = 64
 
 #: Features that depend on the transfer path (its shape or gain): the spectral-shape bands,
 #: the absolute level, the GMF harmonics against each other and the raw spectrum's lines
@@ -175,25 +179,49 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
     -------
     ndarray
     """
+    x = _through_path(force, edge, n, fs_hz, housing)
+    return x + _noise(x, _noise_draw(x.size, fs_hz, seed, floor), noise_ratio, noise_ref_rms,
+                      floor)
+
+
+def _through_path(force, edge, n, fs_hz, housing):
+    """The housing's acceleration of a force, edges trimmed, mean removed (no noise)."""
     x = housing_acceleration(force - force.mean(), fs_hz, housing)[edge:edge + n]
-    x = x - x.mean()
+    return x - x.mean()
+
+
+def _noise_draw(n, fs_hz, seed, floor=None):
+    """The sensor noise's draw of a seed, before :func:`_noise` scales it (the record's
+    floor's coloured noise at gain 1, else white of unit variance)."""
     rng = np.random.default_rng(seed + 7919)
+    return floor.noise(n, fs_hz, rng) if floor is not None else rng.standard_normal(n)
+
+
+def _noise(x, draw, noise_ratio, noise_ref_rms, floor=None):
+    """The sensor noise of :func:`sensor_signal` from its seed's draw."""
     if floor is not None:
-        return x + floor.noise(x.size, fs_hz, rng, noise_ratio / NOMINAL_NOISE_RATIO)
+        return (noise_ratio / NOMINAL_NOISE_RATIO) * draw
     ref = float(np.std(x)) if noise_ref_rms is None else float(noise_ref_rms)
-    return x + noise_ratio * ref * rng.standard_normal(x.size)
+    return noise_ratio * ref * draw
 
 
-def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="1b1"):
-    """The sensor signal of a simulated force (on ``bearing``) through ``setup``'s shaft
-    forces (at the rate of that bearing's shaft) and chain."""
+def _path_chain(setup, force, edge, n, fs, seed, bearing="1b1"):
+    """The housing's acceleration of a simulated force (on ``bearing``) with ``setup``'s
+    shaft forces (at the rate of that bearing's shaft), before the sensor noise."""
     fr = rig_frequencies(setup.rig, setup.op).bearing(bearing).shaft_hz
     force, rotating = _shaft_forces(force, fs, fr, setup.shaft_forces, seed,
                                     setup.shaft_modulation)
     if rotating:
         force = force + rotating_force(force.size, fs, fr, rotating)
-    return sensor_signal(force, edge, n, fs, setup.housing, setup.noise_ratio, noise_ref_rms,
-                         seed, floor)
+    return _through_path(force, edge, n, fs, setup.housing)
+
+
+def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="1b1"):
+    """The sensor signal of a simulated force (on ``bearing``) through ``setup``'s shaft
+    forces (at the rate of that bearing's shaft) and chain."""
+    x = _path_chain(setup, force, edge, n, fs, seed, bearing)
+    return x + _noise(x, _noise_draw(x.size, fs, seed, floor), setup.noise_ratio,
+                      noise_ref_rms, floor)
 
 
 def simulate_setup(setup, fs_hz, duration_s, model_signal, seed, noise_ref_rms=None):
@@ -364,6 +392,7 @@ class Evaluator:
         self.fs = max(record.fs_hz, 1e3)
         self.forces = {}
         self.cache = {}
+        self._paths, self._draws = {}, {}
         self.ref_rms = None
         self.scale = record.unit_scale
         self.floor = None
@@ -404,8 +433,19 @@ class Evaluator:
         if self.ref_rms is None:                   # the healthy level fixes the noise
             self.ref_rms = float(np.std(sensor_signal(*run, self.fs, setup.housing, 0.0,
                                                       None, seed)))
-        return _chain(setup, *run, self.fs, seed, self.ref_rms, self.floor,
-                      bearing=self.sensor_bearing)
+        # the noise ratio, the nuisance refitted most, scales a noise drawn once per seed
+        # over a path signal made once per run and path (bit for bit _chain's samples)
+        key = (setup.dynamics_key(), replace(setup, noise_ratio=1.0).chain_key(), seed)
+        x = self._paths.get(key)
+        if x is None:
+            x = _path_chain(setup, *run, self.fs, seed, bearing=self.sensor_bearing)
+            if len(self._paths) >= PATH_CACHE:
+                self._paths.pop(next(iter(self._paths)))
+            self._paths[key] = x
+        if (seed, x.size) not in self._draws:
+            self._draws[seed, x.size] = _noise_draw(x.size, self.fs, seed, self.floor)
+        return x + _noise(x, self._draws[seed, x.size], setup.noise_ratio, self.ref_rms,
+                          self.floor)
 
     def row(self, setup, seed):
         """Features of one run of ``setup`` with simulation seed ``seed`` (None if it
