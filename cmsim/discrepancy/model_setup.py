@@ -90,9 +90,13 @@ class ModelSetup:
     def dynamics_key(self):
         """What the simulated forces depend on (not the machine, the measurement chain nor
         the shaft forces laid on the force after the dynamics: :data:`CHAIN_FIELDS` at their
-        defaults)."""
-        return repr(replace(self, machine=None,
-                            **{f.name: f.default for f in fields(self) if f.name in CHAIN_FIELDS}))
+        defaults); kept on the setup (its repr is read thousands of times a comparison)."""
+        key = self.__dict__.get("_dynamics_key")
+        if key is None:
+            key = repr(replace(self, machine=None, **{f.name: f.default for f in fields(self)
+                                                      if f.name in CHAIN_FIELDS}))
+            object.__setattr__(self, "_dynamics_key", key)
+        return key
 
     def chain_key(self):
         """What the sensor signal depends on besides the dynamics (:data:`CHAIN_FIELDS`)."""
