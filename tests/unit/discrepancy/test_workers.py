@@ -128,3 +128,26 @@ def test_a_machine_comparison_refines_on_two_threads_as_on_one(monkeypatch):
     two = compare(record, machine=machine, workers=2)
     assert len(threads) == 2 and len(set(threads)) == 2
     _same(one, two)
+
+
+@pytest.mark.parametrize("floor", [False, True])
+def test_a_kept_path_and_noise_draw_give_the_chains_samples_bit_for_bit(floor):
+    """The evaluator keeps a run's path signal and each seed's noise draw and scales the draw
+    by each noise ratio: the sensor signal is, bit for bit, what the whole chain makes of the
+    run (the record's floor's coloured noise, or a share of the healthy level's white)."""
+    import dataclasses
+
+    import numpy as np
+
+    record = hidden_effect_record(None, 5, duration_s=1.0).record
+    setup = ModelSetup(rig=record.rig, op=record.op, housing=record.rig.housing)
+    ev = Evaluator(record, 0.25, 0, 10, floor=record.signal if floor else None)
+    first = ev.signal(setup, 0)
+    for ratio in (0.02, 0.3, 2.0):
+        st = dataclasses.replace(setup, noise_ratio=ratio)
+        for seed in (0, 7777):
+            chain = evaluator._chain(st, *ev._forces(st, seed), ev.fs, seed, ev.ref_rms,
+                                     ev.floor, bearing=ev.sensor_bearing)
+            assert np.array_equal(ev.signal(st, seed), chain)
+    assert len(ev._paths) == 2 and len(ev._draws) == 2     # one path a run, one draw a seed
+    assert np.array_equal(ev.signal(setup, 0), first)
