@@ -207,17 +207,38 @@ def _prepare(record, seg_s, max_segments):
 
 
 def _check_machine(record, machine):
-    """The machine must be the record's: same channel, sample rate and bearings."""
+    """The machine must be the record's: same channel and bearings, and its sample rate; a
+    record at a higher rate is read at the machine's (resampled, and said so in the notes).
+
+    Returns
+    -------
+    (MeasuredRecord, list of str)
+        The record as compared, and the note on a resampling (empty without one).
+    """
     if machine.channel != record.channel:
         raise ParameterError(f"the machine was calibrated on channel {machine.channel!r}, the "
                              f"record's is {record.channel!r}", param="machine")
-    if abs(machine.fs_hz / record.fs_hz - 1.0) > 0.01:
-        raise ParameterError(f"the machine was calibrated at {machine.fs_hz:g} Hz, the record "
-                             f"is at {record.fs_hz:g} Hz", param="machine")
     if machine.rig.bearing_names != record.rig.bearing_names or (
             (machine.rig.gears is None) != (record.rig.gears is None)):
         raise ParameterError("the machine's rig is not the record's (other bearings or "
                              "gears)", param="machine")
+    if abs(machine.fs_hz / record.fs_hz - 1.0) <= 0.01:
+        return record, []
+    hint = (f"calibrate the baseline at the record's rate (cmsim calibrate --resample-hz "
+            f"{record.fs_hz:g}) or give a record at {machine.fs_hz:g} Hz or above")
+    if record.fs_hz < machine.fs_hz:
+        raise ParameterError(f"the machine was calibrated at {machine.fs_hz:g} Hz, the record "
+                             f"is at {record.fs_hz:g} Hz: its features read bands the record "
+                             f"does not hold; {hint}", param="machine")
+    try:
+        resampled = record.resampled(machine.fs_hz)
+    except ParameterError as exc:
+        raise ParameterError(f"the machine was calibrated at {machine.fs_hz:g} Hz, the record "
+                             f"is at {record.fs_hz:g} Hz and cannot be resampled to it "
+                             f"({exc}); {hint}", param="machine") from None
+    note = (f"the record, sampled at {record.fs_hz:g} Hz, was low-passed and resampled to "
+            f"the machine's {machine.fs_hz:g} Hz before it was compared")
+    return resampled, [note]
 
 
 def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
@@ -260,10 +281,12 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         raise ParameterError(f"budget must be an integer >= {least}, got {budget!r}",
                              param="budget", allowed=f">= {least}")
     if machine is not None:
-        _check_machine(record, machine)
-        return _against_machine(record, machine, budget=budget, seed=seed,
-                                max_segments=2 * max_segments, causes=causes,
-                                workers=workers, start=start)
+        record, notes = _check_machine(record, machine)
+        got = _against_machine(record, machine, budget=budget, seed=seed,
+                               max_segments=2 * max_segments, causes=causes,
+                               workers=workers, start=start)
+        got.notes[:0] = notes
+        return got
     mode = "documented" if record.path_documented else "path-free"
     seg_s, duration, names, F = _prepare(record, seg_s, max_segments)
     # path-free with a known unit: the model's noise is the record's own floor (its SNR is

@@ -160,6 +160,33 @@ class MeasuredRecord:
                   dict(self.run.meta, span_s=[float(start_s), stop]), source="measured")
         return replace(self, run=run)
 
+    def resampled(self, fs_out_hz):
+        """The same record at a lower sample rate: every channel low-passed and resampled
+        (:func:`cmsim.sensors.decimate`, the one resampler of cmsim) — e.g. a record made at
+        twice the rate of the baseline its machine was calibrated on.
+
+        Parameters
+        ----------
+        fs_out_hz : float
+            Sample rate, Hz: at most the record's, ``fs·up/down`` (down <= 1000).
+
+        Returns
+        -------
+        MeasuredRecord
+            Its first sample at the filter's half length into the record; the meta says
+            from which rate it was resampled (``resampled_from_hz``).
+        """
+        from cmsim.sensors import decimate
+
+        names = list(self.run.signals)
+        y, _, info = decimate(np.column_stack([np.asarray(self.run[k], dtype=float)
+                                               for k in names]), self.fs_hz, fs_out_hz)
+        fs = float(fs_out_hz)
+        run = Run(np.arange(y.shape[0]) / fs, {k: y[:, i] for i, k in enumerate(names)},
+                  dict(self.run.meta, fs_hz=fs, resampled_from_hz=self.fs_hz,
+                       resampling=info), source="measured")
+        return replace(self, run=run)
+
     def model_frequencies(self, speed_rpm=None):
         """Characteristic frequencies of the model rig (bearings ``1b1``, ...).
 

@@ -387,6 +387,12 @@ CATALOGUE = [
     R("calibrate-span-negative", "calibrate {record} --span -1 0.5 --out {work}/m.toml",
       "--span", numeric=True),
     R("calibrate-out-directory", "calibrate {record} --out {work}", "--out"),
+    R("calibrate-resample-above-the-rate", "calibrate {record} --resample-hz 96000 --out "
+      "{work}/m.toml", "--resample-hz", "at most the baseline's rate"),
+    R("calibrate-resample-no-fraction", "calibrate {record} --resample-hz 7777.7 --out "
+      "{work}/m.toml", "--resample-hz", "not a fraction"),
+    R("calibrate-resample-negative", "calibrate {record} --resample-hz -5 --out "
+      "{work}/m.toml", "--resample-hz", numeric=True),
     R("calibrate-out-exists", "calibrate {record} --out {text}", "--out", "--force"),
     R("calibrate-out-is-the-rig", "calibrate {record} --rig {rig_ok} --out {rig_ok} --force",
       "--out", "--rig"),

@@ -16,7 +16,8 @@ from cmsim.rig import RANGES
 
 #: Options that set a quantity of the table under a name of their own: dest → quantity.
 SETS = {"table_torque_nm": "torque_nm", "sensor_noise": "sensor_noise_m_s2",
-        "sensor_fs_hz": "fs_hz", "ramp_to_rpm": "speed_rpm", "split_seed": "seed"}
+        "sensor_fs_hz": "fs_hz", "ramp_to_rpm": "speed_rpm", "split_seed": "seed",
+        "resample_hz": "record_fs_hz"}
 
 #: Commands whose --fs-hz is a measured recording's rate (any rate a file may hold), not
 #: the simulation's output rate.

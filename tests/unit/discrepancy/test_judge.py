@@ -41,9 +41,9 @@ def machine():
     return m.with_library(lib)
 
 
-def _with(record, x):
-    run = Run(np.arange(x.size) / record.fs_hz, {"DE": x}, {"fs_hz": record.fs_hz},
-              source="measured")
+def _with(record, x, fs_hz=None):
+    fs = record.fs_hz if fs_hz is None else fs_hz
+    run = Run(np.arange(x.size) / fs, {"DE": x}, {"fs_hz": fs}, source="measured")
     return record_from_run(run, "DE", record.rig, record.op, model_signal="accel_1b1_y",
                            components=dict(record.components), unit_scale=1.0)
 
@@ -186,3 +186,28 @@ def test_a_file_that_documents_no_load_is_read_at_the_machine_s():
     op, note = record_load(record({"load_percent": 37.5, "radial_load_n": 0.0}), guessed)
     assert (op.torque_nm, op.radial_load_n) == (50.0, 0.0)
     assert "baseline documented no load (its torque 50 N m was assumed" in note
+
+
+def test_a_record_at_twice_the_machine_s_rate_is_read_at_its_rate(machine):
+    """A record sampled at twice the baseline's rate (MFPT's baselines are at 97 656 Hz, its
+    faults at 48 828) is low-passed and resampled to the machine's rate and compared, said
+    so in the notes: the same finding as the record at the machine's own rate. A record at
+    half the rate is refused, naming what would do (the machine reads bands it lacks)."""
+    from scipy.signal import resample_poly
+
+    from cmsim.errors import ParameterError
+
+    h = hidden_effect_record("bearing_inner_race", SEED)
+    rec = h.record
+    fast = _with(rec, resample_poly(rec.signal, 2, 1), 2 * rec.fs_hz)
+    assert fast.fs_hz == 2 * rec.fs_hz
+    read = fast.resampled(rec.fs_hz)
+    assert read.fs_hz == rec.fs_hz and read.meta["resampled_from_hz"] == fast.fs_hz
+    assert abs(read.signal.size - rec.signal.size) < 0.01 * rec.signal.size
+    c = compare(fast, machine=machine)
+    assert c.finding == h.effect == compare(rec, machine=machine).finding, c.causes[:3]
+    assert c.record["fs_hz"] == rec.fs_hz
+    assert "resampled to the machine's" in c.notes[0]
+    slow = _with(rec, rec.signal[::2], rec.fs_hz / 2)
+    with pytest.raises(ParameterError, match="calibrate the baseline at the record's rate"):
+        compare(slow, machine=machine)
