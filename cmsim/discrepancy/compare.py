@@ -51,6 +51,7 @@ from cmsim.discrepancy.causes import (CAUSE_WORDS, CAUSES, NUISANCES, ModelSetup
                                       applicable_causes)
 from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, feature_floor,
                                          path_free, weight)
+from cmsim.discrepancy.at_rate import check_machine
 from cmsim.discrepancy.judge import judge
 from cmsim.discrepancy.ranking import (REFINE_TOP, Nuisances, decide, evidence, fit, rank,
                                        refine)
@@ -206,41 +207,6 @@ def _prepare(record, seg_s, max_segments):
     return seg_s, duration, names, F
 
 
-def _check_machine(record, machine):
-    """The machine must be the record's: same channel and bearings, and its sample rate; a
-    record at a higher rate is read at the machine's (resampled, and said so in the notes).
-
-    Returns
-    -------
-    (MeasuredRecord, list of str)
-        The record as compared, and the note on a resampling (empty without one).
-    """
-    if machine.channel != record.channel:
-        raise ParameterError(f"the machine was calibrated on channel {machine.channel!r}, the "
-                             f"record's is {record.channel!r}", param="machine")
-    if machine.rig.bearing_names != record.rig.bearing_names or (
-            (machine.rig.gears is None) != (record.rig.gears is None)):
-        raise ParameterError("the machine's rig is not the record's (other bearings or "
-                             "gears)", param="machine")
-    if abs(machine.fs_hz / record.fs_hz - 1.0) <= 0.01:
-        return record, []
-    hint = (f"calibrate the baseline at the record's rate (cmsim calibrate --resample-hz "
-            f"{record.fs_hz:g}) or give a record at {machine.fs_hz:g} Hz or above")
-    if record.fs_hz < machine.fs_hz:
-        raise ParameterError(f"the machine was calibrated at {machine.fs_hz:g} Hz, the record "
-                             f"is at {record.fs_hz:g} Hz: its features read bands the record "
-                             f"does not hold; {hint}", param="machine")
-    try:
-        resampled = record.resampled(machine.fs_hz)
-    except ParameterError as exc:
-        raise ParameterError(f"the machine was calibrated at {machine.fs_hz:g} Hz, the record "
-                             f"is at {record.fs_hz:g} Hz and cannot be resampled to it "
-                             f"({exc}); {hint}", param="machine") from None
-    note = (f"the record, sampled at {record.fs_hz:g} Hz, was low-passed and resampled to "
-            f"the machine's {machine.fs_hz:g} Hz before it was compared")
-    return resampled, [note]
-
-
 def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             max_segments=8, causes=None, workers=1):
     """Compare a measured record with the model, name a cause, fit it, measure the gain.
@@ -281,7 +247,7 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
         raise ParameterError(f"budget must be an integer >= {least}, got {budget!r}",
                              param="budget", allowed=f">= {least}")
     if machine is not None:
-        record, notes = _check_machine(record, machine)
+        record, machine, notes = check_machine(record, machine, workers)
         got = _against_machine(record, machine, budget=budget, seed=seed,
                                max_segments=2 * max_segments, causes=causes,
                                workers=workers, start=start)
