@@ -196,6 +196,14 @@ def _warn_consistency(args, c):
     machine may then read as departures."""
     from cmsim.discrepancy.judge import ALARM_Z, NONE_CHI2_PER_FEATURE
 
+    for r in c.get("records", ()):
+        if r["departs"]:
+            args.warn(f"baseline {r['record']} differs from the other baseline records by "
+                      f"chi2 per feature {r['chi2_per_feature']:.2f} (worst "
+                      f"{r['worst_feature']} z {r['worst_z']:+.1f}), as a record departs "
+                      "from its machine: it may not be of the same healthy machine at the same "
+                      "operating point (a fault in it would read as none); calibrate without "
+                      "it, or check it")
     if not c["departs"]:
         return
     args.warn(f"the baseline's own halves differ by chi2 per feature "

@@ -48,9 +48,8 @@ def run(args):
                                    scheduler=args.scheduler, progress=progress,
                                    verify=args.verify, force=args.force)
     except KeyboardInterrupt as exc:
-        raise CLIError(f"interrupted ({getattr(exc, 'signal_name', 'SIGINT')}); finished "
-                       f"records are kept in {args.out}, re-run the same command to resume",
-                       130) from None
+        raise CLIError(f"interrupted ({getattr(exc, 'signal_name', 'SIGINT')}); "
+                       f"{interrupted_words(args.out, 'records')}", 130) from None
     res = summary.to_dict()
     if summary.records_failed:
         args.warn(f"{summary.records_failed} records failed (status 'failed' in "
@@ -68,3 +67,17 @@ def text(res):
              f"manifest {res['manifest']}"]
     lines += [f"failed {f['record_id']}: {f['error']}" for f in res["failed"][:5]]
     return "\n".join(lines)
+
+
+def interrupted_words(out, what):
+    """What an interrupted dataset job (``dataset``, ``sweep``) left in its folder ``out``,
+    in words: how many of its ``what`` (records, runs) were finished and kept, and how to
+    resume."""
+    from cmsim.datasets.manifest import read_rows
+
+    rows = read_rows(out) if Path(out).is_dir() else None
+    done = 0 if rows is None else int((rows["status"] == "ok").sum())
+    if not done:
+        return f"no {what} were finished yet; re-run the same command to start"
+    return f"{done} finished {what} are kept in {out}; re-run the same command to resume"
+

@@ -78,6 +78,11 @@ def _speed_profile(args):
                     unit="s (the ramp starts before the record ends: warmup_s + duration_s)"
                     ).check("ramp_start_s", args.ramp_start_s or 0.0)
     ramp_s = args.ramp_s if args.ramp_s is not None else max(end_s - start_s, 1e-3)
+    if start_s + ramp_s > end_s * (1 + 1e-9):
+        reached = args.speed_rpm + (args.ramp_to_rpm - args.speed_rpm) * (end_s - start_s) / ramp_s
+        args.warn(f"--ramp-s {ramp_s:g}: the ramp ends {start_s + ramp_s:g} s after the warm-up "
+                  f"starts, the record at {end_s:g} s: it reaches {reached:.0f} rpm, not "
+                  f"--ramp-to-rpm {args.ramp_to_rpm:g}")
     return SpeedProfile.ramp(args.speed_rpm, args.ramp_to_rpm, ramp_s, start_s=start_s)
 
 
@@ -102,6 +107,9 @@ def run(args):
     from cmsim.faults import RollingSlip
     from cmsim.frequencies import rig_frequencies
 
+    if args.out is not None and args.out.suffix.lower() != ".npz":
+        raise CLIError(f"--out {args.out}: a run is written as .npz (cmsim reads it back as "
+                       "one; cmsim export writes other formats)", option="--out")
     machine = None
     if args.machine:
         from cmsim.machine import Machine, twin_mesh

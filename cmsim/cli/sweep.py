@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from cmsim.cli.contract import CLIError, ranged
+from cmsim.cli.dataset import interrupted_words
 from cmsim.errors import IntegrationDiverged
 from cmsim.cli.options import (add_fault_options, add_losses_option, add_mesh_options,
                                add_rig_options, add_sampling_options, check_losses_options,
@@ -78,8 +79,7 @@ def run(args):
         summary = generate_dataset(spec, args.out, workers=args.workers, force=args.force,
                                    progress=progress, verify=True)
     except KeyboardInterrupt:
-        raise CLIError(f"interrupted; finished runs are kept in {args.out}/manifest.parquet, "
-                       f"re-run the same command to resume", 130) from None
+        raise CLIError(f"interrupted; {interrupted_words(args.out, 'runs')}", 130) from None
     if summary.records_failed:
         errors = "; ".join(f"{r}: {e}" for r, e in summary.failed)
         exc = IntegrationDiverged(f"{summary.records_failed} of {summary.records_total} runs "

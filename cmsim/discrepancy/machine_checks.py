@@ -19,6 +19,7 @@ from cmsim.discrepancy.judge import (ALARM_Z, INTERPOLATION_STEPS, NONE_CHI2_PER
                                      decide_record)
 from cmsim.errors import ParameterError
 from cmsim.frequencies import rig_frequencies
+from cmsim.machine.baseline import Baseline
 from cmsim.machine.calibration import feature_rows
 from cmsim.run import signal_info
 
@@ -89,13 +90,16 @@ def detectability(machine, causes=None):
 
 def baseline_consistency(machine):
     """The machine's baseline judged against itself, as a record is judged: the mean of its
-    odd segments against the mean of its even ones, with the comparison's σ
+    odd segments against the mean of its even ones, and, of a baseline of several records,
+    each record against the others, with the comparison's σ
     (:func:`~cmsim.discrepancy.columns.feature_sigma`) and χ²
-    (:func:`~cmsim.discrepancy.columns.chi2_rows`). A baseline whose halves differ by
-    more than a record may before it departs (χ² per feature over
+    (:func:`~cmsim.discrepancy.columns.chi2_rows`). A baseline whose halves or records differ
+    by more than a record may before it departs (χ² per feature over
     :data:`~cmsim.discrepancy.judge.NONE_CHI2_PER_FEATURE`, or a feature
-    :data:`~cmsim.discrepancy.judge.ALARM_Z` σ off) is not stationary: healthy records of
-    this machine may read as departures.
+    :data:`~cmsim.discrepancy.judge.ALARM_Z` σ off) is not stationary, or not one healthy
+    machine: healthy records may read as departures, and a fault one of its records holds as
+    none (the halves interleave every record's segments, so they alone cannot see a faulty
+    record among healthy ones).
 
     Parameters
     ----------
@@ -105,18 +109,37 @@ def baseline_consistency(machine):
     Returns
     -------
     dict
-        ``chi2_per_feature``, ``worst_feature``, ``worst_z``, ``n_features``, ``departs``.
+        ``chi2_per_feature``, ``worst_feature``, ``worst_z``, ``n_features``, ``departs``
+        (of the halves); ``records``: per baseline record (several only) ``record``,
+        ``chi2_per_feature``, ``worst_feature``, ``worst_z``, ``departs``, against the others.
     """
     lib = machine.library
-    segs = machine.baseline.segments(lib.segment_s)
     rig_freqs = rig_frequencies(machine.rig, machine.op)
-    names, rows = feature_rows(segs, machine.fs_hz, rig_freqs,
-                               list(machine.rig.bearing_names), machine.unit_scale)
+    per_record = [feature_rows(Baseline((r,), machine.baseline.fs_hz).segments(lib.segment_s),
+                               machine.fs_hz, rig_freqs, list(machine.rig.bearing_names),
+                               machine.unit_scale) for r in machine.baseline.records]
+    names = per_record[0][0]
+    rows = np.vstack([r for _, r in per_record])
     even, odd = rows[0::2], rows[1::2]
     li, ri, cnames = compared_columns(names, lib, even, odd)
+    out = _judged(odd[:, ri], even[:, ri], lib, li, cnames)
+    out["records"] = []
+    if len(per_record) > 1:
+        labels = list(machine.calibrated_on) + [f"record {k + 1}" for k in
+                                                range(len(per_record))]
+        for k, (_, own) in enumerate(per_record):
+            others = np.vstack([r for j, (_, r) in enumerate(per_record) if j != k])
+            got = _judged(own[:, ri], others[:, ri], lib, li, cnames)
+            out["records"].append({"record": labels[k], **got})
+    return out
+
+
+def _judged(a_rows, b_rows, lib, li, cnames):
+    """The mean of some baseline segments against the mean of others, as a record is
+    judged against its machine: χ² per feature, the worst feature's z, whether it departs."""
     with np.errstate(all="ignore"):
-        a, b = np.nanmean(odd[:, ri], axis=0), np.nanmean(even[:, ri], axis=0)
-    sigma = feature_sigma(lib, li, cnames, odd.shape[0])
+        a, b = np.nanmean(a_rows, axis=0), np.nanmean(b_rows, axis=0)
+    sigma = feature_sigma(lib, li, cnames, a_rows.shape[0])
     chi = float(chi2_rows(a, b[None, :], sigma, cnames)[0][0])
     n_eff = float(sum(weight(k) for k in cnames))
     z = (a - b) / sigma

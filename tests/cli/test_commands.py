@@ -314,3 +314,22 @@ def test_simulate_warns_when_the_mesh_lies_above_the_nyquist(capsys):
     assert any("GMF 14000 Hz" in w and "--sensor-fs-hz 25000" in w for w in said), said
     assert main(argv + ["--speed-rpm", "1000"]) == 0
     assert "warnings" not in json.loads(capsys.readouterr().out)
+
+
+def test_an_interrupted_dataset_says_what_it_kept(monkeypatch, tmp_path, capsys):
+    """Ctrl-C on `dataset` before any record is finished says that nothing was kept (it
+    named a folder that did not exist); the words count a folder's finished records from its
+    manifest rows."""
+    import cmsim.datasets as datasets
+    from cmsim.cli.dataset import interrupted_words
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(datasets, "generate_dataset", interrupted)
+    spec = Path(__file__).resolve().parents[2] / "datasets" / "ci.toml"
+    status = main(["dataset", str(spec), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert status == 130 and "no records were finished yet" in err, err
+    assert not (tmp_path / "out").exists()
+    assert "no runs were finished" in interrupted_words(tmp_path, "runs")

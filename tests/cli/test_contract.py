@@ -130,6 +130,8 @@ CATALOGUE = [
     R("simulate-rig-unknown-key", "simulate --speed-rpm 1000 --rig {rig_unknown}", "--rig",
       "modul_m"),
     R("simulate-out-directory", "simulate --speed-rpm 1000 --out {work}", "--out"),
+    R("simulate-out-not-npz", "simulate --speed-rpm 1000 --duration-s 0.01 --out {work}/r.txt",
+      "--out", ".npz"),
     R("simulate-out-no-parent", "simulate --speed-rpm 1000 --out {work}/no/run.npz", "--out"),
     R("simulate-mesh-choice", "simulate --speed-rpm 1000 --mesh bogus", "--mesh"),
     R("simulate-mesh-and-table", "simulate --speed-rpm 1000 --mesh potential-energy "
@@ -500,6 +502,7 @@ CATALOGUE = [
     R("calibrate-wav-header-rate", "calibrate {rec_wav_rate} --out {work}/m.toml",
       "BASELINE", "48000 Hz"),
     R("spectrum-record-truncated", "spectrum {rec_truncated}", "RECORD", "truncated"),
+    R("compare-text-renamed-npz", "compare {rec_text_npz}", "RECORD", "not an .npz (zip)"),
     R("spectrum-metadata-fs-text", "spectrum {rec_fs_text}", "RECORD", "fs_hz", "'12k'",
       numeric=True),
     R("spectrum-channel-2d", "spectrum {rec_2d}", "RECORD", "'DE'", "1-D"),
@@ -882,6 +885,7 @@ def _bad_recordings(d):
     with_nan = x.copy()
     with_nan[[100, 9000, 20000]] = np.nan
     f = {"rec_truncated": _measured_folder(d / "truncated", raw[: len(raw) // 2]),
+         "rec_text_npz": _measured_folder(d / "text_npz", b"time,acc\n0,1\n"),
          "rec_fs_text": _measured_folder(d / "fs_text", {"DE": x}, entry={"fs_hz": "12k"}),
          "rec_2d": _measured_folder(d / "two_d", {"DE": np.stack([x, x], 1), "FE": x}),
          "rec_zero": _measured_folder(d / "zero", {"DE": np.zeros_like(x)}),

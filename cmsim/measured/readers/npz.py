@@ -9,11 +9,13 @@ is never a channel."""
 from __future__ import annotations
 
 import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from cmsim._io import atomic_savez
+from cmsim.errors import ParameterError
 from cmsim.measured.readers._common import SignalFile, channel_1d, one_rate
 
 __all__ = ["npz_names"]   # read and write: through READERS and WRITERS
@@ -30,6 +32,10 @@ _RATE_NAMES = ("fs_hz", "fs", "sample_rate", "samplerate", "sampling_rate")
 
 def read(path, names=None):
     """Channels of an ``.npz`` file and what it states (module docstring)."""
+    if not zipfile.is_zipfile(path):            # numpy would read it as a pickle, and say so
+        raise ParameterError(f"record {path}: is not an .npz (zip) archive: not a file "
+                             "numpy.savez wrote, or one truncated or damaged", param="record",
+                             allowed="an .npz archive")
     with np.load(path, allow_pickle=False) as z:
         arrays = {k: z[k] for k in z.files}
     one_value = {k for k, a in arrays.items() if a.size == 1 and a.ndim <= 1}

@@ -151,6 +151,31 @@ def test_a_baseline_whose_halves_differ_is_said_not_stationary(machine):
     assert c["departs"] and c["worst_feature"] == "level_db", c
 
 
+def test_a_faulty_record_among_the_baseline_s_is_said_where_the_halves_cannot_see_it(machine):
+    """baseline_consistency, a baseline of several records: each record against the others.
+    Two healthy realisations agree; a healthy one beside an inner-race record departs each
+    way, while the halves, which interleave both records' segments, see nothing (a faulty
+    baseline then reads the fault as none)."""
+    from dataclasses import replace
+
+    from cmsim.discrepancy.machine_checks import baseline_consistency
+    from cmsim.machine.baseline import Baseline
+
+    healthy = [hidden_effect_record(None, SEED, sim_seed=SEED + k).record.signal
+               for k in (21, 22)]
+    faulty = hidden_effect_record("bearing_inner_race", SEED).record.signal
+    both = baseline_consistency(replace(machine, baseline=Baseline(tuple(healthy),
+                                                                   machine.fs_hz)))
+    assert len(both["records"]) == 2
+    assert not both["departs"] and not any(r["departs"] for r in both["records"]), both
+    mixed = baseline_consistency(replace(machine, baseline=Baseline((healthy[0], faulty),
+                                                                    machine.fs_hz)))
+    assert not mixed["departs"], mixed
+    assert all(r["departs"] for r in mixed["records"]), mixed["records"]
+    assert min(r["chi2_per_feature"] for r in mixed["records"]) > 5 * max(
+        r["chi2_per_feature"] for r in both["records"]), (mixed["records"], both["records"])
+
+
 def test_a_file_that_documents_no_load_is_read_at_the_machine_s():
     """A recording whose metadata states no torque (the reader assumes 20 N m on a gear rig)
     is read at its machine's load, and says so; a documented load (torque, load_percent,
