@@ -438,10 +438,18 @@ def _against_machine(record, machine, *, budget, seed, max_segments, causes, wor
                 "machine": machine.name},
         mode="machine", ranges={k: [float(a), float(b)] for k, (a, b) in ranges.items()},
         near_ties=near_ties, departures=departures if finding == "unexplained" else [],
-        not_judged=[], words=describe(finding, component, params, ranges, against="baseline")
+        not_judged=[], words=describe(finding, component, params,
+                                         {} if _a_trend(top) else ranges, against="baseline")
         + (_variant_words(top["variant"]) if top else ""),
         nuisances={"variant": top["variant"]} if top else {}, notes=res["notes"],
         decided_on=res["decided_on"], spectra=spectra)
+
+
+def _a_trend(top):
+    """Whether the named cause's size is read on a variant whose change is scaled off the
+    calibrated path's gain (``path x…``): its size is then a trend, and the range the
+    library's grid gives around it no measure of the size (it was printed as one)."""
+    return top is not None and "; path x" in top["variant"]
 
 
 def _variant_words(variant):

@@ -46,3 +46,21 @@ def test_the_compare_report_shows_no_json_and_no_none(tmp_path, capsys):
     text = re.sub(r'src="data:[^"]*"', "", page)
     assert not re.search(r'\{&quot;|\{"', text), "raw JSON in the report"
     assert ">None<" not in text and "(None)" not in text
+
+
+def test_a_size_read_as_a_trend_carries_no_range():
+    """A cause named on a library variant whose change is scaled off the calibrated path's
+    gain: its size is a trend, so the words give no range around it (CWRU's 0.18-mm inner
+    race read "about 2.5 mm (2.5-3 mm) ... read its size as a trend"); on the path's own
+    gain they do."""
+    from cmsim.discrepancy.compare import _a_trend, _variant_words, describe
+
+    params, ranges = {"size_m": 2.5e-3}, {"size_m": (2.5e-3, 3e-3)}
+    top = {"variant": "5 um preload; path x0.3"}
+    words = describe("bearing_inner_race", "drive_end", params,
+                     {} if _a_trend(top) else ranges, against="baseline")
+    words += _variant_words(top["variant"])
+    assert "2.5-3 mm" not in words and "read its size as a trend" in words, words
+    assert not _a_trend({"variant": "5 um preload"})
+    assert "2.5-3 mm" in describe("bearing_inner_race", "drive_end", params, ranges,
+                                  against="baseline")
