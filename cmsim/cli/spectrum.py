@@ -132,6 +132,8 @@ def text(res):
     families = (", ".join(f"{k} {v / fr:.3f}" for k, v in res["families"].items()) + " orders"
                 if order else ", ".join(f"{k} {v:.3f} Hz" for k, v in res["families"].items()))
     named = (f"families of bearing {res['bearing']}: " if res["bearing"] is not None
+             else "bearings undocumented, peaks named by the gears and shafts only: "
+             if "GMF" in res["families"]
              else "no geometry, peaks named by the shaft rate only: ")
     lines = [f"{res['kind']} spectrum of {res['signal']} [{res['unit']}], resolution "
              + (f"{res['resolution_hz'] / fr:.4g} orders (angle from the "

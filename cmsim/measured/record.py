@@ -612,6 +612,9 @@ def read_run(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, unit=N
         run.rig, run.operating_point  # noqa: B018 - parse the meta now: a bad one is bad input
         return run, (None if "t" in npz_names(p) else sorted(run.signals)[0])
     rec = read_record(p, channel=channel, trust_metadata=trust_metadata, model=False, **stated)
+    if rec.rig is not None and rec.frequencies is not None and not rec.frequencies.bearings:
+        # the model rig's bearings are an assumption (the paper rig's): nothing to name by
+        rec.run.meta["bearings_documented"] = False
     return rec.run, rec.channel
 
 

@@ -49,6 +49,11 @@ def signal_bearing(name, bearing_names):
     return bearing_names[0]
 
 
+#: Families of a bearing (left out where a measured record documents no bearing: the model
+#: rig's are then an assumption, :func:`cmsim.measured.read_run`).
+BEARING_FAMILIES = ("BPF", "BPFO", "BPFI", "BSF", "FTF")
+
+
 def run_families(run, bearing=None):
     """``(RigFrequencies, families dict)`` of a run from its metadata.
 
@@ -201,6 +206,8 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
             raise ParameterError(f"bearing must be one of {list(bearing_names)}, got "
                                  f"{bearing!r}")
         fam = freqs.families(brg)
+        if run.meta.get("bearings_documented") is False:     # an assumed bearing names nothing
+            brg, fam = None, {k: v for k, v in fam.items() if k not in BEARING_FAMILIES}
     rel = (float(run.meta.get("line_tolerance") or 0.0) if relative_tolerance is None
            else relative_tolerance)
     x = np.asarray(run[signal], dtype=float)

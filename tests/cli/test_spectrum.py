@@ -139,6 +139,23 @@ def test_measured_recording(capsys):
     assert any(abs(p["frequency_hz"] - bpfi) < 1.0 for p in res["peaks"]), res["peaks"]
 
 
+@pytest.mark.skipif(not (__import__("cmsim.measured", fromlist=["data_root"]).data_root()
+                         / "spectraquest_gearbox_gfd").is_dir(), reason="shared data absent")
+def test_a_gearbox_with_undocumented_bearings_names_no_bearing_family(capsys):
+    """SpectraQuest's metadata documents the teeth and no bearing: the model rig's bearings
+    are the paper rig's, an assumption, so no peak is named after them (three mesh
+    sidebands read "4GMF-1BPF" from the paper's 209 bearing); the gear and shaft families
+    stay."""
+    from cmsim.measured import data_root
+    path = data_root() / "spectraquest_gearbox_gfd" / "h30hz0.npz"
+    status, res = cli_json(capsys, ["spectrum", str(path), "--top", "12"])
+    assert status == 0, res
+    assert res["bearing"] is None and set(res["families"]) == {"GMF", "fr"}, res["families"]
+    assert not any("BP" in p["label"] or "BSF" in p["label"] or "FTF" in p["label"]
+                   for p in res["peaks"]), res["peaks"]
+    assert any(p["label"] == "4GMF" for p in res["peaks"]), res["peaks"]
+
+
 def test_order_spectrum_of_a_run_up_follows_its_tacho(capsys, tmp_path):
     """A run-up's mesh stays at order 28 (the 28-tooth pinion) when the angle comes from the
     run's tacho; at the nominal speed it would smear over 1.5x the orders."""
