@@ -30,6 +30,15 @@ def check_machine(record, machine, workers=1):
     its own kept baseline resampled to the record's rate (:func:`machine_at_rate`). Either is
     said in the notes.
 
+    Parameters
+    ----------
+    record : MeasuredRecord
+        The record compared.
+    machine : cmsim.machine.Machine
+        Its machine.
+    workers : int
+        Processes that build the library of a machine calibrated again.
+
     Returns
     -------
     (MeasuredRecord, Machine, list of str)

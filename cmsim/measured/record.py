@@ -38,6 +38,7 @@ from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
                                    agreed_unit, speed_uncertainty)
 from cmsim.rig import OperatingPoint, Rig
 from cmsim.run import Run
+from cmsim.sensors import decimate
 
 __all__ = ["MeasuredRecord", "read_record", "read_run", "record_from_run", "MIN_SAMPLES"]
 
@@ -176,8 +177,6 @@ class MeasuredRecord:
             Its first sample at the filter's half length into the record; the meta says
             from which rate it was resampled (``resampled_from_hz``).
         """
-        from cmsim.sensors import decimate
-
         names = list(self.run.signals)
         y, _, info = decimate(np.column_stack([np.asarray(self.run[k], dtype=float)
                                                for k in names]), self.fs_hz, fs_out_hz)
