@@ -53,6 +53,7 @@ from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, fea
                                          path_free, weight)
 from cmsim.discrepancy.at_rate import check_machine
 from cmsim.discrepancy.judge import judge
+from cmsim.discrepancy.signatures import parse_variant
 from cmsim.discrepancy.ranking import (REFINE_TOP, Nuisances, decide, evidence, fit, rank,
                                        refine)
 from cmsim.errors import ParameterError
@@ -449,7 +450,7 @@ def _a_trend(top):
     """Whether the named cause's size is read on a variant whose change is scaled off the
     calibrated path's gain (``path x…``): its size is then a trend, and the range the
     library's grid gives around it no measure of the size (it was printed as one)."""
-    return top is not None and "; path x" in top["variant"]
+    return top is not None and parse_variant(top["variant"])[1] != 1.0
 
 
 def _variant_words(variant):
@@ -457,16 +458,16 @@ def _variant_words(variant):
     contact, its change 3 times the calibrated path's gain: the size is a trend)"``."""
     if variant == "documented":
         return ""
-    base, _, gain = variant.partition("; path x")
+    base, gain = parse_variant(variant)
     if base.startswith("modulation x"):
         return (f" (the load it swings modulating {base[len('modulation x'):]} times its "
                 "share: its size read on its line)")
     parts = [] if base == "documented" else [f"its model in {base.replace('um', 'µm')}"
                                               if base == "line contact"
                                               else f"its model with a {base.replace('um', 'µm')}"]
-    if gain:
-        parts.append(f"its change {gain} times the calibrated path's gain: read its size as a "
-                     "trend")
+    if gain != 1.0:
+        parts.append(f"its change {gain:g} times the calibrated path's gain: read its size as "
+                     "a trend")
     return " (" + ", ".join(parts) + ")"
 
 

@@ -74,6 +74,7 @@ from cmsim.machine.library import SignatureEntry, SignatureLibrary
 from cmsim.run import signal_info
 
 __all__ = ["BAND_FAMILIES", "build_library", "value_grid", "predicted_rows", "change_of",
+           "parse_variant",
            "simulate_entry", "operating_shift",
            "N_SIZES", "LIBRARY_SEGMENTS", "REALISATIONS", "BEARING_VARIANTS", "GRIDS", "DENSER",
            "PATH_GAINS", "SHAFT_MODULATIONS"]
@@ -330,8 +331,9 @@ def _variant_label(label, gain):
     return label if gain == 1.0 else f"{label}; path x{gain:g}"
 
 
-def _parse_variant(label):
-    """(variant label, path gain) of :func:`_variant_label` output."""
+def parse_variant(label):
+    """(variant label, path gain) of a library entry's variant (:func:`_variant_label`'s
+    output): ``"documented; path x0.3"`` → ``("documented", 0.3)``."""
     if "; path x" in label:
         base, g = label.split("; path x")
         return base, float(g)
@@ -511,7 +513,7 @@ def simulate_entry(machine, library, cause, component, variant, value, *, thread
     segs = machine.baseline.segments(library.segment_s, library.segments)
     lib = _Library(machine, segs, library.seed)
     nominal = ModelSetup(rig=machine.rig, op=machine.op, machine=machine)
-    label, gain = _parse_variant(variant)
+    label, gain = parse_variant(variant)
     healthy = dict(_variants(cause, nominal)).get(label)
     if healthy is None:
         return None
