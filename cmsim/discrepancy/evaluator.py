@@ -17,7 +17,6 @@ import math
 import warnings
 from concurrent.futures import CancelledError
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import replace
 
 import numpy as np
 
@@ -179,9 +178,8 @@ def sensor_signal(force, edge, n, fs_hz, housing, noise_ratio, noise_ref_rms, se
     -------
     ndarray
     """
-    x = _through_path(force, edge, n, fs_hz, housing)
-    return x + _noise(x, _noise_draw(x.size, fs_hz, seed, floor), noise_ratio, noise_ref_rms,
-                      floor)
+    return _noisy(_through_path(force, edge, n, fs_hz, housing), fs_hz, seed, noise_ratio,
+                  noise_ref_rms, floor)
 
 
 def _through_path(force, edge, n, fs_hz, housing):
@@ -205,6 +203,12 @@ def _noise(x, draw, noise_ratio, noise_ref_rms, floor=None):
     return noise_ratio * ref * draw
 
 
+def _noisy(x, fs_hz, seed, noise_ratio, noise_ref_rms, floor=None):
+    """``x`` with the sensor noise of :func:`sensor_signal` drawn from ``seed``."""
+    return x + _noise(x, _noise_draw(x.size, fs_hz, seed, floor), noise_ratio, noise_ref_rms,
+                      floor)
+
+
 def _path_chain(setup, force, edge, n, fs, seed, bearing="1b1"):
     """The housing's acceleration of a simulated force (on ``bearing``) with ``setup``'s
     shaft forces (at the rate of that bearing's shaft), before the sensor noise."""
@@ -219,9 +223,8 @@ def _path_chain(setup, force, edge, n, fs, seed, bearing="1b1"):
 def _chain(setup, force, edge, n, fs, seed, noise_ref_rms, floor=None, bearing="1b1"):
     """The sensor signal of a simulated force (on ``bearing``) through ``setup``'s shaft
     forces (at the rate of that bearing's shaft) and chain."""
-    x = _path_chain(setup, force, edge, n, fs, seed, bearing)
-    return x + _noise(x, _noise_draw(x.size, fs, seed, floor), setup.noise_ratio,
-                      noise_ref_rms, floor)
+    return _noisy(_path_chain(setup, force, edge, n, fs, seed, bearing), fs, seed,
+                  setup.noise_ratio, noise_ref_rms, floor)
 
 
 def simulate_setup(setup, fs_hz, duration_s, model_signal, seed, noise_ref_rms=None):
@@ -435,7 +438,7 @@ class Evaluator:
                                                       None, seed)))
         # the noise ratio, the nuisance refitted most, scales a noise drawn once per seed
         # over a path signal made once per run and path (bit for bit _chain's samples)
-        key = (setup.dynamics_key(), replace(setup, noise_ratio=1.0).chain_key(), seed)
+        key = (setup.dynamics_key(), setup.path_key(), seed)
         x = self._paths.get(key)
         if x is None:
             x = _path_chain(setup, *run, self.fs, seed, bearing=self.sensor_bearing)

@@ -102,6 +102,11 @@ class ModelSetup:
         """What the sensor signal depends on besides the dynamics (:data:`CHAIN_FIELDS`)."""
         return tuple(getattr(self, name) for name in CHAIN_FIELDS)
 
+    def path_key(self):
+        """What the signal before its sensor noise depends on besides the dynamics: the
+        chain less the noise ratio, which only scales the noise."""
+        return tuple(getattr(self, name) for name in CHAIN_FIELDS if name != "noise_ratio")
+
 
 #: Fields of :class:`ModelSetup` that shape the sensor signal after the dynamics (the
 #: measurement chain, the machine's background and path, the shaft forces laid on the force):
