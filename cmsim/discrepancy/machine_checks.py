@@ -125,12 +125,12 @@ def baseline_consistency(machine):
     out = _judged(odd[:, ri], even[:, ri], lib, li, cnames)
     out["records"] = []
     if len(per_record) > 1:
-        labels = list(machine.calibrated_on) + [f"record {k + 1}" for k in
-                                                range(len(per_record))]
+        named = machine.calibrated_on
         for k, (_, own) in enumerate(per_record):
             others = np.vstack([r for j, (_, r) in enumerate(per_record) if j != k])
             got = _judged(own[:, ri], others[:, ri], lib, li, cnames)
-            out["records"].append({"record": labels[k], **got})
+            out["records"].append({"record": named[k] if k < len(named) else f"record {k + 1}",
+                                   **got})
     return out
 
 
