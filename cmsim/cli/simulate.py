@@ -78,12 +78,13 @@ def _speed_profile(args):
                     unit="s (the ramp starts before the record ends: warmup_s + duration_s)"
                     ).check("ramp_start_s", args.ramp_start_s or 0.0)
     ramp_s = args.ramp_s if args.ramp_s is not None else max(end_s - start_s, 1e-3)
+    profile = SpeedProfile.ramp(args.speed_rpm, args.ramp_to_rpm, ramp_s, start_s=start_s)
     if start_s + ramp_s > end_s * (1 + 1e-9):
-        reached = args.speed_rpm + (args.ramp_to_rpm - args.speed_rpm) * (end_s - start_s) / ramp_s
         args.warn(f"--ramp-s {ramp_s:g}: the ramp ends {start_s + ramp_s:g} s after the warm-up "
-                  f"starts, the record at {end_s:g} s: it reaches {reached:.0f} rpm, not "
-                  f"--ramp-to-rpm {args.ramp_to_rpm:g}")
-    return SpeedProfile.ramp(args.speed_rpm, args.ramp_to_rpm, ramp_s, start_s=start_s)
+                  f"starts, the record at {end_s:g} s: it reaches "
+                  f"{profile.speed_rpm_at(end_s):.0f} rpm, not --ramp-to-rpm "
+                  f"{args.ramp_to_rpm:g}")
+    return profile
 
 
 def _warn_nyquist(args, rig, op):

@@ -333,3 +333,18 @@ def test_an_interrupted_dataset_says_what_it_kept(monkeypatch, tmp_path, capsys)
     assert status == 130 and "no records were finished yet" in err, err
     assert not (tmp_path / "out").exists()
     assert "no runs were finished" in interrupted_words(tmp_path, "runs")
+
+
+def test_a_ramp_longer_than_the_record_warns_with_the_speed_it_reaches(capsys):
+    """--ramp-s beyond the record: the run is made, and a warning gives the speed the record
+    reaches (the profile's own, 1020 rpm of 1000 → 2000 over 5 s at 0.1 s); a ramp that ends
+    inside the record warns nothing."""
+    status = main(["simulate", "--speed-rpm", "1000", "--duration-s", "0.05", "--ramp-to-rpm",
+                   "2000", "--ramp-s", "5", "--json"])
+    res = json.loads(capsys.readouterr().out)
+    assert status == 0
+    assert any("reaches 1020 rpm" in w for w in res["warnings"]), res["warnings"]
+    status = main(["simulate", "--speed-rpm", "1000", "--duration-s", "0.05", "--ramp-to-rpm",
+                   "2000", "--json"])
+    res = json.loads(capsys.readouterr().out)
+    assert status == 0 and not any("--ramp-s" in w for w in res.get("warnings", [])), res
