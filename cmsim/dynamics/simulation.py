@@ -33,6 +33,7 @@ from cmsim.losses import LossSettings, power_balance, run_losses
 from cmsim.mesh_stiffness.table import MeshStiffnessTable
 from cmsim.progress import stage
 from cmsim.rig import RANGES, SAMPLING
+from cmsim.rig.plausibility import load_warnings
 from cmsim.run import Run
 
 __all__ = ["simulate", "integrate", "check_memory", "kernels_cached", "compile_kernels",
@@ -365,6 +366,11 @@ class RunSetup:
         op = self.op
         loads = (f"torque_nm = {op.torque_nm:g} N m" if self.rig.gears is not None
                  else f"radial_load_n = {op.radial_load_n:g} N")
+        beyond = load_warnings(self.rig, op)
+        if beyond:                                 # a smaller step would not help
+            return IntegrationDiverged(f"no static equilibrium at {loads}, and the run from "
+                                       f"the nominal geometry diverged: the rig cannot carry "
+                                       f"it ({beyond[0]})")
         return IntegrationDiverged(f"no static equilibrium at {loads} (the rig may not carry "
                                    f"it), and the run from the nominal geometry diverged: "
                                    f"{exc}")

@@ -571,7 +571,8 @@ CATALOGUE = [
       "--out {work}/s", "--torque-nm", "gear centres", "<= about", numeric=True,
       needs_model=True),
     R("simulate-torque-at-max-diverges", "simulate --speed-rpm 1000 --torque-nm 1e6 "
-      "--duration-s 0.01", "--torque-nm", "no static equilibrium", "diverged", status=3),
+      "--duration-s 0.01", "--torque-nm", "no static equilibrium", "diverged", "cannot carry",
+      "contact stress", status=3),
     R("simulate-sensor-fs-not-a-fraction", "simulate --speed-rpm 1000 --sensor-fs-hz 1234.567 "
       "--duration-s 0.01", "--sensor-fs-hz = 1234.57 Hz", "--fs-hz = 75000 Hz"),
     R("simulate-ramp-starts-after-record", "simulate --speed-rpm 1000 --ramp-to-rpm 2000 "
