@@ -23,17 +23,28 @@ Families
     BPFI        BPFI       —          fr         1..10
     BSF         BSF        —          FTF        1..10
     FTF         FTF        —          —          1..3
+    shaft       fr         —          —          1..10 (beyond the gear template's ±n)
     ==========  =========  =========  =========  ===================================
 
     |m|, |n| <= ``max_sideband``; a template is used when its carrier is in ``families``
     (the gear template also without GMF, with k = 0). The *family* of a label is the base of
     its leading term (``"GMF"``, ``"BPF"``, ``"fr"``, ``"BPFO"``, ...).
 
+Speed and slip
+    A measured record's speed is known to a relative ``relative_tolerance`` and its balls
+    slip by up to ``slip_tolerance``. One speed moves every line by one factor: it is read
+    first, from the peaks on the shaft and mesh lines (:func:`_speed_scale`), and each
+    slipping family's own factor from its fundamental and harmonics; the lattice is built on
+    the bases so read. A base not read keeps its uncertainty as a window proportional to
+    the frequency of its terms.
+
 Labelling rule
     A peak takes the candidate within ``tolerance_hz`` (default: one bin) of its frequency
-    with the smallest |k| + |m| + |n|; ties go to fewer terms (non-zero indices: "3BPFO"
-    before "2BPFO+1fr" if both fit), then to the smaller frequency error, then to the template order above (so a line at BPF = BPFO
-    reads "1BPF"). Labels write every term with its integer,
+    (or within the window of its bases not read) with the smallest |k| + |m| + |n|, a
+    candidate within the bin before one only a window reaches; ties go to fewer terms
+    (non-zero indices: "3BPFO" before "2BPFO+1fr" if both fit), then to the smaller
+    frequency error, then to the template order above (so a line at BPF = BPFO reads
+    "1BPF"). Labels write every term with its integer,
     positive terms first: "1GMF", "2GMF+1BPF", "3GMF-1BPF-2fr", "1BPF", "1BPFO+1fr",
     "4fr-1BPF". Significant peaks without a candidate are kept as label "?" and family
     "unlabelled".
@@ -104,6 +115,7 @@ TEMPLATES = (
     FamilyTemplate("BPFI", None, "fr"),
     FamilyTemplate("BSF", None, "FTF"),
     FamilyTemplate("FTF", max_harmonic=3),
+    FamilyTemplate("fr"),
 )
 
 
@@ -222,7 +234,8 @@ def _label(k, m, n, tpl):
 
 def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, max_sideband=3,
                 threshold_db=15.0, floor_bins=None, dynamic_range_db=80.0, min_freq=0.0,
-                max_peaks=None, templates=TEMPLATES, relative_tolerance=0.0):
+                max_peaks=None, templates=TEMPLATES, relative_tolerance=0.0,
+                slip_tolerance=0.0):
     """Find the significant peaks of a spectrum and name them (see the module docstring).
 
     Parameters
@@ -247,17 +260,25 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     templates : tuple of FamilyTemplate
         Lattices to try, in tie-break order.
     relative_tolerance : float
-        Added to ``tolerance_hz`` in proportion to each candidate's frequency (>= 0): the
-        uncertainty of the speed every family scales with (a nominal speed's 3 % moves a
-        line at f by up to 0.03·f).
+        Uncertainty of the speed every family scales with (0-0.5; a nominal speed's 3 %
+        moves a line at f by up to 0.03·f). One speed moves every line by the same factor:
+        the labeller first finds the factor within it that puts the most peaks on the
+        lattice (:func:`_speed_scale`), then names each peak on the lattice scaled by it
+        within ``tolerance_hz`` (a window of 0.03·f at every line would let a high mesh
+        harmonic's sideband take its neighbour's label).
+    slip_tolerance : float
+        Relative tolerance of the bearing terms of a label (BPF, BPFO, BPFI, BSF, FTF: their
+        balls slip, the shafts' lines do not), >= 0.
 
     Returns
     -------
     pandas.DataFrame
         One row per significant peak, increasing frequency, columns ``frequency_hz``,
         ``amplitude``, ``db_re_carrier``, ``db_re_max``, ``snr_db``, ``label``, ``family``,
-        ``k``, ``m``, ``n`` (ints; 0 when unlabelled), ``expected_hz`` and ``error_hz`` (NaN
-        when unlabelled). ``df.attrs`` holds ``families`` and ``tolerance_hz``.
+        ``k``, ``m``, ``n`` (ints; 0 when unlabelled), ``expected_hz`` (on the scaled
+        lattice) and ``error_hz`` (NaN when unlabelled). ``df.attrs`` holds ``families``,
+        ``tolerance_hz``, the tolerances and ``speed_scale`` (the factor found, 1 without a
+        relative tolerance).
     """
     freq, amp = spectrum_arrays(freq, amp, min_samples=4)
     fam = _check_families(families)
@@ -268,32 +289,56 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
         max_harmonic = positive_int("max_harmonic", max_harmonic, lo=1, hi=1000)
     msb = positive_int("max_sideband", max_sideband, lo=0, hi=20)
     rel = check_range("relative_tolerance", relative_tolerance, 0.0, 0.5)
+    slip = check_range("slip_tolerance", slip_tolerance, 0.0, 0.5)
     peaks = find_peaks(freq, amp, threshold_db=threshold_db, floor_bins=floor_bins,
                        dynamic_range_db=dynamic_range_db, min_freq=min_freq,
                        max_peaks=max_peaks)
-    cand = _candidates(fam, float(freq[-1]) + tol, max_harmonic, msb, templates)
+    f_pk, a_pk = peaks["frequency_hz"].to_numpy(), peaks["amplitude"].to_numpy()
+    f_top = (float(freq[-1]) + tol) * (1.0 + rel + slip)
+    scale, spread, pinned = 1.0, 0.0, set()
+    if rel > 0.0:
+        cand = _candidates(fam, f_top, max_harmonic, msb, templates)
+        scale = _speed_scale(f_pk, a_pk, cand[:, 0],
+                             tol + slip * _part(cand, fam, templates, SLIPPING), rel)
+        if scale is None:             # too few shaft or mesh lines to read the speed from:
+            scale, spread = 1.0, rel  # each line keeps the whole uncertainty
+    fam = {b: scale * v for b, v in fam.items()}
+    for b in sorted(SLIPPING & fam.keys()) if slip + spread > 0.0 else ():
+        # a slipping family's own factor, read from its fundamental and its harmonics
+        ks = np.arange(1.0, FAMILY_HARMONICS + 1.0)
+        own = _speed_scale(f_pk, a_pk, fam[b] * ks, np.full(ks.size, tol), slip + spread,
+                           proposers=ks == 1.0)
+        if own is not None:
+            fam[b] *= own
+            pinned.add(b)
+    cand = _candidates(fam, f_top, max_harmonic, msb, templates)
     cf, ck, cm, cn, ct = cand.T
     complexity = np.abs(ck) + np.abs(cm) + np.abs(cn)
     n_terms = (ck != 0).astype(int) + (cm != 0).astype(int) + (cn != 0).astype(int)
+    loose = {b: slip * (b in SLIPPING) + spread for b in fam if b not in pinned}
+    window = tol + _part(cand, fam, templates, loose)
     a_max = float(peaks["amplitude"].max()) if len(peaks) else 1.0
     carrier_window = max(tol, 1.5 * df_bin)
 
     rows = []
     for f_pk, a_pk in zip(peaks["frequency_hz"], peaks["amplitude"]):
         err = np.abs(cf - f_pk)
-        hit = np.flatnonzero(err <= tol + rel * cf)
+        hit = np.flatnonzero(err <= window)
         db_max = 20.0 * math.log10(a_pk / a_max) if a_pk > 0 else -math.inf
         if hit.size == 0:
             rows.append(("?", "unlabelled", 0, 0, 0, math.nan, math.nan, db_max))
             continue
-        order = np.lexsort((ct[hit], err[hit], n_terms[hit], complexity[hit]))
+        # a line on its point within the bin beats one a slip or speed window reaches
+        order = np.lexsort((ct[hit], err[hit], n_terms[hit], complexity[hit],
+                            err[hit] > tol))
         j = hit[order[0]]
         tpl = templates[int(ct[j])]
         k, m, n = int(ck[j]), int(cm[j]), int(cn[j])
         text, family = _label(k, m, n, tpl)
         db_car = db_max
         if k != 0:
-            near = np.abs(freq - k * fam[tpl.carrier]) <= carrier_window
+            fc = k * fam[tpl.carrier]
+            near = np.abs(freq - fc) <= carrier_window + loose.get(tpl.carrier, 0.0) * fc
             a_car = float(amp[near].max()) if np.any(near) else 0.0
             db_car = 20.0 * math.log10(a_pk / a_car) if a_car > 0 and a_pk > 0 else math.nan
         rows.append((text, family, k, m, n, float(cf[j]), float(f_pk - cf[j]), db_car))
@@ -309,8 +354,84 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     with np.errstate(divide="ignore"):
         out["db_re_max"] = 20.0 * np.log10(out["amplitude"].to_numpy() / a_max)
     out = out[_COLUMNS].reset_index(drop=True)
-    out.attrs = {"families": dict(fam), "tolerance_hz": tol, "relative_tolerance": rel}
+    out.attrs = {"families": dict(fam), "tolerance_hz": tol, "relative_tolerance": rel,
+                 "slip_tolerance": slip, "speed_scale": scale,
+                 "families_read": sorted(pinned)}
     return out
+
+
+#: Bases of a label whose lines slip with the balls (the rest are shaft and mesh lines).
+SLIPPING = frozenset(("BPF", "BPFO", "BPFI", "BSF", "FTF"))
+
+#: Strongest peaks whose candidates propose a speed factor to :func:`_speed_scale`.
+SCALE_TRIAL_PEAKS = 8
+
+#: Least number of peaks on shaft and mesh lines a speed factor is read from.
+MIN_SCALE_LINES = 2
+
+#: Harmonics of a slipping family its own factor is read on (the fundamental proposes).
+FAMILY_HARMONICS = 10
+
+
+def _part(cand, families, templates, weights):
+    """Σ weight × |frequency| of each candidate's terms whose base has a weight (a dict, or
+    a set: weight 1), Hz."""
+    weights = dict.fromkeys(weights, 1.0) if not isinstance(weights, dict) else weights
+    _, k, m, n, t = cand.T
+    out = np.zeros(k.size)
+    for it, tpl in enumerate(templates):
+        sel = t == it
+        for count, base in ((k, tpl.carrier), (m, tpl.m_base), (n, tpl.n_base)):
+            if base in weights and base in families:
+                out[sel] += weights[base] * np.abs(count[sel]) * families[base]
+    return out
+
+
+def _speed_scale(f_pk, a_pk, cf, window, rel, proposers=None):
+    """The factor within 1 ± ``rel`` that puts the most peaks on the shaft and mesh lines of
+    the lattice ``cf`` (windows ``window``), refined on them; None if fewer than
+    :data:`MIN_SCALE_LINES` peaks sit on them at any factor. With ``proposers`` (a mask of
+    ``cf``) only those candidates propose (a family's fundamental, for its own factor).
+
+    Only the candidates with no slipping term (the narrowest windows) take part: a bearing
+    line's slip blurs the factor, and the bearing lattices are dense enough that a window of
+    their slip holds most peaks at any factor. Each of the :data:`SCALE_TRIAL_PEAKS`
+    strongest peaks near a shaft or mesh line proposes the factor that puts it exactly on
+    it; the proposal holding the most peaks (then the most amplitude, then nearest 1) wins.
+    A wrong factor that shifts a high harmonic's sideband onto its neighbour moves every
+    lower line off its candidate, so the count separates them. The winner is refined by
+    least squares over the pairs it holds (a proposal from a low line carries its
+    centroid's error up the lattice).
+    """
+    if f_pk.size == 0:
+        return None
+    exact = window <= np.min(window) * (1.0 + 1e-9)    # candidates with no slipping term
+    propose = exact if proposers is None else exact & proposers
+    near_any = (np.abs(f_pk[:, None] - cf[None, :]) <= (window + rel * cf)[None, :]) & propose
+    cf, window = cf[exact], window[exact]
+    near_any = near_any[:, exact]
+    strong = [p for p in np.argsort(a_pk)[::-1] if near_any[p].any()][:SCALE_TRIAL_PEAKS]
+    best, best_key = None, None
+    for p in strong:
+        for j in np.flatnonzero(near_any[p]):
+            s = f_pk[p] / cf[j]
+            if abs(s - 1.0) > rel:
+                continue
+            held, _ = _held(f_pk, cf * s, window)
+            key = (int(held.sum()), float(a_pk[held].sum()), -abs(s - 1.0))
+            if best_key is None or key > best_key:
+                best, best_key = s, key
+    if best is None or best_key[0] < MIN_SCALE_LINES:
+        return None
+    held, j = _held(f_pk, cf * best, window)
+    return float(np.sum(f_pk[held] * cf[j[held]]) / np.sum(cf[j[held]] ** 2))
+
+
+def _held(f_pk, cf, window):
+    """Which peaks lie within a candidate's window, and each peak's nearest candidate."""
+    err = np.abs(f_pk[:, None] - cf[None, :])
+    j = np.argmin(err, axis=1)
+    return np.any(err <= window[None, :], axis=1), j
 
 
 def labelled_peaks(x, fs, freqs, kind="amplitude", *, band_hz=None, speed_rpm=None,

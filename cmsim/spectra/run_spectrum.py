@@ -176,9 +176,11 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
     max_sideband : int
         Largest |m|, |n| of a label (0-20).
     relative_tolerance : float, optional
-        Relative tolerance of a label (:func:`~cmsim.spectra.labels.label_peaks`); default
-        the run's ``line_tolerance`` (a measured record's: its speed's uncertainty and the
-        bearings' slip), else 0 (a simulated run's lines stand where its speed puts them).
+        Uncertainty of the speed the labels scale with
+        (:func:`~cmsim.spectra.labels.label_peaks`); default the run's
+        ``speed_uncertainty`` (a measured record's), else 0 (a simulated run's lines stand
+        where its speed puts them). The bearing terms of a label also take the bearings'
+        slip, the rest of the run's ``line_tolerance``.
 
     Returns
     -------
@@ -208,8 +210,9 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         fam = freqs.families(brg)
         if run.meta.get("bearings_documented") is False:     # an assumed bearing names nothing
             brg, fam = None, {k: v for k, v in fam.items() if k not in BEARING_FAMILIES}
-    rel = (float(run.meta.get("line_tolerance") or 0.0) if relative_tolerance is None
-           else relative_tolerance)
+    speed = float(run.meta.get("speed_uncertainty") or 0.0)
+    slip = max(float(run.meta.get("line_tolerance") or 0.0) - speed, 0.0)
+    rel = speed if relative_tolerance is None else relative_tolerance
     x = np.asarray(run[signal], dtype=float)
     res = None if resolution_hz is None else check_range("resolution_hz", resolution_hz, 0.0,
                                                          lo_open=True, unit="Hz")
@@ -253,7 +256,7 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         scale = fr
         extra["n_revolutions"] = int(osp.n_revolutions)
     peaks = label_peaks(lab_f, a, lab_fam, threshold_db=threshold_db, max_sideband=max_sideband,
-                        relative_tolerance=rel)
+                        relative_tolerance=rel, slip_tolerance=slip)
     if kind == "order":
         peaks.insert(1, "order", peaks["frequency_hz"].to_numpy())
         peaks["frequency_hz"] = peaks["order"] * scale

@@ -202,3 +202,61 @@ def test_a_simple_label_slightly_off_beats_a_complex_exact_one():
     assert r["error_hz"] == pytest.approx(-1.0, abs=0.05)
     narrow = label_peaks(f, a, fam, tolerance_hz=0.5)
     assert (_row(narrow, "1GMF+3BPF")["k"], _row(narrow, "1GMF+3BPF")["m"]) == (1, 3)
+
+
+def test_one_speed_factor_names_high_mesh_sidebands_on_their_own_lattice_point():
+    """A gearbox 0.4 % faster than its nominal speed (GMF 960 Hz, fr 30 Hz): its lines sit at
+    1.004 × the lattice. With the speed known to 0.5 %, a window of 0.005·f at each line
+    (24 Hz at 4.8 kHz) reaches the next sideband, 30 Hz away, and the simplest label in it
+    would win (5GMF−2fr read as 5GMF−1fr); one factor for every line puts each peak on its
+    own point, and the factor is read back."""
+    fs, seconds, true = 12_000.0, 4.0, 1.004
+    fam = {"GMF": 960.0, "fr": 30.0}
+    lines = [(1, 0), (1, -1), (1, 1), (2, 0), (3, 0), (3, 2), (4, 0), (4, -3), (5, 0),
+             (5, -2), (5, 1), (5, 3)]
+    t = np.arange(int(fs * seconds)) / fs
+    x = sum((1.0 if n == 0 else 0.4) * np.sin(2 * np.pi * true * (k * 960.0 + n * 30.0) * t
+                                             + k + n) for k, n in lines)
+    f, a = amplitude_spectrum(x, fs, window="flattop")
+    df = label_peaks(f, a, fam, relative_tolerance=0.005)
+    named = {(int(r.k), int(r.n)) for r in df.itertuples() if r.label != "?"}
+    assert named == set(lines)
+    assert df.attrs["speed_scale"] == pytest.approx(true, abs=2e-5)
+    assert np.nanmax(np.abs(df["error_hz"])) < f[1]
+    each = label_peaks(f, a, fam, relative_tolerance=0.005, max_harmonic=5)
+    assert set(each["label"]) == set(df["label"])
+    # the old rule, a window of 0.005·f at each line, names 5GMF-2fr after 5GMF-1fr: the
+    # same spectrum without the factor search fails the check above
+    row = df[np.isclose(df["frequency_hz"], true * 4740.0, atol=0.5)].iloc[0]
+    assert row["label"] == "5GMF-2fr"
+
+
+def test_slip_widens_the_bearing_terms_only():
+    """A BPFO line 1 % below its nominal (the balls slip) is named with a 1.5 % slip
+    tolerance; a line 1 % off the mesh frequency is not (a mesh line does not slip; no
+    bearing label lies within its slip of 495 Hz)."""
+    fs, seconds = 4000.0, 8.0
+    fam = {"GMF": 500.0, "BPFO": 89.8, "fr": 29.95}
+    t = np.arange(int(fs * seconds)) / fs
+    x = np.sin(2 * np.pi * 0.99 * 89.8 * t) + np.sin(2 * np.pi * 0.99 * 500.0 * t)
+    f, a = amplitude_spectrum(x, fs, window="flattop")
+    df = label_peaks(f, a, fam, slip_tolerance=0.015)
+    assert list(df["label"]) == ["1BPFO", "?"]
+    assert df.attrs["speed_scale"] == 1.0
+
+
+def test_a_slipping_familys_harmonics_are_read_on_its_own_fundamental():
+    """An outer race's envelope lines 1.2 % under the nominal BPFO, speed known to 3 %, slip
+    1 %: in windows of 4 % the BPFI lattice (1.465 × BPFO) holds the high harmonics with a
+    simpler label (10·BPFO read 7BPFI); the family's factor, read from its fundamental and
+    harmonics, names every line k·BPFO."""
+    fs, seconds = 4000.0, 3.0
+    fam = {"fr": 25.0, "BPFO": 81.12, "BPFI": 118.88}
+    t = np.arange(int(fs * seconds)) / fs
+    bpfo = 0.988 * 81.12
+    x = sum(np.sin(2 * np.pi * k * bpfo * t + k) / k ** 0.5 for k in range(1, 11))
+    f, a = amplitude_spectrum(x, fs, window="flattop")
+    df = label_peaks(f, a, fam, relative_tolerance=0.03, slip_tolerance=0.01)
+    assert list(df.sort_values("frequency_hz")["label"]) == [f"{k}BPFO" for k in range(1, 11)]
+    assert df.attrs["families_read"] == ["BPFO"]
+    assert df.attrs["families"]["BPFO"] == pytest.approx(bpfo, rel=2e-4)
