@@ -53,6 +53,10 @@ class SignalFile(NamedTuple):
     said: tuple = ()
 
 
+#: Fewest stamps a time base is read from (:func:`even_time`).
+MIN_TIME_STAMPS = 8
+
+
 def channel_1d(path, name, a):
     """A stored array as a 1-D channel of real samples: (n,), (n, 1) and (1, n) are one
     channel; any other shape is refused (a silently dropped channel would let another one be
@@ -147,7 +151,7 @@ def even_time(t):
         from that line: their printing's rounding, or a clock's jitter.
     """
     t = np.asarray(t, dtype=float)
-    if t.size < 8 or not np.all(np.isfinite(t)):
+    if t.size < MIN_TIME_STAMPS or not np.all(np.isfinite(t)):
         return None
     steps = np.diff(t)
     step = (t[-1] - t[0]) / (t.size - 1)
@@ -185,6 +189,11 @@ def time_rate(path, name, t, unit="s", said=None):
     at 12 kHz) but even within their rounding give no rate: None, and why is appended to
     ``said`` (the rate must then be stated another way)."""
     t = np.asarray(t, dtype=float) * TIME_UNITS[unit.lower()]
+    if t.size < MIN_TIME_STAMPS:
+        raise ParameterError(f"record {path}: time {name!r} holds {t.size} stamps, too few to "
+                             f"read a sample rate from (at least {MIN_TIME_STAMPS}; a record "
+                             f"needs thousands of samples)", param="record",
+                             allowed=f">= {MIN_TIME_STAMPS} time stamps")
     found = even_time(t)
     if found is not None:
         step, spread = found

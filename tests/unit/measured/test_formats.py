@@ -488,6 +488,15 @@ def test_csv_uneven_time_steps_are_refused(tmp_path, gap):
         read_file(path)
 
 
+def test_csv_too_short_for_a_time_base_says_so(tmp_path):
+    """Three evenly spaced rows were refused as "not evenly spaced (step 0 ...)": too few
+    stamps to read a rate from is what is wrong."""
+    path = tmp_path / "s.csv"
+    path.write_text("time,acc\n0,0.1\n0.001,0.2\n0.002,0.3\n")
+    with pytest.raises(ParameterError, match="holds 3 stamps, too few to read a sample rate"):
+        read_file(path)
+
+
 # ---------------------------------------------------------------------- .mat forms
 def test_mat_time_vector_is_the_time_base(tmp_path):
     x = _signals(3000)["DE"]
