@@ -42,7 +42,7 @@ __all__ = ["BearingFrequencies", "RigFrequencies", "bearing_frequencies", "rig_f
            "peak_families", "cage_speed_ratios", "FAMILY_KEYS", "lines_above_nyquist"]
 
 #: Keys of a families dict (see :meth:`RigFrequencies.families` and :mod:`cmsim.spectra.labels`).
-FAMILY_KEYS = ("GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF")
+FAMILY_KEYS = ("GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF", "fr1", "fr2")
 
 
 def cage_speed_ratios(ball_diameter_m, pitch_diameter_m, contact_angle_rad=0.0):
@@ -241,8 +241,10 @@ class RigFrequencies:
         -------
         dict of str to float
             Keys from :data:`FAMILY_KEYS` (``"GMF"`` only with gears); ``"fr"`` is the rate
-            of the shaft carrying ``bearing``. Zero frequencies (e.g. BPFO with a co-rotating
-            outer ring) are left out.
+            of the shaft carrying ``bearing``, and with gears of another ratio than 1:1 the
+            other gear shaft's rate is ``"fr2"`` (the output shaft) or ``"fr1"`` (the input
+            shaft): a gear modulates the mesh at its own shaft's rate. Zero frequencies
+            (e.g. BPFO with a co-rotating outer ring) are left out.
         """
         b = self.bearing(bearing)
         fam = {}
@@ -250,6 +252,9 @@ class RigFrequencies:
             fam["GMF"] = float(self.gmf_hz)
         fam.update(fr=b.shaft_hz, BPF=b.bpf_hz, BPFO=b.bpfo_hz, BPFI=b.bpfi_hz, BSF=b.bsf_hz,
                    FTF=b.ftf_hz)
+        for key, rate in self.shaft_rates_hz.items():
+            if not math.isclose(rate, b.shaft_hz, rel_tol=1e-9):
+                fam[key] = rate
         return {k: float(v) for k, v in fam.items() if v > 0.0}
 
     def to_dict(self):

@@ -24,7 +24,12 @@ Families
     BSF         BSF        —          FTF        1..10
     FTF         FTF        —          —          1..3
     shaft       fr         —          —          1..10 (beyond the gear template's ±n)
+    other gear  GMF        —          fr1, fr2   1..50 (the other gear shaft's sidebands)
+    its shaft   fr1, fr2   —          —          1..10
     ==========  =========  =========  =========  ===================================
+
+    ``fr`` is the rate of the shaft carrying the bearing, ``fr1`` or ``fr2`` the other gear
+    shaft's (given on a rig whose gears are not 1:1).
 
     |m|, |n| <= ``max_sideband``; a template is used when its carrier is in ``families``
     (the gear template also without GMF, with k = 0). The *family* of a label is the base of
@@ -116,6 +121,10 @@ TEMPLATES = (
     FamilyTemplate("BSF", None, "FTF"),
     FamilyTemplate("FTF", max_harmonic=3),
     FamilyTemplate("fr"),
+    FamilyTemplate("GMF", None, "fr1"),
+    FamilyTemplate("GMF", None, "fr2"),
+    FamilyTemplate("fr1"),
+    FamilyTemplate("fr2"),
 )
 
 
@@ -206,6 +215,8 @@ def _candidates(families, f_max, max_harmonic, max_sideband, templates):
         b = families.get(tpl.m_base) if tpl.m_base else None
         r = families.get(tpl.n_base) if tpl.n_base else None
         if c is None and not (tpl.k_min == 0 and (b or r)):
+            continue
+        if tpl.n_base and r is None and not b:     # its modulator is not in the families
             continue
         kmax = tpl.max_harmonic if max_harmonic is None else max_harmonic
         ks = np.arange(tpl.k_min, kmax + 1) if c else np.array([0])

@@ -150,7 +150,9 @@ def test_a_gearbox_with_undocumented_bearings_names_no_bearing_family(capsys):
     path = data_root() / "spectraquest_gearbox_gfd" / "h30hz0.npz"
     status, res = cli_json(capsys, ["spectrum", str(path), "--top", "12"])
     assert status == 0, res
-    assert res["bearing"] is None and set(res["families"]) == {"GMF", "fr"}, res["families"]
+    assert res["bearing"] is None and set(res["families"]) == {"GMF", "fr", "fr2"}, \
+        res["families"]
+    assert res["families"]["fr2"] == pytest.approx(30.0 * 32 / 80)   # the output shaft
     assert not any("BP" in p["label"] or "BSF" in p["label"] or "FTF" in p["label"]
                    for p in res["peaks"]), res["peaks"]
     assert any(p["label"] == "4GMF" for p in res["peaks"]), res["peaks"]

@@ -98,7 +98,11 @@ def test_rig_frequencies_follow_gear_ratio_and_outer_ring_speed():
     assert f.bearing("2b1").bpfo_hz > f.bearing("2b2").bpfo_hz    # counter-rotating outer ring
     fam = f.families("2b1")
     assert fam["fr"] == pytest.approx(f.bearing("2b1").shaft_hz)
-    assert set(fam) == {"GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF"}
+    assert set(fam) == {"GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF", "fr1"}
+    assert fam["fr1"] == pytest.approx(20.0)        # the other gear shaft: the input
+    assert "fr2" in f.families("1b1") and "fr1" not in f.families("1b1")
+    assert set(rig_frequencies(rig, OperatingPoint(speed_rpm=1200.0)).families()) == {
+        "GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF"}        # 28:28: one shaft rate
     assert peak_families(f, "2b1") == fam
 
 

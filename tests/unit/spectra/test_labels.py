@@ -260,3 +260,18 @@ def test_a_slipping_familys_harmonics_are_read_on_its_own_fundamental():
     assert list(df.sort_values("frequency_hz")["label"]) == [f"{k}BPFO" for k in range(1, 11)]
     assert df.attrs["families_read"] == ["BPFO"]
     assert df.attrs["families"]["BPFO"] == pytest.approx(bpfo, rel=2e-4)
+
+
+def test_the_other_gear_shafts_sidebands_are_named():
+    """A 32:80 gearbox (fr 30 Hz, fr2 12 Hz): the output gear modulates the mesh at its own
+    shaft's rate, 12 Hz, which no multiple of the input's 30 Hz reaches."""
+    fs, seconds = 4000.0, 4.0
+    fam = {"GMF": 960.0, "fr": 30.0, "fr2": 12.0}
+    lines = {960.0: "1GMF", 948.0: "1GMF-1fr2", 972.0: "1GMF+1fr2", 984.0: "1GMF+2fr2",
+             990.0: "1GMF+1fr", 12.0: "1fr2", 48.0: "4fr2"}
+    t = np.arange(int(fs * seconds)) / fs
+    x = sum(np.sin(2 * np.pi * f * t + f) for f in lines)
+    f, a = amplitude_spectrum(x, fs, window="flattop")
+    df = label_peaks(f, a, fam)
+    got = {round(r.frequency_hz): r.label for r in df.itertuples()}
+    assert got == {round(k): v for k, v in lines.items()}
