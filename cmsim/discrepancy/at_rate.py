@@ -118,7 +118,11 @@ def machine_at_rate(machine, record, workers=1):
     if lib is None:
         return again
     causes = list(dict.fromkeys(e.cause for e in lib.entries))
-    plain = [len(e.values) for e in lib.entries if e.cause not in GRIDS and e.cause not in DENSER]
+    n_sizes = lib.n_sizes
+    if n_sizes is None:           # a file from before the library kept it: its grids' mode
+        plain = [len(e.values) for e in lib.entries
+                 if e.cause not in GRIDS and e.cause not in DENSER]
+        n_sizes = max(set(plain), key=plain.count) if plain else N_SIZES
     return again.with_library(build_library(
         again, causes=[CAUSES[c]() for c in causes], seed=lib.seed, workers=workers,
-        n_segments=lib.segments, n_sizes=max(set(plain), key=plain.count) if plain else N_SIZES))
+        n_segments=lib.segments, n_sizes=n_sizes))

@@ -448,7 +448,8 @@ def build_library(machine, *, causes=None, n_sizes=N_SIZES, n_segments=LIBRARY_S
                             entries=tuple(entries),
                             segment_s=machine.segment_s, segments=int(segs.shape[0]),
                             speed_rpm=machine.op.speed_rpm, torque_nm=machine.op.torque_nm,
-                            radial_load_n=machine.op.radial_load_n, seed=int(seed))
+                            radial_load_n=machine.op.radial_load_n, seed=int(seed),
+                            n_sizes=int(n_sizes))
 
 
 def _run_to_run(laid, twin, n):

@@ -109,6 +109,9 @@ class SignatureLibrary:
     run_spread : numpy.ndarray or None, shape (n_features,)
         The model's run-to-run spread with the machine's own background lines (module
         docstring); None: the realisation spread.
+    n_sizes : int or None
+        Sizes of a cause's grid the library was built with (those with a denser or a fixed
+        grid aside); None in a file written before it was kept.
     """
 
     names: tuple
@@ -123,6 +126,7 @@ class SignatureLibrary:
     radial_load_n: float
     seed: int = 0
     run_spread: np.ndarray | None = None
+    n_sizes: int | None = None
 
     def __post_init__(self):
         m = len(self.names)
@@ -154,6 +158,7 @@ class SignatureLibrary:
                 "segment_s": self.segment_s, "segments": self.segments,
                 "speed_rpm": self.speed_rpm, "torque_nm": self.torque_nm,
                 "radial_load_n": self.radial_load_n, "seed": self.seed,
+                **({} if self.n_sizes is None else {"n_sizes": self.n_sizes}),
                 "entries": [{"cause": e.cause, "component": e.component or "",
                              "variant": e.variant, "parameter": e.parameter,
                              "values": [float(v) for v in e.values]} for e in self.entries],
@@ -176,6 +181,8 @@ class SignatureLibrary:
                                  param="machine")
         check_range('[library] "segment_s"', data["segment_s"], 0.0, 60.0, lo_open=True)
         check_range('[library] "segments"', data["segments"], 1, 100_000)
+        if data.get("n_sizes") is not None:
+            check_range('[library] "n_sizes"', data["n_sizes"], 1, 1000)
         names = tuple(data["names"])
         rows = _unpack(data["tables_float32_zlib_base64"], (int(data["rows"]), len(names)))
         entries, i = [], (3 if version == 1 else 4)
@@ -193,4 +200,5 @@ class SignatureLibrary:
                    entries=tuple(entries), segment_s=float(data["segment_s"]),
                    segments=int(data["segments"]), speed_rpm=float(data["speed_rpm"]),
                    torque_nm=float(data["torque_nm"]),
-                   radial_load_n=float(data["radial_load_n"]), seed=int(data["seed"]))
+                   radial_load_n=float(data["radial_load_n"]), seed=int(data["seed"]),
+                   n_sizes=None if data.get("n_sizes") is None else int(data["n_sizes"]))

@@ -26,7 +26,7 @@ def _library(m=3):
                  SignatureEntry("bearing_inner_race", "1b1", "line contact; path x0.3",
                                 "size_m", (1e-4, 3e-4, 1e-3), rng.standard_normal((3, m)))),
         segment_s=0.5, segments=8, speed_rpm=1797.0, torque_nm=0.0, radial_load_n=98.0,
-        seed=4)
+        seed=4, n_sizes=3)
 
 
 def _machine():
@@ -50,6 +50,7 @@ def test_the_baseline_and_library_round_trip(tmp_path):
         assert np.array_equal(a, b)                          # float32 both ways
     lib, got = m.library, back.library
     assert got.names == lib.names and got.segments == lib.segments and got.seed == lib.seed
+    assert got.n_sizes == 3          # what a calibration again at another rate builds anew
     assert np.allclose(got.mean, lib.mean.astype(np.float32), rtol=0, atol=0)
     assert np.isnan(got.realisation).all()
     assert np.array_equal(got.run_spread, np.arange(3.0))
@@ -120,6 +121,14 @@ def test_baseline_segments_stay_within_each_record_and_a_piece_within_one():
 def test_a_baseline_with_nan_is_refused():
     with pytest.raises(ParameterError, match="NaN"):
         Baseline((np.array([0.0, np.nan, 1.0]),), 1000.0)
+
+
+def test_a_library_written_before_its_size_count_was_kept_reads_none():
+    d = _library().to_dict()
+    del d["n_sizes"]
+    assert SignatureLibrary.from_dict(d).n_sizes is None
+    with pytest.raises(ParameterError, match="n_sizes"):
+        SignatureLibrary.from_dict({**_library().to_dict(), "n_sizes": 0})
 
 
 def test_a_version_one_library_reads_its_realisation_as_its_run_spread():
