@@ -318,7 +318,7 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
         # a slipping family's own factor, read from its fundamental and its harmonics
         ks = np.arange(1.0, FAMILY_HARMONICS + 1.0)
         own = _speed_scale(f_pk, a_pk, fam[b] * ks, np.full(ks.size, tol), slip + spread,
-                           proposers=ks == 1.0)
+                           proposers=ks == 1.0, min_held=FAMILY_MIN_LINES)
         if own is not None:
             fam[b] *= own
             pinned.add(b)
@@ -383,6 +383,11 @@ MIN_SCALE_LINES = 2
 #: Harmonics of a slipping family its own factor is read on (the fundamental proposes).
 FAMILY_HARMONICS = 10
 
+#: Least number of a slipping family's lines its own factor is read from (its fundamental
+#: and two harmonics: a dense spectrum puts a second line within a bin of a harmonic of
+#: about one proposal in twenty by chance).
+FAMILY_MIN_LINES = 3
+
 
 def _part(cand, families, templates, weights):
     """Σ weight × |frequency| of each candidate's terms whose base has a weight (a dict, or
@@ -398,11 +403,11 @@ def _part(cand, families, templates, weights):
     return out
 
 
-def _speed_scale(f_pk, a_pk, cf, window, rel, proposers=None):
+def _speed_scale(f_pk, a_pk, cf, window, rel, proposers=None, min_held=MIN_SCALE_LINES):
     """The factor within 1 ± ``rel`` that puts the most peaks on the shaft and mesh lines of
     the lattice ``cf`` (windows ``window``), refined on them; None if fewer than
-    :data:`MIN_SCALE_LINES` peaks sit on them at any factor. With ``proposers`` (a mask of
-    ``cf``) only those candidates propose (a family's fundamental, for its own factor).
+    ``min_held`` peaks sit on them at any factor. With ``proposers`` (a mask of ``cf``)
+    only those candidates propose (a family's fundamental, for its own factor).
 
     Only the candidates with no slipping term (the narrowest windows) take part: a bearing
     line's slip blurs the factor, and the bearing lattices are dense enough that a window of
@@ -432,7 +437,7 @@ def _speed_scale(f_pk, a_pk, cf, window, rel, proposers=None):
             key = (int(held.sum()), float(a_pk[held].sum()), -abs(s - 1.0))
             if best_key is None or key > best_key:
                 best, best_key = s, key
-    if best is None or best_key[0] < MIN_SCALE_LINES:
+    if best is None or best_key[0] < min_held:
         return None
     held, j = _held(f_pk, cf * best, window)
     return float(np.sum(f_pk[held] * cf[j[held]]) / np.sum(cf[j[held]] ** 2))
