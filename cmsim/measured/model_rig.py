@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from cmsim.errors import ParameterError
+from cmsim.errors import ParameterError, check_range
 from cmsim.frequencies import RigFrequencies, bearing_frequencies
 from cmsim.measured.schema import STANDARD_GRAVITY_M_S2, documented_radial_load_n
 from cmsim.rig import OperatingPoint, Rig, RollingBearing, Rotor
@@ -116,20 +116,29 @@ def documented_geometry(geometry):
 
 def _bearing(geom, like=None):
     """The model bearing of a documented geometry; with ``like``, that bearing's clearance,
-    masses and damping (a gear rig's undocumented properties), else the defaults."""
+    masses and damping (a gear rig's undocumented properties), else the defaults. A
+    documented contact angle above 0 (an angular-contact bearing) sets the cage kinematics'
+    angle; 0, a deep-groove bearing's nominal, leaves the operating angle its clearance
+    gives, as the model computes it."""
     try:
         n = int(geom["n_balls"])
         d = float(geom["ball_diameter_mm"]) * 1e-3
         pd_ = float(geom["pitch_diameter_mm"]) * 1e-3
+        angle = float(geom.get("contact_angle_deg") or 0.0)
     except (KeyError, TypeError, ValueError):
         raise ParameterError(f"bearing geometry needs n_balls, ball_diameter_mm and "
                              f"pitch_diameter_mm, got {geom!r}", param="geometry.bearings")
+    angle = math.radians(check_range("geometry.bearings contact_angle_deg", angle, 0.0, 45.0,
+                                     unit="deg (a radial ball bearing's model)"))
     if like is None:
-        return RollingBearing.from_pitch(n, d, pd_, clearance_m=DEFAULT_CLEARANCE_M)
+        return RollingBearing.from_pitch(n, d, pd_, clearance_m=DEFAULT_CLEARANCE_M,
+                                         contact_angle_rad=angle or None)
     g = RollingBearing.from_pitch(n, d, pd_)
-    return replace(like, **{k: getattr(g, k) for k in (
-        "n_balls", "ball_diameter_m", "inner_raceway_diameter_m", "outer_raceway_diameter_m",
-        "inner_groove_radius_m", "outer_groove_radius_m")})
+    return replace(like, contact_angle_rad=angle or like.contact_angle_rad,
+                   **{k: getattr(g, k) for k in (
+                       "n_balls", "ball_diameter_m", "inner_raceway_diameter_m",
+                       "outer_raceway_diameter_m", "inner_groove_radius_m",
+                       "outer_groove_radius_m")})
 
 
 def _gear_rig(stage, bearings, near):

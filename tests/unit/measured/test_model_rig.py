@@ -105,3 +105,29 @@ def test_a_gearbox_s_geometry_that_cannot_be_read_is_refused_naming_the_key(chan
         (stage if k in stage else bearing)[k] = v
     with pytest.raises(ParameterError, match=match):
         model_rig({"gears": [stage], "bearings": {"de": bearing}}, near="de")
+
+
+@pytest.mark.parametrize("gears", [None, [{"stage": 1, "input_teeth": 20, "output_teeth": 40}]])
+def test_a_documented_contact_angle_sets_the_models_defect_lines(gears):
+    """An angular-contact bearing's 40° moves its defect lines (cos α in the cage speed): the
+    model rig's lines are the documented ones, on a bearing rig and on a gearbox; a 0° deep
+    groove bearing keeps the operating angle its clearance gives; past the model's 45° is
+    refused naming the metadata key. (The angle was read for the labels only: the model
+    simulated 0°.)"""
+    geometry = {"gears": gears, "bearings": {"de": _ball_bearing(contact_angle_deg=40.0,
+                                                                 shaft="input")}}
+    got, components, _ = model_rig(geometry, near="de")
+    node = next(n for n, k in components.items() if k == "de")
+    op = OperatingPoint(speed_rpm=1800.0)
+    model = rig_frequencies(got, op).bearing(node)
+    doc = documented_frequencies(geometry, op.shaft_hz).bearing("de")
+    assert model.bpfi_hz == pytest.approx(doc.bpfi_hz, rel=1e-9)
+    deep = {"gears": gears, "bearings": {"de": _ball_bearing(contact_angle_deg=0.0,
+                                                             shaft="input")}}
+    free, comps, _ = model_rig(deep, near="de")
+    free_node = next(n for n, k in comps.items() if k == "de")
+    assert rig_frequencies(free, op).bearing(free_node).bpfi_hz < 0.97 * model.bpfi_hz \
+        or rig_frequencies(free, op).bearing(free_node).bpfi_hz > 1.03 * model.bpfi_hz
+    with pytest.raises(ParameterError, match="contact_angle_deg"):
+        model_rig({"gears": gears, "bearings": {"de": _ball_bearing(contact_angle_deg=60.0,
+                                                                    shaft="input")}})
