@@ -31,6 +31,7 @@ from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
                                       documented_operating_point, model_operating_point,
                                       model_rig)
 from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
+from cmsim.measured.samples import MIN_SAMPLES, checked_samples, clipping_doubt
 from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
                                    read_metadata, recording_entry, unit_kind, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
@@ -41,10 +42,6 @@ from cmsim.run import Run
 from cmsim.sensors import decimate
 
 __all__ = ["MeasuredRecord", "read_record", "read_run", "record_from_run", "MIN_SAMPLES"]
-
-#: Fewest samples of the compared channel (the speed and sample-rate inference need a few
-#: hundred shaft revolutions' worth of resolution; a kurtogram needs 1024).
-MIN_SAMPLES = 4096
 
 
 @dataclass(frozen=True, eq=False)
@@ -215,35 +212,13 @@ def _channel(signals, sensors, bearings, channel, name):
         raise ParameterError(f"channel {channel!r} is not in {name}; available: "
                              f"{sorted(signals)}", param="--channel",
                              allowed=", ".join(sorted(signals)))
-    return channel, _checked_samples(signals[channel], channel, name)
+    return channel, checked_samples(signals[channel], channel, name)
 
 
 def _rises_throughout(x):
     """Whether no sample of ``x`` is below the one before and the last is above the first (a
     time base, one printed coarser than its step included, or a sample index)."""
     return x.size > 2 and x[-1] > x[0] and bool(np.all(np.diff(x) >= 0))
-
-
-def _checked_samples(x, channel, name):
-    """The compared channel's samples, or the one line that says what is wrong with them:
-    too few, some not finite (where the first is), or constant (nothing recorded)."""
-    if x.size < MIN_SAMPLES:
-        raise ParameterError(f"record {name}: channel {channel!r} holds {x.size} samples; "
-                             f"needs >= {MIN_SAMPLES}", param="record",
-                             allowed=f">= {MIN_SAMPLES} samples")
-    bad = ~np.isfinite(x)
-    if bad.any():
-        raise ParameterError(f"record {name}: channel {channel!r} holds {int(bad.sum())} "
-                             f"non-finite samples (NaN or inf) of {x.size}, the first at "
-                             f"sample {int(np.argmax(bad))}; cmsim does not fill gaps: repair "
-                             f"the file or cut it to a finite stretch", param="record",
-                             allowed="finite samples")
-    if np.ptp(x) == 0.0:
-        raise ParameterError(f"record {name}: channel {channel!r} is constant (every sample "
-                             f"{x[0]:g}): nothing was recorded; check the sensor, its cable "
-                             f"and the channel chosen (--channel)", param="record",
-                             allowed="a varying signal")
-    return x
 
 
 def _sample_rate(fs, x, speed_rpm, teeth, inferred, notes, meta):
@@ -470,6 +445,11 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
     inferred, notes, doubts = {}, list(f.said), list(f.said)   # read_file warned them
+    clipped = clipping_doubt(x, channel, p)
+    if clipped is not None:
+        notes.append(clipped)
+        doubts.append(clipped)
+        warnings.warn(clipped, RecordWarning, stacklevel=2)
     if scale is None and channel in f.counts and sensor_unit is not None:
         text = (f"record {p}: channel {channel!r} holds integer counts of a converter and no "
                 f"calibration states their units: each count is read as 1 {sensor_unit} "
