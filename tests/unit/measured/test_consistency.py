@@ -128,6 +128,22 @@ def test_doctored_rate_or_speed_is_refused(records, kind, factor):
             assert f"shaft_speed_rpm {rpm:g}" in msg, msg
 
 
+@needs_data
+def test_a_correction_is_offered_only_where_the_shafts_own_comb_stands(records):
+    """CWRU IR007_0 stated at 1600 rpm (it turns at 1797) was refused offering 3200 rpm,
+    which the verdicts' 1 % windows found on its defect lines, and at 3200 rpm it then read
+    an outer race on the fan end: the offer now says the shaft's own comb does not stand
+    there. Stated at half its speed the offer stands as it was: the comb is there."""
+    stem, x, fs, rpm, freqs, tol = next(r for r in records if r[0] == "IR007_0")
+    with pytest.raises(ParameterError) as err:
+        check_rate_and_speed(x, fs, 1600.0, freqs, where=stem, speed_tolerance=tol)
+    assert "shaft_speed_rpm 3200 would fit by these lines, but the shaft's own comb does " \
+           "not stand there either" in str(err.value)
+    with pytest.raises(ParameterError) as err:
+        check_rate_and_speed(x, fs, rpm / 2, freqs, where=stem, speed_tolerance=tol)
+    assert f"shaft_speed_rpm {rpm:g} would fit (" in str(err.value)
+
+
 # ---------------------------------------------------------------------- synthetic rigs
 FS = 25600.0
 SHAFT_HZ = 20.0
