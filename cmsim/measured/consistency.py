@@ -65,7 +65,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim.errors import ParameterError
-from cmsim.measured.comb_ratio import (CLEAR_LINE_DB, LARGEST_FACTOR, LINE_TOLERANCE,
+from cmsim.measured.comb_ratio import (CLEAR_LINE_DB, COMB_HARMONICS, COMB_TOLERANCE,
+                                      LARGEST_FACTOR, LINE_TOLERANCE, shaft_comb_db,
                                       MISSING_MARGIN_DB, REFUSE_LINE_DB, STEPS, SUBCOMB_MARGIN_DB, _mean, _steps,
                                       exclusive_contrast_db, family_ratio,
                                       line_prominence_db, lowest_fundamental)
@@ -460,20 +461,10 @@ def _decide(verdicts):
     return "contradicted", top, rho, refuse
 
 
-#: Harmonics of the shaft and their tolerance (or the speed's, if wider) on which a
-#: correction's shaft comb is checked before it is offered: a 1600-rpm statement of a
-#: 1797-rpm CWRU record was refused offering 3200 rpm, whose comb the 1 % windows of the
-#: verdicts found on the record's defect lines (mean 13 dB; 40 dB at 1797 rpm).
-CORRECTED_HARMONICS = 6
-CORRECTED_TOLERANCE = 2e-3
-
-
 def _comb_db(x, fs_hz, shaft_hz, tolerance):
-    """Mean prominence of the first :data:`CORRECTED_HARMONICS` shaft harmonics, dB."""
+    """:func:`~cmsim.measured.comb_ratio.shaft_comb_db` of ``x``'s Hann spectrum."""
     freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
-    log_amp = np.log10(np.maximum(amp, 1e-300))
-    return _mean([line_prominence_db(freq, log_amp, k * shaft_hz, tolerance)
-                  for k in range(1, CORRECTED_HARMONICS + 1)])
+    return shaft_comb_db(freq, np.log10(np.maximum(amp, 1e-300)), shaft_hz, tolerance)
 
 
 def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="fs_hz",
@@ -541,10 +532,10 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     what = (f"record {where}: its {fam.describe()}, where {fs_source} {fs_hz:g} Hz and "
             f"{speed_source} {speed_rpm:g} put them")
     fits = f"{fs_source} {fs_hz / rho:g} Hz or {speed_source} {speed_rpm * rho:g} would fit"
-    comb = _comb_db(x, fs_hz, rho * speed_rpm / 60.0, max(speed_tolerance, CORRECTED_TOLERANCE))
+    comb = _comb_db(x, fs_hz, rho * speed_rpm / 60.0, max(speed_tolerance, COMB_TOLERANCE))
     if not comb >= CLEAR_LINE_DB:    # the correction put the shaft's own comb nowhere either
         fits += (f" by these lines, but the shaft's own comb does not stand there either "
-                 f"({comb:.0f} dB over the floor, its first {CORRECTED_HARMONICS} harmonics): "
+                 f"({comb:.0f} dB over the floor, its first {COMB_HARMONICS} harmonics): "
                  f"the speed or the rate may be off by another factor than {r}; check both")
     if refuse:
         raise ParameterError(

@@ -26,12 +26,14 @@ import re
 
 import numpy as np
 
+from cmsim.measured.comb_ratio import COMB_HARMONICS, COMB_TOLERANCE, shaft_comb_db
 from cmsim.measured.consistency import lowest_fundamental
 from cmsim.measured.stated import NOMINAL_SPEED_UNCERTAINTY
 from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["estimate_shaft_hz", "refine_speed", "infer_sample_rate", "sample_rate_from_note",
-           "SPEED_SEARCH_FRACTION", "MIN_COMB_DB", "MIN_SPEED_CHANGE", "NOTE_AGREEMENT"]
+           "speed_comb_doubt", "SPEED_SEARCH_FRACTION", "MIN_COMB_DB", "MIN_SPEED_CHANGE",
+           "NOTE_AGREEMENT", "DOUBT_RATIOS", "DOUBT_COMB_DB", "DOUBT_MARGIN_DB"]
 
 #: Half-width of the search around a documented speed, relative (a stored nominal speed and
 #: an induction motor's slip under load differ by a few per cent at most: the uncertainty of
@@ -51,6 +53,91 @@ MIN_SPEED_CHANGE = 2e-3
 #: Largest relative disagreement between an inferred sample rate and a metadata note's value
 #: that passes without a warning.
 NOTE_AGREEMENT = 0.02
+
+
+#: Ratios to a stated shaft rate over which :func:`speed_comb_doubt` looks for the shaft's
+#: comb (a factor 2ᵏ is :mod:`cmsim.measured.consistency`'s, the speed's own uncertainty
+#: :func:`refine_speed`'s), and the grid's relative step.
+DOUBT_RATIOS = (0.5, 2.0)
+DOUBT_STEP = COMB_TOLERANCE
+
+#: Combs within this of the highest found are as good: the lowest is named (a comb at twice
+#: the shaft's rate holds its even harmonics, and an outer race's comb at 1.8 × CWRU's
+#: shaft, its 2 × BPFO, stands 2 dB over the shaft's own; a comb at half has its odd lines
+#: missing, 15-20 dB down).
+DOUBT_TIE_DB = 3.0
+
+#: A comb found elsewhere doubts the stated speed when it stands this high over its floor
+#: (:func:`~cmsim.measured.comb_ratio.shaft_comb_db`) and this much over the stated speed's
+#: comb. Measured on the shared records and on copies with a wrong speed or rate: honest,
+#: the best comb of the range stands at most 4.5 dB over the stated one (MFPT, whose shaft
+#: comb is weak: 8-17 dB); stated 5-78 % off or at a wrong rate (12.8, 10.24, 8 kHz for 12
+#: kHz), 22-35 dB (CWRU's comb: 29-40 dB).
+DOUBT_COMB_DB = 25.0
+DOUBT_MARGIN_DB = 15.0
+
+
+def speed_comb_doubt(x, fs_hz, speed_rpm, *, uncertainty=0.0, teeth=None, where="",
+                     fs_source="fs_hz", speed_source="the speed"):
+    """The warning that a record's shaft comb stands at another speed than the stated one,
+    or None.
+
+    A speed (or a sample rate) stated a few per cent to a factor of two off, not a factor
+    2ᵏ, puts every line the rig makes off its window: the families' verdicts
+    (:func:`~cmsim.measured.consistency.check_rate_and_speed`) then find one of the many
+    families by chance, and the record was compared at the wrong speed in silence. The
+    shaft's own comb, read on narrow windows, is searched over :data:`DOUBT_RATIOS` of the
+    stated rate (the speed's uncertainty, the factors 2ᵏ and a gear rig's other shaft left
+    out); a comb standing :data:`DOUBT_COMB_DB` high and :data:`DOUBT_MARGIN_DB` over the
+    stated one's is warned (not refused: another shaft, a belt's, may turn there).
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        The compared channel.
+    fs_hz : float
+        Sample rate, Hz.
+    speed_rpm : float
+        The speed the record is compared at, rpm.
+    uncertainty : float
+        Its relative uncertainty.
+    teeth : tuple of int, optional
+        (Z1, Z2) of a gear rig.
+    where, fs_source, speed_source : str
+        The record and where its rate and speed came from, for the message.
+
+    Returns
+    -------
+    str or None
+    """
+    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
+    log_amp = np.log10(np.maximum(amp, 1e-300))
+    f0 = float(speed_rpm) / 60.0
+    stated = shaft_comb_db(freq, log_amp, f0, max(uncertainty, COMB_TOLERANCE))
+    if stated >= DOUBT_COMB_DB:
+        return None
+    lo, hi = DOUBT_RATIOS
+    ratios = np.exp(np.arange(math.log(lo), math.log(hi), DOUBT_STEP))
+    near = [1.0, 0.5, 2.0] + ([teeth[0] / teeth[1], teeth[1] / teeth[0]] if teeth else [])
+    keep = np.ones(ratios.size, dtype=bool)
+    for r in near:
+        keep &= np.abs(ratios / r - 1.0) > max(uncertainty, COMB_TOLERANCE) + 0.01
+    ratios = ratios[keep]
+    combs = np.array([shaft_comb_db(freq, log_amp, r * f0) for r in ratios])
+    if not np.any(combs == combs):
+        return None
+    best = float(np.nanmax(combs))
+    if not (best >= DOUBT_COMB_DB and best - (stated if stated == stated else 0.0)
+            >= DOUBT_MARGIN_DB):
+        return None
+    good = np.flatnonzero(combs >= best - DOUBT_TIE_DB)
+    i = int(good[0])                              # ratios rise: the lowest
+    best, rho = float(combs[i]), float(ratios[i])
+    return (f"record {where}: the shaft's comb stands at {rho * speed_rpm:.0f} rpm ({best:.0f} "
+            f"dB over its floor, its first {COMB_HARMONICS} harmonics), not at {speed_source} "
+            f"{speed_rpm:g} rpm ({stated:.0f} dB): the speed or the sample rate stated may be "
+            f"wrong ({rho * speed_rpm:.0f} rpm, or {fs_source} {fs_hz / rho:.6g} Hz, would "
+            f"put it there); if another shaft turns at that speed, they stand")
 
 
 def estimate_shaft_hz(x, fs_hz, *, lo_hz, hi_hz, teeth=None, n_harmonics=4):

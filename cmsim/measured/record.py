@@ -26,7 +26,7 @@ from cmsim.errors import ParameterError, RecordWarning
 from cmsim.frequencies import RigFrequencies, rig_frequencies
 from cmsim.measured.consistency import BEARING_SLIP, check_rate_and_speed
 from cmsim.measured.inference import (NOTE_AGREEMENT, infer_sample_rate, note_disagreement,
-                                      refine_speed, sample_rate_from_note)
+                                      refine_speed, sample_rate_from_note, speed_comb_doubt)
 from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
                                       documented_operating_point, model_operating_point,
                                       model_rig)
@@ -492,6 +492,14 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     if "fs_hz" not in inferred and speed_rpm is None:   # the caller's speed is the speed;
                                                         # an inferred rate is scaled by it
         speed, uncertainty = _refined_speed(x, fs, speed, teeth, check, uncertainty, inferred)
+    if speed is not None and not trust_metadata:
+        doubt = speed_comb_doubt(x, fs, speed, uncertainty=uncertainty, teeth=teeth, where=p,
+                                 fs_source=fs_from or "the inferred rate",
+                                 speed_source=speed_from)
+        if doubt is not None:
+            notes.append(doubt)
+            doubts.append(doubt)
+            warnings.warn(doubt, RecordWarning, stacklevel=2)
     op = (model_operating_point(entry, rig, speed, notes) if rig is not None
           else documented_operating_point(entry, speed))
 

@@ -15,7 +15,7 @@ import numpy as np
 from cmsim.errors import ParameterError
 
 __all__ = ["checked_samples", "clipping_doubt", "MIN_SAMPLES", "CLIPPED_MIN_SAMPLES",
-           "CLIPPED_MIN_SHARE"]
+           "CLIPPED_MIN_SHARE", "CLIPPED_MIN_LEVELS"]
 
 #: Fewest samples of the compared channel (the speed and sample-rate inference need a few
 #: hundred shaft revolutions' worth of resolution; a kurtogram needs 1024).
@@ -25,6 +25,12 @@ MIN_SAMPLES = 4096
 #: and :data:`CLIPPED_MIN_SHARE` of its samples (every shared record has one at each).
 CLIPPED_MIN_SAMPLES = 10
 CLIPPED_MIN_SHARE = 1e-4
+
+#: Fewest distinct values (to a millionth of its range) of a channel judged for clipping: a
+#: periodic signal of P samples a period (a synthetic tone at fs/24) repeats its extremes by
+#: construction with at most P values, while a converter driven past its range spans it
+#: all (an 8-bit one's 256).
+CLIPPED_MIN_LEVELS = 64
 
 
 def checked_samples(x, channel, name):
@@ -83,7 +89,8 @@ def clipping_doubt(x, channel, name):
     hi, lo = float(np.max(x)), float(np.min(x))
     tol = 1e-9 * (hi - lo)
     at = int(np.count_nonzero(x >= hi - tol)) + int(np.count_nonzero(x <= lo + tol))
-    if at < max(CLIPPED_MIN_SAMPLES, CLIPPED_MIN_SHARE * x.size):
+    if at < max(CLIPPED_MIN_SAMPLES, CLIPPED_MIN_SHARE * x.size) \
+            or np.unique(np.round((x - lo) / (hi - lo) * 1e6)).size < CLIPPED_MIN_LEVELS:
         return None
     return (f"record {name}: channel {channel!r} sits at its largest ({hi:.4g}) or smallest "
             f"({lo:.4g}) value in {at} samples ({100.0 * at / x.size:.2g} % of them): it was "

@@ -26,7 +26,7 @@ def test_a_clipped_channel_is_doubted_with_its_share():
 
 
 @pytest.mark.parametrize("form", ["float", "int16 at 12 bits", "int16 of a weak signal",
-                                  "one rail only touched once"])
+                                  "one rail only touched once", "a synthetic tone at fs/24"])
 def test_honest_samples_are_not_doubted(form):
     x = _impacts()
     if form == "int16 at 12 bits":
@@ -35,6 +35,9 @@ def test_honest_samples_are_not_doubted(form):
         x = np.round(x * 3.0).astype(np.int16) * 0.01
     elif form == "one rail only touched once":
         x = x - x.min()
+    elif form == "a synthetic tone at fs/24":     # its extremes every 24 samples
+        t = np.arange(x.size)
+        x = 3.0 * np.sin(2 * np.pi * t / 24) + np.sin(2 * np.pi * t / 8)
     assert clipping_doubt(np.asarray(x, float), "DE", "r.npz") is None
 
 
