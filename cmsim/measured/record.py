@@ -31,7 +31,8 @@ from cmsim.measured.model_rig import (NO_GEOMETRY, documented_frequencies,
                                       documented_operating_point, model_operating_point,
                                       model_rig)
 from cmsim.measured.readers import is_cmsim_run, npz_names, read_file, resolve_path
-from cmsim.measured.samples import MIN_SAMPLES, checked_samples, clipping_doubt
+from cmsim.measured.samples import (MIN_SAMPLES, checked_samples, clipping_doubt,
+                                    count_doubt)
 from cmsim.measured.schema import (FOLDER_KEYS, checked_unit, documented_speed,
                                    read_metadata, recording_entry, unit_kind, unit_scale_of)
 from cmsim.measured.stated import (CALIBRATION_TOLERANCE, HEADER_RATE_TOLERANCE,
@@ -445,11 +446,12 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     if sensor_unit is not None:
         sensor["unit"] = sensor_unit
     inferred, notes, doubts = {}, list(f.said), list(f.said)   # read_file warned them
-    clipped = clipping_doubt(x, channel, p)
-    if clipped is not None:
-        notes.append(clipped)
-        doubts.append(clipped)
-        warnings.warn(clipped, RecordWarning, stacklevel=2)
+    for text in (clipping_doubt(x, channel, p), count_doubt(x, entry.get("n_samples"),
+                                                            channel, p)):
+        if text is not None:
+            notes.append(text)
+            doubts.append(text)
+            warnings.warn(text, RecordWarning, stacklevel=2)
     if scale is None and channel in f.counts and sensor_unit is not None:
         text = (f"record {p}: channel {channel!r} holds integer counts of a converter and no "
                 f"calibration states their units: each count is read as 1 {sensor_unit} "

@@ -14,7 +14,7 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 
-__all__ = ["checked_samples", "clipping_doubt", "MIN_SAMPLES", "CLIPPED_MIN_SAMPLES",
+__all__ = ["checked_samples", "clipping_doubt", "count_doubt", "MIN_SAMPLES", "CLIPPED_MIN_SAMPLES",
            "CLIPPED_MIN_SHARE", "CLIPPED_MIN_LEVELS"]
 
 #: Fewest samples of the compared channel (the speed and sample-rate inference need a few
@@ -97,3 +97,30 @@ def clipping_doubt(x, channel, name):
             f"clipped (the converter's or amplifier's range exceeded); the peaks above the "
             f"rail are lost, so levels, kurtosis and envelope lines read low and a fault may "
             f"be missed: record it again with more range")
+
+
+def count_doubt(x, stated, channel, name):
+    """The warning that a channel holds another number of samples than its metadata states
+    (``n_samples``), or None: the file was cut or replaced, or the entry is another
+    record's — and the rate, speed and load it states may be too.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (n,)
+        The channel's samples.
+    stated : int or None
+        The metadata's ``n_samples`` (None: not stated).
+    channel : str
+        Its name, for the message.
+    name : str
+        The record, for the message.
+
+    Returns
+    -------
+    str or None
+    """
+    if stated is None or int(stated) == x.size:
+        return None
+    return (f"record {name}: metadata.json \"n_samples\" says {int(stated)}, channel "
+            f"{channel!r} holds {x.size}: the file was cut or replaced, or the entry is "
+            f"another record's (check the rate, speed and load it states)")

@@ -7,7 +7,7 @@ finely quantised data reach their extremes once or a few times).
 import numpy as np
 import pytest
 
-from cmsim.measured.samples import clipping_doubt
+from cmsim.measured.samples import clipping_doubt, count_doubt
 
 
 def _impacts(n=120_000, seed=0):
@@ -49,3 +49,13 @@ def test_clipping_in_a_few_samples_is_left_alone_and_in_more_is_doubted():
     assert clipping_doubt(np.minimum(x, top), "DE", "r") is None
     top = np.sort(x)[-120]
     assert clipping_doubt(np.minimum(x, top), "DE", "r") is not None
+
+
+def test_a_sample_count_other_than_the_metadata_states_is_doubted():
+    """A 2-s cut (24 000 samples) of a record whose entry states 120 000 was compared with
+    the entry's rate, speed and load in silence."""
+    x = _impacts(24_000)
+    text = count_doubt(x, 120_000, "DE", "r.npz")
+    assert text is not None and "says 120000" in text and "holds 24000" in text
+    assert count_doubt(x, 24_000, "DE", "r.npz") is None
+    assert count_doubt(x, None, "DE", "r.npz") is None
