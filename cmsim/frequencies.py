@@ -39,10 +39,15 @@ import numpy as np
 from cmsim.errors import ParameterError, check_range, check_type
 
 __all__ = ["BearingFrequencies", "RigFrequencies", "bearing_frequencies", "rig_frequencies",
-           "peak_families", "cage_speed_ratios", "FAMILY_KEYS", "lines_above_nyquist"]
+           "peak_families", "cage_speed_ratios", "FAMILY_KEYS", "BEARING_FAMILY_KEYS",
+           "lines_above_nyquist"]
 
 #: Keys of a families dict (see :meth:`RigFrequencies.families` and :mod:`cmsim.spectra.labels`).
 FAMILY_KEYS = ("GMF", "BPF", "fr", "BPFO", "BPFI", "BSF", "FTF", "fr1", "fr2")
+
+#: The keys of :data:`FAMILY_KEYS` a bearing makes: its lines slip with the balls, and a
+#: record that documents no bearing has none to name by (the rest are shaft and mesh lines).
+BEARING_FAMILY_KEYS = frozenset(("BPF", "BPFO", "BPFI", "BSF", "FTF"))
 
 
 def cage_speed_ratios(ball_diameter_m, pitch_diameter_m, contact_angle_rad=0.0):

@@ -72,7 +72,8 @@ import scipy.ndimage
 import scipy.signal
 
 from cmsim.errors import ParameterError, check_choice, check_range
-from cmsim.frequencies import FAMILY_KEYS, RigFrequencies, peak_families
+from cmsim.frequencies import (BEARING_FAMILY_KEYS, FAMILY_KEYS, RigFrequencies,
+                               peak_families)
 from cmsim.spectra._checks import (WINDOWS, band, positive_int, sampling_rate, signal_1d,
                                    spectrum_arrays)
 from cmsim.spectra.amplitude import amplitude_spectrum
@@ -309,12 +310,12 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     scale, spread, pinned = 1.0, 0.0, set()
     if rel > 0.0:
         cand = _candidates(fam, f_top, max_harmonic, msb, templates)
-        scale = _speed_scale(f_pk, a_pk, cand[:, 0],
-                             tol + slip * _part(cand, fam, templates, SLIPPING), rel)
+        slips = tol + slip * _part(cand, fam, templates, BEARING_FAMILY_KEYS)
+        scale = _speed_scale(f_pk, a_pk, cand[:, 0], slips, rel)
         if scale is None:             # too few shaft or mesh lines to read the speed from:
             scale, spread = 1.0, rel  # each line keeps the whole uncertainty
     fam = {b: scale * v for b, v in fam.items()}
-    for b in sorted(SLIPPING & fam.keys()) if slip + spread > 0.0 else ():
+    for b in sorted(BEARING_FAMILY_KEYS & fam.keys()) if slip + spread > 0.0 else ():
         # a slipping family's own factor, read from its fundamental and its harmonics
         ks = np.arange(1.0, FAMILY_HARMONICS + 1.0)
         own = _speed_scale(f_pk, a_pk, fam[b] * ks, np.full(ks.size, tol), slip + spread,
@@ -326,16 +327,16 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
     cf, ck, cm, cn, ct = cand.T
     complexity = np.abs(ck) + np.abs(cm) + np.abs(cn)
     n_terms = (ck != 0).astype(int) + (cm != 0).astype(int) + (cn != 0).astype(int)
-    loose = {b: slip * (b in SLIPPING) + spread for b in fam if b not in pinned}
+    loose = {b: slip * (b in BEARING_FAMILY_KEYS) + spread for b in fam if b not in pinned}
     window = tol + _part(cand, fam, templates, loose)
     a_max = float(peaks["amplitude"].max()) if len(peaks) else 1.0
     carrier_window = max(tol, 1.5 * df_bin)
 
     rows = []
-    for f_pk, a_pk in zip(peaks["frequency_hz"], peaks["amplitude"]):
-        err = np.abs(cf - f_pk)
+    for f_p, a_p in zip(f_pk, a_pk):
+        err = np.abs(cf - f_p)
         hit = np.flatnonzero(err <= window)
-        db_max = 20.0 * math.log10(a_pk / a_max) if a_pk > 0 else -math.inf
+        db_max = 20.0 * math.log10(a_p / a_max) if a_p > 0 else -math.inf
         if hit.size == 0:
             rows.append(("?", "unlabelled", 0, 0, 0, math.nan, math.nan, db_max))
             continue
@@ -351,8 +352,8 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
             fc = k * fam[tpl.carrier]
             near = np.abs(freq - fc) <= carrier_window + loose.get(tpl.carrier, 0.0) * fc
             a_car = float(amp[near].max()) if np.any(near) else 0.0
-            db_car = 20.0 * math.log10(a_pk / a_car) if a_car > 0 and a_pk > 0 else math.nan
-        rows.append((text, family, k, m, n, float(cf[j]), float(f_pk - cf[j]), db_car))
+            db_car = 20.0 * math.log10(a_p / a_car) if a_car > 0 and a_p > 0 else math.nan
+        rows.append((text, family, k, m, n, float(cf[j]), float(f_p - cf[j]), db_car))
 
     out = peaks[["frequency_hz", "amplitude", "snr_db"]].copy()
     out["label"] = [r[0] for r in rows]
@@ -370,9 +371,6 @@ def label_peaks(freq, amp, families, *, tolerance_hz=None, max_harmonic=None, ma
                  "families_read": sorted(pinned)}
     return out
 
-
-#: Bases of a label whose lines slip with the balls (the rest are shaft and mesh lines).
-SLIPPING = frozenset(("BPF", "BPFO", "BPFI", "BSF", "FTF"))
 
 #: Strongest peaks whose candidates propose a speed factor to :func:`_speed_scale`.
 SCALE_TRIAL_PEAKS = 8

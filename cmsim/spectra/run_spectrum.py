@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cmsim.errors import ParameterError, check_choice, check_range
-from cmsim.frequencies import rig_frequencies
+from cmsim.frequencies import BEARING_FAMILY_KEYS, rig_frequencies
 from cmsim.run import signal_info
 from cmsim.spectra._checks import band as check_band
 from cmsim.spectra._checks import positive_int
@@ -47,11 +47,6 @@ def signal_bearing(name, bearing_names):
         if part in bearing_names:
             return part
     return bearing_names[0]
-
-
-#: Families of a bearing (left out where a measured record documents no bearing: the model
-#: rig's are then an assumption, :func:`cmsim.measured.read_run`).
-BEARING_FAMILIES = ("BPF", "BPFO", "BPFI", "BSF", "FTF")
 
 
 def run_families(run, bearing=None):
@@ -209,7 +204,7 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
                                  f"{bearing!r}")
         fam = freqs.families(brg)
         if run.meta.get("bearings_documented") is False:     # an assumed bearing names nothing
-            brg, fam = None, {k: v for k, v in fam.items() if k not in BEARING_FAMILIES}
+            brg, fam = None, {k: v for k, v in fam.items() if k not in BEARING_FAMILY_KEYS}
     speed = float(run.meta.get("speed_uncertainty") or 0.0)
     slip = max(float(run.meta.get("line_tolerance") or 0.0) - speed, 0.0)
     rel = speed if relative_tolerance is None else relative_tolerance
