@@ -396,9 +396,9 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     MeasuredRecord
         Its meta holds ``rate_check`` (the check's outcome,
         :class:`~cmsim.measured.consistency.RateCheck`), ``speed_uncertainty`` (relative:
-        the stated speed's, smaller once refined from the signal), ``line_tolerance`` (that
-        plus the rolling elements' slip: how far a line of the record may stand from where
-        the speed puts it; a spectrum's labels read it) and ``warnings``: what the user
+        the stated speed's, smaller once refined from the signal), ``bearing_slip`` (how far
+        the rolling elements' lines may stand from where the speed puts them besides; a
+        spectrum's labels read both) and ``warnings``: what the user
         should hear (a contradiction too weak to refuse the record, a value replaced).
 
     Raises
@@ -521,7 +521,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                "rig": rig.to_dict() if rig is not None else None, "notes": notes,
                "inferred": inferred,
                "warnings": doubts, "speed_uncertainty": uncertainty,
-               "line_tolerance": uncertainty + BEARING_SLIP,
+               "bearing_slip": BEARING_SLIP,
                "rate_check": check.to_dict() if check is not None else None},
               source="measured")
     return MeasuredRecord(

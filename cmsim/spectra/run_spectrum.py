@@ -174,8 +174,8 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         Uncertainty of the speed the labels scale with
         (:func:`~cmsim.spectra.labels.label_peaks`); default the run's
         ``speed_uncertainty`` (a measured record's), else 0 (a simulated run's lines stand
-        where its speed puts them). The bearing terms of a label also take the bearings'
-        slip, the rest of the run's ``line_tolerance``.
+        where its speed puts them). The bearing terms of a label also take the run's
+        ``bearing_slip``.
 
     Returns
     -------
@@ -205,9 +205,9 @@ def run_spectrum(run, signal, kind="amplitude", *, band_hz=None, max_hz=None,
         fam = freqs.families(brg)
         if run.meta.get("bearings_documented") is False:     # an assumed bearing names nothing
             brg, fam = None, {k: v for k, v in fam.items() if k not in BEARING_FAMILY_KEYS}
-    speed = float(run.meta.get("speed_uncertainty") or 0.0)
-    slip = max(float(run.meta.get("line_tolerance") or 0.0) - speed, 0.0)
-    rel = speed if relative_tolerance is None else relative_tolerance
+    rel = (float(run.meta.get("speed_uncertainty") or 0.0) if relative_tolerance is None
+           else relative_tolerance)
+    slip = float(run.meta.get("bearing_slip") or 0.0)
     x = np.asarray(run[signal], dtype=float)
     res = None if resolution_hz is None else check_range("resolution_hz", resolution_hz, 0.0,
                                                          lo_open=True, unit="Hz")

@@ -195,7 +195,8 @@ def test_a_relative_record_is_found_under_cmsim_data(capsys, run_file, monkeypat
 def test_labels_of_a_measured_record_allow_for_its_speed_and_slip(capsys):
     """Issue 48: the BPFO comb of MFPT's outer-race record (80.1 and 160.1 Hz, 1 % under
     its nominal-speed values) was "?" with a one-bin tolerance; it is labelled within the
-    stated speed's uncertainty and the bearing's slip (the record's line_tolerance)."""
+    stated speed's uncertainty and the bearing's slip (the record's speed_uncertainty and
+    bearing_slip)."""
     from cmsim.measured import data_root
     path = data_root() / "mfpt_bearing" / "OR_vload1_25lb.npz"
     if not path.is_file():
