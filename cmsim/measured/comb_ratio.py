@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.lines import line_window
 
-__all__ = ["line_prominence_db", "exclusive_contrast_db", "family_ratio", "lowest_fundamental",
+__all__ = ["log_spectrum", "line_prominence_db", "exclusive_contrast_db", "family_ratio", "lowest_fundamental",
            "shaft_comb_db", "LINE_TOLERANCE", "LINE_WINDOW_BINS", "SUBCOMB_MARGIN_DB",
            "MISSING_MARGIN_DB", "CLEAR_LINE_DB", "REFUSE_LINE_DB", "LARGEST_FACTOR", "STEPS",
            "COMB_HARMONICS", "COMB_TOLERANCE"]
@@ -50,6 +51,25 @@ LARGEST_FACTOR = 4
 
 #: Factors a fundamental is moved by, one step at a time (4 = 2·2).
 STEPS = (2,)
+
+
+def log_spectrum(x, fs_hz):
+    """``(freq, log10 amplitude)`` of ``x``'s Hann amplitude spectrum (at least 1e-300): the
+    spectrum every line of these checks is read on.
+
+    Parameters
+    ----------
+    x : array_like, shape (n,)
+        Signal.
+    fs_hz : float
+        Sample rate, Hz (1 for cycles per sample).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+    """
+    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
+    return freq, np.log10(np.maximum(amp, 1e-300))
 
 
 def line_prominence_db(freq, log_amp, f_hz, tolerance=LINE_TOLERANCE):
@@ -92,10 +112,8 @@ def shaft_comb_db(freq, log_amp, shaft_hz, tolerance=COMB_TOLERANCE):
 
     Parameters
     ----------
-    freq : numpy.ndarray, shape (n,)
-        Bin frequencies, Hz (uniform from 0).
-    log_amp : numpy.ndarray, shape (n,)
-        log10 of the amplitude.
+    freq, log_amp : numpy.ndarray
+        The spectrum, as :func:`line_prominence_db` reads it (:func:`log_spectrum`).
     shaft_hz : float
         The shaft's rate, Hz.
     tolerance : float

@@ -66,11 +66,11 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.measured.comb_ratio import (CLEAR_LINE_DB, COMB_HARMONICS, COMB_TOLERANCE,
-                                      LARGEST_FACTOR, LINE_TOLERANCE, shaft_comb_db,
+                                      LARGEST_FACTOR, LINE_TOLERANCE, log_spectrum,
+                                      shaft_comb_db,
                                       MISSING_MARGIN_DB, REFUSE_LINE_DB, STEPS, SUBCOMB_MARGIN_DB, _mean, _steps,
                                       exclusive_contrast_db, family_ratio,
                                       line_prominence_db, lowest_fundamental)
-from cmsim.spectra.amplitude import amplitude_spectrum
 from cmsim.spectra.envelope import envelope_spectrum
 from cmsim.spectra.kurtogram import kurtogram
 
@@ -410,7 +410,7 @@ def family_verdicts(x, fs_hz, shaft_hz, frequencies, speed_tolerance=0.0):
 def _verdicts_and_scale(x, fs_hz, shaft_hz, frequencies, speed_tolerance):
     """:func:`family_verdicts` and the factor on the stated speed they were read at."""
     families = line_families(frequencies)
-    spectra = {False: _log_spectrum(amplitude_spectrum(x, fs_hz, window="hann")),
+    spectra = {False: log_spectrum(x, fs_hz),
                True: _envelope_log_spectrum(x, fs_hz, max(f.order for f in families)
                                             * shaft_hz)}
     scale = _speed_scale(spectra, families, shaft_hz, float(speed_tolerance))
@@ -459,12 +459,6 @@ def _decide(verdicts):
     sources = {v.family.source for v in same}
     refuse = top.strong and not rival and (not top.family.envelope or len(sources) >= 2)
     return "contradicted", top, rho, refuse
-
-
-def _comb_db(x, fs_hz, shaft_hz, tolerance):
-    """:func:`~cmsim.measured.comb_ratio.shaft_comb_db` of ``x``'s Hann spectrum."""
-    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
-    return shaft_comb_db(freq, np.log10(np.maximum(amp, 1e-300)), shaft_hz, tolerance)
 
 
 def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="fs_hz",
@@ -532,7 +526,8 @@ def check_rate_and_speed(x, fs_hz, speed_rpm, frequencies, *, where, fs_source="
     what = (f"record {where}: its {fam.describe()}, where {fs_source} {fs_hz:g} Hz and "
             f"{speed_source} {speed_rpm:g} put them")
     fits = f"{fs_source} {fs_hz / rho:g} Hz or {speed_source} {speed_rpm * rho:g} would fit"
-    comb = _comb_db(x, fs_hz, rho * speed_rpm / 60.0, max(speed_tolerance, COMB_TOLERANCE))
+    comb = shaft_comb_db(*log_spectrum(x, fs_hz), rho * speed_rpm / 60.0,
+                         max(speed_tolerance, COMB_TOLERANCE))
     if not comb >= CLEAR_LINE_DB:    # the correction put the shaft's own comb nowhere either
         fits += (f" by these lines, but the shaft's own comb does not stand there either "
                  f"({comb:.0f} dB over the floor, its first {COMB_HARMONICS} harmonics): "

@@ -16,7 +16,7 @@
   disagreement of more than :data:`NOTE_AGREEMENT` is reported; the note is used only when
   the signal cannot say (no tooth counts or no speed), and then reported as unverified.
 
-Spectra come from :func:`cmsim.spectra.amplitude.amplitude_spectrum` (Hann window).
+Spectra come from :func:`cmsim.measured.comb_ratio.log_spectrum` (Hann window).
 """
 
 from __future__ import annotations
@@ -26,10 +26,10 @@ import re
 
 import numpy as np
 
-from cmsim.measured.comb_ratio import COMB_HARMONICS, COMB_TOLERANCE, shaft_comb_db
+from cmsim.measured.comb_ratio import (COMB_HARMONICS, COMB_TOLERANCE, log_spectrum,
+                                      shaft_comb_db)
 from cmsim.measured.consistency import lowest_fundamental
 from cmsim.measured.stated import NOMINAL_SPEED_UNCERTAINTY
-from cmsim.spectra.amplitude import amplitude_spectrum
 
 __all__ = ["estimate_shaft_hz", "refine_speed", "infer_sample_rate", "sample_rate_from_note",
            "speed_comb_doubt", "SPEED_SEARCH_FRACTION", "MIN_COMB_DB", "MIN_SPEED_CHANGE",
@@ -110,8 +110,7 @@ def speed_comb_doubt(x, fs_hz, speed_rpm, *, uncertainty=0.0, teeth=None, where=
     -------
     str or None
     """
-    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
-    log_amp = np.log10(np.maximum(amp, 1e-300))
+    freq, log_amp = log_spectrum(x, fs_hz)
     f0 = float(speed_rpm) / 60.0
     stated = shaft_comb_db(freq, log_amp, f0, max(uncertainty, COMB_TOLERANCE))
     if stated >= DOUBT_COMB_DB:
@@ -162,9 +161,8 @@ def estimate_shaft_hz(x, fs_hz, *, lo_hz, hi_hz, teeth=None, n_harmonics=4):
         Shaft rate, Hz, and the comb score (mean prominence of its lines over the median
         spectrum level, dB).
     """
-    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
+    freq, logamp = log_spectrum(x, fs_hz)
     df = freq[1]
-    logamp = np.log10(np.maximum(amp, 1e-300))
     floor = np.median(logamp[1:])
     mults = [float(m) for m in range(1, n_harmonics + 1)]
     if teeth is not None:
@@ -239,8 +237,7 @@ def refine_speed(x, fs_hz, speed_rpm, teeth=None):
     if speed_rpm is None:
         f, score = estimate_shaft_hz(x, fs_hz, lo_hz=5.0, hi_hz=min(100.0, fs_hz / 40),
                                      teeth=teeth)
-        freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), fs_hz, window="hann")
-        ratio = lowest_fundamental(freq, np.log10(np.maximum(amp, 1e-300)), f, 4, lo_hz=5.0)
+        ratio = lowest_fundamental(*log_spectrum(x, fs_hz), f, 4, lo_hz=5.0)
         how = f"shaft-harmonic comb, {score:.1f} dB over the median level"
         if ratio != 1.0:       # the best comb was a harmonic of the shaft's
             f *= ratio
@@ -285,8 +282,7 @@ def infer_sample_rate(x, shaft_hz, teeth):
     """
     lo = 2e-4
     nu, score = estimate_shaft_hz(x, 1.0, lo_hz=lo, hi_hz=0.45 / (3 * teeth[0]), teeth=teeth)
-    freq, amp = amplitude_spectrum(np.asarray(x, dtype=float), 1.0, window="hann")
-    nu *= lowest_fundamental(freq, np.log10(np.maximum(amp, 1e-300)), nu, 4, lo_hz=lo)
+    nu *= lowest_fundamental(*log_spectrum(x, 1.0), nu, 4, lo_hz=lo)
     return shaft_hz / nu, nu, score
 
 
