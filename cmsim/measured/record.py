@@ -308,6 +308,15 @@ def _refined_speed(x, fs, speed, teeth, check, uncertainty, inferred):
     return refined, min(uncertainty, MEASURED_SPEED_UNCERTAINTY)
 
 
+def _say(text, notes, doubts, stacklevel=2):
+    """What the user should hear of a record: noted, kept among its doubts (the meta's
+    ``warnings``) and warned (:class:`~cmsim.errors.RecordWarning`), at ``stacklevel`` as
+    the function saying it counts (2: its caller)."""
+    notes.append(text)
+    doubts.append(text)
+    warnings.warn(text, RecordWarning, stacklevel=stacklevel + 1)
+
+
 def _stated_speed(path, file_rpm, entry, speed_rpm, notes, doubts):
     """``(speed, where from)``: the caller's ``speed_rpm`` when given — it replaces what the
     file and metadata.json state, and a value it replaces is warned of
@@ -322,9 +331,7 @@ def _stated_speed(path, file_rpm, entry, speed_rpm, notes, doubts):
             gap = 100 * (float(speed_rpm) / float(value) - 1)
             text = (f"record {path}: speed_rpm {float(speed_rpm):g} replaces {float(value):g} "
                     f"rpm, the speed {what} states ({gap:+.2g} %)")
-            doubts.append(text)
-            notes.append(text)
-            warnings.warn(text, RecordWarning, stacklevel=3)
+            _say(text, notes, doubts, stacklevel=3)
     return float(speed_rpm), "speed_rpm"
 
 
@@ -449,17 +456,13 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
     for text in (clipping_doubt(x, channel, p), count_doubt(x, entry.get("n_samples"),
                                                             channel, p)):
         if text is not None:
-            notes.append(text)
-            doubts.append(text)
-            warnings.warn(text, RecordWarning, stacklevel=2)
+            _say(text, notes, doubts)
     if scale is None and channel in f.counts and sensor_unit is not None:
         text = (f"record {p}: channel {channel!r} holds integer counts of a converter and no "
                 f"calibration states their units: each count is read as 1 {sensor_unit} "
                 f"(state the {sensor_unit} per count, in metadata.json \"calibration\" or "
                 f"as the command's calibration, where it is not 1)")
-        notes.append(text)
-        doubts.append(text)
-        warnings.warn(text, RecordWarning, stacklevel=2)
+        _say(text, notes, doubts)
     speed, speed_from = _stated_speed(p, f.speed_rpm, entry, speed_rpm, notes, doubts)
     fs, fs_from = agreed(p, "sample rate", [
         (f.rate_from, "record", f.rate_hz),
@@ -479,9 +482,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                 f"model's sensors measure acceleration, so it is differentiated "
                 f"{DIFFERENTIATIONS[quantity]} (x j2\u03c0f) to m/s^2")
         sensor_unit = sensor["unit"] = "m/s^2"
-        notes.append(text)
-        doubts.append(text)
-        warnings.warn(text, RecordWarning, stacklevel=2)
+        _say(text, notes, doubts)
     lines = documented_frequencies(geometry, 1.0)
     if rig_given and not lines.bearings and lines.gmf_hz is None:
         lines = rig_frequencies(rig, OperatingPoint(speed_rpm=60.0))
@@ -499,9 +500,7 @@ def read_record(path, *, channel=None, rig=None, fs_hz=None, speed_rpm=None, uni
                                  fs_source=fs_from or "the inferred rate",
                                  speed_source=speed_from)
         if doubt is not None:
-            notes.append(doubt)
-            doubts.append(doubt)
-            warnings.warn(doubt, RecordWarning, stacklevel=2)
+            _say(doubt, notes, doubts)
     op = (model_operating_point(entry, rig, speed, notes) if rig is not None
           else documented_operating_point(entry, speed))
 

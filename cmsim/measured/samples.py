@@ -75,12 +75,8 @@ def clipping_doubt(x, channel, name):
 
     Parameters
     ----------
-    x : numpy.ndarray, shape (n,)
-        The channel's samples (finite, varying).
-    channel : str
-        Its name, for the message.
-    name : str
-        The record, for the message.
+    x, channel, name
+        As :func:`checked_samples` (``x`` finite and varying).
 
     Returns
     -------
@@ -106,14 +102,10 @@ def count_doubt(x, stated, channel, name):
 
     Parameters
     ----------
-    x : numpy.ndarray, shape (n,)
-        The channel's samples.
+    x, channel, name
+        As :func:`checked_samples`.
     stated : int or None
         The metadata's ``n_samples`` (None: not stated).
-    channel : str
-        Its name, for the message.
-    name : str
-        The record, for the message.
 
     Returns
     -------
