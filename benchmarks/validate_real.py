@@ -217,6 +217,9 @@ def main(argv=None):
                 print(f"calibrated {Path(base).name} (first half) in {wall:.1f} s", flush=True)
             jobs = [(*j, a.channel, None if j[2] is None else machines[str(j[2])])
                     for j in jobs]
+            # the path-free comparisons (10-30 s each) first, the machine's (0.2-2 s) after:
+            # the short ones fill the workers' ends instead of one long one running alone
+            jobs.sort(key=lambda j: j[0] != "free")
             t1 = time.perf_counter()
             for key, c in pool.map(one, jobs):
                 results[key] = c
