@@ -42,8 +42,8 @@ import scipy.linalg
 import scipy.signal
 
 from cmsim.errors import ParameterError, check_range
-from cmsim.spectra._kurtogram_kernels import stft_moments_jit
 from cmsim.spectra._checks import positive_int, sampling_rate, signal_1d
+from cmsim.spectra._kurtogram_kernels import stft_moments_jit
 
 __all__ = ["Kurtogram", "spectral_kurtosis", "kurtogram", "prediction_residual",
            "residual_kurtogram",
