@@ -244,3 +244,42 @@ def test_the_band_rule_reads_past_a_gearbox_discrete_part_to_the_impacts():
         assert hi < 3000.0                                  # the mesh band wins on the signal
         lo, hi = demodulation_band(x, fs, 118.7)
         assert lo < 4000.0 < hi                             # the band rule reads the impacts
+
+
+@pytest.mark.parametrize("nperseg", [16, 24, 96, 1536])
+def test_the_stft_moments_kernel_is_numpys_to_the_bit(nperseg):
+    """The kurtogram's second and fourth STFT moments come from a numba pass over the
+    segments; numpy's ``mean(axis=0)`` of |z|² and |z|⁴ sums each bin row by row in the same
+    order, so every spectral kurtosis (and the band a comparison reads) is the same."""
+    from cmsim.spectra._kurtogram_kernels import stft_moments_jit
+
+    rng = np.random.default_rng(nperseg)
+    frames = rng.standard_normal((24_300 // (nperseg // 4), nperseg)) * rng.uniform(0.1, 10.0)
+    z = np.fft.rfft(frames * np.hanning(nperseg), axis=1)
+    p2 = z.real * z.real + z.imag * z.imag
+    m2, m4 = stft_moments_jit(z)
+    assert np.array_equal(m2, p2.mean(axis=0))
+    assert np.array_equal(m4, (p2 ** 2).mean(axis=0))
+
+
+@pytest.mark.parametrize("n", [6_000, 6_480, 24_300, 300])
+def test_the_predictor_reads_the_biased_autocorrelation(n):
+    """The predictor's normal equations are those of the biased autocorrelation
+    r_k = Σ x_i x_(i+k) / n, read from a zero-padded FFT only as long as the lags need:
+    the residual of each order is that of the direct sums' predictor within rounding."""
+    import scipy.linalg
+
+    from cmsim.spectra.kurtogram import prediction_residual
+
+    rng = np.random.default_rng(n)
+    t = np.arange(n) / FS
+    x = np.sin(2 * np.pi * 1234.5 * t) + 0.3 * rng.standard_normal(n)
+    for p in (16, 128):
+        p_eff = min(p, n // 20)
+        xc = x - x.mean()
+        r = np.array([xc[: n - k] @ xc[k:] for k in range(p_eff + 1)]) / n
+        a = scipy.linalg.solve_toeplitz(r[:p_eff], r[1:p_eff + 1])
+        want = np.convolve(xc, np.r_[1.0, -a], mode="valid")
+        got = prediction_residual(x, orders=(p,))
+        assert got.size == want.size
+        assert np.allclose(got, want, rtol=0.0, atol=1e-9 * np.abs(want).max())
