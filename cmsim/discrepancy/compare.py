@@ -47,8 +47,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from cmsim.discrepancy.causes import (CAUSE_WORDS, CAUSES, NUISANCES, ModelSetup,
-                                      applicable_causes)
+from cmsim.discrepancy.causes import (CAUSE_WORDS, CAUSES, NOMINAL_NOISE_RATIO, NUISANCES,
+                                      ModelSetup, applicable_causes)
 from cmsim.discrepancy.evaluator import (LEVEL_REF, Budget, Evaluator, chi2, feature_floor,
                                          path_free, weight)
 from cmsim.discrepancy.at_rate import check_machine
@@ -87,6 +87,16 @@ UNEXPLAINED_CHI2_PER_FEATURE = 2.5
 #: broadband floor (:func:`~cmsim.discrepancy.evaluator.record_floor`) rather than
 #: :data:`~cmsim.discrepancy.causes.NOMINAL_NOISE_RATIO` of the healthy model's RMS.
 RECORD_FLOOR = True
+
+#: What a path-free comparison of a record without a unit says (the noise then is
+#: :data:`~cmsim.discrepancy.causes.NOMINAL_NOISE_RATIO` of the healthy model's RMS: the
+#: shared records stand 26-65 dB over that model, so its noise sits 46-85 dB under their
+#: floor, and of five CWRU and MFPT fault records read so, two were named, five with the unit).
+NO_UNIT_NOTE = ("the record states no unit, so the model's sensor noise is not the record's "
+                "own broadband floor but {pct:g} % of the healthy model's RMS, far quieter than "
+                "a real machine's background: how far a defect's family stands over its floor "
+                "is then the model's guess, not the record's. State the sensor's unit (--unit, "
+                "or the channel's \"unit\" in metadata.json: g or m/s^2) for a sharper reading")
 
 #: The nominal models (see the module docstring).
 MODES = ("machine", "documented", "path-free")
@@ -380,7 +390,8 @@ def compare(record, *, machine=None, budget=DEFAULT_BUDGET, seed=0, seg_s=None,
             mode=mode, ranges={k: [float(a), float(b)] for k, (a, b) in ranges.items()},
             near_ties=near_ties, departures=departures if finding == "unexplained" else [],
             not_judged=not_judged, words=describe(finding, component, params, ranges),
-            spectra=spectra)
+            notes=[NO_UNIT_NOTE.format(pct=100 * NOMINAL_NOISE_RATIO)]
+            if mode == "path-free" and record.unit_scale is None else [], spectra=spectra)
 
 
 def _against_machine(record, machine, *, budget, seed, max_segments, causes, workers, start):

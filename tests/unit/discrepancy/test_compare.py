@@ -322,6 +322,21 @@ def test_cli_compare_json(tmp_path, capsys):
     assert "data:image/png;base64" in html and out["finding"] in html
 
 
+def test_a_record_without_a_unit_says_what_its_path_free_reading_lacks(tmp_path):
+    """Path-free, the model's sensor noise is the record's own floor only when its unit is
+    known; without one it is an assumed share of the model's RMS, and the result says so and
+    how to state the unit (five shared fault records read so: two named, five with it)."""
+    import dataclasses
+
+    h = hidden_effect_record(None, 1003)
+    rec = read_record(_write_dataset(tmp_path / "u", h.record.run["DE"], 12000.0))
+    with_unit = compare(rec, budget=12)
+    without = compare(dataclasses.replace(rec, unit_scale=None), budget=12)
+    assert with_unit.mode == without.mode == "path-free"
+    assert not any("unit" in n for n in with_unit.notes)
+    assert [n for n in without.notes if "states no unit" in n and "--unit" in n]
+
+
 def test_every_line_feature_says_where_it_reads_in_hz():
     """The output an engineer acts on names each feature's band or line in Hz (issue 25): a
     bearing family at the record's rates, by the record's name of the bearing; a mesh
