@@ -50,7 +50,8 @@ import numpy as np
 
 from cmsim.errors import ParameterError
 from cmsim.features.lines import (FALLBACK_BAND, SLIP_TOLERANCE, demodulation_band,
-                                  highest_fault_hz, line_amplitude, line_bins)
+                                  highest_fault_hz, line_amplitude, line_amplitudes_at,
+                                  line_bins)
 from cmsim.frequencies import BearingFrequencies
 from cmsim.spectra.envelope import envelope_spectrum
 
@@ -168,8 +169,10 @@ def line_amplitudes(freq, amp, lines, tolerance=SLIP_TOLERANCE):
     dict of str to float
         NaN for a line outside (0, last bin).
     """
-    return {ln.name: (line_amplitude(freq, amp, ln.frequency_hz, tolerance)
-                      if 0.0 < ln.frequency_hz < freq[-1] else math.nan) for ln in lines}
+    f = np.array([ln.frequency_hz for ln in lines], dtype=float)
+    a = line_amplitudes_at(freq, amp, np.where((f > 0.0) & (f < freq[-1]), f, math.nan),
+                           tolerance)
+    return {ln.name: float(v) for ln, v in zip(lines, a)}
 
 
 def line_ratios(freq, amp, lines, tolerance=SLIP_TOLERANCE):

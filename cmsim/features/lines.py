@@ -42,9 +42,10 @@ import numpy as np
 from cmsim.errors import ParameterError
 from cmsim.spectra.kurtogram import FAULT_BANDWIDTH_FACTOR, residual_kurtogram
 from cmsim.spectra.lines import (EXACT_TOLERANCE, LINE_HALF_WIDTH_BINS, SLIP_TOLERANCE,
-                                 line_amplitude, line_bins, line_window)
+                                 line_amplitude, line_amplitudes_at, line_bins, line_window)
 
-__all__ = ["line_window", "line_bins", "line_amplitude", "demodulation_band", "highest_fault_hz",
+__all__ = ["line_window", "line_bins", "line_amplitude", "line_amplitudes_at",
+           "demodulation_band", "highest_fault_hz",
            "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE", "SLIP_TOLERANCE",
            "FAULT_BANDWIDTH_FACTOR", "MAX_FAULT_FRACTION", "NARROW_BAND_FRACTION",
            "FALLBACK_BAND"]

@@ -41,7 +41,8 @@ import math
 
 import numpy as np
 
-__all__ = ["line_window", "line_bins", "line_amplitude", "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE",
+__all__ = ["line_window", "line_bins", "line_amplitude", "line_amplitudes_at",
+           "LINE_HALF_WIDTH_BINS", "EXACT_TOLERANCE",
            "AVOID_HALF_WIDTH_BINS", "leakage_bins",
            "SLIP_TOLERANCE"]
 
@@ -110,10 +111,55 @@ def line_bins(freq, f_hz, tolerance=EXACT_TOLERANCE, half_width_bins=LINE_HALF_W
     """
     if not (math.isfinite(f_hz) and f_hz > 0.0):
         return None
-    half = tolerance * f_hz + half_width_bins * float(freq[1] - freq[0])
-    lo = int(np.searchsorted(freq, f_hz - half, side="left"))    # first bin >= f - half
-    hi = int(np.searchsorted(freq, f_hz + half, side="right"))   # first bin > f + half
+    lo, hi = (int(i) for i in _window_edges(freq, f_hz, tolerance, half_width_bins))
     return slice(lo, hi) if hi > lo else None
+
+
+def _window_edges(freq, f_hz, tolerance, half_width_bins):
+    """First bin >= f − half and first bin > f + half of the line windows at ``f_hz`` (a
+    float or an array of them): the one window rule of :func:`line_bins` and
+    :func:`line_amplitudes_at`."""
+    half = tolerance * f_hz + half_width_bins * float(freq[1] - freq[0])
+    return (np.searchsorted(freq, f_hz - half, side="left"),
+            np.searchsorted(freq, f_hz + half, side="right"))
+
+
+def line_amplitudes_at(freq, amp, f_hz, tolerance=EXACT_TOLERANCE):
+    """:func:`line_amplitude` of many lines of one spectrum at once (no lines avoided): the
+    windows found in one bisection of the bins, each line's the largest bin of its own (a
+    feature row reads hundreds; one call each cost 13 µs, most of it the call).
+
+    Parameters
+    ----------
+    freq : numpy.ndarray, shape (n_bins,)
+        Bin frequencies, Hz, uniformly spaced from 0.
+    amp : numpy.ndarray, shape (n_bins,)
+        Amplitude spectrum, any unit.
+    f_hz : array_like, shape (k,)
+        Nominal frequencies of the lines, Hz.
+    tolerance : float
+        Relative tolerance, >= 0.
+
+    Returns
+    -------
+    numpy.ndarray, shape (k,)
+        Each line's amplitude, as :func:`line_amplitude` reads it; NaN where it does.
+
+    Examples
+    --------
+    >>> f = np.arange(0.0, 1000.0, 1.0)
+    >>> a = np.zeros_like(f); a[102] = 2.0; a[203] = 2.0
+    >>> line_amplitudes_at(f, a, [101.0, 200.0, -5.0], SLIP_TOLERANCE).tolist()
+    [2.0, 2.0, nan]
+    """
+    amp = np.asarray(amp)
+    f = np.asarray(f_hz, dtype=float)
+    out = np.full(f.shape, math.nan)
+    ok = np.isfinite(f) & (f > 0.0)
+    lo, hi = _window_edges(freq, np.where(ok, f, 1.0), tolerance, LINE_HALF_WIDTH_BINS)
+    for i in np.flatnonzero(ok & (hi > lo)):
+        out[i] = amp[lo[i]:hi[i]].max()
+    return out
 
 
 def leakage_bins(level):

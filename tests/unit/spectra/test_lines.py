@@ -10,7 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from cmsim.spectra.lines import LINE_HALF_WIDTH_BINS, line_amplitude, line_window
+from cmsim.spectra.lines import (EXACT_TOLERANCE, LINE_HALF_WIDTH_BINS, SLIP_TOLERANCE,
+                                 line_amplitude, line_window)
 
 
 @pytest.mark.parametrize("n, fs", [(1000, 12_000.0), (1001, 20_000.0), (6000, 25_600.0)])
@@ -42,3 +43,20 @@ def test_a_line_s_amplitude_over_several_spectra_at_once():
     amp[:, 40] = [1.0, 2.0, 3.0]
     np.testing.assert_array_equal(line_amplitude(freq, amp, 40.5), [1.0, 2.0, 3.0])
     assert np.isnan(line_amplitude(freq, amp, 500.0)).all()
+
+
+@pytest.mark.parametrize("tolerance", [EXACT_TOLERANCE, SLIP_TOLERANCE, 0.1])
+def test_many_lines_at_once_read_what_each_reads_alone(tolerance):
+    """A feature row's lines are read in one call; each is the one line rule's reading, to
+    the bit, including lines past either end of the spectrum, at 0 Hz, negative or NaN."""
+    from cmsim.spectra.lines import line_amplitudes_at
+
+    rng = np.random.default_rng(7)
+    freq = np.arange(3241) * 2.0
+    amp = rng.exponential(size=freq.size)
+    f = np.concatenate([rng.uniform(-50.0, freq[-1] + 50.0, 400),
+                        [0.0, -3.0, np.nan, np.inf, freq[-1], freq[-1] + 2.9, 1.0]])
+    want = [line_amplitude(freq, amp, v, tolerance) for v in f]
+    got = line_amplitudes_at(freq, amp, f, tolerance)
+    assert np.array_equal(got, np.array(want), equal_nan=True)
+    assert np.isnan(got[-7:-3]).all() and not np.isnan(got[-3:]).any()
