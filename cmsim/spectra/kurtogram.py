@@ -102,8 +102,8 @@ def prediction_residual(x, orders=PREDICTION_ORDERS):
     n = x.size
     p_max = min(max(orders), n // 20)
     # the biased autocorrelation's first p_max + 1 lags: a circular one of n + p_max zero-
-    # padded samples or more holds them unwrapped (2n, 2·3⁵·5² at 0.5 s of 48.6 kHz, took
-    # three times as long as the 2¹³·3 its next fast length is)
+    # padded samples or more holds them unwrapped (2n = 48 600 = 2³·3⁵·5² at 0.5 s of
+    # 48.8 kHz took three times as long as 24 576 = 2¹³·3, the next fast length)
     nfft = scipy.fft.next_fast_len(n + p_max + 1, real=True)
     spec = np.fft.rfft(x, nfft)
     r = np.fft.irfft(spec.real * spec.real + spec.imag * spec.imag, nfft)[:p_max + 1] / n
